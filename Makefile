@@ -1,0 +1,112 @@
+# fdsusp build. Uses PETSc's own make variables (compilers, flags, include and link lines).
+#   make            build bin/fdsusp, bin/pairtraj and the unit-test programs (optimised)
+#   make debug      the same in bin/debug/ with bounds checks and floating-point traps
+#   make check      build and run the whole test suite; last line "N passed, N failed"
+#   make run        run input/demo.nml on 2 ranks
+#   make bench      timings recorded in doc/BENCHMARKS.md
+# PETSC_DIR defaults to Debian's petsc-dev; set it to use a cluster's PETSc (3.18, real, double).
+
+SHELL := /bin/bash
+DEFAULT_PETSC_DIR := /usr/lib/petsc
+PETSC_DIR ?= $(DEFAULT_PETSC_DIR)
+export PETSC_DIR
+# Open MPI refuses to run as root without these (CI and containers run as root).
+export OMPI_ALLOW_RUN_AS_ROOT := 1
+export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
+
+ifeq ($(wildcard $(PETSC_DIR)/lib/petsc/conf/variables),)
+  ifeq ($(PETSC_DIR),$(DEFAULT_PETSC_DIR))
+    $(info PETSc not found in $(PETSC_DIR): running scripts/install-deps)
+    INSTALL_STATUS := $(shell bash scripts/install-deps 1>&2; echo $$?)
+    ifneq ($(INSTALL_STATUS),0)
+      $(error scripts/install-deps failed (status $(INSTALL_STATUS)))
+    endif
+  else
+    $(error PETSC_DIR=$(PETSC_DIR) holds no PETSc (no lib/petsc/conf/variables))
+  endif
+endif
+include $(PETSC_DIR)/lib/petsc/conf/variables
+
+# HDF5's Fortran API (series files); PETSc's link line already holds the C library and its path.
+HDF5_FC_LIB ?= -lhdf5_fortran
+
+MODE ?= opt
+ifeq ($(MODE),debug)
+  BUILD := build/debug
+  BIN := bin/debug
+  OPTFLAGS := -O0 -g -fcheck=all -ffpe-trap=invalid,zero,overflow -fbacktrace -finit-real=snan
+else
+  BUILD := build/opt
+  BIN := bin
+  OPTFLAGS := -O2 -g -fbacktrace
+endif
+WARN := -Wall -Wextra -Wimplicit-interface -Wno-unused-dummy-argument -Wno-compare-reals \
+        -Wno-maybe-uninitialized -Wno-conversion
+FCFLAGS_ALL := $(FC_FLAGS) $(OPTFLAGS) $(WARN) -fimplicit-none -std=f2018 -fall-intrinsics \
+               -J $(BUILD) -I $(BUILD) $(PETSC_FC_INCLUDES)
+CFLAGS_ALL := $(CC_FLAGS) $(OPTFLAGS) -Wall -Wextra $(PETSC_CC_INCLUDES)
+LIBS := $(HDF5_FC_LIB) $(PETSC_LIB)
+
+# Program sources: everything else in src/ is a module linked into every program.
+PROGRAM_SRC := src/main.F90
+SRC_F90 := $(filter-out $(PROGRAM_SRC),$(wildcard src/*.F90))
+SRC_C := $(wildcard src/*.c)
+REF_F90 := $(wildcard ref/*.F90)
+UNIT_F90 := $(wildcard tests/unit/test_*.F90)
+
+obj = $(addprefix $(BUILD)/,$(subst /,_,$(patsubst %.F90,%.o,$(patsubst %.c,%.o,$(1)))))
+LIB_OBJ := $(call obj,$(SRC_F90) $(SRC_C))
+# Pure modules use neither PETSc, MPI nor HDF5: the physics kernels. Unit tests link only these,
+# so they run without PETSc.
+PURE_F90 := $(shell grep -L -E '^\#include *<petsc|^ *use +(hdf5|mpi)' $(SRC_F90) 2>/dev/null)
+PURE_OBJ := $(call obj,$(PURE_F90))
+# pairtraj shares only kinds and the resistance module with the solver (design.md).
+PAIRTRAJ_OBJ := $(call obj,$(REF_F90) src/kinds.F90 $(wildcard src/resistance*.F90))
+UNIT_BIN := $(patsubst tests/unit/%.F90,$(BUILD)/tests/%,$(UNIT_F90))
+
+PROGRAMS := $(BIN)/fdsusp $(if $(REF_F90),$(BIN)/pairtraj)
+
+.PHONY: all debug check run bench clean tests-build
+all: $(PROGRAMS) $(UNIT_BIN)
+
+debug:
+	$(MAKE) MODE=debug all
+
+$(BUILD) $(BIN) $(BUILD)/tests:
+	@mkdir -p $@
+
+$(BUILD)/src_%.o: src/%.F90 | $(BUILD)
+	$(FC) $(FCFLAGS_ALL) -c $< -o $@
+$(BUILD)/ref_%.o: ref/%.F90 | $(BUILD)
+	$(FC) $(FCFLAGS_ALL) -c $< -o $@
+$(BUILD)/src_%.o: src/%.c | $(BUILD)
+	$(CC) $(CFLAGS_ALL) -c $< -o $@
+$(BUILD)/tests_unit_%.o: tests/unit/%.F90 | $(BUILD)
+	$(FC) $(FCFLAGS_ALL) -c $< -o $@
+
+$(BIN)/fdsusp: $(call obj,$(PROGRAM_SRC)) $(LIB_OBJ) | $(BIN)
+	$(FC_LINKER) $(OPTFLAGS) -o $@ $^ $(LIBS)
+$(BIN)/pairtraj: $(PAIRTRAJ_OBJ) | $(BIN)
+	$(FC_LINKER) $(OPTFLAGS) -o $@ $^
+$(BUILD)/tests/%: $(BUILD)/tests_unit_%.o $(PURE_OBJ) | $(BUILD)/tests
+	$(FC_LINKER) $(OPTFLAGS) -o $@ $^
+
+# Module dependencies, regenerated whenever a source changes.
+$(BUILD)/deps.mk: $(SRC_F90) $(PROGRAM_SRC) $(REF_F90) $(UNIT_F90) scripts/f90deps | $(BUILD)
+	@scripts/f90deps $(BUILD) $(SRC_F90) $(PROGRAM_SRC) $(REF_F90) $(UNIT_F90) > $@
+-include $(BUILD)/deps.mk
+
+NP ?= 2
+MPIRUN := mpiexec --oversubscribe
+run: all
+	$(MPIRUN) -n $(NP) $(BIN)/fdsusp input/demo.nml
+
+# TESTS=pattern runs only the tests whose path contains pattern.
+check: all
+	@bash tests/run_tests.sh $(BUILD)/tests $(TESTS)
+
+bench: all
+	@bash scripts/bench.sh
+
+clean:
+	rm -rf build bin

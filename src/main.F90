@@ -1,0 +1,3 @@
+program fdsusp
+  implicit none
+end program fdsusp
