@@ -35,16 +35,18 @@ ifeq ($(MODE),debug)
   BUILD := build/debug
   BIN := bin/debug
   OPTFLAGS := -O0 -g -fcheck=all -ffpe-trap=invalid,zero,overflow -fbacktrace -finit-real=snan
+  COPTFLAGS := -O0 -g
 else
   BUILD := build/opt
   BIN := bin
   OPTFLAGS := -O2 -g -fbacktrace
+  COPTFLAGS := -O2 -g
 endif
-WARN := -Wall -Wextra -Wimplicit-interface -Wno-unused-dummy-argument -Wno-compare-reals \
+WARN := -Wall -Wextra -Wno-unused-dummy-argument -Wno-compare-reals \
         -Wno-maybe-uninitialized -Wno-conversion
 FCFLAGS_ALL := $(FC_FLAGS) $(OPTFLAGS) $(WARN) -fimplicit-none -std=f2018 -fall-intrinsics \
                -J $(BUILD) -I $(BUILD) $(PETSC_FC_INCLUDES)
-CFLAGS_ALL := $(CC_FLAGS) $(OPTFLAGS) -Wall -Wextra $(PETSC_CC_INCLUDES)
+CFLAGS_ALL := $(CC_FLAGS) $(COPTFLAGS) -Wall -Wextra $(PETSC_CC_INCLUDES)
 LIBS := $(HDF5_FC_LIB) $(PETSC_LIB)
 
 # Program sources: everything else in src/ is a module linked into every program.
@@ -58,7 +60,7 @@ obj = $(addprefix $(BUILD)/,$(subst /,_,$(patsubst %.F90,%.o,$(patsubst %.c,%.o,
 LIB_OBJ := $(call obj,$(SRC_F90) $(SRC_C))
 # Pure modules use neither PETSc, MPI nor HDF5: the physics kernels. Unit tests link only these,
 # so they run without PETSc.
-PURE_F90 := $(shell grep -L -E '^\#include *<petsc|^ *use +(hdf5|mpi)' $(SRC_F90) 2>/dev/null)
+PURE_F90 := $(shell python3 scripts/pure-modules $(SRC_F90))
 PURE_OBJ := $(call obj,$(PURE_F90))
 # pairtraj shares only kinds and the resistance module with the solver (design.md).
 PAIRTRAJ_OBJ := $(call obj,$(REF_F90) src/kinds.F90 $(wildcard src/resistance*.F90))

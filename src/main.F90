@@ -1,3 +1,224 @@
+! fdsusp: fictitious-domain simulation of sheared suspensions (design.md).
+!   bin/fdsusp DECK [-restart CHECKPOINT] [PETSc options]
+! Reads and checks everything before any work, then steps the flow in time, writing the series,
+! field snapshots and checkpoints the deck asks for. SIGTERM or SIGUSR1 (what batch schedulers
+! send before the kill) ends the run at the end of the current step with a checkpoint, status 0.
 program fdsusp
+#include <petsc/finclude/petscsys.h>
+  use petscsys
+  use mod_kinds, only: dp
+  use mod_params, only: config_t, read_deck, echo_deck, max_line
+  use mod_errors, only: log_line, input_error, fatal_error
+  use mod_grid, only: grid_t, grid_create, grid_destroy
+  use mod_fluid, only: fluid_t, fluid_create, fluid_step, fluid_destroy, fluid_errors_vs_manufactured
+  use mod_series, only: series_t, series_open, series_record, series_flush
+  use mod_output, only: write_fields, progress_line
+  use mod_checkpoint, only: checkpoint_write, checkpoint_check, checkpoint_read
+  use mod_system, only: install_signal_handlers, stop_signal, make_directory, probe_directory
+  use mod_timers, only: timers_register, stage_push, stage_pop, STAGE_SETUP, STAGE_FLUID, STAGE_OUTPUT
+  use mod_h5util, only: h5util_init
   implicit none
+
+  PetscErrorCode :: ierr
+  type(config_t) :: cfg
+  type(grid_t) :: grid
+  type(fluid_t) :: fl
+  type(series_t) :: series
+  character(len=max_line) :: deck, restart, checkpoint_path
+  character(len=200) :: text
+  character(len=32), allocatable :: columns(:)
+  integer :: step, first_step, stop_reason
+  real(dp) :: time, wall_start, wall_now, wall_per_step
+  real(dp) :: err_vel, err_p_max, err_p_rms
+  logical :: restarting
+  integer, parameter :: RUNNING = 0, DONE = 1, SIGNALLED = 2, WALL_LIMIT = 3, STEADY = 4
+
+  PetscCallA(PetscInitialize(ierr))
+  wall_start = MPI_Wtime()
+  call h5util_init()
+
+  ! ---- everything is checked before any work ----
+  call command_line(deck, restart, restarting)
+  call read_deck(deck, cfg)
+  call log_line('fdsusp: '//trim(cfg%title))
+  call echo_deck(cfg)
+  call prepare_output_directory(cfg)
+  checkpoint_path = trim(cfg%output_directory)//'/checkpoint.h5'
+  step = 0
+  time = 0.0_dp
+  if (restarting) then
+    call checkpoint_check(restart, cfg, step, time)
+    write(text, '(a,i0,a,es12.5)') 'restart from '//trim(restart)//' at step ', step, ', time ', time
+    call log_line(text)
+  end if
+
+  ! ---- set-up ----
+  PetscCallA(timers_register(ierr))
+  PetscCallA(stage_push(STAGE_SETUP, ierr))
+  PetscCallA(grid_create(cfg, grid, ierr))
+  PetscCallA(fluid_create(cfg, grid, fl, ierr))
+  if (restarting) then
+    PetscCallA(checkpoint_read(restart, fl, ierr))
+  end if
+  columns = [character(len=32) :: 'step', 'time', 'wall_time', 'tau_wall_bottom', 'tau_wall_top', &
+             'divergence', 'rate_of_change', 'iterations_u', 'iterations_v', 'iterations_w', 'iterations_p']
+  if (cfg%manufactured_solution) columns = [character(len=32) :: columns, 'mms_error_velocity_max', &
+             'mms_error_pressure_max', 'mms_error_pressure_rms']
+  call series_open(series, cfg%output_directory, columns, merge(step, -1, restarting))
+  call install_signal_handlers()
+  PetscCallA(stage_pop(ierr))
+  call log_line('models: fluid (unsteady Stokes, projection); no particles in this deck')
+
+  ! ---- time loop ----
+  first_step = step
+  stop_reason = RUNNING
+  if (step >= cfg%steps) stop_reason = DONE
+  do while (stop_reason == RUNNING)
+    PetscCallA(stage_push(STAGE_FLUID, ierr))
+    PetscCallA(fluid_step(grid, fl, ierr))
+    PetscCallA(stage_pop(ierr))
+    step = step + 1
+    time = time + cfg%dt
+
+    PetscCallA(stage_push(STAGE_OUTPUT, ierr))
+    wall_now = MPI_Wtime() - wall_start
+    if (mod(step, cfg%series_every) == 0) call record()
+    if (mod(step, cfg%progress_every) == 0) then
+      wall_per_step = wall_now / (step - first_step)
+      call progress_line(step, cfg%steps, time, wall_now, wall_per_step, fl)
+      call series_flush(series)
+    end if
+    if (cfg%fields_every > 0) then
+      if (mod(step, cfg%fields_every) == 0) then
+        PetscCallA(write_fields(cfg%output_directory, grid, fl, step, time, ierr))
+      end if
+    end if
+    if (cfg%checkpoint_every > 0) then
+      if (mod(step, cfg%checkpoint_every) == 0) call checkpoint()
+    end if
+    PetscCallA(stage_pop(ierr))
+
+    stop_reason = why_stop()
+  end do
+
+  ! ---- end of run: the series, the last fields and a checkpoint to continue from ----
+  PetscCallA(stage_push(STAGE_OUTPUT, ierr))
+  if (step > first_step .and. mod(step, cfg%series_every) /= 0) call record()
+  call series_flush(series)
+  if (step > first_step) then
+    PetscCallA(write_fields(cfg%output_directory, grid, fl, step, time, ierr))
+    call checkpoint()
+  end if
+  PetscCallA(stage_pop(ierr))
+  select case (stop_reason)
+  case (SIGNALLED)
+    write(text, '(a,i0,a,i0,a)') 'stopped by signal ', stop_signal(), ' at step ', step, &
+         ': checkpoint written to '//trim(checkpoint_path)
+  case (WALL_LIMIT)
+    write(text, '(a,i0,a)') 'stopped at step ', step, ' before &run max_wall_hours: checkpoint written to '// &
+         trim(checkpoint_path)
+  case (STEADY)
+    write(text, '(a,i0,a,es10.3)') 'steady state at step ', step, ': max|du/dt| = ', fl%max_rate
+  case default
+    write(text, '(a,i0)') 'finished at step ', step
+  end select
+  call log_line(text)
+  if (cfg%manufactured_solution) then
+    PetscCallA(fluid_errors_vs_manufactured(grid, fl, cfg%shear_rate, err_vel, err_p_max, err_p_rms, ierr))
+    write(text, '(a,3es14.6)') 'manufactured solution errors (velocity max, pressure max, pressure rms):', &
+         err_vel, err_p_max, err_p_rms
+    call log_line(text)
+  end if
+  write(text, '(a,f10.2,a)') 'wall time ', MPI_Wtime() - wall_start, ' s'
+  call log_line(text)
+
+  PetscCallA(fluid_destroy(fl, ierr))
+  PetscCallA(grid_destroy(grid, ierr))
+  PetscCallA(PetscFinalize(ierr))
+
+contains
+
+  ! DECK is the first argument; -restart FILE is read from PETSc's options database.
+  subroutine command_line(deck, restart, restarting)
+    character(len=*), intent(out) :: deck, restart
+    logical, intent(out) :: restarting
+    PetscBool :: set
+    PetscErrorCode :: ierr
+    call get_command_argument(1, deck)
+    if (len_trim(deck) == 0 .or. deck(1:1) == '-') &
+      call fatal_error('usage: fdsusp DECK [-restart CHECKPOINT] [PETSc options]', 2)
+    restart = ''
+    PetscCallA(PetscOptionsGetString(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-restart', restart, set, ierr))
+    restarting = logical(set)
+    if (restarting .and. len_trim(restart) == 0) &
+      call fatal_error('fdsusp: -restart needs the path of a checkpoint', 2)
+  end subroutine command_line
+
+  ! The output directory must exist (it is created) and be writable now, not hours from now.
+  subroutine prepare_output_directory(cfg)
+    type(config_t), intent(in) :: cfg
+    integer :: err
+    character(len=16) :: code
+    err = 0
+    if (is_rank0()) then
+      err = make_directory(cfg%output_directory)
+      if (err == 0) err = probe_directory(cfg%output_directory)
+    end if
+    call MPI_Bcast(err, 1, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
+    if (err /= 0) then
+      write(code, '(i0)') err
+      call input_error(cfg%deck_file, 'output', 'directory', '"'//trim(cfg%output_directory)// &
+           '" cannot be created or written (errno '//trim(code)//')')
+    end if
+  end subroutine prepare_output_directory
+
+  logical function is_rank0()
+    PetscMPIInt :: rank
+    PetscErrorCode :: ierr
+    call MPI_Comm_rank(PETSC_COMM_WORLD, rank, ierr)
+    is_rank0 = (rank == 0)
+  end function is_rank0
+
+  subroutine record()
+    real(dp) :: values(14)
+    integer :: n
+    values(1:11) = [real(step, dp), time, MPI_Wtime() - wall_start, fl%tau_bottom, fl%tau_top, &
+                    fl%divergence, fl%max_rate, real(fl%solver(1)%iterations, dp), &
+                    real(fl%solver(2)%iterations, dp), real(fl%solver(3)%iterations, dp), &
+                    real(fl%solver(4)%iterations, dp)]
+    n = 11
+    if (cfg%manufactured_solution) then
+      PetscCallA(fluid_errors_vs_manufactured(grid, fl, cfg%shear_rate, err_vel, err_p_max, err_p_rms, ierr))
+      values(12:14) = [err_vel, err_p_max, err_p_rms]
+      n = 14
+    end if
+    call series_record(series, values(1:n))
+  end subroutine record
+
+  subroutine checkpoint()
+    call series_flush(series)
+    PetscCallA(checkpoint_write(checkpoint_path, cfg, fl, step, time, ierr))
+  end subroutine checkpoint
+
+  ! Collective: every rank takes the same decision.
+  integer function why_stop()
+    integer :: flags(3), all_flags(3)
+    real(dp) :: elapsed, per_step
+    flags = 0
+    if (stop_signal() /= 0) flags(1) = 1
+    if (cfg%max_wall_hours > 0.0_dp) then
+      elapsed = MPI_Wtime() - wall_start
+      per_step = elapsed / max(1, step - first_step)
+      ! leave room for two more steps and the final output
+      if (elapsed + 3.0_dp * per_step > 3600.0_dp * cfg%max_wall_hours) flags(2) = 1
+    end if
+    if (cfg%steady_tolerance > 0.0_dp .and. fl%max_rate < cfg%steady_tolerance) flags(3) = 1
+    call MPI_Allreduce(flags, all_flags, 3, MPI_INTEGER, MPI_MAX, PETSC_COMM_WORLD, ierr)
+    why_stop = RUNNING
+    if (step >= cfg%steps) why_stop = DONE
+    if (all_flags(3) == 1) why_stop = STEADY
+    if (all_flags(2) == 1) why_stop = WALL_LIMIT
+    if (all_flags(1) == 1) why_stop = SIGNALLED
+  end function why_stop
+
 end program fdsusp

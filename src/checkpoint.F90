@@ -1,0 +1,203 @@
+! Checkpoints: the complete state of a run in one HDF5 file, for an exact restart.
+!   datasets  /u /v /w (face velocities u^n), /p (p^{n-1/2}), /phi (last pressure increment, the
+!             warm start of the next Poisson solve: without it a restart would iterate from
+!             another guess and differ at the solver tolerance)
+!   attributes format_version, step, time, cells, box, walls, reynolds, dt, shear_rate
+! Written in parallel to NAME.tmp by PETSc's HDF5 viewer, completed by rank 0, flushed to disk
+! and renamed over NAME: the previous checkpoint survives until the new one is whole.
+#include <petsc/finclude/petscdmda.h>
+module mod_checkpoint
+  use petscdmda
+  use hdf5
+  use mod_kinds, only: dp
+  use mod_params, only: config_t
+  use mod_grid, only: grid_t, FIELD_U, FIELD_V, FIELD_W
+  use mod_fluid, only: fluid_t
+  use mod_h5util, only: write_attribute, read_attribute, write_string_attribute, has_object
+  use mod_system, only: publish_file
+  use mod_errors, only: is_root, abort_run, file_error
+  implicit none
+  private
+  public :: checkpoint_write, checkpoint_check, checkpoint_read, checkpoint_format_version
+
+  integer, parameter :: checkpoint_format_version = 1
+  character(len=*), parameter :: field_datasets(5) = ['u  ', 'v  ', 'w  ', 'p  ', 'phi']
+
+contains
+
+  subroutine checkpoint_write(path, cfg, fl, step, time, ierr)
+    character(len=*), intent(in) :: path
+    type(config_t), intent(in) :: cfg
+    type(fluid_t), intent(inout) :: fl
+    integer, intent(in) :: step
+    real(dp), intent(in) :: time
+    PetscErrorCode, intent(out) :: ierr
+    PetscViewer :: viewer
+    integer(HID_T) :: file
+    integer :: err, e(10), c, walls
+    character(len=1100) :: tmp
+    character(len=16) :: code
+
+    tmp = trim(path)//'.tmp'
+    PetscCall(PetscViewerHDF5Open(PETSC_COMM_WORLD, trim(tmp), FILE_MODE_WRITE, viewer, ierr))
+    do c = FIELD_U, FIELD_W
+      PetscCall(VecView(fl%vel(c), viewer, ierr))
+    end do
+    PetscCall(VecView(fl%pressure, viewer, ierr))
+    PetscCall(VecView(fl%phi, viewer, ierr))
+    PetscCall(PetscViewerDestroy(viewer, ierr))
+
+    if (is_root()) then
+      call h5fopen_f(trim(tmp), H5F_ACC_RDWR_F, file, err)
+      if (err /= 0) call abort_run('cannot reopen '//trim(tmp)//' to complete the checkpoint')
+      walls = merge(1, 0, cfg%walls)
+      e = 0
+      call write_attribute(file, 'format_version', [checkpoint_format_version], e(1))
+      call write_attribute(file, 'step', [step], e(2))
+      call write_attribute(file, 'time', [time], e(3))
+      call write_attribute(file, 'cells', cfg%cells, e(4))
+      call write_attribute(file, 'box', cfg%box, e(5))
+      call write_attribute(file, 'walls', [walls], e(6))
+      call write_attribute(file, 'reynolds', [cfg%reynolds], e(7))
+      call write_attribute(file, 'dt', [cfg%dt], e(8))
+      call write_attribute(file, 'shear_rate', [cfg%shear_rate], e(9))
+      call write_string_attribute(file, 'program', 'fdsusp', e(10))
+      call h5fclose_f(file, err)
+      if (any(e /= 0) .or. err /= 0) call abort_run('cannot write the attributes of '//trim(tmp))
+      err = publish_file(tmp, path)
+      if (err /= 0) then
+        write(code, '(i0)') err
+        call abort_run('cannot rename '//trim(tmp)//' to '//trim(path)//' (errno '//trim(code)//')')
+      end if
+    end if
+    call MPI_Barrier(PETSC_COMM_WORLD, ierr)
+  end subroutine checkpoint_write
+
+  ! Before any work: is PATH a checkpoint of this scene? Returns its step and time. Rank 0
+  ! inspects the file, every rank learns the verdict, and a bad file stops the run with a message
+  ! naming the file and the item at fault.
+  subroutine checkpoint_check(path, cfg, step, time)
+    character(len=*), intent(in) :: path
+    type(config_t), intent(in) :: cfg
+    integer, intent(out) :: step
+    real(dp), intent(out) :: time
+    character(len=400) :: item, message
+    real(dp) :: values(2)
+    PetscErrorCode :: ierr
+
+    item = ''
+    message = ''
+    values = 0.0_dp
+    if (is_root()) call inspect(path, cfg, item, message, values)
+    call MPI_Bcast(item, len(item), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
+    call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
+    call MPI_Bcast(values, 2, MPI_DOUBLE_PRECISION, 0, PETSC_COMM_WORLD, ierr)
+    if (len_trim(message) > 0) call file_error(path, item, message)
+    step = nint(values(1))
+    time = values(2)
+  end subroutine checkpoint_check
+
+  subroutine inspect(path, cfg, item, message, values)
+    character(len=*), intent(in) :: path
+    type(config_t), intent(in) :: cfg
+    character(len=*), intent(out) :: item, message
+    real(dp), intent(out) :: values(2)
+    integer(HID_T) :: file, dset, space
+    integer(HSIZE_T) :: dims(3), maxdims(3)
+    integer :: err, version(1), cells(3), walls(1), istep(1), rank, d
+    real(dp) :: box(3), t(1)
+    logical :: exists
+
+    item = ''
+    message = ''
+    values = 0.0_dp
+    inquire(file=path, exist=exists)
+    if (.not. exists) then
+      message = 'the checkpoint does not exist'
+      return
+    end if
+    call h5fopen_f(path, H5F_ACC_RDONLY_F, file, err)
+    if (err /= 0) then
+      message = 'cannot be opened as HDF5: the file is truncated or is not a checkpoint'
+      return
+    end if
+    call read_attribute(file, 'format_version', version, err)
+    if (err /= 0) then
+      item = 'format_version'
+      message = 'missing: not an fdsusp checkpoint'
+    else if (version(1) /= checkpoint_format_version) then
+      item = 'format_version'
+      write(message, '(a,i0,a,i0)') 'this program reads checkpoint format ', checkpoint_format_version, &
+           ', the file has format ', version(1)
+    end if
+    if (len_trim(message) == 0) then
+      call read_attribute(file, 'cells', cells, err)
+      if (err /= 0) then
+        item = 'cells'; message = 'missing'
+      else if (any(cells /= cfg%cells)) then
+        item = 'cells'
+        write(message, '(a,3(i0,:,"x"),a,3(i0,:,"x"))') 'the checkpoint grid has ', cells, &
+             ' cells, the deck asks for ', cfg%cells
+      end if
+    end if
+    if (len_trim(message) == 0) then
+      call read_attribute(file, 'box', box, err)
+      if (err /= 0) then
+        item = 'box'; message = 'missing'
+      else if (any(abs(box - cfg%box) > 1.0e-12_dp * cfg%box)) then
+        item = 'box'
+        write(message, '(a,3f10.4,a,3f10.4)') 'the checkpoint box is', box, ', the deck asks for', cfg%box
+      end if
+    end if
+    if (len_trim(message) == 0) then
+      call read_attribute(file, 'walls', walls, err)
+      if (err /= 0) then
+        item = 'walls'; message = 'missing'
+      else if ((walls(1) == 1) .neqv. cfg%walls) then
+        item = 'walls'; message = 'the checkpoint and the deck disagree on &domain y_boundary'
+      end if
+    end if
+    if (len_trim(message) == 0) then
+      call read_attribute(file, 'step', istep, err)
+      if (err == 0) call read_attribute(file, 'time', t, err)
+      if (err /= 0) then
+        item = 'step'; message = 'step or time missing'
+      else
+        values = [real(istep(1), dp), t(1)]
+      end if
+    end if
+    do d = 1, size(field_datasets)
+      if (len_trim(message) > 0) exit
+      if (.not. has_object(file, trim(field_datasets(d)))) then
+        item = '/'//trim(field_datasets(d)); message = 'dataset missing'
+        exit
+      end if
+      call h5dopen_f(file, trim(field_datasets(d)), dset, err)
+      call h5dget_space_f(dset, space, err)
+      call h5sget_simple_extent_ndims_f(space, rank, err)
+      if (rank == 3) call h5sget_simple_extent_dims_f(space, dims, maxdims, err)
+      call h5sclose_f(space, err)
+      call h5dclose_f(dset, err)
+      if (rank /= 3 .or. any(dims /= int([cfg%cells(3), cfg%cells(2), cfg%cells(1)], HSIZE_T))) then
+        item = '/'//trim(field_datasets(d)); message = 'dataset of the wrong shape for this grid'
+      end if
+    end do
+    call h5fclose_f(file, err)
+  end subroutine inspect
+
+  subroutine checkpoint_read(path, fl, ierr)
+    character(len=*), intent(in) :: path
+    type(fluid_t), intent(inout) :: fl
+    PetscErrorCode, intent(out) :: ierr
+    PetscViewer :: viewer
+    integer :: c
+    PetscCall(PetscViewerHDF5Open(PETSC_COMM_WORLD, trim(path), FILE_MODE_READ, viewer, ierr))
+    do c = FIELD_U, FIELD_W
+      PetscCall(VecLoad(fl%vel(c), viewer, ierr))
+    end do
+    PetscCall(VecLoad(fl%pressure, viewer, ierr))
+    PetscCall(VecLoad(fl%phi, viewer, ierr))
+    PetscCall(PetscViewerDestroy(viewer, ierr))
+  end subroutine checkpoint_read
+
+end module mod_checkpoint

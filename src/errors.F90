@@ -1,0 +1,79 @@
+! Error reporting shared by every module that talks to the user.
+! Input errors are raised collectively (every rank reads and validates the same deck), so the run
+! stops cleanly on all ranks with one message printed by rank 0. Runtime faults detected on one
+! rank only abort the MPI job.
+#include <petsc/finclude/petscsys.h>
+module mod_errors
+  use petscsys
+  implicit none
+  private
+  public :: input_error, file_error, fatal_error, abort_run, is_root, log_line, warn_line
+
+contains
+
+  logical function is_root()
+    PetscMPIInt :: rank
+    PetscErrorCode :: ierr
+    call MPI_Comm_rank(PETSC_COMM_WORLD, rank, ierr)
+    is_root = (rank == 0)
+  end function is_root
+
+  ! One line on the run log (rank 0 only).
+  subroutine log_line(text)
+    character(len=*), intent(in) :: text
+    if (is_root()) then
+      write(*, '(a)') trim(text)
+      flush(6)
+    end if
+  end subroutine log_line
+
+  subroutine warn_line(text)
+    character(len=*), intent(in) :: text
+    if (is_root()) then
+      write(0, '(a)') 'fdsusp: warning: '//trim(text)
+      flush(0)
+    end if
+  end subroutine warn_line
+
+  ! Bad input: one message naming the file, the group and the variable. Collective.
+  subroutine input_error(file, group, variable, message)
+    character(len=*), intent(in) :: file, group, variable, message
+    character(len=:), allocatable :: where
+    where = 'fdsusp: input error: '//trim(file)
+    if (len_trim(group) > 0) where = where//', group &'//trim(group)
+    if (len_trim(variable) > 0) where = where//', variable '//trim(variable)
+    call fatal_error(where//': '//trim(message), 2)
+  end subroutine input_error
+
+  ! A file the run reads (checkpoint, particle file, table) is unusable. Collective.
+  subroutine file_error(file, item, message)
+    character(len=*), intent(in) :: file, item, message
+    character(len=:), allocatable :: where
+    where = 'fdsusp: input error: '//trim(file)
+    if (len_trim(item) > 0) where = where//', item '//trim(item)
+    call fatal_error(where//': '//trim(message), 2)
+  end subroutine file_error
+
+  ! A collective fatal error: every rank calls it. Rank 0 prints; all ranks finalise and exit.
+  subroutine fatal_error(message, status)
+    character(len=*), intent(in) :: message
+    integer, intent(in) :: status
+    PetscErrorCode :: ierr
+    if (is_root()) then
+      write(0, '(a)') trim(message)
+      flush(0)
+    end if
+    call PetscFinalize(ierr)
+    call exit(status)
+  end subroutine fatal_error
+
+  ! A fault seen by one rank only: print it and abort the whole job.
+  subroutine abort_run(message)
+    character(len=*), intent(in) :: message
+    PetscErrorCode :: ierr
+    write(0, '(a)') 'fdsusp: fatal: '//trim(message)
+    flush(0)
+    call MPI_Abort(PETSC_COMM_WORLD, 3, ierr)
+  end subroutine abort_run
+
+end module mod_errors

@@ -1,0 +1,400 @@
+! The fluid sub-problem: unsteady Stokes, rho du/dt = -grad p + eta lap u + f, div u = 0, on the
+! MAC grid of mod_grid, by an incremental pressure-correction projection in rotational form with a
+! theta scheme for the viscous term (theta = 1/2: Crank-Nicolson). method.md §1.3. In fdsusp
+! units eta = 1 and rho = Re (Re = rho gamma_dot a^2 / eta).
+!
+! One step, from u^n and p^{n-1/2}:
+!   1. (Re/dt - theta lap) u* = (Re/dt) u^n + (1-theta) lap u^n - grad p^{n-1/2} + f
+!   2. lap phi = (Re/dt) div u*                       (solved as -lap phi = -(Re/dt) div u*)
+!   3. u^{n+1} = u* - (dt/Re) grad phi                (discretely divergence-free)
+!   4. p^{n+1/2} = p^{n-1/2} + phi - theta eta div u*  (rotational correction)
+! The discrete Poisson operator is exactly div(grad) on this grid, so step 3 leaves div u^{n+1}
+! at the level of the Poisson solver's residual. At a steady state the scheme satisfies the
+! discrete steady Stokes equations exactly (phi -> constant).
+#include <petsc/finclude/petscdmda.h>
+module mod_fluid
+  use petscdmda
+  use mod_kinds, only: dp
+  use mod_params, only: config_t
+  use mod_grid, only: grid_t, grid_position, field_names, FIELD_U, FIELD_V, FIELD_W, FIELD_P
+  use mod_solvers, only: solver_t, solvers_configure, solver_create, solver_solve, solver_destroy
+  use mod_manufactured, only: mms_forcing, mms_velocity, mms_pressure
+  implicit none
+  private
+  public :: fluid_t, fluid_create, fluid_step, fluid_destroy, fluid_errors_vs_manufactured
+
+  type :: fluid_t
+    Vec :: vel(3)           ! u^n, v^n, w^n
+    Vec :: pressure         ! p^{n-1/2}
+    Vec :: phi              ! pressure increment of the last step (warm start of the Poisson solve)
+    Vec :: vel_star(3)      ! provisional velocity u*
+    Vec :: rhs(3), rhs_p    ! right-hand sides
+    Vec :: div_star         ! div u*
+    Vec :: forcing(3)       ! steady body-force density at the faces
+    Vec :: loc(4)           ! ghosted work vectors, one per field
+    logical :: has_forcing = .false.
+    type(solver_t) :: solver(4)
+    real(dp) :: reynolds = 0.0_dp, dt = 0.0_dp, theta = 0.5_dp, viscosity = 1.0_dp
+    real(dp) :: wall_speed = 0.0_dp
+    ! diagnostics of the last step
+    real(dp) :: divergence = 0.0_dp   ! max|div u| h / max|u| after projection
+    real(dp) :: tau_bottom = 0.0_dp   ! mean eta du/dy on the wall y = 0
+    real(dp) :: tau_top = 0.0_dp      ! mean eta du/dy on the wall y = Ly
+    real(dp) :: max_rate = 0.0_dp     ! max|u^{n+1} - u^n| / dt
+  end type fluid_t
+
+contains
+
+  subroutine fluid_create(cfg, grid, fl, ierr)
+    type(config_t), intent(in) :: cfg
+    type(grid_t), intent(in) :: grid
+    type(fluid_t), intent(inout) :: fl
+    PetscErrorCode, intent(out) :: ierr
+    integer :: c
+    real(dp) :: tol
+
+    fl%reynolds = cfg%reynolds
+    fl%dt = cfg%dt
+    fl%theta = cfg%viscous_theta
+    fl%wall_speed = cfg%wall_speed
+    do c = 1, 3
+      PetscCall(DMCreateGlobalVector(grid%da(c), fl%vel(c), ierr))
+      PetscCall(VecDuplicate(fl%vel(c), fl%vel_star(c), ierr))
+      PetscCall(VecDuplicate(fl%vel(c), fl%rhs(c), ierr))
+      PetscCall(VecDuplicate(fl%vel(c), fl%forcing(c), ierr))
+      PetscCall(VecSet(fl%vel(c), 0.0_dp, ierr))
+      PetscCall(PetscObjectSetName(fl%vel(c), field_names(c), ierr))
+    end do
+    do c = 1, 4
+      PetscCall(DMCreateLocalVector(grid%da(c), fl%loc(c), ierr))
+    end do
+    PetscCall(DMCreateGlobalVector(grid%da(FIELD_P), fl%pressure, ierr))
+    PetscCall(VecDuplicate(fl%pressure, fl%phi, ierr))
+    PetscCall(VecDuplicate(fl%pressure, fl%rhs_p, ierr))
+    PetscCall(VecDuplicate(fl%pressure, fl%div_star, ierr))
+    PetscCall(VecSet(fl%pressure, 0.0_dp, ierr))
+    PetscCall(VecSet(fl%phi, 0.0_dp, ierr))
+    PetscCall(PetscObjectSetName(fl%pressure, 'p', ierr))
+    PetscCall(PetscObjectSetName(fl%phi, 'phi', ierr))
+
+    call set_forcing(cfg, grid, fl, ierr)
+
+    call solvers_configure(fl%reynolds / fl%dt, fl%theta * fl%viscosity, grid%box, grid%walls)
+    do c = 1, 4
+      tol = cfg%velocity_tolerance
+      if (c == FIELD_P) tol = cfg%pressure_tolerance
+      call solver_create(grid, c, tol, fl%solver(c), ierr)
+    end do
+  end subroutine fluid_create
+
+  ! Uniform body force plus, in verification runs, the manufactured-solution forcing.
+  subroutine set_forcing(cfg, grid, fl, ierr)
+    type(config_t), intent(in) :: cfg
+    type(grid_t), intent(in) :: grid
+    type(fluid_t), intent(inout) :: fl
+    PetscErrorCode, intent(out) :: ierr
+    PetscScalar, pointer :: f(:,:,:)
+    integer :: c, i, j, k
+
+    fl%has_forcing = cfg%manufactured_solution .or. any(cfg%body_force /= 0.0_dp)
+    do c = 1, 3
+      PetscCall(VecSet(fl%forcing(c), cfg%body_force(c), ierr))
+      if (.not. cfg%manufactured_solution) cycle
+      PetscCall(DMDAVecGetArrayF90(grid%da(c), fl%forcing(c), f, ierr))
+      do k = grid%lo(3), grid%hi(3)
+        do j = grid%lo(2), grid%hi(2)
+          do i = grid%lo(1), grid%hi(1)
+            f(i, j, k) = mms_forcing(c, grid_position(grid, c, i, j, k), grid%box, grid%walls, fl%viscosity)
+          end do
+        end do
+      end do
+      PetscCall(DMDAVecRestoreArrayF90(grid%da(c), fl%forcing(c), f, ierr))
+    end do
+  end subroutine set_forcing
+
+  ! Wall velocity seen by component c at the bottom (side = -1) or top (side = +1) wall.
+  pure real(dp) function wall_velocity(fl, c, side)
+    type(fluid_t), intent(in) :: fl
+    integer, intent(in) :: c, side
+    wall_velocity = 0.0_dp
+    if (c == FIELD_U) wall_velocity = side * fl%wall_speed
+  end function wall_velocity
+
+  ! Ghosted copy of a face field with the wall ghosts of cell-centred-in-y components set to
+  ! 2 U_wall - x_0 (second order, method.md §1.3). v needs nothing: its wall face holds 0.
+  subroutine ghosted(grid, fl, c, global, ierr)
+    type(grid_t), intent(in) :: grid
+    type(fluid_t), intent(inout) :: fl
+    integer, intent(in) :: c
+    Vec, intent(in) :: global
+    PetscErrorCode, intent(out) :: ierr
+    PetscScalar, pointer :: a(:,:,:)
+    integer :: ny
+    PetscCall(DMGlobalToLocalBegin(grid%da(c), global, INSERT_VALUES, fl%loc(c), ierr))
+    PetscCall(DMGlobalToLocalEnd(grid%da(c), global, INSERT_VALUES, fl%loc(c), ierr))
+    if (.not. grid%walls .or. c == FIELD_V .or. c == FIELD_P) return
+    ny = grid%n(2)
+    PetscCall(DMDAVecGetArrayF90(grid%da(c), fl%loc(c), a, ierr))
+    if (grid%lo(2) == 0) a(:, -1, :) = 2.0_dp * wall_velocity(fl, c, -1) - a(:, 0, :)
+    if (grid%hi(2) == ny - 1) a(:, ny, :) = 2.0_dp * wall_velocity(fl, c, +1) - a(:, ny - 1, :)
+    PetscCall(DMDAVecRestoreArrayF90(grid%da(c), fl%loc(c), a, ierr))
+  end subroutine ghosted
+
+  ! True for the rows that are not unknowns: v on the wall face j = 0.
+  pure logical function fixed_row(grid, c, j)
+    type(grid_t), intent(in) :: grid
+    integer, intent(in) :: c, j
+    fixed_row = grid%walls .and. c == FIELD_V .and. j == 0
+  end function fixed_row
+
+  subroutine fluid_step(grid, fl, ierr)
+    type(grid_t), intent(in) :: grid
+    type(fluid_t), intent(inout) :: fl
+    PetscErrorCode, intent(out) :: ierr
+    PetscScalar, pointer :: a(:,:,:), p(:,:,:), r(:,:,:), f(:,:,:), ph(:,:,:), ds(:,:,:)
+    integer :: c, i, j, k, e(3), ny
+    real(dp) :: h, mass, lap, explicit, implicit, wall_term, rate
+    PetscReal :: local_max, global_max
+    PetscErrorCode :: mpierr
+
+    h = grid%h
+    ny = grid%n(2)
+    mass = fl%reynolds / fl%dt
+    explicit = (1.0_dp - fl%theta) * fl%viscosity
+    implicit = fl%theta * fl%viscosity
+
+    ! 1. provisional velocity
+    call ghosted(grid, fl, FIELD_P, fl%pressure, ierr)
+    PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_P), fl%loc(FIELD_P), p, ierr))
+    do c = 1, 3
+      e = 0
+      e(c) = 1
+      call ghosted(grid, fl, c, fl%vel(c), ierr)
+      PetscCall(DMDAVecGetArrayReadF90(grid%da(c), fl%loc(c), a, ierr))
+      PetscCall(DMDAVecGetArrayF90(grid%da(c), fl%rhs(c), r, ierr))
+      PetscCall(DMDAVecGetArrayReadF90(grid%da(c), fl%forcing(c), f, ierr))
+      do k = grid%lo(3), grid%hi(3)
+        do j = grid%lo(2), grid%hi(2)
+          do i = grid%lo(1), grid%hi(1)
+            if (fixed_row(grid, c, j)) then
+              r(i, j, k) = 0.0_dp
+              cycle
+            end if
+            lap = (a(i-1, j, k) + a(i+1, j, k) + a(i, j-1, k) + a(i, j+1, k) + a(i, j, k-1) &
+                 + a(i, j, k+1) - 6.0_dp * a(i, j, k)) / h**2
+            r(i, j, k) = mass * a(i, j, k) + explicit * lap &
+                 - (p(i, j, k) - p(i - e(1), j - e(2), k - e(3))) / h + f(i, j, k)
+            ! implicit half of the wall ghost 2 U_w - x_0: its U_w part is known
+            if (grid%walls .and. c /= FIELD_V) then
+              wall_term = 0.0_dp
+              if (j == 0) wall_term = 2.0_dp * wall_velocity(fl, c, -1)
+              if (j == ny - 1) wall_term = 2.0_dp * wall_velocity(fl, c, +1)
+              r(i, j, k) = r(i, j, k) + implicit * wall_term / h**2
+            end if
+          end do
+        end do
+      end do
+      PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), fl%forcing(c), f, ierr))
+      PetscCall(DMDAVecRestoreArrayF90(grid%da(c), fl%rhs(c), r, ierr))
+      PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), fl%loc(c), a, ierr))
+      PetscCall(VecCopy(fl%vel(c), fl%vel_star(c), ierr))    ! warm start from u^n
+      call solver_solve(fl%solver(c), fl%rhs(c), fl%vel_star(c), ierr)
+    end do
+    PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_P), fl%loc(FIELD_P), p, ierr))
+
+    ! 2. pressure increment: -lap phi = -(Re/dt) div u*
+    call divergence(grid, fl, fl%vel_star, fl%div_star, ierr)
+    PetscCall(VecAXPBY(fl%rhs_p, -mass, 0.0_dp, fl%div_star, ierr))
+    call solver_solve(fl%solver(FIELD_P), fl%rhs_p, fl%phi, ierr)
+
+    ! 3. projection, with the rate of change for steady-state detection
+    call ghosted(grid, fl, FIELD_P, fl%phi, ierr)
+    PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_P), fl%loc(FIELD_P), ph, ierr))
+    local_max = 0.0_dp
+    do c = 1, 3
+      e = 0
+      e(c) = 1
+      PetscCall(DMDAVecGetArrayF90(grid%da(c), fl%vel(c), a, ierr))
+      PetscCall(DMDAVecGetArrayReadF90(grid%da(c), fl%vel_star(c), r, ierr))
+      do k = grid%lo(3), grid%hi(3)
+        do j = grid%lo(2), grid%hi(2)
+          do i = grid%lo(1), grid%hi(1)
+            if (fixed_row(grid, c, j)) cycle
+            rate = r(i, j, k) - fl%dt / fl%reynolds * (ph(i, j, k) - ph(i - e(1), j - e(2), k - e(3))) / h
+            local_max = max(local_max, abs(rate - a(i, j, k)))
+            a(i, j, k) = rate
+          end do
+        end do
+      end do
+      PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), fl%vel_star(c), r, ierr))
+      PetscCall(DMDAVecRestoreArrayF90(grid%da(c), fl%vel(c), a, ierr))
+    end do
+    PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_P), fl%loc(FIELD_P), ph, ierr))
+    call MPI_Allreduce(local_max, global_max, 1, MPIU_REAL, MPI_MAX, PETSC_COMM_WORLD, mpierr)
+    fl%max_rate = global_max / fl%dt
+
+    ! 4. rotational pressure update
+    PetscCall(DMDAVecGetArrayF90(grid%da(FIELD_P), fl%pressure, p, ierr))
+    PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_P), fl%phi, ph, ierr))
+    PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_P), fl%div_star, ds, ierr))
+    p = p + ph - implicit * ds
+    PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_P), fl%div_star, ds, ierr))
+    PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_P), fl%phi, ph, ierr))
+    PetscCall(DMDAVecRestoreArrayF90(grid%da(FIELD_P), fl%pressure, p, ierr))
+
+    call diagnostics(grid, fl, ierr)
+  end subroutine fluid_step
+
+  ! div of a face field at the cell centres: (u(i+1)-u(i) + v(j+1)-v(j) + w(k+1)-w(k))/h.
+  ! With walls, v(n) is the periodic image of v(0) = 0: the top wall.
+  subroutine divergence(grid, fl, vel, div, ierr)
+    type(grid_t), intent(in) :: grid
+    type(fluid_t), intent(inout) :: fl
+    Vec, intent(in) :: vel(3)
+    Vec, intent(inout) :: div
+    PetscErrorCode, intent(out) :: ierr
+    PetscScalar, pointer :: u(:,:,:), v(:,:,:), w(:,:,:), d(:,:,:)
+    integer :: i, j, k
+    do i = 1, 3
+      PetscCall(DMGlobalToLocalBegin(grid%da(i), vel(i), INSERT_VALUES, fl%loc(i), ierr))
+      PetscCall(DMGlobalToLocalEnd(grid%da(i), vel(i), INSERT_VALUES, fl%loc(i), ierr))
+    end do
+    PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_U), fl%loc(FIELD_U), u, ierr))
+    PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_V), fl%loc(FIELD_V), v, ierr))
+    PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_W), fl%loc(FIELD_W), w, ierr))
+    PetscCall(DMDAVecGetArrayF90(grid%da(FIELD_P), div, d, ierr))
+    do k = grid%lo(3), grid%hi(3)
+      do j = grid%lo(2), grid%hi(2)
+        do i = grid%lo(1), grid%hi(1)
+          d(i, j, k) = (u(i+1, j, k) - u(i, j, k) + v(i, j+1, k) - v(i, j, k) &
+                      + w(i, j, k+1) - w(i, j, k)) / grid%h
+        end do
+      end do
+    end do
+    PetscCall(DMDAVecRestoreArrayF90(grid%da(FIELD_P), div, d, ierr))
+    PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_W), fl%loc(FIELD_W), w, ierr))
+    PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_V), fl%loc(FIELD_V), v, ierr))
+    PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_U), fl%loc(FIELD_U), u, ierr))
+  end subroutine divergence
+
+  ! Divergence of u^{n+1} relative to max|u|/h, and the mean shear stress on each wall,
+  ! tau = eta du/dy with du/dy = (u_0 - U_bottom)/(h/2) at y = 0 and (U_top - u_{n-1})/(h/2).
+  subroutine diagnostics(grid, fl, ierr)
+    type(grid_t), intent(in) :: grid
+    type(fluid_t), intent(inout) :: fl
+    PetscErrorCode, intent(out) :: ierr
+    PetscScalar, pointer :: u(:,:,:)
+    PetscReal :: dmax, umax, c_max, sums(2), tot(2)
+    PetscErrorCode :: mpierr
+    integer :: c, ny
+
+    call divergence(grid, fl, fl%vel, fl%div_star, ierr)
+    PetscCall(VecNorm(fl%div_star, NORM_INFINITY, dmax, ierr))
+    umax = 0.0_dp
+    do c = 1, 3
+      PetscCall(VecNorm(fl%vel(c), NORM_INFINITY, c_max, ierr))
+      umax = max(umax, c_max)
+    end do
+    fl%divergence = 0.0_dp
+    if (umax > 0.0_dp) fl%divergence = dmax * grid%h / umax
+
+    fl%tau_bottom = 0.0_dp
+    fl%tau_top = 0.0_dp
+    if (.not. grid%walls) return
+    ny = grid%n(2)
+    sums = 0.0_dp
+    PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_U), fl%vel(FIELD_U), u, ierr))
+    if (grid%lo(2) == 0) sums(1) = sum(u(:, 0, :) - wall_velocity(fl, FIELD_U, -1))
+    if (grid%hi(2) == ny - 1) sums(2) = sum(wall_velocity(fl, FIELD_U, +1) - u(:, ny - 1, :))
+    PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_U), fl%vel(FIELD_U), u, ierr))
+    call MPI_Allreduce(sums, tot, 2, MPIU_REAL, MPI_SUM, PETSC_COMM_WORLD, mpierr)
+    tot = tot * fl%viscosity / (0.5_dp * grid%h) / real(grid%n(1) * grid%n(3), dp)
+    fl%tau_bottom = tot(1)
+    fl%tau_top = tot(2)
+  end subroutine diagnostics
+
+  ! Errors against the manufactured solution (plus the Couette shear, which needs no forcing):
+  ! max over all velocity unknowns, and max and rms of the pressure with both means removed.
+  subroutine fluid_errors_vs_manufactured(grid, fl, shear_rate, err_vel, err_p_max, err_p_rms, ierr)
+    type(grid_t), intent(in) :: grid
+    type(fluid_t), intent(inout) :: fl
+    real(dp), intent(in) :: shear_rate
+    real(dp), intent(out) :: err_vel, err_p_max, err_p_rms
+    PetscErrorCode, intent(out) :: ierr
+    PetscScalar, pointer :: a(:,:,:)
+    real(dp) :: x(3), exact, loc(3), tot(3), mean_h, mean_e, ncell
+    PetscErrorCode :: mpierr
+    integer :: c, i, j, k
+
+    loc = 0.0_dp
+    do c = 1, 3
+      PetscCall(DMDAVecGetArrayReadF90(grid%da(c), fl%vel(c), a, ierr))
+      do k = grid%lo(3), grid%hi(3)
+        do j = grid%lo(2), grid%hi(2)
+          do i = grid%lo(1), grid%hi(1)
+            if (fixed_row(grid, c, j)) cycle
+            x = grid_position(grid, c, i, j, k)
+            exact = mms_velocity(c, x, grid%box, grid%walls)
+            if (c == FIELD_U .and. grid%walls) exact = exact + shear_rate * (x(2) - 0.5_dp * grid%box(2))
+            loc(1) = max(loc(1), abs(a(i, j, k) - exact))
+          end do
+        end do
+      end do
+      PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), fl%vel(c), a, ierr))
+    end do
+    call MPI_Allreduce(loc(1), tot(1), 1, MPIU_REAL, MPI_MAX, PETSC_COMM_WORLD, mpierr)
+    err_vel = tot(1)
+
+    ! means of the computed and the exact pressure
+    ncell = real(grid%n(1), dp) * grid%n(2) * grid%n(3)
+    PetscCall(VecSum(fl%pressure, mean_h, ierr))
+    mean_h = mean_h / ncell
+    loc = 0.0_dp
+    PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_P), fl%pressure, a, ierr))
+    do k = grid%lo(3), grid%hi(3)
+      do j = grid%lo(2), grid%hi(2)
+        do i = grid%lo(1), grid%hi(1)
+          loc(1) = loc(1) + mms_pressure(grid_position(grid, FIELD_P, i, j, k), grid%box, grid%walls)
+        end do
+      end do
+    end do
+    call MPI_Allreduce(loc(1), mean_e, 1, MPIU_REAL, MPI_SUM, PETSC_COMM_WORLD, mpierr)
+    mean_e = mean_e / ncell
+    loc = 0.0_dp
+    do k = grid%lo(3), grid%hi(3)
+      do j = grid%lo(2), grid%hi(2)
+        do i = grid%lo(1), grid%hi(1)
+          exact = mms_pressure(grid_position(grid, FIELD_P, i, j, k), grid%box, grid%walls) - mean_e
+          loc(2) = max(loc(2), abs(a(i, j, k) - mean_h - exact))
+          loc(3) = loc(3) + (a(i, j, k) - mean_h - exact)**2
+        end do
+      end do
+    end do
+    PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_P), fl%pressure, a, ierr))
+    call MPI_Allreduce(loc(2), tot(2), 1, MPIU_REAL, MPI_MAX, PETSC_COMM_WORLD, mpierr)
+    call MPI_Allreduce(loc(3), tot(3), 1, MPIU_REAL, MPI_SUM, PETSC_COMM_WORLD, mpierr)
+    err_p_max = tot(2)
+    err_p_rms = sqrt(tot(3) / ncell)
+  end subroutine fluid_errors_vs_manufactured
+
+  subroutine fluid_destroy(fl, ierr)
+    type(fluid_t), intent(inout) :: fl
+    PetscErrorCode, intent(out) :: ierr
+    integer :: c
+    do c = 1, 3
+      PetscCall(VecDestroy(fl%vel(c), ierr))
+      PetscCall(VecDestroy(fl%vel_star(c), ierr))
+      PetscCall(VecDestroy(fl%rhs(c), ierr))
+      PetscCall(VecDestroy(fl%forcing(c), ierr))
+    end do
+    do c = 1, 4
+      PetscCall(VecDestroy(fl%loc(c), ierr))
+      call solver_destroy(fl%solver(c), ierr)
+    end do
+    PetscCall(VecDestroy(fl%pressure, ierr))
+    PetscCall(VecDestroy(fl%phi, ierr))
+    PetscCall(VecDestroy(fl%rhs_p, ierr))
+    PetscCall(VecDestroy(fl%div_star, ierr))
+  end subroutine fluid_destroy
+
+end module mod_fluid

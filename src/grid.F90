@@ -1,0 +1,136 @@
+! The staggered (MAC) grid and its PETSc layout: the only module that knows where each unknown
+! lives.
+!
+! Cells are cubes of side h = a/cells_per_radius; there are n(1) x n(2) x n(3) of them. Unknowns,
+! with 0-based indices (i, j, k):
+!   u(i,j,k) at (i h, (j+1/2) h, (k+1/2) h)         x-faces
+!   v(i,j,k) at ((i+1/2) h, j h, (k+1/2) h)         y-faces
+!   w(i,j,k) at ((i+1/2) h, (j+1/2) h, k h)         z-faces
+!   p(i,j,k) at ((i+1/2) h, (j+1/2) h, (k+1/2) h)   cell centres
+! Every field is stored on its own scalar DMDA of n(1) x n(2) x n(3) points, all four with the
+! same decomposition, and every DMDA is periodic in x, y and z. With walls in y the walls are
+! enforced by the operators, not by the layout: the bottom wall y = 0 is the face j = 0 of v
+! (v = 0 there, a fixed row), and the top wall y = Ly is the face j = n(2), which the periodic
+! layout identifies with j = 0, so it holds the same zero. Cell-centred fields see the walls
+! between j = n(2)-1 and j = 0 and never couple across them. This keeps one layout for all
+! fields and lets PETSc's periodic DMDA coarsening (n -> n/2) build the multigrid hierarchy.
+#include <petsc/finclude/petscdmda.h>
+module mod_grid
+  use petscdmda
+  use mod_kinds, only: dp
+  use mod_params, only: config_t
+  use mod_errors, only: log_line
+  implicit none
+  private
+  public :: grid_t, grid_create, grid_destroy, grid_position
+  public :: FIELD_U, FIELD_V, FIELD_W, FIELD_P, field_names
+
+  integer, parameter :: FIELD_U = 1, FIELD_V = 2, FIELD_W = 3, FIELD_P = 4
+  character(len=1), parameter :: field_names(4) = ['u', 'v', 'w', 'p']
+
+  type :: grid_t
+    integer :: n(3) = 0           ! cells in x, y, z
+    real(dp) :: h = 0.0_dp        ! cell size [a]
+    real(dp) :: box(3) = 0.0_dp   ! box lengths [a]
+    logical :: walls = .true.     ! walls at y = 0 and y = Ly
+    integer :: mg_levels = 1      ! levels the decomposition allows for geometric multigrid
+    integer :: nprocs(3) = 1      ! process grid
+    DM :: da(4)                   ! u, v, w, p
+    integer :: lo(3) = 0, hi(3) = -1    ! owned index range (inclusive, 0-based)
+    integer :: glo(3) = 0, ghi(3) = -1  ! owned range with one layer of ghosts
+  end type grid_t
+
+contains
+
+  subroutine grid_create(cfg, grid, ierr)
+    type(config_t), intent(in) :: cfg
+    type(grid_t), intent(inout) :: grid
+    PetscErrorCode, intent(out) :: ierr
+    DM :: trial
+    PetscInt :: dim, mx, my, mz, m(3), dof, sw, nlev, block, d, f
+    PetscInt :: bt(3), st
+    PetscInt, allocatable :: lx(:), ly(:), lz(:)
+    PetscInt :: xs, ys, zs, xm, ym, zm
+    character(len=200) :: text
+
+    grid%n = cfg%cells
+    grid%h = cfg%h
+    grid%box = cfg%box
+    grid%walls = cfg%walls
+
+    ! Let PETSc choose the process grid, then align each rank's share to the coarsest
+    ! multigrid block so that every level coarsens with the same decomposition.
+    PetscCall(DMDACreate3d(PETSC_COMM_WORLD, DM_BOUNDARY_PERIODIC, DM_BOUNDARY_PERIODIC, DM_BOUNDARY_PERIODIC, DMDA_STENCIL_STAR, grid%n(1), grid%n(2), grid%n(3), PETSC_DECIDE, PETSC_DECIDE, PETSC_DECIDE, 1, 1, PETSC_NULL_INTEGER, PETSC_NULL_INTEGER, PETSC_NULL_INTEGER, trial, ierr))
+    PetscCall(DMSetUp(trial, ierr))
+    PetscCall(DMDAGetInfo(trial, dim, mx, my, mz, m(1), m(2), m(3), dof, sw, bt(1), bt(2), bt(3), st, ierr))
+    PetscCall(DMDestroy(trial, ierr))
+    grid%nprocs = m
+
+    nlev = 1
+    do while (nlev < 8)
+      block = 2**nlev
+      if (any(mod(grid%n, block) /= 0)) exit
+      if (any(grid%n / block < max(3, m))) exit
+      nlev = nlev + 1
+    end do
+    grid%mg_levels = nlev
+    block = 2**(nlev - 1)
+    call shares(grid%n(1) / block, m(1), block, lx)
+    call shares(grid%n(2) / block, m(2), block, ly)
+    call shares(grid%n(3) / block, m(3), block, lz)
+
+    do f = 1, 4
+      PetscCall(DMDACreate3d(PETSC_COMM_WORLD, DM_BOUNDARY_PERIODIC, DM_BOUNDARY_PERIODIC, DM_BOUNDARY_PERIODIC, DMDA_STENCIL_STAR, grid%n(1), grid%n(2), grid%n(3), m(1), m(2), m(3), 1, 1, lx, ly, lz, grid%da(f), ierr))
+      PetscCall(DMSetOptionsPrefix(grid%da(f), field_names(f)//'_', ierr))
+      PetscCall(DMSetUp(grid%da(f), ierr))
+    end do
+    PetscCall(DMDAGetCorners(grid%da(FIELD_P), xs, ys, zs, xm, ym, zm, ierr))
+    grid%lo = [xs, ys, zs]
+    grid%hi = grid%lo + [xm, ym, zm] - 1
+    PetscCall(DMDAGetGhostCorners(grid%da(FIELD_P), xs, ys, zs, xm, ym, zm, ierr))
+    grid%glo = [xs, ys, zs]
+    grid%ghi = grid%glo + [xm, ym, zm] - 1
+
+    write(text, '(a,3(i0,1x),a,es10.3,a,3(i0,1x),a,i0)') 'grid: cells ', grid%n, '  h = ', grid%h, &
+         '  process grid ', m, '  multigrid levels ', nlev
+    call log_line(text)
+    do d = 1, 3
+      if (grid%n(d) / 2**(nlev - 1) > 64) then
+        call log_line('grid: note: the coarsest multigrid level is large in one direction; '// &
+             'cell counts with more factors of 2 make the solves cheaper')
+        exit
+      end if
+    end do
+  end subroutine grid_create
+
+  ! Split nblocks blocks of size block over nproc ranks as evenly as possible.
+  subroutine shares(nblocks, nproc, block, l)
+    PetscInt, intent(in) :: nblocks, nproc, block
+    PetscInt, allocatable, intent(out) :: l(:)
+    integer :: r
+    allocate(l(nproc))
+    do r = 1, nproc
+      l(r) = block * (nblocks / nproc)
+      if (r <= mod(nblocks, nproc)) l(r) = l(r) + block
+    end do
+  end subroutine shares
+
+  ! Position of unknown (i,j,k) of field f.
+  pure function grid_position(grid, f, i, j, k) result(x)
+    type(grid_t), intent(in) :: grid
+    integer, intent(in) :: f, i, j, k
+    real(dp) :: x(3)
+    x = ([i, j, k] + 0.5_dp) * grid%h
+    if (f <= 3) x(f) = x(f) - 0.5_dp * grid%h
+  end function grid_position
+
+  subroutine grid_destroy(grid, ierr)
+    type(grid_t), intent(inout) :: grid
+    PetscErrorCode, intent(out) :: ierr
+    integer :: f
+    do f = 1, 4
+      PetscCall(DMDestroy(grid%da(f), ierr))
+    end do
+  end subroutine grid_destroy
+
+end module mod_grid

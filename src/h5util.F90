@@ -1,0 +1,145 @@
+! Small helpers over HDF5's Fortran API: attributes and extendible 1-D series datasets.
+! Used by one rank at a time (series.h5 and checkpoint attributes are written by rank 0);
+! parallel field I/O goes through PETSc's HDF5 viewer instead.
+module mod_h5util
+  use hdf5
+  use mod_kinds, only: dp
+  implicit none
+  private
+  public :: h5util_init, write_attribute, read_attribute, has_attribute, has_object
+  public :: write_string_attribute
+  public :: HID_T, HSIZE_T
+
+  interface write_attribute
+    module procedure write_attr_real, write_attr_int
+  end interface write_attribute
+  interface read_attribute
+    module procedure read_attr_real, read_attr_int
+  end interface read_attribute
+
+contains
+
+  ! Open the library and silence its error stack: fdsusp reports failures itself.
+  subroutine h5util_init()
+    integer :: err
+    call h5open_f(err)
+    call h5eset_auto_f(0, err)
+  end subroutine h5util_init
+
+  subroutine write_attr_real(loc, name, values, err)
+    integer(HID_T), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    real(dp), intent(in) :: values(:)
+    integer, intent(out) :: err
+    integer(HID_T) :: space, attr
+    integer(HSIZE_T) :: dims(1)
+    dims(1) = size(values)
+    call h5screate_simple_f(1, dims, space, err)
+    if (err /= 0) return
+    call h5acreate_f(loc, name, H5T_NATIVE_DOUBLE, space, attr, err)
+    if (err == 0) then
+      call h5awrite_f(attr, H5T_NATIVE_DOUBLE, values, dims, err)
+      call h5aclose_f(attr, err)
+    end if
+    call h5sclose_f(space, err)
+  end subroutine write_attr_real
+
+  subroutine write_attr_int(loc, name, values, err)
+    integer(HID_T), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: values(:)
+    integer, intent(out) :: err
+    integer(HID_T) :: space, attr
+    integer(HSIZE_T) :: dims(1)
+    dims(1) = size(values)
+    call h5screate_simple_f(1, dims, space, err)
+    if (err /= 0) return
+    call h5acreate_f(loc, name, H5T_NATIVE_INTEGER, space, attr, err)
+    if (err == 0) then
+      call h5awrite_f(attr, H5T_NATIVE_INTEGER, values, dims, err)
+      call h5aclose_f(attr, err)
+    end if
+    call h5sclose_f(space, err)
+  end subroutine write_attr_int
+
+  subroutine write_string_attribute(loc, name, text, err)
+    integer(HID_T), intent(in) :: loc
+    character(len=*), intent(in) :: name, text
+    integer, intent(out) :: err
+    integer(HID_T) :: space, attr, strtype
+    integer(HSIZE_T) :: dims(1)
+    dims(1) = 1
+    call h5tcopy_f(H5T_FORTRAN_S1, strtype, err)
+    call h5tset_size_f(strtype, int(max(1, len_trim(text)), kind=8), err)
+    call h5screate_f(H5S_SCALAR_F, space, err)
+    call h5acreate_f(loc, name, strtype, space, attr, err)
+    if (err == 0) then
+      call h5awrite_f(attr, strtype, trim(text), dims, err)
+      call h5aclose_f(attr, err)
+    end if
+    call h5sclose_f(space, err)
+    call h5tclose_f(strtype, err)
+  end subroutine write_string_attribute
+
+  logical function has_attribute(loc, name)
+    integer(HID_T), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    integer :: err
+    call h5aexists_f(loc, name, has_attribute, err)
+    if (err /= 0) has_attribute = .false.
+  end function has_attribute
+
+  logical function has_object(loc, name)
+    integer(HID_T), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    integer :: err
+    call h5lexists_f(loc, name, has_object, err)
+    if (err /= 0) has_object = .false.
+  end function has_object
+
+  ! Read an attribute of exactly size(values) elements; err /= 0 if absent or of another size.
+  subroutine read_attr_real(loc, name, values, err)
+    integer(HID_T), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    real(dp), intent(out) :: values(:)
+    integer, intent(out) :: err
+    integer(HID_T) :: attr, space
+    integer(HSIZE_T) :: dims(1), npoints
+    integer :: e2
+    call h5aopen_f(loc, name, attr, err)
+    if (err /= 0) return
+    call h5aget_space_f(attr, space, err)
+    call h5sget_simple_extent_npoints_f(space, npoints, err)
+    call h5sclose_f(space, e2)
+    if (npoints /= size(values)) then
+      err = -1
+    else
+      dims(1) = size(values)
+      call h5aread_f(attr, H5T_NATIVE_DOUBLE, values, dims, err)
+    end if
+    call h5aclose_f(attr, e2)
+  end subroutine read_attr_real
+
+  subroutine read_attr_int(loc, name, values, err)
+    integer(HID_T), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    integer, intent(out) :: values(:)
+    integer, intent(out) :: err
+    integer(HID_T) :: attr, space
+    integer(HSIZE_T) :: dims(1), npoints
+    integer :: e2
+    call h5aopen_f(loc, name, attr, err)
+    if (err /= 0) return
+    call h5aget_space_f(attr, space, err)
+    call h5sget_simple_extent_npoints_f(space, npoints, err)
+    call h5sclose_f(space, e2)
+    if (npoints /= size(values)) then
+      err = -1
+    else
+      dims(1) = size(values)
+      call h5aread_f(attr, H5T_NATIVE_INTEGER, values, dims, err)
+    end if
+    call h5aclose_f(attr, e2)
+  end subroutine read_attr_int
+
+end module mod_h5util

@@ -1,0 +1,128 @@
+! Field snapshots for viewing: p and the velocity interpolated to the cell centres, written in
+! parallel by PETSc's HDF5 viewer (datasets /u /v /w /p of shape nz x ny x nx), each with an XDMF
+! file that ParaView opens, plus fields.xmf, a time series of this run's snapshots.
+! Also the progress line of the run log.
+#include <petsc/finclude/petscdmda.h>
+module mod_output
+  use petscdmda
+  use mod_kinds, only: dp
+  use mod_grid, only: grid_t, field_names, FIELD_U, FIELD_V, FIELD_W, FIELD_P
+  use mod_fluid, only: fluid_t
+  use mod_errors, only: is_root
+  implicit none
+  private
+  public :: write_fields, progress_line
+
+  integer, parameter :: max_snapshots = 100000
+  integer, save :: nsnap = 0
+  integer, save, allocatable :: snap_step(:)
+  real(dp), save, allocatable :: snap_time(:)
+
+contains
+
+  subroutine write_fields(outdir, grid, fl, step, time, ierr)
+    character(len=*), intent(in) :: outdir
+    type(grid_t), intent(in) :: grid
+    type(fluid_t), intent(inout) :: fl
+    integer, intent(in) :: step
+    real(dp), intent(in) :: time
+    PetscErrorCode, intent(out) :: ierr
+    Vec :: centre(3)
+    PetscViewer :: viewer
+    PetscScalar, pointer :: a(:,:,:), c(:,:,:)
+    character(len=32) :: base
+    integer :: f, e(3), i, j, k
+
+    do f = 1, 3
+      e = 0
+      e(f) = 1
+      PetscCall(DMCreateGlobalVector(grid%da(FIELD_P), centre(f), ierr))
+      PetscCall(PetscObjectSetName(centre(f), field_names(f), ierr))
+      PetscCall(DMGlobalToLocalBegin(grid%da(f), fl%vel(f), INSERT_VALUES, fl%loc(f), ierr))
+      PetscCall(DMGlobalToLocalEnd(grid%da(f), fl%vel(f), INSERT_VALUES, fl%loc(f), ierr))
+      PetscCall(DMDAVecGetArrayReadF90(grid%da(f), fl%loc(f), a, ierr))
+      PetscCall(DMDAVecGetArrayF90(grid%da(FIELD_P), centre(f), c, ierr))
+      ! mean of the two faces of each cell (with walls, v(n) is the wall face v(0) = 0)
+      do k = grid%lo(3), grid%hi(3)
+        do j = grid%lo(2), grid%hi(2)
+          do i = grid%lo(1), grid%hi(1)
+            c(i, j, k) = 0.5_dp * (a(i, j, k) + a(i + e(1), j + e(2), k + e(3)))
+          end do
+        end do
+      end do
+      PetscCall(DMDAVecRestoreArrayF90(grid%da(FIELD_P), centre(f), c, ierr))
+      PetscCall(DMDAVecRestoreArrayReadF90(grid%da(f), fl%loc(f), a, ierr))
+    end do
+
+    write(base, '(a,i8.8)') 'fields_', step
+    PetscCall(PetscViewerHDF5Open(PETSC_COMM_WORLD, trim(outdir)//'/'//trim(base)//'.h5', FILE_MODE_WRITE, viewer, ierr))
+    do f = 1, 3
+      PetscCall(VecView(centre(f), viewer, ierr))
+      PetscCall(VecDestroy(centre(f), ierr))
+    end do
+    PetscCall(VecView(fl%pressure, viewer, ierr))
+    PetscCall(PetscViewerDestroy(viewer, ierr))
+
+    if (.not. allocated(snap_step)) allocate(snap_step(max_snapshots), snap_time(max_snapshots))
+    if (nsnap < max_snapshots) nsnap = nsnap + 1
+    snap_step(nsnap) = step
+    snap_time(nsnap) = time
+    if (is_root()) then
+      call write_xdmf(trim(outdir)//'/'//trim(base)//'.xmf', grid, snap_step(nsnap:nsnap), snap_time(nsnap:nsnap))
+      call write_xdmf(trim(outdir)//'/fields.xmf', grid, snap_step(1:nsnap), snap_time(1:nsnap))
+    end if
+  end subroutine write_fields
+
+  ! XDMF 2 for ParaView: a co-rectilinear mesh of cell corners, fields on the cells.
+  subroutine write_xdmf(path, grid, steps, times)
+    character(len=*), intent(in) :: path
+    type(grid_t), intent(in) :: grid
+    integer, intent(in) :: steps(:)
+    real(dp), intent(in) :: times(:)
+    character(len=*), parameter :: names(4) = ['u', 'v', 'w', 'p']
+    character(len=64) :: nodes, cells, h5
+    integer :: unit, s, f
+    write(nodes, '(3(i0,1x))') grid%n(3) + 1, grid%n(2) + 1, grid%n(1) + 1
+    write(cells, '(3(i0,1x))') grid%n(3), grid%n(2), grid%n(1)
+    open(newunit=unit, file=path, status='replace', action='write')
+    write(unit, '(a)') '<?xml version="1.0" ?>'
+    write(unit, '(a)') '<Xdmf Version="2.0">'
+    write(unit, '(a)') ' <Domain>'
+    write(unit, '(a)') '  <Grid Name="fields" GridType="Collection" CollectionType="Temporal">'
+    do s = 1, size(steps)
+      write(h5, '(a,i8.8,a)') 'fields_', steps(s), '.h5'
+      write(unit, '(a,i0,a)') '   <Grid Name="step ', steps(s), '" GridType="Uniform">'
+      write(unit, '(a,es23.15,a)') '    <Time Value="', times(s), '"/>'
+      write(unit, '(3a)') '    <Topology TopologyType="3DCoRectMesh" Dimensions="', trim(nodes), '"/>'
+      write(unit, '(a)') '    <Geometry GeometryType="ORIGIN_DXDYDZ">'
+      write(unit, '(a)') '     <DataItem Dimensions="3" Format="XML">0 0 0</DataItem>'
+      write(unit, '(a,3es23.15,a)') '     <DataItem Dimensions="3" Format="XML">', grid%h, grid%h, grid%h, '</DataItem>'
+      write(unit, '(a)') '    </Geometry>'
+      do f = 1, 4
+        write(unit, '(3a)') '    <Attribute Name="', names(f), '" AttributeType="Scalar" Center="Cell">'
+        write(unit, '(5a)') '     <DataItem Dimensions="', trim(cells), &
+             '" NumberType="Float" Precision="8" Format="HDF">', trim(h5)//':/'//names(f), '</DataItem>'
+        write(unit, '(a)') '    </Attribute>'
+      end do
+      write(unit, '(a)') '   </Grid>'
+    end do
+    write(unit, '(a)') '  </Grid>'
+    write(unit, '(a)') ' </Domain>'
+    write(unit, '(a)') '</Xdmf>'
+    close(unit)
+  end subroutine write_xdmf
+
+  ! step, strain, wall time, estimated time left, iterations of each solver, divergence.
+  subroutine progress_line(step, last_step, strain, wall, wall_per_step, fl)
+    integer, intent(in) :: step, last_step
+    real(dp), intent(in) :: strain, wall, wall_per_step
+    type(fluid_t), intent(in) :: fl
+    if (.not. is_root()) return
+    write(*, '(a,i9,a,f10.4,a,f9.1,a,f9.1,a,3(i0,"/"),i0,a,es8.1)') 'step', step, '  strain', strain, &
+         '  wall', wall, ' s  left', wall_per_step * (last_step - step), ' s  its u/v/w/p ', &
+         fl%solver(FIELD_U)%iterations, fl%solver(FIELD_V)%iterations, fl%solver(FIELD_W)%iterations, &
+         fl%solver(FIELD_P)%iterations, '  div', fl%divergence
+    flush(6)
+  end subroutine progress_line
+
+end module mod_output

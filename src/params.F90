@@ -1,0 +1,402 @@
+! The input deck: Fortran namelist groups, their defaults, units, valid ranges and the echo of the
+! effective deck. Every variable is documented in doc/INPUT.md; keep the two in step.
+!
+! Reading is collective: every rank reads the same file, so every rank detects the same error and
+! the run stops cleanly with one message (mod_errors::input_error) naming the file, the group and
+! the variable, before any work is done.
+!
+! Units: radius a = 1, fluid viscosity eta = 1, imposed shear rate = 1 (design.md). Lengths in a,
+! times in strain units 1/gamma_dot, stresses in eta*gamma_dot.
+module mod_params
+  use mod_kinds, only: dp
+  use mod_errors, only: input_error, log_line, is_root
+  implicit none
+  private
+  public :: config_t, read_deck, echo_deck, max_line
+
+  integer, parameter :: max_line = 1024
+  integer, parameter :: ngroups = 6
+  character(len=16), parameter :: known_groups(ngroups) = [character(len=16) :: &
+       'domain', 'fluid', 'time', 'output', 'run', 'verification']
+
+  type :: config_t
+    character(len=max_line) :: deck_file = ''
+    ! &domain
+    real(dp) :: box(3) = [20.0_dp, 20.0_dp, 20.0_dp]   ! box lengths Lx, Ly, Lz [a]
+    real(dp) :: cells_per_radius = 5.0_dp               ! a/Delta [-]
+    character(len=16) :: y_boundary = 'walls'           ! 'walls' (Couette) or 'periodic'
+    real(dp) :: shear_rate = 1.0_dp                     ! walls move at +-shear_rate*Ly/2 [gamma_dot]
+    ! &fluid
+    real(dp) :: reynolds = 0.01_dp                      ! rho*gamma_dot*a^2/eta [-]
+    real(dp) :: body_force(3) = 0.0_dp                  ! uniform force density [eta*gamma_dot/a]
+    real(dp) :: velocity_tolerance = 1.0e-8_dp          ! KSP rtol of the Helmholtz solves [-]
+    real(dp) :: pressure_tolerance = 1.0e-10_dp         ! KSP rtol of the pressure Poisson solve [-]
+    real(dp) :: viscous_theta = 0.5_dp                  ! 0.5 Crank-Nicolson, 1 backward Euler [-]
+    ! &time
+    real(dp) :: dt = 1.0e-3_dp                          ! time step [1/gamma_dot]
+    integer :: steps = 1000                             ! number of steps of this run [-]
+    real(dp) :: steady_tolerance = 0.0_dp               ! stop when max|du|/dt < tol*U_ref (0: off)
+    ! &output
+    character(len=max_line) :: output_directory = 'out'
+    integer :: progress_every = 100                     ! steps between progress lines
+    integer :: series_every = 1                         ! steps between series.h5 records
+    integer :: fields_every = 0                         ! steps between field snapshots (0: end only)
+    integer :: checkpoint_every = 0                     ! steps between checkpoints (0: end only)
+    ! &run
+    character(len=256) :: title = ''
+    real(dp) :: max_wall_hours = 0.0_dp                 ! checkpoint and stop after this (0: never)
+    ! &verification
+    logical :: manufactured_solution = .false.          ! force with the manufactured solution
+    ! derived, not read
+    integer :: cells(3) = 0
+    logical :: walls = .true.
+    real(dp) :: h = 0.0_dp                              ! grid spacing Delta [a]
+    real(dp) :: wall_speed = 0.0_dp                     ! top wall +U, bottom wall -U [a*gamma_dot]
+  end type config_t
+
+contains
+
+  ! Read, validate and derive the whole configuration from DECK. Collective.
+  subroutine read_deck(deck, cfg)
+    character(len=*), intent(in) :: deck
+    type(config_t), intent(out) :: cfg
+    character(len=max_line), allocatable :: lines(:)
+    integer :: g
+
+    cfg%deck_file = deck
+    call load_lines(deck, lines)
+    call check_group_names(deck, lines)
+    do g = 1, ngroups
+      call read_group(deck, lines, trim(known_groups(g)), cfg)
+    end do
+    call validate(cfg)
+  end subroutine read_deck
+
+  subroutine load_lines(deck, lines)
+    character(len=*), intent(in) :: deck
+    character(len=max_line), allocatable, intent(out) :: lines(:)
+    character(len=max_line) :: buf
+    character(len=256) :: msg
+    integer :: unit, ios, n
+    logical :: exists
+
+    inquire(file=deck, exist=exists)
+    if (.not. exists) call input_error(deck, '', '', 'the deck does not exist')
+    open(newunit=unit, file=deck, status='old', action='read', iostat=ios, iomsg=msg)
+    if (ios /= 0) call input_error(deck, '', '', 'cannot open the deck: '//trim(msg))
+    n = 0
+    do
+      read(unit, '(a)', iostat=ios) buf
+      if (ios /= 0) exit
+      n = n + 1
+    end do
+    allocate(lines(n + 1))
+    rewind(unit)
+    do n = 1, size(lines) - 1
+      read(unit, '(a)', iostat=ios, iomsg=msg) lines(n)
+      if (ios /= 0) call input_error(deck, '', '', 'cannot read the deck: '//trim(msg))
+    end do
+    close(unit)
+    lines(size(lines)) = ''
+  end subroutine load_lines
+
+  ! Every '&name' in the deck must be a group this program knows.
+  subroutine check_group_names(deck, lines)
+    character(len=*), intent(in) :: deck
+    character(len=*), intent(in) :: lines(:)
+    integer :: l
+    character(len=64) :: name
+    character(len=16) :: lnum
+    do l = 1, size(lines)
+      name = group_on_line(lines(l))
+      if (len_trim(name) == 0 .or. name == 'end') cycle
+      if (.not. any(known_groups == name)) then
+        write(lnum, '(i0)') l
+        call input_error(deck, trim(name), '', 'unknown group (line '//trim(lnum)// &
+             '); known groups: &domain &fluid &time &output &run &verification')
+      end if
+    end do
+  end subroutine check_group_names
+
+  ! The group name if the line opens a namelist group ('&name'), else ''.
+  function group_on_line(line) result(name)
+    character(len=*), intent(in) :: line
+    character(len=64) :: name
+    character(len=max_line) :: s
+    integer :: e
+    name = ''
+    s = adjustl(line)
+    if (s(1:1) /= '&' .and. s(1:1) /= '$') return
+    e = scan(s(2:), ' ,!/') 
+    if (e == 0) e = len_trim(s)
+    name = to_lower(s(2:e))
+  end function group_on_line
+
+  function to_lower(s) result(t)
+    character(len=*), intent(in) :: s
+    character(len=len(s)) :: t
+    integer :: i
+    t = s
+    do i = 1, len(s)
+      if (s(i:i) >= 'A' .and. s(i:i) <= 'Z') t(i:i) = achar(iachar(s(i:i)) + 32)
+    end do
+  end function to_lower
+
+  ! Read one group from the deck text. If it is absent, the defaults stand. If reading fails,
+  ! read ever longer prefixes of the group to find the line at fault, and name its variable.
+  subroutine read_group(deck, lines, group, cfg)
+    character(len=*), intent(in) :: deck, group
+    character(len=*), intent(in) :: lines(:)
+    type(config_t), intent(inout) :: cfg
+    type(config_t) :: trial
+    character(len=max_line), allocatable :: prefix(:)
+    character(len=512) :: msg
+    character(len=16) :: lnum
+    integer :: first, l, ios, k
+
+    first = 0
+    do l = 1, size(lines)
+      if (group_on_line(lines(l)) == group) then
+        first = l
+        exit
+      end if
+    end do
+    if (first == 0) return
+
+    call group_io(group, cfg, lines(first:), ios, msg)
+    if (ios == 0) return
+
+    ! Diagnose: the first prefix (closed by '/') that fails holds the bad item.
+    do k = first, size(lines)
+      prefix = [lines(first:k), '/']
+      trial = cfg
+      call group_io(group, trial, prefix, ios, msg)
+      if (ios /= 0) exit
+    end do
+    k = min(k, size(lines))
+    write(lnum, '(i0)') k
+    call input_error(deck, group, item_name(lines(k), msg), trim(explain(msg))// &
+         ' (line '//trim(lnum)//': "'//trim(adjustl(lines(k)))//'")')
+  end subroutine read_group
+
+  ! The variable a failed read is about: from the compiler's message if it names it, else the
+  ! name before '=' on the line at fault.
+  function item_name(line, msg) result(name)
+    character(len=*), intent(in) :: line, msg
+    character(len=128) :: name
+    character(len=*), parameter :: unknown = 'Cannot match namelist object name'
+    character(len=max_line) :: s
+    integer :: p, e
+    p = index(msg, unknown)
+    if (p > 0) then
+      name = to_lower(adjustl(msg(p + len(unknown):)))
+      return
+    end if
+    s = adjustl(line)
+    if (s(1:1) == '&') s = adjustl(s(scan(s, ' ') + 1:))
+    e = index(s, '=')
+    if (e > 1) then
+      name = to_lower(adjustl(s(1:e - 1)))
+      p = index(name, '(')
+      if (p > 1) name = name(1:p - 1)
+    else
+      name = '?'
+    end if
+  end function item_name
+
+  function explain(msg) result(text)
+    character(len=*), intent(in) :: msg
+    character(len=:), allocatable :: text
+    if (index(msg, 'Cannot match namelist object name') > 0) then
+      text = 'unknown variable in this group (see doc/INPUT.md)'
+    else
+      text = 'cannot read its value: '//trim(msg)
+    end if
+  end function explain
+
+  ! One place per group declares its namelist: used to read it (src present) and to echo it.
+  subroutine group_io(group, cfg, src, ios, msg, echo_unit)
+    character(len=*), intent(in) :: group
+    type(config_t), intent(inout) :: cfg
+    character(len=*), intent(in), optional :: src(:)
+    integer, intent(out), optional :: ios
+    character(len=*), intent(inout), optional :: msg
+    integer, intent(in), optional :: echo_unit
+    ! &domain
+    real(dp) :: box(3), cells_per_radius, shear_rate
+    character(len=16) :: y_boundary
+    ! &fluid
+    real(dp) :: reynolds, body_force(3), velocity_tolerance, pressure_tolerance, viscous_theta
+    ! &time
+    real(dp) :: dt, steady_tolerance
+    integer :: steps
+    ! &output
+    character(len=max_line) :: directory
+    integer :: progress_every, series_every, fields_every, checkpoint_every
+    ! &run
+    character(len=256) :: title
+    real(dp) :: max_wall_hours
+    ! &verification
+    logical :: manufactured_solution
+    namelist /domain/ box, cells_per_radius, y_boundary, shear_rate
+    namelist /fluid/ reynolds, body_force, velocity_tolerance, pressure_tolerance, viscous_theta
+    namelist /time/ dt, steps, steady_tolerance
+    namelist /output/ directory, progress_every, series_every, fields_every, checkpoint_every
+    namelist /run/ title, max_wall_hours
+    namelist /verification/ manufactured_solution
+    integer :: stat
+
+    box = cfg%box; cells_per_radius = cfg%cells_per_radius
+    y_boundary = cfg%y_boundary; shear_rate = cfg%shear_rate
+    reynolds = cfg%reynolds; body_force = cfg%body_force
+    velocity_tolerance = cfg%velocity_tolerance; pressure_tolerance = cfg%pressure_tolerance
+    viscous_theta = cfg%viscous_theta
+    dt = cfg%dt; steps = cfg%steps; steady_tolerance = cfg%steady_tolerance
+    directory = cfg%output_directory; progress_every = cfg%progress_every
+    series_every = cfg%series_every; fields_every = cfg%fields_every
+    checkpoint_every = cfg%checkpoint_every
+    title = cfg%title; max_wall_hours = cfg%max_wall_hours
+    manufactured_solution = cfg%manufactured_solution
+
+    stat = 0
+    if (present(src)) then
+      select case (group)
+      case ('domain');       read(src, nml=domain, iostat=stat, iomsg=msg)
+      case ('fluid');        read(src, nml=fluid, iostat=stat, iomsg=msg)
+      case ('time');         read(src, nml=time, iostat=stat, iomsg=msg)
+      case ('output');       read(src, nml=output, iostat=stat, iomsg=msg)
+      case ('run');          read(src, nml=run, iostat=stat, iomsg=msg)
+      case ('verification'); read(src, nml=verification, iostat=stat, iomsg=msg)
+      end select
+      if (present(ios)) ios = stat
+      if (stat /= 0) return
+      cfg%box = box; cfg%cells_per_radius = cells_per_radius
+      cfg%y_boundary = to_lower(y_boundary); cfg%shear_rate = shear_rate
+      cfg%reynolds = reynolds; cfg%body_force = body_force
+      cfg%velocity_tolerance = velocity_tolerance; cfg%pressure_tolerance = pressure_tolerance
+      cfg%viscous_theta = viscous_theta
+      cfg%dt = dt; cfg%steps = steps; cfg%steady_tolerance = steady_tolerance
+      cfg%output_directory = directory; cfg%progress_every = progress_every
+      cfg%series_every = series_every; cfg%fields_every = fields_every
+      cfg%checkpoint_every = checkpoint_every
+      cfg%title = title; cfg%max_wall_hours = max_wall_hours
+      cfg%manufactured_solution = manufactured_solution
+    end if
+    if (present(echo_unit)) then
+      select case (group)
+      case ('domain');       write(echo_unit, nml=domain)
+      case ('fluid');        write(echo_unit, nml=fluid)
+      case ('time');         write(echo_unit, nml=time)
+      case ('output');       write(echo_unit, nml=output)
+      case ('run');          write(echo_unit, nml=run)
+      case ('verification'); write(echo_unit, nml=verification)
+      end select
+    end if
+  end subroutine group_io
+
+  ! The effective deck (defaults included), at the top of the run log.
+  subroutine echo_deck(cfg)
+    type(config_t), intent(in) :: cfg
+    type(config_t) :: copy
+    integer :: g
+    if (.not. is_root()) return
+    copy = cfg
+    write(*, '(a)') '# effective deck (file '//trim(cfg%deck_file)//', defaults included)'
+    do g = 1, ngroups
+      call group_io(trim(known_groups(g)), copy, echo_unit=6)
+    end do
+    write(*, '(a)') '# end of effective deck'
+    flush(6)
+  end subroutine echo_deck
+
+  ! ---- validation -------------------------------------------------------------------------
+
+  subroutine check_real(cfg, group, name, value, lo, hi, lo_open)
+    type(config_t), intent(in) :: cfg
+    character(len=*), intent(in) :: group, name
+    real(dp), intent(in) :: value, lo, hi
+    logical, intent(in), optional :: lo_open
+    character(len=160) :: text
+    character(len=1) :: bracket
+    logical :: open_lo
+    open_lo = .false.
+    if (present(lo_open)) open_lo = lo_open
+    bracket = '['
+    if (open_lo) bracket = '('
+    if (value /= value .or. value > hi .or. value < lo .or. (open_lo .and. value <= lo)) then
+      write(text, '(a,es11.4,3a,es10.3,a,es10.3,a)') 'value', value, ' out of range ', bracket, lo, ',', hi, ']'
+      call input_error(cfg%deck_file, group, name, trim(text))
+    end if
+  end subroutine check_real
+
+  subroutine check_int(cfg, group, name, value, lo, hi)
+    type(config_t), intent(in) :: cfg
+    character(len=*), intent(in) :: group, name
+    integer, intent(in) :: value, lo, hi
+    character(len=160) :: text
+    if (value < lo .or. value > hi) then
+      write(text, '(a,i0,a,i0,a,i0,a)') 'value ', value, ' out of range [', lo, ', ', hi, ']'
+      call input_error(cfg%deck_file, group, name, trim(text))
+    end if
+  end subroutine check_int
+
+  subroutine validate(cfg)
+    type(config_t), intent(inout) :: cfg
+    integer :: d
+    real(dp) :: n
+    character(len=*), parameter :: xyz = 'xyz'
+    character(len=200) :: text
+
+    do d = 1, 3
+      call check_real(cfg, 'domain', 'box('//xyz(d:d)//')', cfg%box(d), 0.0_dp, 1.0e4_dp, .true.)
+    end do
+    call check_real(cfg, 'domain', 'cells_per_radius', cfg%cells_per_radius, 1.0_dp, 64.0_dp)
+    if (cfg%y_boundary /= 'walls' .and. cfg%y_boundary /= 'periodic') &
+      call input_error(cfg%deck_file, 'domain', 'y_boundary', 'must be ''walls'' or ''periodic'', not '''// &
+           trim(cfg%y_boundary)//'''')
+    call check_real(cfg, 'domain', 'shear_rate', cfg%shear_rate, -1.0e3_dp, 1.0e3_dp)
+    cfg%walls = (cfg%y_boundary == 'walls')
+    if (.not. cfg%walls .and. cfg%shear_rate /= 0.0_dp) &
+      call input_error(cfg%deck_file, 'domain', 'shear_rate', &
+           'a periodic box in y cannot be sheared by walls: set shear_rate = 0 or y_boundary = ''walls''')
+    cfg%h = 1.0_dp / cfg%cells_per_radius
+    do d = 1, 3
+      n = cfg%box(d) * cfg%cells_per_radius
+      if (abs(n - nint(n)) > 1.0e-9_dp * n) then
+        write(text, '(a,f0.6,a)') 'box length times cells_per_radius must be a whole number of cells (it is ', n, ')'
+        call input_error(cfg%deck_file, 'domain', 'box('//xyz(d:d)//')', trim(text))
+      end if
+      cfg%cells(d) = nint(n)
+      if (cfg%cells(d) < 4) &
+        call input_error(cfg%deck_file, 'domain', 'box('//xyz(d:d)//')', 'fewer than 4 cells across the box')
+    end do
+    cfg%wall_speed = 0.0_dp
+    if (cfg%walls) cfg%wall_speed = 0.5_dp * cfg%shear_rate * cfg%box(2)
+
+    call check_real(cfg, 'fluid', 'reynolds', cfg%reynolds, 0.0_dp, 100.0_dp, .true.)
+    do d = 1, 3
+      call check_real(cfg, 'fluid', 'body_force('//xyz(d:d)//')', cfg%body_force(d), -1.0e6_dp, 1.0e6_dp)
+    end do
+    call check_real(cfg, 'fluid', 'velocity_tolerance', cfg%velocity_tolerance, 1.0e-15_dp, 0.1_dp)
+    call check_real(cfg, 'fluid', 'pressure_tolerance', cfg%pressure_tolerance, 1.0e-15_dp, 0.1_dp)
+    call check_real(cfg, 'fluid', 'viscous_theta', cfg%viscous_theta, 0.5_dp, 1.0_dp)
+
+    call check_real(cfg, 'time', 'dt', cfg%dt, 0.0_dp, 10.0_dp, .true.)
+    call check_int(cfg, 'time', 'steps', cfg%steps, 0, 1000000000)
+    call check_real(cfg, 'time', 'steady_tolerance', cfg%steady_tolerance, 0.0_dp, 1.0_dp)
+
+    if (len_trim(cfg%output_directory) == 0) &
+      call input_error(cfg%deck_file, 'output', 'directory', 'must not be empty')
+    call check_int(cfg, 'output', 'progress_every', cfg%progress_every, 1, huge(1))
+    call check_int(cfg, 'output', 'series_every', cfg%series_every, 1, huge(1))
+    call check_int(cfg, 'output', 'fields_every', cfg%fields_every, 0, huge(1))
+    call check_int(cfg, 'output', 'checkpoint_every', cfg%checkpoint_every, 0, huge(1))
+
+    call check_real(cfg, 'run', 'max_wall_hours', cfg%max_wall_hours, 0.0_dp, 1.0e5_dp)
+
+    if (cfg%manufactured_solution .and. any(cfg%body_force /= 0.0_dp)) &
+      call input_error(cfg%deck_file, 'verification', 'manufactured_solution', &
+           'the manufactured solution brings its own forcing: set &fluid body_force = 0')
+  end subroutine validate
+
+end module mod_params

@@ -1,0 +1,36 @@
+! One PetscLogStage per phase of the time step, so that -log_view tells where the time goes.
+! Later phases (particles, lubrication, contacts) register their own stage here.
+#include <petsc/finclude/petscsys.h>
+module mod_timers
+  use petscsys
+  implicit none
+  private
+  public :: timers_register, stage_push, stage_pop
+  public :: STAGE_SETUP, STAGE_FLUID, STAGE_OUTPUT
+
+  integer, parameter :: STAGE_SETUP = 1, STAGE_FLUID = 2, STAGE_OUTPUT = 3
+  character(len=*), parameter :: stage_names(3) = ['Setup ', 'Fluid ', 'Output']
+  PetscLogStage, save :: stages(3)
+
+contains
+
+  subroutine timers_register(ierr)
+    PetscErrorCode, intent(out) :: ierr
+    integer :: s
+    do s = 1, size(stages)
+      PetscCall(PetscLogStageRegister(trim(stage_names(s)), stages(s), ierr))
+    end do
+  end subroutine timers_register
+
+  subroutine stage_push(s, ierr)
+    integer, intent(in) :: s
+    PetscErrorCode, intent(out) :: ierr
+    PetscCall(PetscLogStagePush(stages(s), ierr))
+  end subroutine stage_push
+
+  subroutine stage_pop(ierr)
+    PetscErrorCode, intent(out) :: ierr
+    PetscCall(PetscLogStagePop(ierr))
+  end subroutine stage_pop
+
+end module mod_timers
