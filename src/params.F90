@@ -294,17 +294,30 @@ contains
     end if
   end subroutine group_io
 
-  ! The effective deck (defaults included), at the top of the run log.
+  ! The effective deck (defaults included), at the top of the run log. The compiler pads
+  ! character values to their declared length; the padding is removed for reading.
   subroutine echo_deck(cfg)
     type(config_t), intent(in) :: cfg
     type(config_t) :: copy
-    integer :: g
+    character(len=8192) :: line
+    integer :: g, unit, ios, q1, q2
     if (.not. is_root()) return
     copy = cfg
-    write(*, '(a)') '# effective deck (file '//trim(cfg%deck_file)//', defaults included)'
+    open(newunit=unit, status='scratch', action='readwrite', recl=8192)
     do g = 1, ngroups
-      call group_io(trim(known_groups(g)), copy, echo_unit=6)
+      call group_io(trim(known_groups(g)), copy, echo_unit=unit)
     end do
+    rewind(unit)
+    write(*, '(a)') '# effective deck (file '//trim(cfg%deck_file)//', defaults included)'
+    do
+      read(unit, '(a)', iostat=ios) line
+      if (ios /= 0) exit
+      q1 = index(line, '"')
+      q2 = index(line, '"', back=.true.)
+      if (q1 > 0 .and. q2 > q1) line = line(1:q1)//trim(line(q1 + 1:q2 - 1))//line(q2:)
+      write(*, '(a)') trim(line)
+    end do
+    close(unit)
     write(*, '(a)') '# end of effective deck'
     flush(6)
   end subroutine echo_deck

@@ -14,6 +14,11 @@ export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 export OMPI_MCA_rmaps_base_oversubscribe=1
 export FDSUSP_ROOT=$root
 export FDSUSP_BIN=${FDSUSP_BIN:-$root/bin}
+# Debian's python3 has numpy and h5py (python3-numpy, python3-h5py); another python3 may be first
+# on PATH.
+PYTHON=python3
+[ -x /usr/bin/python3 ] && PYTHON=/usr/bin/python3
+export PYTHON
 logdir=$root/build/test-logs
 mkdir -p "$logdir"
 
@@ -29,7 +34,7 @@ for t in "${tests[@]}"; do
   log=$logdir/$name.log
   t0=$(date +%s%N)
   case "$t" in
-    *.py) timeout 900 python3 "$t" > "$log" 2>&1 ;;
+    *.py) timeout 900 "$PYTHON" "$t" > "$log" 2>&1 ;;
     *.sh) timeout 900 bash "$t" > "$log" 2>&1 ;;
     *)    (cd "$root" && timeout 900 "$t") > "$log" 2>&1 ;;
   esac

@@ -1,0 +1,107 @@
+"""Helpers shared by the fdsusp test scripts: run bin/fdsusp on a deck in a scratch directory
+and read what it wrote. Needs Debian's python3 with numpy and h5py."""
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+
+import h5py
+import numpy as np
+
+ROOT = os.environ.get('FDSUSP_ROOT', os.path.abspath(os.path.join(os.path.dirname(__file__), '..')))
+BIN = os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin'))
+FDSUSP = os.path.join(BIN, 'fdsusp')
+
+ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT='1', OMPI_ALLOW_RUN_AS_ROOT_CONFIRM='1',
+           OMPI_MCA_rmaps_base_oversubscribe='1')
+
+failures = []
+
+
+def scratch(name):
+    """A fresh scratch directory under build/test-work."""
+    d = os.path.join(ROOT, 'build', 'test-work', name)
+    shutil.rmtree(d, ignore_errors=True)
+    os.makedirs(d)
+    return d
+
+
+def write_deck(directory, name, text):
+    path = os.path.join(directory, name)
+    with open(path, 'w') as f:
+        f.write(text)
+    return path
+
+
+def command(deck, np_ranks=1, args=()):
+    cmd = [FDSUSP, deck] + list(args)
+    if np_ranks > 1:
+        cmd = ['mpiexec', '--oversubscribe', '-n', str(np_ranks)] + cmd
+    return cmd
+
+
+def run(deck, cwd, np_ranks=1, args=(), expect_ok=True, timeout=600):
+    """Run fdsusp; return (exit status, stdout, stderr)."""
+    p = subprocess.run(command(deck, np_ranks, args), cwd=cwd, env=ENV, capture_output=True,
+                       text=True, timeout=timeout)
+    if expect_ok and p.returncode != 0:
+        print(p.stdout[-3000:])
+        print(p.stderr[-3000:])
+        raise SystemExit('fdsusp failed with status %d on %s' % (p.returncode, deck))
+    return p.returncode, p.stdout, p.stderr
+
+
+def run_until_then_signal(deck, cwd, min_step, sig=signal.SIGTERM, np_ranks=1, timeout=300):
+    """Start fdsusp, wait until its progress line reports at least min_step, send sig.
+    Return (exit status, stdout)."""
+    log = open(os.path.join(cwd, 'signal_run.log'), 'w+')
+    p = subprocess.Popen(command(deck, np_ranks), cwd=cwd, env=ENV, stdout=log,
+                         stderr=subprocess.STDOUT, text=True)
+    t0 = time.time()
+    while time.time() - t0 < timeout:
+        time.sleep(0.05)
+        log.flush()
+        with open(log.name) as f:
+            steps = [int(l.split()[1]) for l in f if l.startswith('step ')]
+        if steps and steps[-1] >= min_step:
+            break
+        if p.poll() is not None:
+            break
+    p.send_signal(sig)
+    status = p.wait(timeout=timeout)
+    with open(log.name) as f:
+        out = f.read()
+    return status, out
+
+
+def read_h5(path, names):
+    with h5py.File(path, 'r') as f:
+        return {n: np.array(f[n]) for n in names}
+
+
+def h5_attr(path, name):
+    with h5py.File(path, 'r') as f:
+        return np.array(f.attrs[name])
+
+
+def series(outdir):
+    with h5py.File(os.path.join(outdir, 'series.h5'), 'r') as f:
+        return {k: np.array(f[k]) for k in f.keys()}
+
+
+def check(condition, message):
+    """Record one assertion; print it either way."""
+    print(('ok    ' if condition else 'FAIL  ') + message)
+    sys.stdout.flush()
+    if not condition:
+        failures.append(message)
+
+
+def finish():
+    if failures:
+        print('%d check(s) failed' % len(failures))
+        sys.exit(1)
+    print('all checks passed')
