@@ -175,7 +175,7 @@ contains
     end do
     k = min(k, size(lines))
     write(lnum, '(i0)') k
-    call input_error(deck, group, item_name(lines(k), msg), trim(explain(msg))// &
+    call input_error(deck, group, item_name(lines(k), msg), trim(explain(lines(k), msg))// &
          ' (line '//trim(lnum)//': "'//trim(adjustl(lines(k)))//'")')
   end subroutine read_group
 
@@ -185,32 +185,67 @@ contains
     character(len=*), intent(in) :: line, msg
     character(len=128) :: name
     character(len=*), parameter :: unknown = 'Cannot match namelist object name'
-    character(len=max_line) :: s
-    integer :: p, e
+    integer :: p
     p = index(msg, unknown)
     if (p > 0) then
       name = to_lower(adjustl(msg(p + len(unknown):)))
-      return
+      ! A value the compiler could not read may be taken for a name ("steps = 'many'"): then
+      ! the item is the variable the value was given to.
+      if (.not. follows_equals(to_lower(line), trim(name))) return
     end if
-    s = adjustl(line)
-    if (s(1:1) == '&') s = adjustl(s(scan(s, ' ') + 1:))
-    e = index(s, '=')
-    if (e > 1) then
-      name = to_lower(adjustl(s(1:e - 1)))
-      p = index(name, '(')
-      if (p > 1) name = name(1:p - 1)
-    else
-      name = '?'
-    end if
+    name = variable_before(to_lower(line), len_trim(line) + 1)
   end function item_name
 
-  function explain(msg) result(text)
-    character(len=*), intent(in) :: msg
+  ! True if token stands on the line as (part of) a value: right after an '=' (spaces and
+  ! quotes skipped), or glued to the characters before it.
+  logical function follows_equals(line, token)
+    character(len=*), intent(in) :: line, token
+    integer :: p, q
+    follows_equals = .false.
+    p = index(line, token)
+    if (p == 0) return
+    q = p - 1
+    ! glued to what precedes it ("1e-3x"): part of a value
+    if (q > 0) then
+      if (scan(line(q:q), ' ,''"') == 0) then
+        follows_equals = .true.
+        return
+      end if
+    end if
+    do while (q > 0)
+      if (scan(line(q:q), ' ''"') == 0) exit
+      q = q - 1
+    end do
+    follows_equals = (q > 0 .and. line(q:q) == '=')
+  end function follows_equals
+
+  ! The name before the last '=' that comes before position last on the line.
+  function variable_before(line, last) result(name)
+    character(len=*), intent(in) :: line
+    integer, intent(in) :: last
+    character(len=128) :: name
+    character(len=max_line) :: s
+    integer :: e, b
+    name = '?'
+    e = index(line(1:last - 1), '=', back=.true.)
+    if (e <= 1) return
+    s = line(1:e - 1)
+    b = scan(trim(s), ' ,&', back=.true.)
+    name = adjustl(s(b + 1:))
+    b = index(name, '(')
+    if (b > 1) name = name(1:b - 1)
+  end function variable_before
+
+  function explain(line, msg) result(text)
+    character(len=*), intent(in) :: line, msg
     character(len=:), allocatable :: text
-    if (index(msg, 'Cannot match namelist object name') > 0) then
-      text = 'unknown variable in this group (see doc/INPUT.md)'
-    else
-      text = 'cannot read its value: '//trim(msg)
+    character(len=*), parameter :: unknown = 'Cannot match namelist object name'
+    integer :: p
+    p = index(msg, unknown)
+    text = 'cannot read its value: '//trim(msg)
+    if (p > 0) then
+      if (.not. follows_equals(to_lower(line), trim(to_lower(adjustl(msg(p + len(unknown):)))))) &
+        text = 'unknown variable in this group (see doc/INPUT.md)'
     end if
   end function explain
 
@@ -337,7 +372,7 @@ contains
     bracket = '['
     if (open_lo) bracket = '('
     if (value /= value .or. value > hi .or. value < lo .or. (open_lo .and. value <= lo)) then
-      write(text, '(a,es11.4,3a,es10.3,a,es10.3,a)') 'value', value, ' out of range ', bracket, lo, ',', hi, ']'
+      write(text, '(a,es11.4,2a,es10.3,a,es10.3,a)') 'value ', value, ' out of range ', bracket, lo, ',', hi, ']'
       call input_error(cfg%deck_file, group, name, trim(text))
     end if
   end subroutine check_real

@@ -1,0 +1,59 @@
+"""Invariant: bad input stops the run before any work, with a non-zero status and one message that
+names the file and the item at fault (group and variable for a deck). 'Before any work' is
+checked by the absence of any time step in the log and of series.h5 in the output directory."""
+import os
+import sys
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
+import fdsusp_testlib as T
+
+GOOD = """&domain box = 3.2, 3.2, 3.2, cells_per_radius = 5 /
+&fluid reynolds = 0.01 /
+&time dt = 0.005, steps = 4 /
+&output directory = 'out', progress_every = 1 /
+"""
+d = T.scratch('bad_input')
+# a good checkpoint to corrupt
+T.run(T.write_deck(d, 'good.nml', GOOD), d)
+ckpt = os.path.join(d, 'out', 'checkpoint.h5')
+data = open(ckpt, 'rb').read()
+with open(os.path.join(d, 'truncated.h5'), 'wb') as f:
+    f.write(data[:len(data) // 2])
+with open(os.path.join(d, 'not_a_directory'), 'w') as f:
+    f.write('a file')
+os.rename(os.path.join(d, 'out'), os.path.join(d, 'good_run'))
+
+cases = [
+    # name, deck text (None: do not write), extra args, words the message must contain
+    ('unknown variable', GOOD.replace('reynolds', 'reynold'), [], ['bad.nml', '&fluid', 'reynold', 'unknown variable']),
+    ('value out of range', GOOD.replace('dt = 0.005', 'dt = -1'), [], ['bad.nml', '&time', 'dt', 'out of range']),
+    ('wrong type', GOOD.replace('steps = 4', "steps = 'many'"), [], ['bad.nml', '&time', 'steps', 'cannot read']),
+    ('unknown group', GOOD + '&fluidd reynolds = 1 /\n', [], ['bad.nml', '&fluidd', 'unknown group']),
+    ('missing deck', None, [], ['bad.nml', 'does not exist']),
+    ('periodic box with shear', GOOD.replace('cells_per_radius = 5', "cells_per_radius = 5, y_boundary = 'periodic'"),
+     [], ['bad.nml', '&domain', 'shear_rate', 'periodic']),
+    ('fractional cell count', GOOD.replace('box = 3.2, 3.2, 3.2', 'box = 3.3, 3.2, 3.2'), [], ['bad.nml', '&domain', 'box(x)', 'whole number']),
+    ('bad y_boundary', GOOD.replace('cells_per_radius = 5', "cells_per_radius = 5, y_boundary = 'wall'"), [], ['bad.nml', '&domain', 'y_boundary']),
+    ('unwritable output directory', GOOD.replace("directory = 'out'", "directory = 'not_a_directory/out'"), [],
+     ['bad.nml', '&output', 'directory', 'cannot be created']),
+    ('truncated checkpoint', GOOD, ['-restart', 'truncated.h5'], ['truncated.h5', 'truncated']),
+    ('missing checkpoint', GOOD, ['-restart', 'nowhere.h5'], ['nowhere.h5', 'does not exist']),
+    ('checkpoint from another grid', GOOD.replace('cells_per_radius = 5', 'cells_per_radius = 2.5'),
+     ['-restart', 'good_run/checkpoint.h5'], ['good_run/checkpoint.h5', 'item cells', '16x16x16', '8x8x8']),
+    ('checkpoint from another box', GOOD.replace('box = 3.2, 3.2, 3.2', 'box = 3.2, 6.4, 3.2').replace('cells_per_radius = 5', 'cells_per_radius = 5'),
+     ['-restart', 'good_run/checkpoint.h5'], ['good_run/checkpoint.h5', 'item cells']),
+    ('not a checkpoint', GOOD, ['-restart', 'bad.nml'], ['bad.nml', 'cannot be opened as HDF5']),
+]
+for name, text, args, words in cases:
+    deck = os.path.join(d, 'bad.nml')
+    if os.path.exists(deck):
+        os.remove(deck)
+    if text is not None:
+        T.write_deck(d, 'bad.nml', text)
+    status, out, err = T.run('bad.nml', d, args=args, expect_ok=False)
+    messages = [l for l in err.splitlines() if l.startswith('fdsusp:')]
+    T.check(status != 0, '%s: exit status %d != 0' % (name, status))
+    T.check(len(messages) == 1, '%s: one message (%d): %s' % (name, len(messages), messages[:1]))
+    T.check(all(w in err for w in words), '%s: the message names %s' % (name, ', '.join(words)))
+    T.check(not any(l.startswith('step ') for l in out.splitlines()) and
+            not os.path.exists(os.path.join(d, 'out', 'series.h5')), '%s: no time step was taken' % name)
+T.finish()

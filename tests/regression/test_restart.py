@@ -1,0 +1,74 @@
+"""Invariant: restart is exact. N steps in one run equal N/2 steps, a checkpoint, a restart and
+N/2 steps: the checkpoint holds the complete state (u, v, w, p and the last pressure increment,
+the warm start of the next Poisson solve), so the continued run repeats the same arithmetic and
+agrees to round-off; asserted to 1e-12 absolute on O(1) fields. The same holds when the
+checkpoint was written because the run received SIGTERM (exit status 0), and SIGUSR1 through
+mpiexec on 2 ranks stops the run cleanly with a checkpoint too. series.h5 of the continued run
+holds each step exactly once, with the values of the uninterrupted run."""
+import os
+import shutil
+import signal
+import sys
+import numpy as np
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
+import fdsusp_testlib as T
+
+DECK = """&domain box = 3.2, 3.2, 3.2, cells_per_radius = 5, y_boundary = 'walls', shear_rate = 1 /
+&fluid reynolds = 0.01 /
+&time dt = 0.005, steps = {steps} /
+&output directory = 'out', progress_every = {progress} /
+&verification manufactured_solution = .true. /
+"""
+NAMES = ['u', 'v', 'w', 'p', 'phi']
+
+
+def state(d):
+    return T.read_h5(os.path.join(d, 'out', 'checkpoint.h5'), NAMES)
+
+
+def compare(a, b, what):
+    for k in NAMES:
+        diff = np.abs(a[k] - b[k]).max()
+        T.check(diff <= 1e-12, '%s: max |%s difference| = %.1e <= 1e-12' % (what, k, diff))
+
+
+def compare_series(da, db, what):
+    sa, sb = T.series(os.path.join(da, 'out')), T.series(os.path.join(db, 'out'))
+    T.check(np.array_equal(sa['step'], sb['step']) and np.array_equal(sb['step'], np.arange(1, len(sb['step']) + 1)),
+            '%s: series steps 1..%d, each once' % (what, len(sb['step'])))
+    for k in ('tau_wall_bottom', 'tau_wall_top', 'mms_error_velocity_max'):
+        T.check(np.allclose(sa[k], sb[k], rtol=0, atol=1e-12), '%s: series %s identical' % (what, k))
+
+
+# 20 steps straight against 10 + restart + 10
+a = T.scratch('restart_straight')
+T.run(T.write_deck(a, 'd.nml', DECK.format(steps=20, progress=5)), a)
+b = T.scratch('restart_split')
+T.run(T.write_deck(b, 'd10.nml', DECK.format(steps=10, progress=5)), b)
+T.check(int(T.h5_attr(os.path.join(b, 'out', 'checkpoint.h5'), 'step')[0]) == 10, 'checkpoint at step 10')
+T.run(T.write_deck(b, 'd.nml', DECK.format(steps=20, progress=5)), b, args=['-restart', 'out/checkpoint.h5'])
+compare(state(a), state(b), '20 steps vs 10 + restart + 10')
+compare_series(a, b, '20 steps vs 10 + restart + 10')
+
+# SIGTERM in the middle of a long run, then continue 10 steps
+c = T.scratch('restart_sigterm')
+status, out = T.run_until_then_signal(T.write_deck(c, 'long.nml', DECK.format(steps=100000, progress=1)), c, 5)
+T.check(status == 0, 'SIGTERM: exit status %d == 0' % status)
+T.check('stopped by signal 15' in out, 'SIGTERM: the log says the run stopped on the signal')
+k = int(T.h5_attr(os.path.join(c, 'out', 'checkpoint.h5'), 'step')[0])
+T.check(k >= 5, 'SIGTERM: checkpoint written at step %d' % k)
+T.run(T.write_deck(c, 'd.nml', DECK.format(steps=k + 10, progress=5)), c, args=['-restart', 'out/checkpoint.h5'])
+e = T.scratch('restart_sigterm_reference')
+T.run(T.write_deck(e, 'd.nml', DECK.format(steps=k + 10, progress=5)), e)
+compare(state(e), state(c), 'SIGTERM at step %d + restart + 10 vs %d straight' % (k, k + 10))
+compare_series(e, c, 'SIGTERM restart')
+
+# SIGUSR1 through mpiexec on 2 ranks
+f = T.scratch('restart_sigusr1')
+status, out = T.run_until_then_signal(T.write_deck(f, 'long.nml', DECK.format(steps=100000, progress=1)), f, 3,
+                                      sig=signal.SIGUSR1, np_ranks=2)
+T.check(status == 0, 'SIGUSR1 on 2 ranks: exit status %d == 0' % status)
+T.check('stopped by signal 10' in out, 'SIGUSR1: the log says the run stopped on the signal')
+k = int(T.h5_attr(os.path.join(f, 'out', 'checkpoint.h5'), 'step')[0])
+T.check(k >= 3, 'SIGUSR1: checkpoint written at step %d' % k)
+T.finish()
