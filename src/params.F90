@@ -192,6 +192,8 @@ contains
       ! A value the compiler could not read may be taken for a name ("steps = 'many'"): then
       ! the item is the variable the value was given to.
       if (.not. follows_equals(to_lower(line), trim(name))) return
+      name = variable_before(to_lower(line), index(to_lower(line), trim(name)))
+      return
     end if
     name = variable_before(to_lower(line), len_trim(line) + 1)
   end function item_name
