@@ -17,6 +17,8 @@ program fdsusp
   use mod_system, only: install_signal_handlers, stop_signal, make_directory, probe_directory
   use mod_timers, only: timers_register, stage_push, stage_pop, STAGE_SETUP, STAGE_FLUID, STAGE_OUTPUT
   use mod_h5util, only: h5util_init
+  use mod_solvers, only: solver_cold_solve
+  use mod_grid, only: FIELD_P
   implicit none
 
   PetscErrorCode :: ierr
@@ -27,8 +29,10 @@ program fdsusp
   character(len=max_line) :: deck, restart, checkpoint_path
   character(len=200) :: text
   character(len=32), allocatable :: columns(:)
-  integer :: step, first_step, stop_reason
-  real(dp) :: time, wall_start, wall_now, wall_per_step
+  integer :: step, first_step, stop_reason, cold_its
+  integer :: iterations_sum(4)
+  real(dp) :: time, wall_start, wall_now, wall_per_step, wall_loop, cold_seconds
+  PetscBool :: bench_cold
   real(dp) :: err_vel, err_p_max, err_p_rms
   logical :: restarting
   integer, parameter :: RUNNING = 0, DONE = 1, SIGNALLED = 2, WALL_LIMIT = 3, STEADY = 4
@@ -68,6 +72,15 @@ program fdsusp
   call install_signal_handlers()
   PetscCallA(stage_pop(ierr))
   call log_line('models: fluid (unsteady Stokes, projection); no particles in this deck')
+  ! -bench_cold_poisson: time one pressure solve from a zero guess to 1e-8 (doc/BENCHMARKS.md)
+  PetscCallA(PetscOptionsHasName(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-bench_cold_poisson', bench_cold, ierr))
+  if (bench_cold) then
+    PetscCallA(solver_cold_solve(fl%solver(FIELD_P), 1.0e-8_dp, cold_seconds, cold_its, ierr))
+    write(text, '(a,f10.5,a,i0,a)') 'bench: cold Poisson solve to 1e-8:', cold_seconds, ' s, ', cold_its, ' iterations'
+    call log_line(text)
+  end if
+  iterations_sum = 0
+  wall_loop = MPI_Wtime()
 
   ! ---- time loop ----
   first_step = step
@@ -77,6 +90,8 @@ program fdsusp
     PetscCallA(stage_push(STAGE_FLUID, ierr))
     PetscCallA(fluid_step(grid, fl, ierr))
     PetscCallA(stage_pop(ierr))
+    iterations_sum = iterations_sum + [fl%solver(1)%iterations, fl%solver(2)%iterations, &
+                                       fl%solver(3)%iterations, fl%solver(4)%iterations]
     step = step + 1
     time = time + cfg%dt
 
@@ -102,6 +117,12 @@ program fdsusp
   end do
 
   ! ---- end of run: the series, the last fields and a checkpoint to continue from ----
+  if (step > first_step) then
+    wall_loop = (MPI_Wtime() - wall_loop) / (step - first_step)
+    write(text, '(a,i0,a,f10.5,a,4(f6.1))') 'steps run: ', step - first_step, '  wall time per step:', wall_loop, &
+         ' s  mean iterations u v w p:', real(iterations_sum, dp) / (step - first_step)
+    call log_line(text)
+  end if
   PetscCallA(stage_push(STAGE_OUTPUT, ierr))
   if (step > first_step .and. mod(step, cfg%series_every) /= 0) call record()
   call series_flush(series)

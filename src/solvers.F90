@@ -15,7 +15,7 @@ module mod_solvers
   implicit none
   private
   public :: solver_t, solvers_configure, solver_create, solver_solve, solver_destroy
-  public :: set_default_option
+  public :: set_default_option, solver_cold_solve
 
   type :: solver_t
     KSP :: ksp
@@ -146,6 +146,47 @@ contains
       PetscCall(MatNullSpaceRemove(s%nullspace, x, ierr))
     end if
   end subroutine solver_solve
+
+  ! Benchmark: seconds for one solve from a zero initial guess to relative tolerance rtol, with a
+  ! random consistent right-hand side (the operator and preconditioner are already set up).
+  ! Returns the iteration count too. The solver's own tolerance is restored afterwards.
+  subroutine solver_cold_solve(s, rtol, seconds, iterations, ierr)
+    type(solver_t), intent(inout) :: s
+    real(dp), intent(in) :: rtol
+    real(dp), intent(out) :: seconds
+    integer, intent(out) :: iterations
+    PetscErrorCode, intent(out) :: ierr
+    Vec :: b, x
+    PetscReal :: old_rtol, abstol, dtol
+    PetscInt :: maxit, its
+    PetscRandom :: rnd
+    DM :: dm
+    real(dp) :: t0
+    PetscCall(KSPGetDM(s%ksp, dm, ierr))
+    PetscCall(DMCreateGlobalVector(dm, b, ierr))
+    PetscCall(VecDuplicate(b, x, ierr))
+    PetscCall(PetscRandomCreate(PETSC_COMM_WORLD, rnd, ierr))
+    PetscCall(PetscRandomSetSeed(rnd, 20141107_8, ierr))
+    PetscCall(PetscRandomSeed(rnd, ierr))
+    PetscCall(VecSetRandom(b, rnd, ierr))
+    PetscCall(PetscRandomDestroy(rnd, ierr))
+    if (s%singular) then
+      PetscCall(MatNullSpaceRemove(s%nullspace, b, ierr))
+    end if
+    PetscCall(VecSet(x, 0.0_dp, ierr))
+    PetscCall(KSPGetTolerances(s%ksp, old_rtol, abstol, dtol, maxit, ierr))
+    PetscCall(KSPSetTolerances(s%ksp, rtol, abstol, dtol, maxit, ierr))
+    call MPI_Barrier(PETSC_COMM_WORLD, ierr)
+    t0 = MPI_Wtime()
+    PetscCall(KSPSolve(s%ksp, b, x, ierr))
+    call MPI_Barrier(PETSC_COMM_WORLD, ierr)
+    seconds = MPI_Wtime() - t0
+    PetscCall(KSPGetIterationNumber(s%ksp, its, ierr))
+    iterations = its
+    PetscCall(KSPSetTolerances(s%ksp, old_rtol, abstol, dtol, maxit, ierr))
+    PetscCall(VecDestroy(b, ierr))
+    PetscCall(VecDestroy(x, ierr))
+  end subroutine solver_cold_solve
 
   subroutine solver_destroy(s, ierr)
     type(solver_t), intent(inout) :: s
