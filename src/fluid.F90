@@ -51,7 +51,7 @@ contains
     type(fluid_t), intent(inout) :: fl
     PetscErrorCode, intent(out) :: ierr
     integer :: c
-    real(dp) :: tol
+    real(dp) :: tol, floor, u_ref, cells
 
     fl%reynolds = cfg%reynolds
     fl%dt = cfg%dt
@@ -80,10 +80,22 @@ contains
     call set_forcing(cfg, grid, fl, ierr)
 
     call solvers_configure(fl%reynolds / fl%dt, fl%theta * fl%viscosity, grid%box, grid%walls)
+    ! Round-off floor of each solve: 100 machine epsilons of the right-hand side that a field of
+    ! the reference speed U_ref = max(U_wall, a*gamma_dot) would give (before the h^3 row scaling),
+    ! Helmholtz (Re/dt) U_ref per face, Poisson (Re/dt) U_ref/h per cell, times sqrt(cells) for
+    ! the 2-norm. It stops solves whose right-hand side is pure round-off (the steady Couette
+    ! profile gives v, w and phi right-hand sides of order 1e-16) at zero iterations; it is
+    ! 2e-14 of a physically sized right-hand side, below any tolerance worth asking for.
+    u_ref = max(abs(fl%wall_speed), 1.0_dp)
+    cells = real(grid%n(1), dp) * real(grid%n(2), dp) * real(grid%n(3), dp)
     do c = 1, 4
       tol = cfg%velocity_tolerance
-      if (c == FIELD_P) tol = cfg%pressure_tolerance
-      call solver_create(grid, c, tol, fl%solver(c), ierr)
+      floor = 1.0e2_dp * epsilon(1.0_dp) * (fl%reynolds / fl%dt) * u_ref * sqrt(cells)
+      if (c == FIELD_P) then
+        tol = cfg%pressure_tolerance
+        floor = floor / grid%h
+      end if
+      call solver_create(grid, c, tol, floor, fl%solver(c), ierr)
     end do
   end subroutine fluid_create
 

@@ -57,10 +57,13 @@ contains
     end if
   end subroutine set_default_option
 
-  subroutine solver_create(grid, field, rtol, s, ierr)
+  ! rtol: relative tolerance from the deck. atol: the residual norm at which the solve stops
+  ! whatever |b| is; the caller sets it at round-off level of a physically sized right-hand side,
+  ! so a right-hand side that is itself round-off (a steady state) costs no iterations.
+  subroutine solver_create(grid, field, rtol, atol, s, ierr)
     type(grid_t), intent(in) :: grid
     integer, intent(in) :: field
-    real(dp), intent(in) :: rtol
+    real(dp), intent(in) :: rtol, atol
     type(solver_t), intent(inout) :: s
     PetscErrorCode, intent(out) :: ierr
     character(len=3) :: prefix
@@ -74,6 +77,8 @@ contains
     PetscCall(set_default_option(prefix//'ksp_norm_type', 'unpreconditioned', ierr))
     write(text, '(es12.5)') rtol
     PetscCall(set_default_option(prefix//'ksp_rtol', trim(adjustl(text)), ierr))
+    write(text, '(es12.5)') atol * s%cell_volume
+    PetscCall(set_default_option(prefix//'ksp_atol', trim(adjustl(text)), ierr))
     PetscCall(set_default_option(prefix//'ksp_max_it', '1000', ierr))
     ! The warm start can hold a residual far above |b| (decaying increments): no divergence test.
     PetscCall(set_default_option(prefix//'ksp_divtol', '1e100', ierr))
