@@ -1,18 +1,34 @@
 #!/usr/bin/env python3
 """Generate src/resistance_table.F90 (module mod_resistance_table) from
-input/tables/two_sphere_resistance_equal_spheres.csv.
+input/tables/two_sphere_resistance_equal_spheres.csv, and the twin-multipole series coefficients
+of the equal-sphere resistance functions (Jeffrey & Onishi 1984; Jeffrey 1992).
 
-The generated Fortran module is committed to the repository, so the build never reads the CSV;
-re-run this script (from anywhere) whenever the CSV changes:
+The generated Fortran module is committed to the repository, so the build never reads the CSV
+and never runs the recurrences; re-run this script (from anywhere) whenever the CSV changes or
+the series order is raised:
 
-    python3 scripts/gen_resistance_table.py
+    /usr/bin/python3 scripts/gen_resistance_table.py [--nmax 200]
 
-Only the Python standard library is used. Numbers are copied digit for digit (as text) from the
-CSV, so the Fortran data equal the table exactly (no binary round trip).
+Table numbers are copied digit for digit (as text) from the CSV, so the Fortran data equal the
+table exactly (no binary round trip). The series coefficients need numpy (Debian python3-numpy)
+and take about a minute at nmax = 200 (the recurrences cost O(nmax^4)).
+
+Series coefficients. For two spheres of radius ratio lambda at s = 2r/(a1 + a2), Jeffrey & Onishi
+(1984, J. Fluid Mech. 139:261, eqs 3.6-3.15, 4.6-4.11, 7.3-7.5) and Jeffrey (1992, Phys. Fluids A
+4:16, eqs 19-81) write each resistance function as a power series in 1/s whose coefficients
+f_k(lambda) = 2^k sum_q P_{n0, k-q, q} lambda^q follow from recurrences for P, V, Q. This script
+implements those recurrences (in the form corrected and completed by Townsend 2018,
+arXiv:1802.08226, eqs 5-8 and 18, whose corrections matter for YH, YM and ZM) at lambda = 1 and
+writes G_m = 4^-m f_m(1), so that a scalar is  sigma * sum_m G_m t^m  over the even or the odd m,
+with t = 2/s = 1/(1 + xi/2) (mod_resistance documents sigma and the parity of each scalar).
+Checked: the first ten coefficients of every family equal method.md section 3.2 (libstokes), and
+the ZM coefficients equal libstokes' independently generated ZM.c to all printed digits.
 """
+import argparse
 import csv
 import os
 import sys
+from math import comb
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CSV_PATH = os.path.join(ROOT, "input", "tables", "two_sphere_resistance_equal_spheres.csv")
@@ -46,7 +62,118 @@ def data_lines(values, per_line=4, indent="    "):
     return out
 
 
+# ------------------------------------------------------------------------------------------------
+# Twin-multipole recurrences (lambda = 1 enters only through f_k; the recurrences are lambda-free)
+# ------------------------------------------------------------------------------------------------
+
+# Families, in the column order of resistance_series_coef:
+#   (name, recurrence type, seed index n0, seeded array, evaluated array, evaluated n, factor)
+# Type A: binomial C(n+s, n) (X^A, X^G, X^M); type Y: C(n+s, n+1) (Y^A, Y^B, Y^C, Y^G, Y^H, Y^M);
+# type Z: C(n+s, n+2), s >= 2 (Z^M).
+SERIES_FAMILIES = [
+    ("XA", "A", 1, "P", "P", 1, 1.0),
+    ("YA", "Y", 1, "P", "P", 1, 1.0),
+    ("YB", "Y", 1, "P", "Q", 1, 2.0),
+    ("YC", "Y", 1, "Q", "Q", 1, 1.0),
+    ("XG", "A", 1, "P", "P", 2, 0.75),
+    ("YG", "Y", 1, "P", "P", 2, 0.75),
+    ("YH", "Y", 1, "Q", "P", 2, -0.375),
+    ("XM", "A", 2, "P", "P", 2, 1.0),
+    ("YM", "Y", 2, "P", "P", 2, 1.0),
+    ("ZM", "Z", 2, "P", "P", 2, 1.0),
+]
+
+
+def recurrence(nmax, kind, n0, seed):
+    """P, V, Q[n, p, q] (p + q <= nmax) of the Jeffrey-Onishi / Jeffrey recurrences.
+
+    Computed in order of increasing p + q (every right-hand side has a smaller p + q), vectorised
+    over n and the summation index s. At total T only n <= nmax - T + 2 is ever referenced."""
+    import numpy as np
+    nn_ = nmax + 3
+    P = np.zeros((nn_, nmax + 1, nmax + 1))
+    V = np.zeros_like(P)
+    Q = np.zeros_like(P)
+    if seed == "P":
+        P[n0, 0, 0] = V[n0, 0, 0] = 1.0
+    else:
+        Q[n0, 0, 0] = 1.0
+    smin = 2 if kind == "Z" else 1
+    shift = {"A": 0, "Y": 1, "Z": 2}[kind]
+    binom = np.zeros((nn_, nmax + 2))
+    for a in range(1, nn_):
+        for b in range(smin, nmax + 2):
+            binom[a, b] = float(comb(a + b, a + shift))
+
+    def look(arr, s, i2, i3):
+        ok = (i2[None, :] >= 0) & (i3[:, None] >= 0)
+        return np.where(ok, arr[s[None, :], np.maximum(i2, 0)[None, :], np.maximum(i3, 0)[:, None]],
+                        0.0)
+
+    for total in range(1, nmax + 1):
+        for p in range(0, total + 1):
+            q = total - p
+            nhi = min(nmax - total + 2, p + 2)
+            if q < smin or nhi < 1:
+                continue
+            nv = np.arange(1, nhi + 1)
+            n = nv.astype(float)[:, None]
+            s = np.arange(smin, q + 1)
+            sf = s.astype(float)[None, :]
+            b = binom[1:nhi + 1, smin:q + 1]
+            pa = look(P, s, q - s, p - nv + 1)
+            pb = look(P, s, q - s, p - nv - 1)
+            vc = look(V, s, q - s - 2, p - nv + 1)
+            if kind == "A":
+                t = (n * (2 * n + 1) * (2 * n * sf - n - sf + 2) / (2 * (n + 1) * (2 * sf - 1) * (n + sf)) * pa
+                     - n * (2 * n - 1) / (2 * (n + 1)) * pb
+                     - n * (4 * n**2 - 1) / (2 * (n + 1) * (2 * sf + 1)) * vc)
+                P[1:nhi + 1, p, q] = np.sum(b * t, axis=1)
+                V[1:nhi + 1, p, q] = (P[1:nhi + 1, p, q]
+                                      - (2 * n / ((n + 1) * (2 * n + 3)))[:, 0] * np.sum(b * pb, axis=1))
+                continue
+            qd = look(Q, s, q - s - 1, p - nv + 1)
+            qe = look(Q, s, q - s - 1, p - nv)
+            pe = look(P, s, q - s, p - nv)
+            if kind == "Y":
+                t = ((2 * n + 1) / (2 * (n + 1)) * (3 * (n + sf) - (n * sf + 1) * (2 * n * sf - sf - n + 2))
+                     / (sf * (n + sf) * (2 * sf - 1)) * pa
+                     + n * (2 * n - 1) / (2 * (n + 1)) * pb
+                     + n * (4 * n**2 - 1) / (2 * (n + 1) * (2 * sf + 1)) * vc
+                     - 2 * (4 * n**2 - 1) / (3 * (n + 1)) * qd)
+                Q[1:nhi + 1, p, q] = np.sum(b * (sf / (n + 1) * qe - 3 / (2 * n * sf * (n + 1)) * pe), axis=1)
+            else:
+                t = (-2 * (2 * n + 1) * (2 * n - 1) / (n + 1) * qd
+                     + n * (2 * n + 1) * (2 * n - 1) / (2 * (n + 1) * (2 * sf + 1)) * vc
+                     + (2 * n + 1) / (n + 1) * (n * sf * (n + sf - 2 * n * sf - 2) - 4 * (2 * n * sf - 4 * sf - 4 * n + 2))
+                     / (2 * sf * (n + sf) * (2 * sf - 1)) * pa
+                     + n * (2 * n - 1) / (2 * (n + 1)) * pb)
+                Q[1:nhi + 1, p, q] = np.sum(b * (sf / (n + 1) * qe - 2 / (n * sf * (n + 1)) * pe), axis=1)
+            P[1:nhi + 1, p, q] = np.sum(b * t, axis=1)
+            V[1:nhi + 1, p, q] = (P[1:nhi + 1, p, q]
+                                  + (2 * n / ((n + 1) * (2 * n + 3)))[:, 0] * np.sum(b * pb, axis=1))
+    return P, V, Q
+
+
+def series_coefficients(nmax):
+    """{family: [G_0 .. G_nmax]} with G_m = 4^-m f_m(lambda = 1)."""
+    cache = {}
+    out = {}
+    for name, kind, n0, seed, which, nev, fac in SERIES_FAMILIES:
+        key = (kind, n0, seed)
+        if key not in cache:
+            cache[key] = recurrence(nmax, kind, n0, seed)
+        P, _, Q = cache[key]
+        arr = P if which == "P" else Q
+        out[name] = [fac * 2.0**(-m) * sum(arr[nev, m - q, q] for q in range(m + 1))
+                     for m in range(nmax + 1)]
+    return out
+
+
 def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--nmax", type=int, default=200, help="highest power of the series (default 200)")
+    args = ap.parse_args()
     with open(CSV_PATH, newline="") as f:
         rows = list(csv.reader(f))
     header, body = rows[0], [r for r in rows[1:] if r]
@@ -77,6 +204,8 @@ def main():
     L.append("  private")
     L.append("  public :: resistance_table_size, resistance_table_scalar_count, resistance_table_sep, &")
     L.append("            resistance_table_values, resistance_table_a_bg, resistance_table_names")
+    L.append("  public :: resistance_series_nmax, resistance_series_families, resistance_series_names, &")
+    L.append("            resistance_series_coef")
     L.append("")
     L.append(f"  integer, parameter :: resistance_table_size = {n}")
     L.append(f"  integer, parameter :: resistance_table_scalar_count = {len(SCALARS)}")
@@ -107,10 +236,33 @@ def main():
             lines[-1] = lines[-1][:-2] + ", &"
         L += lines
     L.append("    ], [resistance_table_size, resistance_table_scalar_count])")
+    L.append("")
+    coef = series_coefficients(args.nmax)
+    names = [f[0] for f in SERIES_FAMILIES]
+    L.append("  ! Twin-multipole series (Jeffrey & Onishi 1984; Jeffrey 1992; recurrences as corrected by")
+    L.append("  ! Townsend 2018): resistance_series_coef(m, j) = G_m = 4^-m f_m(lambda = 1) of family j, the")
+    L.append("  ! coefficient of t^m, t = 2/s. Computed by the recurrences in scripts/gen_resistance_table.py.")
+    L.append(f"  integer, parameter :: resistance_series_nmax = {args.nmax}")
+    L.append(f"  integer, parameter :: resistance_series_families = {len(names)}")
+    L.append("  character(len=2), parameter :: resistance_series_names(resistance_series_families) = [ &")
+    L += data_lines([f'"{n}"' for n in names], per_line=10)
+    L.append("    ]")
+    L.append("  real(dp), parameter :: resistance_series_coef(0:resistance_series_nmax, &")
+    L.append("                                                resistance_series_families) = reshape([ &")
+    for j, name in enumerate(names):
+        L.append(f"    ! {name}")
+        col = [f"{float(v):.17e}".replace("e", "e") + "_dp" for v in coef[name]]
+        col = [c.replace("e+", "e").replace("e-0", "e-").replace("e0", "e") for c in col]
+        lines = data_lines(col, per_line=3)
+        if j < len(names) - 1:
+            lines[-1] = lines[-1][:-2] + ", &"
+        L += lines
+    L.append("    ], [resistance_series_nmax + 1, resistance_series_families])")
     L.append("end module mod_resistance_table")
     with open(OUT_PATH, "w") as f:
         f.write("\n".join(L) + "\n")
-    print(f"gen_resistance_table: wrote {OUT_PATH} ({n} separations x {len(SCALARS)} scalars)")
+    print(f"gen_resistance_table: wrote {OUT_PATH} ({n} separations x {len(SCALARS)} scalars, "
+          f"series to t^{args.nmax})")
 
 
 if __name__ == "__main__":

@@ -43,7 +43,8 @@
 module mod_resistance
   use mod_kinds, only: dp, pi
   use mod_resistance_table, only: resistance_table_size, resistance_table_sep, &
-                                  resistance_table_values
+                                  resistance_table_values, resistance_series_nmax, &
+                                  resistance_series_coef
   implicit none
   private
 
@@ -62,8 +63,15 @@ module mod_resistance
   ! Join locations (gap xi = s - 2).
   real(dp), parameter, public :: near_join_gap = 0.025_dp    ! first Lamb-method row, s = 2.025
   real(dp), parameter, public :: far_join_gap = 2.5_dp       ! last table row, s = 4.5
+  ! Z^M_11 and Z^M_12 join at s = 2.1 instead: the table's Z^M rows at s = 2.025 and 2.05 differ
+  ! from the converged series by 2.1e-4 and 7.7e-5 absolute (4.1e-3 and 9e-4 of |Z^M_12|),
+  ! at s = 2.1 by 2.2e-5 (2.1e-4 of |Z^M_12|); the series there is converged to < 1e-6 (the same
+  ! at nmax = 60, 120, 200) and equals libstokes' independently generated coefficients, so the
+  ! module follows the series below s = 2.1 (doc/RESISTANCE.md).
+  real(dp), parameter, public :: zm_join_gap = 0.1_dp
 
-  public :: resistance_init, resistance_scalars, near_field_scalars, far_field_scalars
+  public :: resistance_init, resistance_scalars, near_field_scalars, far_field_scalars, &
+            series_scalars, contact_constants
   public :: pair_shear_functions
   public :: pair_resistance_fu, pair_resistance_fe, pair_resistance_su, pair_resistance_se
   public :: pair_force_torque_from_strain, pair_stresslets
@@ -95,58 +103,20 @@ module mod_resistance
     -3.0_dp/112, 0.0_dp, 0.125_dp, 0.125_dp, 0.062_dp, -117.0_dp/560, -0.0625_dp, 0.0565_dp, &
     493.0_dp/2800, 0.1332_dp, 0.075_dp]
 
-  ! Far-field series (method.md section 3.2): f = sum_{n=0}^{10} far_coef(n, k) s^-n,
-  ! tail exponent far_tail_power(k) = first power the truncated series omits.
-  integer, parameter :: far_nmax = 10
-  real(dp), parameter :: far_coef(0:far_nmax, n_pair_scalars) = reshape([ &
-    ! XA11
-    1.0_dp, 0.0_dp, 2.25_dp, 0.0_dp, 93.0_dp/16, 0.0_dp, 18.703_dp, 0.0_dp, 77.43_dp, 0.0_dp, 0.0_dp, &
-    ! YA11
-    1.0_dp, 0.0_dp, 9.0_dp/16, 0.0_dp, 1.8164_dp, 0.0_dp, 3.600_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, &
-    ! YB11
-    0.0_dp, 0.0_dp, 0.0_dp, -9.0_dp/8, 0.0_dp, -2.1328_dp, 0.0_dp, -8.606_dp, 0.0_dp, 0.0_dp, 0.0_dp, &
-    ! XC11
-    1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, 0.0_dp, 3.0_dp, 0.0_dp, 6.0_dp, &
-    ! YC11
-    1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.75_dp, 0.0_dp, 4.4219_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, &
-    ! XG11
-    0.0_dp, 0.0_dp, 0.0_dp, 45.0_dp/8, 0.0_dp, 18.656_dp, 0.0_dp, 47.04_dp, 0.0_dp, 0.0_dp, 0.0_dp, &
-    ! YG11
-    0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 27.0_dp/8, 0.0_dp, 4.148_dp, 0.0_dp, 0.0_dp, 0.0_dp, &
-    ! YH11
-    0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, -1.5_dp, 0.0_dp, 1.266_dp, 0.0_dp, 0.0_dp, &
-    ! XM11
-    1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 3.75_dp, 0.0_dp, 21.44_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, &
-    ! YM11
-    1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 10.0_dp, 0.0_dp, 8.2_dp, 0.0_dp, 0.0_dp, &
-    ! ZM11
-    1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 3.125_dp, 0.0_dp, 0.0_dp, &
-    ! XA12
-    0.0_dp, -1.5_dp, 0.0_dp, -19.0_dp/8, 0.0_dp, -12.094_dp, 0.0_dp, -41.65_dp, 0.0_dp, 0.0_dp, 0.0_dp, &
-    ! YA12
-    0.0_dp, -0.75_dp, 0.0_dp, -59.0_dp/64, 0.0_dp, -2.2061_dp, 0.0_dp, -5.471_dp, 0.0_dp, 0.0_dp, 0.0_dp, &
-    ! YB12
-    0.0_dp, 0.0_dp, 1.5_dp, 0.0_dp, 27.0_dp/32, 0.0_dp, 3.287_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, &
-    ! XC12
-    0.0_dp, 0.0_dp, 0.0_dp, -1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, -1.0_dp, 0.0_dp, &
-    ! YC12
-    0.0_dp, 0.0_dp, 0.0_dp, 0.5_dp, 0.0_dp, 9.0_dp/16, 0.0_dp, 1.4414_dp, 0.0_dp, 0.0_dp, 0.0_dp, &
-    ! XG12
-    0.0_dp, 0.0_dp, -3.75_dp, 0.0_dp, -39.0_dp/16, 0.0_dp, -36.42_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, &
-    ! YG12
-    0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, -2.0_dp, 0.0_dp, -2.531_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, &
-    ! YH12
-    0.0_dp, 0.0_dp, 0.0_dp, 1.25_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.6875_dp, 0.0_dp, 0.0_dp, 0.0_dp, &
-    ! XM12
-    0.0_dp, 0.0_dp, 0.0_dp, 5.0_dp, 0.0_dp, -6.375_dp, 0.0_dp, 28.41_dp, 0.0_dp, 0.0_dp, 0.0_dp, &
-    ! YM12
-    0.0_dp, 0.0_dp, 0.0_dp, -2.5_dp, 0.0_dp, 8.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, &
-    ! ZM12
-    0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, -2.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp], &
-    [far_nmax + 1, n_pair_scalars])
-  integer, parameter :: far_tail_power(n_pair_scalars) = [ &
-    10, 8, 9, 12, 8, 9, 9, 10, 8, 10, 10, &
-    9, 9, 8, 11, 9, 8, 8, 9, 9, 7, 7]
+  ! Twin-multipole series (Jeffrey & Onishi 1984; Jeffrey 1992; coefficients generated into
+  ! mod_resistance_table by scripts/gen_resistance_table.py). Scalar k is
+  !   f_k = series_sign(k) * sum_{m = parity(k) mod 2} G_m(family(k)) t^m,   t = 2/s,
+  ! evaluated in resummed form (see series_scalars). Family 0 = X^C (exact Jeffery 1915 sums).
+  integer, parameter :: series_family(n_pair_scalars) = [ &
+    1, 2, 3, 0, 4, 5, 6, 7, 8, 9, 10, 1, 2, 3, 0, 4, 5, 6, 7, 8, 9, 10]
+  integer, parameter :: series_parity(n_pair_scalars) = [ &
+    0, 0, 1, 0, 0, 1, 1, 0, 0, 0, 0, 1, 1, 0, 1, 1, 0, 0, 1, 1, 1, 1]
+  real(dp), parameter :: series_sign(n_pair_scalars) = [ &
+    1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, -1, -1, -1, 1, 1, -1, -1, 1, 1, 1, -1] * 1.0_dp
+  ! Decay power of the (round-off sized) far-join offset term.
+  integer, parameter :: far_tail_power = 8
+  ! Below this gap X^C uses c + g3 xi ln(1/xi) + b xi, b from the exact sum at this gap.
+  real(dp), parameter :: xc_series_min_gap = 1.0e-3_dp
 
   ! Spline of the remainder r = f - singular part in x = ln(xi), built once on first use.
   logical, save :: spline_ready = .false.
@@ -154,8 +124,14 @@ module mod_resistance
   real(dp), save :: knot_x(resistance_table_size)
   real(dp), save :: knot_r(resistance_table_size, n_pair_scalars)
   real(dp), save :: knot_r2(resistance_table_size, n_pair_scalars)   ! second derivatives
-  real(dp), save :: near_offset(n_pair_scalars)   ! table(0.025) - near form(0.025)
-  real(dp), save :: far_offset(n_pair_scalars)    ! table(4.5) - far series(4.5)
+  real(dp), save :: near_offset(n_pair_scalars)   ! table(join) - series(join)
+  real(dp), save :: join_gap(n_pair_scalars)      ! near join of each scalar
+  integer, save :: join_knot(n_pair_scalars)      ! its table row
+  real(dp), save :: far_offset(n_pair_scalars)    ! table(4.5) - series(4.5)
+  ! Residual series coefficients sigma*(G_m - g1 - 2 g2/m + 4 g3/(m(m+2))) (m >= 1, own parity;
+  ! entry 0 = sigma G_0 for even scalars) and the X^C O(xi) coefficients (11, 12).
+  real(dp), save :: series_res(0:resistance_series_nmax, n_pair_scalars)
+  real(dp), save :: xc_lin(2)
 
   ! Sphere-wall joins (method.md section 2.8; doc/RESISTANCE.md).
   real(dp), parameter :: wall_normal_series_min_gap = 1.0e-2_dp   ! below: Cox-Brenner form
@@ -174,16 +150,20 @@ contains
   function resistance_scalars(gap) result(f)
     real(dp), intent(in) :: gap
     real(dp) :: f(n_pair_scalars)
-    real(dp) :: xi, s
+    real(dp) :: xi, s, g(n_pair_scalars)
     call ensure_spline()
     xi = max(gap, 1.0e-300_dp)
     s = 2.0_dp + xi
     if (xi < near_join_gap) then
-      f = near_field_scalars(xi) + near_offset * (xi / near_join_gap)
+      f = series_scalars(xi) + near_offset * (xi / join_gap)
     else if (xi <= far_join_gap) then
       f = singular_part(xi) + spline_remainder(log(xi))
+      if (xi < zm_join_gap) then
+        g = series_scalars(xi) + near_offset * (xi / join_gap)
+        f([i_zm11, i_zm12]) = g([i_zm11, i_zm12])
+      end if
     else
-      f = far_field_scalars(s) + far_offset * (resistance_table_sep(resistance_table_size) / s) &
+      f = series_scalars(xi) + far_offset * (resistance_table_sep(resistance_table_size) / s) &
           ** far_tail_power
     end if
   end function resistance_scalars
@@ -196,19 +176,111 @@ contains
     f = singular_part(gap) + near_c
   end function near_field_scalars
 
-  !> Truncated far-field series alone (method.md section 3.2) at separation s = r/a.
-  pure function far_field_scalars(sep) result(f)
+  !> Far-field values at separation s = r/a: the twin-multipole series (series_scalars), which
+  !> at s >= 4.5 (t <= 0.44) is converged to round-off. Kept under this name for the tests.
+  function far_field_scalars(sep) result(f)
     real(dp), intent(in) :: sep
     real(dp) :: f(n_pair_scalars)
-    integer :: n
-    real(dp) :: inv_s_n
-    f = 0.0_dp
-    inv_s_n = 1.0_dp
-    do n = 0, far_nmax
-      f = f + far_coef(n, :) * inv_s_n
-      inv_s_n = inv_s_n / sep
-    end do
+    f = series_scalars(sep - 2.0_dp)
   end function far_field_scalars
+
+  !> The 22 scalars from the twin-multipole series of Jeffrey & Onishi (1984) and Jeffrey (1992),
+  !> resummed so that it holds down to contact (their eqs 3.17-3.23 evaluated at finite s):
+  !>   f = h1 S1(t) + h2 S2(t) - h3 S3(t) + sum_{m <= nmax} series_res(m) t^m,   t = 2/(2 + xi),
+  !> where h1, h2, h3 are the near-field coefficients (1/xi, ln(1/xi), xi ln(1/xi)) and S1..S3 the
+  !> closed-form sums of t^m, (2/m) t^m and 4 t^m/(m(m+2)) over the scalar's parity:
+  !>   even: S1 = 4/(xi(4+xi)), S2 = -ln(1-t^2), S3 = 1 + (1-t^2) ln(1-t^2)/t^2;
+  !>   odd:  S1 = 2(2+xi)/(xi(4+xi)), S2 = ln((1+t)/(1-t)), S3 = 2/t - (1/t^2 - 1) ln((1+t)/(1-t)).
+  !> As nmax -> infinity this is the exact function at every gap; what the truncation leaves is
+  !> largest at contact (residual coefficients ~ m^-3, oscillating): measured 9e-6 for the
+  !> co-translation X^A_11 + X^A_12 against Stimson & Jeffery, and below 1e-6 for gap >= 0.025
+  !> (doc/RESISTANCE.md). X^C uses Jeffery's (1915) exact bispherical sums instead.
+  function series_scalars(gap) result(f)
+    real(dp), intent(in) :: gap
+    real(dp) :: f(n_pair_scalars)
+    real(dp) :: xi, t, l1t2, lodd, s_even(3), s_odd(3), p(n_pair_scalars)
+    integer :: m, k
+    call ensure_spline()
+    xi = max(gap, 1.0e-300_dp)
+    t = 2.0_dp / (2.0_dp + xi)
+    l1t2 = log(xi) + log(4.0_dp + xi) - 2.0_dp * log(2.0_dp + xi)      ! ln(1 - t^2)
+    lodd = log((4.0_dp + xi) / xi)                                      ! ln((1+t)/(1-t))
+    s_even = [4.0_dp / (xi * (4.0_dp + xi)), -l1t2, 1.0_dp + 0.25_dp * xi * (4.0_dp + xi) * l1t2]
+    s_odd = [2.0_dp * (2.0_dp + xi) / (xi * (4.0_dp + xi)), lodd, &
+             (2.0_dp + xi) - 0.25_dp * xi * (4.0_dp + xi) * lodd]
+    ! Horner in t over the residual series (all 22 columns at once).
+    p = series_res(resistance_series_nmax, :)
+    do m = resistance_series_nmax - 1, 0, -1
+      p = p * t + series_res(m, :)
+    end do
+    do k = 1, n_pair_scalars
+      if (series_parity(k) == 0) then
+        f(k) = near_g1(k) * s_even(1) + near_g2(k) * s_even(2) - near_g3(k) * s_even(3) + p(k)
+      else
+        f(k) = near_g1(k) * s_odd(1) + near_g2(k) * s_odd(2) - near_g3(k) * s_odd(3) + p(k)
+      end if
+    end do
+    call xc_scalars(xi, f(i_xc11), f(i_xc12))
+  end function series_scalars
+
+  !> X^C_11 and X^C_12 from Jeffery's (1915) exact bispherical solutions, cosh(alpha) = s/2:
+  !> counter-rotation XC11 - XC12 = sum_n (sinh a / sinh n a)^3 (the mid-plane is a no-slip
+  !> plane), co-rotation XC11 + XC12 = sum_n (-1)^(n+1) (sinh a / sinh n a)^3. Below gap 1e-3
+  !> (where the sums need more than ~400 terms) the inner forms (7/8) zeta(3) - (1/8) xi ln(1/xi)
+  !> + b11 xi and -(1/8) zeta(3) + (1/8) xi ln(1/xi) + b12 xi, with b fixed by the exact sums at
+  !> 1e-3 (neglected: O(xi^2 ln xi) < 1e-6).
+  subroutine xc_scalars(xi, xc11, xc12)
+    real(dp), intent(in) :: xi
+    real(dp), intent(out) :: xc11, xc12
+    real(dp), parameter :: zeta3_local = 1.2020569031595942_dp
+    if (xi < xc_series_min_gap) then
+      xc11 = 0.875_dp * zeta3_local - 0.125_dp * xi * log(1.0_dp / xi) + xc_lin(1) * xi
+      xc12 = -0.125_dp * zeta3_local + 0.125_dp * xi * log(1.0_dp / xi) + xc_lin(2) * xi
+    else
+      call xc_exact(xi, xc11, xc12)
+    end if
+  end subroutine xc_scalars
+
+  pure subroutine xc_exact(xi, xc11, xc12)
+    real(dp), intent(in) :: xi
+    real(dp), intent(out) :: xc11, xc12
+    real(dp) :: alpha, term, co, counter, sgn, e2
+    integer :: n
+    alpha = acosh(1.0_dp + 0.5_dp * xi)
+    e2 = 1.0_dp - exp(-2.0_dp * alpha)
+    co = 0.0_dp
+    counter = 0.0_dp
+    sgn = 1.0_dp
+    do n = 1, 100000000
+      ! (sinh a / sinh(n a))^3 written with exponentials (no overflow at large n a)
+      term = (e2 / (1.0_dp - exp(-2.0_dp * n * alpha)))**3 * exp(-3.0_dp * (n - 1) * alpha)
+      counter = counter + term
+      co = co + sgn * term
+      sgn = -sgn
+      if (term < 1.0e-17_dp) exit
+    end do
+    xc11 = 0.5_dp * (co + counter)
+    xc12 = 0.5_dp * (co - counter)
+  end subroutine xc_exact
+
+  !> O(1) constants of the 22 near-contact forms as given by the resummed series (t -> 1):
+  !> c = sum_m series_res(m) + h1 c1 + h2 c2 - h3 c3 with (c1, c2, c3) = (-1/4, 0, 1) (even
+  !> scalars) or (1/4, ln 4, 2) (odd). X^C: (7/8) zeta(3), -(1/8) zeta(3).
+  function contact_constants() result(c)
+    real(dp) :: c(n_pair_scalars)
+    integer :: k
+    call ensure_spline()
+    do k = 1, n_pair_scalars
+      if (series_parity(k) == 0) then
+        c(k) = sum(series_res(:, k)) - 0.25_dp * near_g1(k) - near_g3(k)
+      else
+        c(k) = sum(series_res(:, k)) + 0.25_dp * near_g1(k) + near_g2(k) * log(4.0_dp) &
+               - 2.0_dp * near_g3(k)
+      end if
+    end do
+    c(i_xc11) = 0.875_dp * zeta3
+    c(i_xc12) = -0.125_dp * zeta3
+  end function contact_constants
 
   !> The singular (and xi ln xi) part of the near-field form, without the constant c.
   pure function singular_part(xi) result(f)
@@ -232,44 +304,71 @@ contains
     df = -near_g1 / xi - near_g2 + near_g3 * xi * (log(1.0_dp / xi) - 1.0_dp)
   end function singular_slope
 
-  !> d(far series)/ds.
-  pure function far_field_slope(sep) result(df)
-    real(dp), intent(in) :: sep
-    real(dp) :: df(n_pair_scalars)
-    integer :: n
-    df = 0.0_dp
-    do n = 1, far_nmax
-      df = df - n * far_coef(n, :) / sep**(n + 1)
-    end do
-  end function far_field_slope
-
   !> Build the clamped cubic splines of the remainder (once).
   subroutine ensure_spline()
-    integer :: k, nt, k0
-    real(dp) :: xin, s_end, slope_lo(n_pair_scalars), slope_hi(n_pair_scalars)
+    integer :: k, nt, k0, m, fam
+    real(dp) :: xin, s_end, slope_lo(n_pair_scalars), slope_hi(n_pair_scalars), g(3), sig, mm, h
+    real(dp) :: x11, x12, f0(n_pair_scalars), fp(n_pair_scalars), fm(n_pair_scalars)
     if (spline_ready) return
-    nt = resistance_table_size
-    k0 = 1
-    do while (resistance_table_sep(k0) - 2.0_dp < near_join_gap * (1.0_dp - 1.0e-9_dp))
-      k0 = k0 + 1
+    ! Residual series coefficients (needed by series_scalars, which the rest below calls).
+    series_res = 0.0_dp
+    do k = 1, n_pair_scalars
+      fam = series_family(k)
+      if (fam == 0) cycle
+      sig = series_sign(k)
+      g = sig * [near_g1(k), near_g2(k), near_g3(k)]
+      if (series_parity(k) == 0) series_res(0, k) = sig * resistance_series_coef(0, fam)
+      do m = 1, resistance_series_nmax
+        if (mod(m, 2) /= series_parity(k)) cycle
+        mm = real(m, dp)
+        series_res(m, k) = sig * (resistance_series_coef(m, fam) - g(1) - 2.0_dp * g(2) / mm &
+                                  + 4.0_dp * g(3) / (mm * (mm + 2.0_dp)))
+      end do
     end do
-    first_knot = k0
+    call xc_exact(xc_series_min_gap, x11, x12)
+    xc_lin(1) = (x11 - 0.875_dp * zeta3 + 0.125_dp * xc_series_min_gap * log(1.0_dp / xc_series_min_gap)) &
+                / xc_series_min_gap
+    xc_lin(2) = (x12 + 0.125_dp * zeta3 - 0.125_dp * xc_series_min_gap * log(1.0_dp / xc_series_min_gap)) &
+                / xc_series_min_gap
+    spline_ready = .true.   ! series_scalars is usable from here on
+
+    nt = resistance_table_size
+    join_gap = near_join_gap
+    join_gap([i_zm11, i_zm12]) = zm_join_gap
+    do k = 1, n_pair_scalars
+      k0 = 1
+      do while (resistance_table_sep(k0) - 2.0_dp < join_gap(k) * (1.0_dp - 1.0e-9_dp))
+        k0 = k0 + 1
+      end do
+      join_knot(k) = k0
+    end do
+    first_knot = minval(join_knot)
     knot_x = log(resistance_table_sep - 2.0_dp)
     xin = resistance_table_sep(nt) - 2.0_dp
     s_end = resistance_table_sep(nt)
     do k = 1, nt
       knot_r(k, :) = resistance_table_values(k, :) - singular_part(resistance_table_sep(k) - 2.0_dp)
     end do
-    near_offset = resistance_table_values(k0, :) - near_field_scalars(near_join_gap)
-    far_offset = resistance_table_values(nt, :) - far_field_scalars(s_end)
-    ! End slopes d r / d ln(xi). Below the join the remainder is c + b xi with
-    ! b xi_join = near_offset: slope near_offset at the join. Above the table f = far series +
-    ! tail, whose slope in ln(xi) is xi df/ds, minus the slope of the singular part.
-    slope_lo = near_offset
-    slope_hi = xin * (far_field_slope(s_end) - far_offset * far_tail_power / s_end) &
-               - singular_slope(xin)
+    ! End slopes d r / d ln(xi) of the neighbouring pieces (central differences in ln xi, step
+    ! 1e-4: error ~1e-8 of the slope). Below the near join f = series + near_offset xi/xi_j, whose
+    ! remainder slope is that of (series - singular part) plus near_offset. Above the table
+    ! f = series + far_offset (s_end/s)^p.
+    h = 1.0e-4_dp
+    do k = 1, n_pair_scalars
+      k0 = join_knot(k)
+      f0 = series_scalars(join_gap(k))
+      near_offset(k) = resistance_table_values(k0, k) - f0(k)
+      fp = series_scalars(join_gap(k) * exp(h)) - singular_part(join_gap(k) * exp(h))
+      fm = series_scalars(join_gap(k) * exp(-h)) - singular_part(join_gap(k) * exp(-h))
+      slope_lo(k) = (fp(k) - fm(k)) / (2.0_dp * h) + near_offset(k)
+    end do
+    far_offset = resistance_table_values(nt, :) - series_scalars(xin)
+    slope_hi = (series_scalars(xin * exp(h)) - singular_part(xin * exp(h)) &
+                - series_scalars(xin * exp(-h)) + singular_part(xin * exp(-h))) / (2.0_dp * h) &
+               - xin * far_offset * far_tail_power / s_end
     knot_r2 = 0.0_dp
     do k = 1, n_pair_scalars
+      k0 = join_knot(k)
       call clamped_spline(knot_x(k0:nt), knot_r(k0:nt, k), slope_lo(k), slope_hi(k), &
                           knot_r2(k0:nt, k))
     end do
