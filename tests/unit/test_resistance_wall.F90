@@ -9,15 +9,15 @@
 !      2e-4 for l/a >= 3.76 (method.md 2.8: "to 4 digits").
 !   3. Tangential translation/rotation at delta/a = 1e-3 against O'Neill & Stewartson's (1967)
 !      table as quoted in method.md 2.8: F_xt = 4.640 (f_tt), F_xr = 0.665 (f_tr),
-!      T_yr = 4.184 ((4/3) f_rr): relative error <= 1e-2 (the inner forms are O(eps ln eps)
-!      accurate and the quoted constants differ by 0.5 % between sources).
+!      T_yr = 4.184 ((4/3) f_rr): relative error <= 1e-3 (4 digits; the module evaluates the
+!      exact bispherical solution there; more in test_resistance_wall_tangential).
 !   4. Rotation about the wall normal: by mirror symmetry a sphere twisting next to a no-slip wall
 !      is half of two spheres counter-rotating about their line of centres, so
 !      X_w(eps) = XC11 - XC12 at s = 2 + 2 eps. Checked against the Lamb-method rows of the pair
 !      table (independent data) at 13 gaps, relative error <= 1e-4; X_w -> zeta(3) at contact.
 !   5. The 6x6 sphere-wall resistance is symmetric and positive definite for eps in
 !      [1e-6, 100] (dissipation), and the tangential functions are continuous across the
-!      near/far blend (relative jump < 1e-6 over a 1e-8 step).
+!      exact/inner/far switches (relative jump < 1e-6 over a 1e-8 step).
 !   6. Coupling sign (GCB 1967): a torque-free sphere pushed parallel to the wall (n = +y, force
 !      along +x) rotates in the rolling sense, Om_z < 0, with 0 < -a Om_z / U_x < 1/4 (1/4 is the
 !      contact limit f_tr/((4/3) f_rr) -> (2/15)/(4/3 * 2/5)), at eps = 1e-3, 1e-2, 0.1, 1.
@@ -61,7 +61,7 @@ program test_resistance_wall
     '  (O''Neill & Stewartson: 4.640, 0.665, 4.184)'
   worst = max(abs(f_tt / 4.640_dp - 1.0_dp), abs(f_tr / 0.665_dp - 1.0_dp), &
               abs(4.0_dp / 3.0_dp * f_rr / 4.184_dp - 1.0_dp))
-  call check('3. tangential vs O''Neill & Stewartson at 1e-3, max rel. error', worst, 1.0e-2_dp)
+  call check('3. tangential vs O''Neill & Stewartson at 1e-3, max rel. error', worst, 1.0e-3_dp)
 
   worst = 0.0_dp
   n = 0
@@ -102,7 +102,7 @@ program test_resistance_wall
     worst = max(worst, abs(g_tt - f_tt) / f_tt, abs(g_tr - f_tr) / max(abs(f_tr), 1.0e-2_dp), &
                 abs(g_rr - f_rr) / f_rr)
   end do
-  call check('5. tangential functions continuous across the blend', worst, 1.0e-6_dp)
+  call check('5. tangential functions continuous (0.04 < eps < 0.8)', worst, 1.0e-6_dp)
 
   do k = 1, 4
     eps = 10.0_dp**(k - 4)
