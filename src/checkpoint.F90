@@ -2,6 +2,9 @@
 !   datasets  /u /v /w (face velocities u^n), /p (p^{n-1/2}), /phi (last pressure increment, the
 !             warm start of the next Poisson solve: without it a restart would iterate from
 !             another guess and differ at the solver tolerance)
+!             with particles also /lambda_u /lambda_v /lambda_w (the fictitious-domain force
+!             density Lambda^n, a source of the next fluid step) and the group /particles
+!             (mod_particles_io: positions with attribute box, velocities, Adams-Bashforth history)
 !   attributes format_version, step, time, cells, box, walls, reynolds, dt, shear_rate
 ! Written in parallel to NAME.tmp by PETSc's HDF5 viewer, completed by rank 0, flushed to disk
 ! and renamed over NAME: the previous checkpoint survives until the new one is whole.
@@ -16,6 +19,8 @@ module mod_checkpoint
   use mod_h5util, only: write_attribute, read_attribute, write_string_attribute, has_object
   use mod_system, only: publish_file
   use mod_errors, only: is_root, abort_run, file_error
+  use mod_particles, only: particles_t
+  use mod_particles_io, only: particles_write, particles_read_state
   implicit none
   private
   public :: checkpoint_write, checkpoint_check, checkpoint_read, checkpoint_format_version
@@ -25,13 +30,16 @@ module mod_checkpoint
 
 contains
 
-  subroutine checkpoint_write(path, cfg, fl, step, time, ierr)
+  ! lambda and parts: present when the run has particles.
+  subroutine checkpoint_write(path, cfg, fl, step, time, ierr, lambda, parts)
     character(len=*), intent(in) :: path
     type(config_t), intent(in) :: cfg
     type(fluid_t), intent(inout) :: fl
     integer, intent(in) :: step
     real(dp), intent(in) :: time
     PetscErrorCode, intent(out) :: ierr
+    Vec, intent(in), optional :: lambda(3)
+    type(particles_t), intent(in), optional :: parts
     PetscViewer :: viewer
     integer(HID_T) :: file
     integer :: err, e(10), c, walls
@@ -45,6 +53,11 @@ contains
     end do
     PetscCall(VecView(fl%pressure, viewer, ierr))
     PetscCall(VecView(fl%phi, viewer, ierr))
+    if (present(lambda)) then
+      do c = 1, 3
+        PetscCall(VecView(lambda(c), viewer, ierr))
+      end do
+    end if
     PetscCall(PetscViewerDestroy(viewer, ierr))
 
     if (is_root()) then
@@ -62,6 +75,7 @@ contains
       call write_attribute(file, 'dt', [cfg%dt], e(8))
       call write_attribute(file, 'shear_rate', [cfg%shear_rate], e(9))
       call write_string_attribute(file, 'program', 'fdsusp', e(10))
+      if (present(parts)) call particles_write(file, parts, cfg%box, .true.)
       call h5fclose_f(file, err)
       if (any(e /= 0) .or. err /= 0) call abort_run('cannot write the attributes of '//trim(tmp))
       err = publish_file(tmp, path)
@@ -185,10 +199,12 @@ contains
     call h5fclose_f(file, err)
   end subroutine inspect
 
-  subroutine checkpoint_read(path, fl, ierr)
+  subroutine checkpoint_read(path, fl, ierr, lambda, parts)
     character(len=*), intent(in) :: path
     type(fluid_t), intent(inout) :: fl
     PetscErrorCode, intent(out) :: ierr
+    Vec, intent(inout), optional :: lambda(3)
+    type(particles_t), intent(inout), optional :: parts
     PetscViewer :: viewer
     integer :: c
     PetscCall(PetscViewerHDF5Open(PETSC_COMM_WORLD, trim(path), FILE_MODE_READ, viewer, ierr))
@@ -197,7 +213,13 @@ contains
     end do
     PetscCall(VecLoad(fl%pressure, viewer, ierr))
     PetscCall(VecLoad(fl%phi, viewer, ierr))
+    if (present(lambda)) then
+      do c = 1, 3
+        PetscCall(VecLoad(lambda(c), viewer, ierr))
+      end do
+    end if
     PetscCall(PetscViewerDestroy(viewer, ierr))
+    if (present(parts)) call particles_read_state(path, parts)
   end subroutine checkpoint_read
 
 end module mod_checkpoint

@@ -78,6 +78,7 @@ contains
     PetscCall(PetscObjectSetName(fl%phi, 'phi', ierr))
 
     call set_forcing(cfg, grid, fl, ierr)
+    if (cfg%initial_flow == 'shear' .and. grid%walls) call set_linear_shear(grid, fl, ierr)
 
     call solvers_configure(fl%reynolds / fl%dt, fl%theta * fl%viscosity, grid%box, grid%walls)
     ! Round-off floor of each solve: 100 machine epsilons of the right-hand side that a field of
@@ -124,6 +125,22 @@ contains
     end do
   end subroutine set_forcing
 
+  ! u = U (2y/Ly - 1): the steady Couette profile, exact on the grid (the wall ghosts reproduce it).
+  subroutine set_linear_shear(grid, fl, ierr)
+    type(grid_t), intent(in) :: grid
+    type(fluid_t), intent(inout) :: fl
+    PetscErrorCode, intent(out) :: ierr
+    PetscScalar, pointer :: a(:,:,:)
+    integer :: j
+    real(dp) :: y
+    PetscCall(DMDAVecGetArrayF90(grid%da(FIELD_U), fl%vel(FIELD_U), a, ierr))
+    do j = grid%lo(2), grid%hi(2)
+      y = (j + 0.5_dp) * grid%h
+      a(:, j, :) = fl%wall_speed * (2.0_dp * y / grid%box(2) - 1.0_dp)
+    end do
+    PetscCall(DMDAVecRestoreArrayF90(grid%da(FIELD_U), fl%vel(FIELD_U), a, ierr))
+  end subroutine set_linear_shear
+
   ! Wall velocity seen by component c at the bottom (side = -1) or top (side = +1) wall.
   pure real(dp) function wall_velocity(fl, c, side)
     type(fluid_t), intent(in) :: fl
@@ -159,10 +176,12 @@ contains
     fixed_row = grid%walls .and. c == FIELD_V .and. j == 0
   end function fixed_row
 
-  subroutine fluid_step(grid, fl, ierr)
+  ! source: an extra force density on the u, v, w faces (the fictitious-domain Lambda^n).
+  subroutine fluid_step(grid, fl, ierr, source)
     type(grid_t), intent(in) :: grid
     type(fluid_t), intent(inout) :: fl
     PetscErrorCode, intent(out) :: ierr
+    Vec, intent(in), optional :: source(3)
     PetscScalar, pointer :: a(:,:,:), p(:,:,:), r(:,:,:), f(:,:,:), ph(:,:,:), ds(:,:,:)
     integer :: c, i, j, k, e(3), ny
     real(dp) :: h, mass, lap, explicit, implicit, wall_term, rate
@@ -209,6 +228,10 @@ contains
       PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), fl%forcing(c), f, ierr))
       PetscCall(DMDAVecRestoreArrayF90(grid%da(c), fl%rhs(c), r, ierr))
       PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), fl%loc(c), a, ierr))
+      if (present(source)) then
+        PetscCall(VecAXPY(fl%rhs(c), 1.0_dp, source(c), ierr))
+        ! the wall row of v stays a fixed row (v = 0): a particle never forces it
+      end if
       PetscCall(VecCopy(fl%vel(c), fl%vel_star(c), ierr))    ! warm start from u^n
       call solver_solve(fl%solver(c), fl%rhs(c), fl%vel_star(c), ierr)
     end do

@@ -15,7 +15,11 @@ program fdsusp
   use mod_output, only: write_fields, progress_line
   use mod_checkpoint, only: checkpoint_write, checkpoint_check, checkpoint_read
   use mod_system, only: install_signal_handlers, stop_signal, make_directory, probe_directory
-  use mod_timers, only: timers_register, stage_push, stage_pop, STAGE_SETUP, STAGE_FLUID, STAGE_OUTPUT
+  use mod_timers, only: timers_register, stage_push, stage_pop, STAGE_SETUP, STAGE_FLUID, STAGE_OUTPUT, &
+                        STAGE_PARTICLES
+  use mod_particles, only: particles_t, advance_positions
+  use mod_particles_io, only: particles_load
+  use mod_fictitious_domain, only: fd_t, fd_create, fd_geometry, fd_particle_step, fd_destroy
   use mod_h5util, only: h5util_init
   use mod_solvers, only: solver_cold_solve
   use mod_grid, only: FIELD_P
@@ -26,6 +30,10 @@ program fdsusp
   type(grid_t) :: grid
   type(fluid_t) :: fl
   type(series_t) :: series
+  type(particles_t) :: parts
+  type(fd_t) :: fd
+  logical :: has_particles
+  integer, allocatable :: shapes(:, :)
   character(len=max_line) :: deck, restart, checkpoint_path
   character(len=200) :: text
   character(len=32), allocatable :: columns(:)
@@ -47,6 +55,8 @@ program fdsusp
   call log_line('fdsusp: '//trim(cfg%title))
   call echo_deck(cfg)
   call prepare_output_directory(cfg)
+  call particles_load(cfg, parts)
+  has_particles = parts%n > 0
   checkpoint_path = trim(cfg%output_directory)//'/checkpoint.h5'
   step = 0
   time = 0.0_dp
@@ -61,17 +71,38 @@ program fdsusp
   PetscCallA(stage_push(STAGE_SETUP, ierr))
   PetscCallA(grid_create(cfg, grid, ierr))
   PetscCallA(fluid_create(cfg, grid, fl, ierr))
+  if (has_particles) then
+    PetscCallA(fd_create(grid, cfg%reynolds, cfg%dt, cfg%slip_kappa, cfg%radius_offset, fd, ierr))
+  end if
   if (restarting) then
-    PetscCallA(checkpoint_read(restart, fl, ierr))
+    if (has_particles) then
+      PetscCallA(checkpoint_read(restart, fl, ierr, fd%lambda, parts))
+    else
+      PetscCallA(checkpoint_read(restart, fl, ierr))
+    end if
   end if
   columns = [character(len=32) :: 'step', 'time', 'wall_time', 'tau_wall_bottom', 'tau_wall_top', &
              'divergence', 'rate_of_change', 'iterations_u', 'iterations_v', 'iterations_w', 'iterations_p']
   if (cfg%manufactured_solution) columns = [character(len=32) :: columns, 'mms_error_velocity_max', &
              'mms_error_pressure_max', 'mms_error_pressure_rms']
-  call series_open(series, cfg%output_directory, columns, merge(step, -1, restarting))
+  allocate(shapes(3, size(columns)))
+  shapes = 0
+  if (has_particles) then
+    columns = [character(len=32) :: columns, 'particles/position', 'particles/velocity', 'particles/omega', &
+               'particles/force_hydro', 'particles/torque_hydro', 'particles/stresslet_hydro']
+    shapes = reshape([shapes, [3, parts%n, 0], [3, parts%n, 0], [3, parts%n, 0], [3, parts%n, 0], &
+                      [3, parts%n, 0], [3, 3, parts%n]], [3, size(columns)])
+  end if
+  call series_open(series, cfg%output_directory, columns, merge(step, -1, restarting), shapes)
   call install_signal_handlers()
   PetscCallA(stage_pop(ierr))
-  call log_line('models: fluid (unsteady Stokes, projection); no particles in this deck')
+  if (has_particles) then
+    write(text, '(a,i0,a)') 'models: fluid (unsteady Stokes, projection); ', parts%n, &
+         ' rigid spheres (fictitious domain, motion '''//trim(cfg%motion)//'''); no contacts, no lubrication yet'
+    call log_line(text)
+  else
+    call log_line('models: fluid (unsteady Stokes, projection); no particles in this deck')
+  end if
   ! -bench_cold_poisson: time one pressure solve from a zero guess to 1e-8 (doc/BENCHMARKS.md)
   PetscCallA(PetscOptionsHasName(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-bench_cold_poisson', bench_cold, ierr))
   if (bench_cold) then
@@ -87,9 +118,22 @@ program fdsusp
   stop_reason = RUNNING
   if (step >= cfg%steps) stop_reason = DONE
   do while (stop_reason == RUNNING)
-    PetscCallA(stage_push(STAGE_FLUID, ierr))
-    PetscCallA(fluid_step(grid, fl, ierr))
-    PetscCallA(stage_pop(ierr))
+    if (has_particles) then
+      PetscCallA(stage_push(STAGE_PARTICLES, ierr))
+      call fd_geometry(grid, fd, parts)
+      PetscCallA(stage_pop(ierr))
+      PetscCallA(stage_push(STAGE_FLUID, ierr))
+      PetscCallA(fluid_step(grid, fl, ierr, fd%lambda))
+      PetscCallA(stage_pop(ierr))
+      PetscCallA(stage_push(STAGE_PARTICLES, ierr))
+      PetscCallA(fd_particle_step(grid, fd, fl%vel, fl%pressure, parts, ierr))
+      call advance_positions(parts, cfg%dt, cfg%box, [.true., .not. cfg%walls, .true.])
+      PetscCallA(stage_pop(ierr))
+    else
+      PetscCallA(stage_push(STAGE_FLUID, ierr))
+      PetscCallA(fluid_step(grid, fl, ierr))
+      PetscCallA(stage_pop(ierr))
+    end if
     iterations_sum = iterations_sum + [fl%solver(1)%iterations, fl%solver(2)%iterations, &
                                        fl%solver(3)%iterations, fl%solver(4)%iterations]
     step = step + 1
@@ -153,6 +197,9 @@ program fdsusp
   write(text, '(a,f10.2,a)') 'wall time ', MPI_Wtime() - wall_start, ' s'
   call log_line(text)
 
+  if (has_particles) then
+    PetscCallA(fd_destroy(fd, ierr))
+  end if
   PetscCallA(fluid_destroy(fl, ierr))
   PetscCallA(grid_destroy(grid, ierr))
   PetscCallA(PetscFinalize(ierr))
@@ -203,6 +250,7 @@ contains
   subroutine record()
     real(dp) :: values(14)
     integer :: n
+    real(dp), allocatable :: row(:)
     values(1:11) = [real(step, dp), time, MPI_Wtime() - wall_start, fl%tau_bottom, fl%tau_top, &
                     fl%divergence, fl%max_rate, real(fl%solver(1)%iterations, dp), &
                     real(fl%solver(2)%iterations, dp), real(fl%solver(3)%iterations, dp), &
@@ -213,12 +261,23 @@ contains
       values(12:14) = [err_vel, err_p_max, err_p_rms]
       n = 14
     end if
-    call series_record(series, values(1:n))
+    if (has_particles) then
+      row = [values(1:n), reshape(parts%position, [3 * parts%n]), reshape(parts%velocity, [3 * parts%n]), &
+             reshape(parts%omega, [3 * parts%n]), reshape(parts%force_hydro, [3 * parts%n]), &
+             reshape(parts%torque_hydro, [3 * parts%n]), reshape(parts%stresslet_hydro, [9 * parts%n])]
+      call series_record(series, row)
+    else
+      call series_record(series, values(1:n))
+    end if
   end subroutine record
 
   subroutine checkpoint()
     call series_flush(series)
-    PetscCallA(checkpoint_write(checkpoint_path, cfg, fl, step, time, ierr))
+    if (has_particles) then
+      PetscCallA(checkpoint_write(checkpoint_path, cfg, fl, step, time, ierr, fd%lambda, parts))
+    else
+      PetscCallA(checkpoint_write(checkpoint_path, cfg, fl, step, time, ierr))
+    end if
   end subroutine checkpoint
 
   ! Collective: every rank takes the same decision.

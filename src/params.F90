@@ -12,12 +12,13 @@ module mod_params
   use mod_errors, only: input_error, log_line, is_root
   implicit none
   private
-  public :: config_t, read_deck, echo_deck, max_line
+  public :: config_t, read_deck, echo_deck, max_line, max_inline_particles
 
   integer, parameter :: max_line = 1024
-  integer, parameter :: ngroups = 6
+  integer, parameter :: max_inline_particles = 64
+  integer, parameter :: ngroups = 7
   character(len=16), parameter :: known_groups(ngroups) = [character(len=16) :: &
-       'domain', 'fluid', 'time', 'output', 'run', 'verification']
+       'domain', 'fluid', 'time', 'output', 'run', 'verification', 'particles']
 
   type :: config_t
     character(len=max_line) :: deck_file = ''
@@ -32,6 +33,7 @@ module mod_params
     real(dp) :: velocity_tolerance = 1.0e-8_dp          ! KSP rtol of the Helmholtz solves [-]
     real(dp) :: pressure_tolerance = 1.0e-10_dp         ! KSP rtol of the pressure Poisson solve [-]
     real(dp) :: viscous_theta = 0.5_dp                  ! 0.5 Crank-Nicolson, 1 backward Euler [-]
+    character(len=16) :: initial_flow = 'rest'          ! 'rest' or 'shear' (the linear Couette profile)
     ! &time
     real(dp) :: dt = 1.0e-3_dp                          ! time step [1/gamma_dot]
     integer :: steps = 1000                             ! number of steps of this run [-]
@@ -47,6 +49,18 @@ module mod_params
     real(dp) :: max_wall_hours = 0.0_dp                 ! checkpoint and stop after this (0: never)
     ! &verification
     logical :: manufactured_solution = .false.          ! force with the manufactured solution
+    ! &particles (inline arrays hold up to max_inline_particles; larger sets come from a file)
+    integer :: particle_number = 0                      ! particles given inline
+    real(dp) :: particle_position(3, max_inline_particles) = 0.0_dp     ! centres [a]
+    character(len=max_line) :: position_file = ''       ! HDF5 file with particles/position
+    real(dp) :: radius = 1.0_dp                         ! sphere radius [a]
+    character(len=16) :: motion = 'free'                ! 'free', 'prescribed' or 'frozen'
+    real(dp) :: particle_velocity(3, max_inline_particles) = 0.0_dp    ! prescribed U [a*gamma_dot]
+    real(dp) :: particle_omega(3, max_inline_particles) = 0.0_dp       ! prescribed Omega [gamma_dot]
+    real(dp) :: external_force(3, max_inline_particles) = 0.0_dp       ! [eta*gamma_dot*a^2]
+    real(dp) :: external_torque(3, max_inline_particles) = 0.0_dp      ! [eta*gamma_dot*a^3]
+    real(dp) :: radius_offset = 0.38_dp                 ! alpha radius = radius + offset*h [h]
+    real(dp) :: slip_kappa = 0.5_dp                     ! relaxation on partly covered faces [-]
     ! derived, not read
     integer :: cells(3) = 0
     logical :: walls = .true.
@@ -113,7 +127,7 @@ contains
       if (.not. any(known_groups == name)) then
         write(lnum, '(i0)') l
         call input_error(deck, trim(name), '', 'unknown group (line '//trim(lnum)// &
-             '); known groups: &domain &fluid &time &output &run &verification')
+             '); known groups: &domain &fluid &time &output &run &verification &particles')
       end if
     end do
   end subroutine check_group_names
@@ -264,6 +278,7 @@ contains
     character(len=16) :: y_boundary
     ! &fluid
     real(dp) :: reynolds, body_force(3), velocity_tolerance, pressure_tolerance, viscous_theta
+    character(len=16) :: initial_flow
     ! &time
     real(dp) :: dt, steady_tolerance
     integer :: steps
@@ -275,8 +290,17 @@ contains
     real(dp) :: max_wall_hours
     ! &verification
     logical :: manufactured_solution
+    ! &particles
+    integer :: number
+    real(dp) :: position(3, max_inline_particles), radius, radius_offset, slip_kappa
+    real(dp) :: velocity(3, max_inline_particles), omega(3, max_inline_particles)
+    real(dp) :: external_force(3, max_inline_particles), external_torque(3, max_inline_particles)
+    character(len=max_line) :: position_file
+    character(len=16) :: motion
+    namelist /particles/ number, position, position_file, radius, motion, velocity, omega, &
+         external_force, external_torque, radius_offset, slip_kappa
     namelist /domain/ box, cells_per_radius, y_boundary, shear_rate
-    namelist /fluid/ reynolds, body_force, velocity_tolerance, pressure_tolerance, viscous_theta
+    namelist /fluid/ reynolds, body_force, velocity_tolerance, pressure_tolerance, viscous_theta, initial_flow
     namelist /time/ dt, steps, steady_tolerance
     namelist /output/ directory, progress_every, series_every, fields_every, checkpoint_every
     namelist /run/ title, max_wall_hours
@@ -287,13 +311,18 @@ contains
     y_boundary = cfg%y_boundary; shear_rate = cfg%shear_rate
     reynolds = cfg%reynolds; body_force = cfg%body_force
     velocity_tolerance = cfg%velocity_tolerance; pressure_tolerance = cfg%pressure_tolerance
-    viscous_theta = cfg%viscous_theta
+    viscous_theta = cfg%viscous_theta; initial_flow = cfg%initial_flow
     dt = cfg%dt; steps = cfg%steps; steady_tolerance = cfg%steady_tolerance
     directory = cfg%output_directory; progress_every = cfg%progress_every
     series_every = cfg%series_every; fields_every = cfg%fields_every
     checkpoint_every = cfg%checkpoint_every
     title = cfg%title; max_wall_hours = cfg%max_wall_hours
     manufactured_solution = cfg%manufactured_solution
+    number = cfg%particle_number; position = cfg%particle_position; position_file = cfg%position_file
+    radius = cfg%radius; motion = cfg%motion; velocity = cfg%particle_velocity
+    omega = cfg%particle_omega; external_force = cfg%external_force
+    external_torque = cfg%external_torque; radius_offset = cfg%radius_offset
+    slip_kappa = cfg%slip_kappa
 
     stat = 0
     if (present(src)) then
@@ -304,6 +333,7 @@ contains
       case ('output');       read(src, nml=output, iostat=stat, iomsg=msg)
       case ('run');          read(src, nml=run, iostat=stat, iomsg=msg)
       case ('verification'); read(src, nml=verification, iostat=stat, iomsg=msg)
+      case ('particles');    read(src, nml=particles, iostat=stat, iomsg=msg)
       end select
       if (present(ios)) ios = stat
       if (stat /= 0) return
@@ -311,13 +341,18 @@ contains
       cfg%y_boundary = to_lower(y_boundary); cfg%shear_rate = shear_rate
       cfg%reynolds = reynolds; cfg%body_force = body_force
       cfg%velocity_tolerance = velocity_tolerance; cfg%pressure_tolerance = pressure_tolerance
-      cfg%viscous_theta = viscous_theta
+      cfg%viscous_theta = viscous_theta; cfg%initial_flow = to_lower(initial_flow)
       cfg%dt = dt; cfg%steps = steps; cfg%steady_tolerance = steady_tolerance
       cfg%output_directory = directory; cfg%progress_every = progress_every
       cfg%series_every = series_every; cfg%fields_every = fields_every
       cfg%checkpoint_every = checkpoint_every
       cfg%title = title; cfg%max_wall_hours = max_wall_hours
       cfg%manufactured_solution = manufactured_solution
+      cfg%particle_number = number; cfg%particle_position = position
+      cfg%position_file = position_file; cfg%radius = radius; cfg%motion = to_lower(motion)
+      cfg%particle_velocity = velocity; cfg%particle_omega = omega
+      cfg%external_force = external_force; cfg%external_torque = external_torque
+      cfg%radius_offset = radius_offset; cfg%slip_kappa = slip_kappa
     end if
     if (present(echo_unit)) then
       select case (group)
@@ -327,9 +362,36 @@ contains
       case ('output');       write(echo_unit, nml=output)
       case ('run');          write(echo_unit, nml=run)
       case ('verification'); write(echo_unit, nml=verification)
+      case ('particles');    call echo_particles(echo_unit, cfg)
       end select
     end if
   end subroutine group_io
+
+  ! &particles echoed with its inline arrays cut to the particles given (not 64 x 3 zeros each).
+  subroutine echo_particles(unit, cfg)
+    integer, intent(in) :: unit
+    type(config_t), intent(in) :: cfg
+    integer :: number
+    real(dp) :: radius, radius_offset, slip_kappa
+    character(len=max_line) :: position_file
+    character(len=16) :: motion
+    namelist /particles/ number, position_file, radius, motion, radius_offset, slip_kappa
+    integer :: p
+    number = cfg%particle_number; position_file = cfg%position_file; radius = cfg%radius
+    motion = cfg%motion; radius_offset = cfg%radius_offset; slip_kappa = cfg%slip_kappa
+    write(unit, nml=particles)
+    do p = 1, cfg%particle_number
+      write(unit, '(a,i0,a,3(es23.15e3,:,","))') ' position(:,', p, ')=', cfg%particle_position(:, p)
+      if (any(cfg%particle_velocity(:, p) /= 0.0_dp)) &
+        write(unit, '(a,i0,a,3(es23.15e3,:,","))') ' velocity(:,', p, ')=', cfg%particle_velocity(:, p)
+      if (any(cfg%particle_omega(:, p) /= 0.0_dp)) &
+        write(unit, '(a,i0,a,3(es23.15e3,:,","))') ' omega(:,', p, ')=', cfg%particle_omega(:, p)
+      if (any(cfg%external_force(:, p) /= 0.0_dp)) &
+        write(unit, '(a,i0,a,3(es23.15e3,:,","))') ' external_force(:,', p, ')=', cfg%external_force(:, p)
+      if (any(cfg%external_torque(:, p) /= 0.0_dp)) &
+        write(unit, '(a,i0,a,3(es23.15e3,:,","))') ' external_torque(:,', p, ')=', cfg%external_torque(:, p)
+    end do
+  end subroutine echo_particles
 
   ! The effective deck (defaults included), at the top of the run log. The compiler pads
   ! character values to their declared length; the padding is removed for reading.
@@ -430,6 +492,9 @@ contains
     call check_real(cfg, 'fluid', 'velocity_tolerance', cfg%velocity_tolerance, 1.0e-15_dp, 0.1_dp)
     call check_real(cfg, 'fluid', 'pressure_tolerance', cfg%pressure_tolerance, 1.0e-15_dp, 0.1_dp)
     call check_real(cfg, 'fluid', 'viscous_theta', cfg%viscous_theta, 0.5_dp, 1.0_dp)
+    if (cfg%initial_flow /= 'rest' .and. cfg%initial_flow /= 'shear') &
+      call input_error(cfg%deck_file, 'fluid', 'initial_flow', 'must be ''rest'' or ''shear'', not '''// &
+           trim(cfg%initial_flow)//'''')
 
     call check_real(cfg, 'time', 'dt', cfg%dt, 0.0_dp, 10.0_dp, .true.)
     call check_int(cfg, 'time', 'steps', cfg%steps, 0, 1000000000)
@@ -444,9 +509,38 @@ contains
 
     call check_real(cfg, 'run', 'max_wall_hours', cfg%max_wall_hours, 0.0_dp, 1.0e5_dp)
 
+    call validate_particles(cfg)
+
     if (cfg%manufactured_solution .and. any(cfg%body_force /= 0.0_dp)) &
       call input_error(cfg%deck_file, 'verification', 'manufactured_solution', &
            'the manufactured solution brings its own forcing: set &fluid body_force = 0')
   end subroutine validate
+
+  ! Ranges of &particles; positions given inline are checked against the box here, those from a
+  ! file by mod_particles_io when it reads them (same rules, mod_particles::configuration_fault).
+  subroutine validate_particles(cfg)
+    type(config_t), intent(inout) :: cfg
+    logical :: exists
+    call check_int(cfg, 'particles', 'number', cfg%particle_number, 0, max_inline_particles)
+    call check_real(cfg, 'particles', 'radius', cfg%radius, 0.0_dp, 100.0_dp, .true.)
+    if (all(cfg%motion /= [character(len=16) :: 'free', 'prescribed', 'frozen'])) &
+      call input_error(cfg%deck_file, 'particles', 'motion', 'must be ''free'', ''prescribed'' or ''frozen'', not '''// &
+           trim(cfg%motion)//'''')
+    call check_real(cfg, 'particles', 'radius_offset', cfg%radius_offset, -2.0_dp, 2.0_dp)
+    call check_real(cfg, 'particles', 'slip_kappa', cfg%slip_kappa, 0.0_dp, 100.0_dp)
+    if (len_trim(cfg%position_file) > 0) then
+      if (cfg%particle_number > 0) &
+        call input_error(cfg%deck_file, 'particles', 'position_file', &
+             'give the particles either inline (number, position) or in position_file, not both')
+      inquire(file=trim(cfg%position_file), exist=exists)
+      if (.not. exists) call input_error(cfg%deck_file, 'particles', 'position_file', &
+           '"'//trim(cfg%position_file)//'" does not exist')
+      if (cfg%motion == 'prescribed') call input_error(cfg%deck_file, 'particles', 'motion', &
+           'prescribed velocities are given inline: use number and position, not position_file')
+    end if
+    if (cfg%radius + cfg%radius_offset * cfg%h < 1.5_dp * cfg%h) &
+      call input_error(cfg%deck_file, 'particles', 'radius', &
+           'the sphere must span at least 1.5 grid cells in radius (raise &domain cells_per_radius)')
+  end subroutine validate_particles
 
 end module mod_params

@@ -1,4 +1,7 @@
-! series.h5: one record per output step, one 1-D dataset per quantity (design.md "Files").
+! series.h5: one record per output step, one dataset per quantity (design.md "Files"): scalars
+! as 1-D datasets (records), per-particle quantities with a per-record shape, e.g. (3, N) in
+! Fortran order, which C and Python see as records x N x 3 (particles/velocity) or, for (3, 3, N),
+! records x N x 3 x 3 (particles/stresslet_hydro).
 ! Rank 0 buffers the records and appends them when flushed (at progress lines, checkpoints and
 ! the end of the run), opening and closing the file each time, so that a killed run leaves a
 ! readable file. On restart the file is cut back to the checkpoint's step, so that a continued
@@ -15,7 +18,9 @@ module mod_series
   type :: series_t
     character(len=1024) :: path = ''
     character(len=64), allocatable :: names(:)
-    real(dp), allocatable :: buffer(:, :)    ! (quantity, record)
+    integer, allocatable :: shapes(:, :)     ! (3, column): per-record shape, 0 where unused
+    integer, allocatable :: first(:)         ! offset of each column in a record
+    real(dp), allocatable :: buffer(:, :)    ! (value, record)
     integer :: nbuf = 0
   end type series_t
 
@@ -25,18 +30,26 @@ contains
 
   ! Create OUTDIR/series.h5 with the given quantities, or, when restarting from step
   ! restart_step (>= 0), keep the records up to that step. names(1) must be 'step'.
-  subroutine series_open(s, outdir, names, restart_step)
+  ! shapes(:, c): the per-record shape of column c, 0 where unused (absent or all 0: a scalar).
+  subroutine series_open(s, outdir, names, restart_step, shapes)
     type(series_t), intent(inout) :: s
     character(len=*), intent(in) :: outdir
     character(len=*), intent(in) :: names(:)
     integer, intent(in) :: restart_step
+    integer, intent(in), optional :: shapes(:, :)
     integer(HID_T) :: file
     logical :: exists, fits
     integer :: err, c
 
-    allocate(s%names(size(names)))
+    allocate(s%names(size(names)), s%shapes(3, size(names)), s%first(size(names) + 1))
     s%names = names
-    allocate(s%buffer(size(names), 256))
+    s%shapes = 0
+    if (present(shapes)) s%shapes = shapes
+    s%first(1) = 1
+    do c = 1, size(names)
+      s%first(c + 1) = s%first(c) + product(max(1, s%shapes(:, c)))
+    end do
+    allocate(s%buffer(s%first(size(names) + 1) - 1, 256))
     s%nbuf = 0
     s%path = trim(outdir)//'/series.h5'
     if (.not. is_root()) return
@@ -58,26 +71,45 @@ contains
     call h5fcreate_f(trim(s%path), H5F_ACC_TRUNC_F, file, err)
     if (err /= 0) call abort_run('cannot create '//trim(s%path))
     do c = 1, size(names)
-      call create_column(file, trim(names(c)), c == 1)
+      call create_column(file, trim(names(c)), c == 1, s%shapes(:, c))
     end do
     call h5fclose_f(file, err)
   end subroutine series_open
 
-  subroutine create_column(file, name, is_integer)
+  ! Rank of a column's dataset: its per-record dimensions (those > 0) plus records.
+  pure integer function column_rank(shape)
+    integer, intent(in) :: shape(3)
+    column_rank = count(shape > 0) + 1
+  end function column_rank
+
+  subroutine create_column(file, name, is_integer, shape)
     integer(HID_T), intent(in) :: file
     character(len=*), intent(in) :: name
     logical, intent(in) :: is_integer
-    integer(HID_T) :: space, plist, dset, dtype
-    integer(HSIZE_T) :: dims(1), maxdims(1), chunks(1)
-    integer :: err
-    dims = 0
-    maxdims = H5S_UNLIMITED_F
-    chunks = chunk
+    integer, intent(in) :: shape(3)
+    integer(HID_T) :: space, plist, dset, dtype, group
+    integer(HSIZE_T) :: dims(4), maxdims(4), chunks(4)
+    integer :: err, rank, slash
+    rank = column_rank(shape)
+    dims(1:rank - 1) = shape(1:rank - 1)
+    dims(rank) = 0
+    maxdims = dims
+    maxdims(rank) = H5S_UNLIMITED_F
+    chunks = dims
+    chunks(rank) = max(1_HSIZE_T, chunk / product(max(1_HSIZE_T, dims(1:rank - 1))))
     dtype = H5T_NATIVE_DOUBLE
     if (is_integer) dtype = H5T_NATIVE_INTEGER
-    call h5screate_simple_f(1, dims, space, err, maxdims)
+    ! a name with a '/' lives in a group (particles/velocity)
+    slash = index(name, '/')
+    if (slash > 0) then
+      if (.not. has_object(file, name(1:slash - 1))) then
+        call h5gcreate_f(file, name(1:slash - 1), group, err)
+        call h5gclose_f(group, err)
+      end if
+    end if
+    call h5screate_simple_f(rank, dims(1:rank), space, err, maxdims(1:rank))
     call h5pcreate_f(H5P_DATASET_CREATE_F, plist, err)
-    call h5pset_chunk_f(plist, 1, chunks, err)
+    call h5pset_chunk_f(plist, rank, chunks(1:rank), err)
     call h5dcreate_f(file, name, dtype, space, dset, err, plist)
     if (err /= 0) call abort_run('cannot create dataset '//name//' in series.h5')
     call h5dclose_f(dset, err)
@@ -91,9 +123,9 @@ contains
     integer, intent(in) :: last_step
     character(len=*), intent(in) :: names(:)
     integer(HID_T) :: dset, space
-    integer(HSIZE_T) :: dims(1), maxdims(1), keep(1)
+    integer(HSIZE_T) :: dims(1), maxdims(1), keep(1), cdims(4), cmax(4)
     integer, allocatable :: steps(:)
-    integer :: err, c
+    integer :: err, c, rank
     call h5dopen_f(file, 'step', dset, err)
     call h5dget_space_f(dset, space, err)
     call h5sget_simple_extent_dims_f(space, dims, maxdims, err)
@@ -104,12 +136,18 @@ contains
     keep = count(steps <= last_step)
     do c = 1, size(names)
       call h5dopen_f(file, trim(names(c)), dset, err)
-      call h5dset_extent_f(dset, keep, err)
+      call h5dget_space_f(dset, space, err)
+      call h5sget_simple_extent_ndims_f(space, rank, err)
+      call h5sget_simple_extent_dims_f(space, cdims(1:rank), cmax(1:rank), err)
+      call h5sclose_f(space, err)
+      cdims(rank) = keep(1)
+      call h5dset_extent_f(dset, cdims(1:rank), err)
       call h5dclose_f(dset, err)
     end do
   end subroutine cut_back
 
-  ! Add one record (values in the order of names; values(1) is the step).
+  ! Add one record (values in the order of names, each column's values flattened in Fortran
+  ! order; values(1) is the step).
   subroutine series_record(s, values)
     type(series_t), intent(inout) :: s
     real(dp), intent(in) :: values(:)
@@ -128,27 +166,32 @@ contains
   subroutine series_flush(s)
     type(series_t), intent(inout) :: s
     integer(HID_T) :: file, dset, fspace, mspace
-    integer(HSIZE_T) :: dims(1), maxdims(1), newdims(1), offset(1), count(1)
-    integer :: err, c
+    integer(HSIZE_T) :: dims(4), maxdims(4), offset(4), count(4)
+    integer :: err, c, rank
+    real(dp), allocatable :: block(:, :)
     if (.not. is_root() .or. s%nbuf == 0) return
     call h5fopen_f(trim(s%path), H5F_ACC_RDWR_F, file, err)
     if (err /= 0) call abort_run('cannot open '//trim(s%path)//' to append the series')
-    count = s%nbuf
     do c = 1, size(s%names)
+      rank = column_rank(s%shapes(:, c))
       call h5dopen_f(file, trim(s%names(c)), dset, err)
       call h5dget_space_f(dset, fspace, err)
-      call h5sget_simple_extent_dims_f(fspace, dims, maxdims, err)
+      call h5sget_simple_extent_dims_f(fspace, dims(1:rank), maxdims(1:rank), err)
       call h5sclose_f(fspace, err)
-      offset = dims
-      newdims = dims + count
-      call h5dset_extent_f(dset, newdims, err)
+      offset = 0
+      offset(rank) = dims(rank)
+      count(1:rank) = dims(1:rank)
+      count(rank) = s%nbuf
+      dims(rank) = dims(rank) + s%nbuf
+      call h5dset_extent_f(dset, dims(1:rank), err)
       call h5dget_space_f(dset, fspace, err)
-      call h5sselect_hyperslab_f(fspace, H5S_SELECT_SET_F, offset, count, err)
-      call h5screate_simple_f(1, count, mspace, err)
+      call h5sselect_hyperslab_f(fspace, H5S_SELECT_SET_F, offset(1:rank), count(1:rank), err)
+      call h5screate_simple_f(rank, count(1:rank), mspace, err)
+      block = s%buffer(s%first(c):s%first(c + 1) - 1, 1:s%nbuf)
       if (c == 1) then
-        call h5dwrite_f(dset, H5T_NATIVE_INTEGER, nint(s%buffer(c, 1:s%nbuf)), count, err, mspace, fspace)
+        call h5dwrite_f(dset, H5T_NATIVE_INTEGER, nint(block(1, :)), count(1:1), err, mspace, fspace)
       else
-        call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, s%buffer(c, 1:s%nbuf), count, err, mspace, fspace)
+        call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, block, count(1:rank), err, mspace, fspace)
       end if
       if (err /= 0) call abort_run('cannot write '//trim(s%names(c))//' to '//trim(s%path))
       call h5sclose_f(mspace, err)

@@ -6,11 +6,11 @@ module mod_timers
   implicit none
   private
   public :: timers_register, stage_push, stage_pop
-  public :: STAGE_SETUP, STAGE_FLUID, STAGE_OUTPUT
+  public :: STAGE_SETUP, STAGE_FLUID, STAGE_OUTPUT, STAGE_PARTICLES
 
-  integer, parameter :: STAGE_SETUP = 1, STAGE_FLUID = 2, STAGE_OUTPUT = 3
-  character(len=*), parameter :: stage_names(3) = ['Setup ', 'Fluid ', 'Output']
-  PetscLogStage, save :: stages(3)
+  integer, parameter :: STAGE_SETUP = 1, STAGE_FLUID = 2, STAGE_OUTPUT = 3, STAGE_PARTICLES = 4
+  character(len=*), parameter :: stage_names(4) = ['Setup    ', 'Fluid    ', 'Output   ', 'Particles']
+  PetscLogStage, save :: stages(4)
 
 contains
 

@@ -1,0 +1,349 @@
+! The fictitious domain: inertialess rigid spheres in the MAC-grid fluid (method.md §1.4-1.6,
+! with the correction of §1.5b).
+!
+! Lambda is stored as the force density Lambda = rho*lambda on the u, v, w faces (fdsusp units:
+! rho = Re). One time step, given the geometry at X^n:
+!   geometry   solid fraction alpha of every face control volume for a sphere of radius
+!              a + radius_offset*h (§1.5b: the relaxed constraint shrinks the effective sphere);
+!              each face goes to the particle covering most of it (one owner, so sum alpha <= 1);
+!              gamma = kappa (1 - alpha) beta h^2 / eta, beta = rho/dt, weight w = alpha/(1+gamma);
+!              the discrete rigid-body matrix M_p = sum_f w g g^T dV with g the 6-vector such that
+!              (U + Omega x r)_c = g . (U, Omega), i.e. g = (e_c, r x e_c).
+!   fluid      the projection step with Lambda^n as a body force (mod_fluid) -> u~.
+!   particles  beta M U = beta b(u~) - m(Lambda^n) + F_ext    (method.md eq. (1) with the weights)
+!              b = sum_f w u~_c g dV,  m = sum_f Lambda^n_f/(1+gamma) g dV; later models add their
+!              stiffness and forces through mod_particle_system.
+!              Lambda^{n+1} = [Lambda^n + beta alpha (g.U - u~)]/(1 + gamma) on owned faces, 0 elsewhere;
+!              u^{n+1} = u~ + (Lambda^{n+1} - Lambda^n)/beta.
+!   moments    F = -sum Lambda e_c dV, T = -sum r x Lambda e_c dV,
+!              S = -1/2 sum Lambda (r e_c + e_c r) dV - (sum_cells alpha p dV) I   (§1.6: the
+!              trace of the traction moment needs the interior pressure).
+! Particle data is replicated; each rank works on the faces it owns and the moments are summed
+! over ranks, so spheres cross processor boundaries freely and the result does not depend on the
+! decomposition beyond round-off.
+#include <petsc/finclude/petscdmda.h>
+module mod_fictitious_domain
+  use petscdmda
+  use mod_kinds, only: dp
+  use mod_grid, only: grid_t, FIELD_U, FIELD_V, FIELD_W, FIELD_P
+  use mod_particles, only: particles_t, MOTION_FREE, MOTION_PRESCRIBED, MOTION_FROZEN
+  use mod_particle_system, only: particle_system_t, psys_reset, psys_add_diagonal, psys_solve
+  use mod_solid_fraction, only: cube_fraction, relaxation_gamma
+  use mod_errors, only: fatal_error
+  implicit none
+  private
+  public :: fd_t, fd_create, fd_geometry, fd_particle_step, fd_destroy
+
+  type :: fd_t
+    real(dp) :: beta = 0.0_dp           ! rho/dt = Re/dt
+    real(dp) :: kappa = 0.5_dp          ! relaxation constant of §1.5b
+    real(dp) :: radius_offset = 0.38_dp ! in grid cells
+    real(dp) :: eta = 1.0_dp
+    Vec :: lambda(3)                    ! Lambda = rho*lambda on the u, v, w faces
+    ! ownership of the owned faces (and cell centres, c = 4): particle index, alpha
+    integer, allocatable :: owner(:, :, :, :)   ! (lo1:hi1, lo2:hi2, lo3:hi3, 4)
+    real(dp), allocatable :: alpha(:, :, :, :)
+    ! the covered faces and cells of this rank, grouped by nothing (one list)
+    integer :: nf = 0
+    integer, allocatable :: f_comp(:), f_ijk(:, :), f_part(:)
+    real(dp), allocatable :: f_r(:, :), f_alpha(:), f_relax(:)   ! r, alpha, 1/(1+gamma)
+    real(dp), allocatable :: rigid_matrix(:, :, :)               ! M_p (6, 6, n), summed over ranks
+    type(particle_system_t) :: system
+    integer :: solver_iterations = 0
+  end type fd_t
+
+  type :: field_pointer
+    PetscScalar, pointer :: ptr(:, :, :) => null()
+  end type field_pointer
+
+  ! position of unknown c inside its cell, in cells: u on x-faces, v on y-faces, ...
+  real(dp), parameter :: stagger(3, 4) = reshape([0.0_dp, 0.5_dp, 0.5_dp, 0.5_dp, 0.0_dp, 0.5_dp, &
+       0.5_dp, 0.5_dp, 0.0_dp, 0.5_dp, 0.5_dp, 0.5_dp], [3, 4])
+
+contains
+
+  subroutine fd_create(grid, reynolds, dt, kappa, radius_offset, fd, ierr)
+    type(grid_t), intent(in) :: grid
+    real(dp), intent(in) :: reynolds, dt, kappa, radius_offset
+    type(fd_t), intent(inout) :: fd
+    PetscErrorCode, intent(out) :: ierr
+    integer :: c
+    character(len=8), parameter :: names(3) = ['lambda_u', 'lambda_v', 'lambda_w']
+    fd%beta = reynolds / dt
+    fd%kappa = kappa
+    fd%radius_offset = radius_offset
+    do c = 1, 3
+      PetscCall(DMCreateGlobalVector(grid%da(c), fd%lambda(c), ierr))
+      PetscCall(VecSet(fd%lambda(c), 0.0_dp, ierr))
+      PetscCall(PetscObjectSetName(fd%lambda(c), trim(names(c)), ierr))
+    end do
+    allocate(fd%owner(grid%lo(1):grid%hi(1), grid%lo(2):grid%hi(2), grid%lo(3):grid%hi(3), 4))
+    allocate(fd%alpha(grid%lo(1):grid%hi(1), grid%lo(2):grid%hi(2), grid%lo(3):grid%hi(3), 4))
+    allocate(fd%f_comp(1024), fd%f_ijk(3, 1024), fd%f_part(1024), fd%f_r(3, 1024), &
+             fd%f_alpha(1024), fd%f_relax(1024))
+  end subroutine fd_create
+
+  ! The geometry at the current positions: face ownership, alpha, the face list and M_p.
+  ! Collective (M_p is summed over ranks).
+  subroutine fd_geometry(grid, fd, parts)
+    type(grid_t), intent(in) :: grid
+    type(fd_t), intent(inout) :: fd
+    type(particles_t), intent(in) :: parts
+    integer :: q, c, pass, ierr
+    real(dp) :: radius
+
+    radius = parts%radius + fd%radius_offset * grid%h
+    fd%owner = 0
+    fd%alpha = 0.0_dp
+    fd%nf = 0
+    ! pass 1: ownership (the largest alpha wins; ties to the lower index); pass 2: the face list
+    do pass = 1, 2
+      do q = 1, parts%n
+        do c = 1, 4
+          call visit(grid, fd, q, c, parts%position(:, q), radius, pass)
+        end do
+      end do
+    end do
+
+    if (allocated(fd%rigid_matrix)) then
+      if (size(fd%rigid_matrix, 3) /= parts%n) deallocate(fd%rigid_matrix)
+    end if
+    if (.not. allocated(fd%rigid_matrix)) allocate(fd%rigid_matrix(6, 6, parts%n))
+    fd%rigid_matrix = 0.0_dp
+    block
+      integer :: f
+      real(dp) :: g(6), w, dv
+      dv = grid%h**3
+      do f = 1, fd%nf
+        if (fd%f_comp(f) == FIELD_P) cycle
+        g = rigid_row(fd%f_comp(f), fd%f_r(:, f))
+        w = fd%f_alpha(f) * fd%f_relax(f)
+        fd%rigid_matrix(:, :, fd%f_part(f)) = fd%rigid_matrix(:, :, fd%f_part(f)) &
+             + w * dv * spread(g, 2, 6) * spread(g, 1, 6)
+      end do
+    end block
+    call MPI_Allreduce(MPI_IN_PLACE, fd%rigid_matrix, 36 * parts%n, MPI_DOUBLE_PRECISION, MPI_SUM, &
+                       PETSC_COMM_WORLD, ierr)
+  end subroutine fd_geometry
+
+  ! Every unknown of component c (1..4, 4 = cell centres) whose control volume may meet particle q,
+  ! with its owned (wrapped) index and its offset r from the centre (unwrapped, so no image logic).
+  ! Pass 1 claims ownership, pass 2 lists the unknowns particle q owns.
+  subroutine visit(grid, fd, q, c, centre, radius, pass)
+    type(grid_t), intent(in) :: grid
+    type(fd_t), intent(inout) :: fd
+    integer, intent(in) :: q, c, pass
+    real(dp), intent(in) :: centre(3), radius
+    integer :: lo(3), hi(3), i, j, k, ijk(3), d
+    real(dp) :: r(3), a, h, gamma
+    logical :: inside
+    h = grid%h
+    do d = 1, 3
+      lo(d) = floor((centre(d) - radius) / h - stagger(d, c)) - 1
+      hi(d) = ceiling((centre(d) + radius) / h - stagger(d, c)) + 1
+    end do
+    do k = lo(3), hi(3)
+      do j = lo(2), hi(2)
+        do i = lo(1), hi(1)
+          ijk = [i, j, k]
+          inside = .true.
+          do d = 1, 3
+            if (d == 2 .and. grid%walls) then
+              if (j < 0 .or. j >= grid%n(2)) inside = .false.
+            else
+              ijk(d) = modulo(ijk(d), grid%n(d))
+            end if
+            if (ijk(d) < grid%lo(d) .or. ijk(d) > grid%hi(d)) inside = .false.
+          end do
+          if (.not. inside) cycle
+          if (grid%walls .and. c == FIELD_V .and. j == 0) cycle   ! the wall: v = 0 stays
+          r = ([i, j, k] + stagger(:, c)) * h - centre
+          if (pass == 1) then
+            a = cube_fraction(r, radius, h)
+            if (a > fd%alpha(ijk(1), ijk(2), ijk(3), c)) then
+              fd%alpha(ijk(1), ijk(2), ijk(3), c) = a
+              fd%owner(ijk(1), ijk(2), ijk(3), c) = q
+            end if
+          else if (fd%owner(ijk(1), ijk(2), ijk(3), c) == q) then
+            a = fd%alpha(ijk(1), ijk(2), ijk(3), c)
+            gamma = 0.0_dp
+            if (c /= FIELD_P) gamma = relaxation_gamma(a, fd%kappa, fd%beta, h, fd%eta)
+            call push_face(fd, c, ijk, q, r, a, 1.0_dp / (1.0_dp + gamma))
+          end if
+        end do
+      end do
+    end do
+  end subroutine visit
+
+  subroutine push_face(fd, c, ijk, q, r, a, relax)
+    type(fd_t), intent(inout) :: fd
+    integer, intent(in) :: c, ijk(3), q
+    real(dp), intent(in) :: r(3), a, relax
+    integer :: m
+    integer, allocatable :: ti(:), t3(:, :)
+    real(dp), allocatable :: tr(:), tr3(:, :)
+    if (fd%nf == size(fd%f_comp)) then
+      m = 2 * fd%nf
+      allocate(ti(m)); ti(1:fd%nf) = fd%f_comp(1:fd%nf); call move_alloc(ti, fd%f_comp)
+      allocate(ti(m)); ti(1:fd%nf) = fd%f_part(1:fd%nf); call move_alloc(ti, fd%f_part)
+      allocate(t3(3, m)); t3(:, 1:fd%nf) = fd%f_ijk(:, 1:fd%nf); call move_alloc(t3, fd%f_ijk)
+      allocate(tr3(3, m)); tr3(:, 1:fd%nf) = fd%f_r(:, 1:fd%nf); call move_alloc(tr3, fd%f_r)
+      allocate(tr(m)); tr(1:fd%nf) = fd%f_alpha(1:fd%nf); call move_alloc(tr, fd%f_alpha)
+      allocate(tr(m)); tr(1:fd%nf) = fd%f_relax(1:fd%nf); call move_alloc(tr, fd%f_relax)
+    end if
+    fd%nf = fd%nf + 1
+    fd%f_comp(fd%nf) = c
+    fd%f_ijk(:, fd%nf) = ijk
+    fd%f_part(fd%nf) = q
+    fd%f_r(:, fd%nf) = r
+    fd%f_alpha(fd%nf) = a
+    fd%f_relax(fd%nf) = relax
+  end subroutine push_face
+
+  ! g such that (U + Omega x r)_c = g . (U, Omega): g = (e_c, r x e_c).
+  pure function rigid_row(c, r) result(g)
+    integer, intent(in) :: c
+    real(dp), intent(in) :: r(3)
+    real(dp) :: g(6), e(3)
+    e = 0.0_dp
+    e(c) = 1.0_dp
+    g(1:3) = e
+    g(4:6) = [r(2) * e(3) - r(3) * e(2), r(3) * e(1) - r(1) * e(3), r(1) * e(2) - r(2) * e(1)]
+  end function rigid_row
+
+  ! The particle sub-problem after the fluid step: velocities, lambda^{n+1}, u^{n+1}, and the
+  ! resolved force, torque and stresslet. vel: the projected velocity u~ on entry, u^{n+1} on exit.
+  subroutine fd_particle_step(grid, fd, vel, pressure, parts, ierr)
+    type(grid_t), intent(in) :: grid
+    type(fd_t), intent(inout) :: fd
+    Vec, intent(inout) :: vel(3)
+    Vec, intent(in) :: pressure
+    type(particles_t), intent(inout) :: parts
+    PetscErrorCode, intent(out) :: ierr
+    real(dp), allocatable :: moments(:, :), rhs(:, :), x(:, :), lambda_new(:), sums(:, :)
+    type(field_pointer) :: u(3), lam(3)
+    PetscScalar, pointer :: p(:,:,:)
+    real(dp) :: g(6), dv, b, l_old, rigid, s(3, 3), r(3), e(3), integral
+    integer :: f, c, q, i, j, k, n
+    logical :: ok
+    character(len=200) :: text
+
+    n = parts%n
+    dv = grid%h**3
+    allocate(moments(12, n), rhs(6, n), x(6, n), lambda_new(fd%nf), sums(16, n))
+
+    ! moments b(u~) and m(Lambda^n) (rows 1-6 and 7-12)
+    moments = 0.0_dp
+    do c = 1, 3
+      PetscCall(DMDAVecGetArrayReadF90(grid%da(c), vel(c), u(c)%ptr, ierr))
+      PetscCall(DMDAVecGetArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
+    end do
+    do f = 1, fd%nf
+      c = fd%f_comp(f)
+      if (c == FIELD_P) cycle
+      i = fd%f_ijk(1, f); j = fd%f_ijk(2, f); k = fd%f_ijk(3, f)
+      q = fd%f_part(f)
+      g = rigid_row(c, fd%f_r(:, f))
+      moments(1:6, q) = moments(1:6, q) + fd%f_alpha(f) * fd%f_relax(f) * u(c)%ptr(i, j, k) * dv * g
+      moments(7:12, q) = moments(7:12, q) + lam(c)%ptr(i, j, k) * fd%f_relax(f) * dv * g
+    end do
+    call MPI_Allreduce(MPI_IN_PLACE, moments, 12 * n, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
+
+    ! the 6N system (method.md eq. (1))
+    select case (parts%motion)
+    case (MOTION_FREE)
+      call psys_reset(fd%system, n)
+      do q = 1, n
+        call psys_add_diagonal(fd%system, q, fd%beta * fd%rigid_matrix(:, :, q))
+        rhs(:, q) = fd%beta * moments(1:6, q) - moments(7:12, q) &
+             + [parts%external_force(:, q), parts%external_torque(:, q)]
+      end do
+      call psys_solve(fd%system, rhs, x, 1.0e-12_dp, fd%solver_iterations, ok)
+      if (.not. ok) then
+        write(text, '(a,i0,a)') 'fdsusp: fatal: the particle system is not positive definite or did not '// &
+             'converge (', fd%solver_iterations, ' iterations): a particle covers no grid face?'
+        call fatal_error(text, 4)
+      end if
+      parts%velocity = x(1:3, :)
+      parts%omega = x(4:6, :)
+    case (MOTION_PRESCRIBED)
+      parts%velocity = parts%prescribed_velocity
+      parts%omega = parts%prescribed_omega
+    case (MOTION_FROZEN)
+      parts%velocity = 0.0_dp
+      parts%omega = 0.0_dp
+    end select
+
+    ! Lambda^{n+1} on the owned faces of each particle (from u~ and Lambda^n)
+    do f = 1, fd%nf
+      c = fd%f_comp(f)
+      if (c == FIELD_P) cycle
+      i = fd%f_ijk(1, f); j = fd%f_ijk(2, f); k = fd%f_ijk(3, f)
+      q = fd%f_part(f)
+      g = rigid_row(c, fd%f_r(:, f))
+      rigid = dot_product(g(1:3), parts%velocity(:, q)) + dot_product(g(4:6), parts%omega(:, q))
+      lambda_new(f) = (lam(c)%ptr(i, j, k) + fd%beta * fd%f_alpha(f) * (rigid - u(c)%ptr(i, j, k))) &
+           * fd%f_relax(f)
+    end do
+    do c = 1, 3
+      PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
+      PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), vel(c), u(c)%ptr, ierr))
+    end do
+
+    ! u^{n+1} = u~ + (Lambda^{n+1} - Lambda^n)/beta everywhere: first remove Lambda^n (faces a
+    ! particle has left get their force back), then add Lambda^{n+1} on the covered faces.
+    do c = 1, 3
+      PetscCall(VecAXPY(vel(c), -1.0_dp / fd%beta, fd%lambda(c), ierr))
+      PetscCall(VecSet(fd%lambda(c), 0.0_dp, ierr))
+      PetscCall(DMDAVecGetArrayF90(grid%da(c), vel(c), u(c)%ptr, ierr))
+      PetscCall(DMDAVecGetArrayF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
+    end do
+    PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_P), pressure, p, ierr))
+    sums = 0.0_dp
+    do f = 1, fd%nf
+      c = fd%f_comp(f)
+      i = fd%f_ijk(1, f); j = fd%f_ijk(2, f); k = fd%f_ijk(3, f)
+      q = fd%f_part(f)
+      if (c == FIELD_P) then
+        sums(16, q) = sums(16, q) + fd%f_alpha(f) * p(i, j, k) * dv     ! interior pressure
+        cycle
+      end if
+      b = lambda_new(f)
+      lam(c)%ptr(i, j, k) = b
+      u(c)%ptr(i, j, k) = u(c)%ptr(i, j, k) + b / fd%beta
+      r = fd%f_r(:, f)
+      e = 0.0_dp
+      e(c) = 1.0_dp
+      sums(1:3, q) = sums(1:3, q) - b * dv * e
+      sums(4:6, q) = sums(4:6, q) - b * dv * [r(2) * e(3) - r(3) * e(2), r(3) * e(1) - r(1) * e(3), &
+                                              r(1) * e(2) - r(2) * e(1)]
+      s = -0.5_dp * b * dv * (spread(r, 2, 3) * spread(e, 1, 3) + spread(e, 2, 3) * spread(r, 1, 3))
+      sums(7:15, q) = sums(7:15, q) + reshape(s, [9])
+    end do
+    PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_P), pressure, p, ierr))
+    do c = 1, 3
+      PetscCall(DMDAVecRestoreArrayF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
+      PetscCall(DMDAVecRestoreArrayF90(grid%da(c), vel(c), u(c)%ptr, ierr))
+    end do
+    call MPI_Allreduce(MPI_IN_PLACE, sums, 16 * n, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
+    do q = 1, n
+      parts%force_hydro(:, q) = sums(1:3, q)
+      parts%torque_hydro(:, q) = sums(4:6, q)
+      integral = sums(16, q)
+      parts%stresslet_hydro(:, :, q) = reshape(sums(7:15, q), [3, 3])
+      do c = 1, 3
+        parts%stresslet_hydro(c, c, q) = parts%stresslet_hydro(c, c, q) - integral
+      end do
+    end do
+  end subroutine fd_particle_step
+
+  subroutine fd_destroy(fd, ierr)
+    type(fd_t), intent(inout) :: fd
+    PetscErrorCode, intent(out) :: ierr
+    integer :: c
+    do c = 1, 3
+      PetscCall(VecDestroy(fd%lambda(c), ierr))
+    end do
+  end subroutine fd_destroy
+
+end module mod_fictitious_domain

@@ -1,0 +1,139 @@
+! The particles: state of the inertialess rigid spheres, replicated on every rank (design.md
+! "Parallelism"), their motion mode, and the Adams-Bashforth position update (method.md §1.8).
+! Pure: no PETSc, MPI or files.
+module mod_particles
+  use mod_kinds, only: dp
+  implicit none
+  private
+  public :: particles_t, particles_init, advance_positions, configuration_fault, minimum_image
+  public :: MOTION_FREE, MOTION_PRESCRIBED, MOTION_FROZEN, motion_code
+
+  integer, parameter :: MOTION_FREE = 1, MOTION_PRESCRIBED = 2, MOTION_FROZEN = 3
+
+  type :: particles_t
+    integer :: n = 0
+    integer :: motion = MOTION_FREE
+    real(dp) :: radius = 1.0_dp
+    real(dp), allocatable :: position(:, :)        ! (3, n) centres [a], wrapped into the box
+    real(dp), allocatable :: velocity(:, :)        ! (3, n) U^n [a gamma_dot]
+    real(dp), allocatable :: omega(:, :)           ! (3, n) Omega^n [gamma_dot]
+    real(dp), allocatable :: velocity_prev(:, :)   ! (3, n) U^(n-1), Adams-Bashforth history
+    logical :: have_prev = .false.                 ! false until one step has been taken
+    real(dp), allocatable :: prescribed_velocity(:, :), prescribed_omega(:, :)
+    real(dp), allocatable :: external_force(:, :), external_torque(:, :)
+    ! resolved hydrodynamics from lambda (method.md §1.6), on the particle
+    real(dp), allocatable :: force_hydro(:, :)     ! (3, n) [eta gamma_dot a^2]
+    real(dp), allocatable :: torque_hydro(:, :)    ! (3, n) [eta gamma_dot a^3]
+    real(dp), allocatable :: stresslet_hydro(:, :, :)   ! (3, 3, n) [eta gamma_dot a^3]
+  end type particles_t
+
+contains
+
+  integer function motion_code(name)
+    character(len=*), intent(in) :: name
+    select case (name)
+    case ('prescribed'); motion_code = MOTION_PRESCRIBED
+    case ('frozen');     motion_code = MOTION_FROZEN
+    case default;        motion_code = MOTION_FREE
+    end select
+  end function motion_code
+
+  subroutine particles_init(p, n, radius, motion)
+    type(particles_t), intent(out) :: p
+    integer, intent(in) :: n, motion
+    real(dp), intent(in) :: radius
+    p%n = n
+    p%radius = radius
+    p%motion = motion
+    allocate(p%position(3, n), p%velocity(3, n), p%omega(3, n), p%velocity_prev(3, n), &
+             p%prescribed_velocity(3, n), p%prescribed_omega(3, n), p%external_force(3, n), &
+             p%external_torque(3, n), p%force_hydro(3, n), p%torque_hydro(3, n), &
+             p%stresslet_hydro(3, 3, n))
+    p%position = 0.0_dp
+    p%velocity = 0.0_dp
+    p%omega = 0.0_dp
+    p%velocity_prev = 0.0_dp
+    p%have_prev = .false.
+    p%prescribed_velocity = 0.0_dp
+    p%prescribed_omega = 0.0_dp
+    p%external_force = 0.0_dp
+    p%external_torque = 0.0_dp
+    p%force_hydro = 0.0_dp
+    p%torque_hydro = 0.0_dp
+    p%stresslet_hydro = 0.0_dp
+  end subroutine particles_init
+
+  ! X^{n+1} = X^n + dt (3/2 U^n - 1/2 U^{n-1}), forward Euler on the first step; wrap the
+  ! periodic directions into [0, L).
+  subroutine advance_positions(p, dt, box, periodic)
+    type(particles_t), intent(inout) :: p
+    real(dp), intent(in) :: dt, box(3)
+    logical, intent(in) :: periodic(3)
+    integer :: d
+    if (p%motion == MOTION_FROZEN) return
+    if (p%have_prev) then
+      p%position = p%position + dt * (1.5_dp * p%velocity - 0.5_dp * p%velocity_prev)
+    else
+      p%position = p%position + dt * p%velocity
+    end if
+    p%velocity_prev = p%velocity
+    p%have_prev = .true.
+    do d = 1, 3
+      if (periodic(d)) p%position(d, :) = modulo(p%position(d, :), box(d))
+    end do
+  end subroutine advance_positions
+
+  ! r wrapped to the nearest periodic image.
+  pure function minimum_image(r, box, periodic) result(s)
+    real(dp), intent(in) :: r(3), box(3)
+    logical, intent(in) :: periodic(3)
+    real(dp) :: s(3)
+    integer :: d
+    s = r
+    do d = 1, 3
+      if (periodic(d)) s(d) = s(d) - box(d) * anint(s(d) / box(d))
+    end do
+  end function minimum_image
+
+  ! '' if the configuration is acceptable, else what is wrong (and the particle at fault):
+  ! a centre outside the box, a sphere crossing a wall, or two spheres overlapping by more than
+  ! 5 % of the radius (far beyond any roughness overlap; an O(N^2) check, done once at start-up).
+  function configuration_fault(position, radius, box, walls, culprit) result(message)
+    real(dp), intent(in) :: position(:, :), radius, box(3)
+    logical, intent(in) :: walls
+    integer, intent(out) :: culprit
+    character(len=200) :: message
+    logical :: periodic(3)
+    integer :: i, j, d
+    real(dp) :: dist
+    message = ''
+    culprit = 0
+    periodic = [.true., .not. walls, .true.]
+    do i = 1, size(position, 2)
+      do d = 1, 3
+        if (position(d, i) < 0.0_dp .or. position(d, i) > box(d) .or. position(d, i) /= position(d, i)) then
+          write(message, '(a,i0,a,3f12.5,a)') 'particle ', i, ' at (', position(:, i), ') is outside the box'
+          culprit = i
+          return
+        end if
+      end do
+      if (walls .and. (position(2, i) < radius .or. position(2, i) > box(2) - radius)) then
+        write(message, '(a,i0,a,f12.5,a)') 'particle ', i, ' at y = ', position(2, i), ' crosses a wall'
+        culprit = i
+        return
+      end if
+    end do
+    do i = 1, size(position, 2)
+      do j = i + 1, size(position, 2)
+        dist = norm2(minimum_image(position(:, j) - position(:, i), box, periodic))
+        if (dist < 1.95_dp * radius) then
+          write(message, '(a,i0,a,i0,a,f10.5,a)') 'particles ', i, ' and ', j, ' overlap (centre distance ', &
+               dist / radius, ' radii)'
+          culprit = i
+          return
+        end if
+      end do
+    end do
+  end function configuration_fault
+
+end module mod_particles

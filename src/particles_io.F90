@@ -1,0 +1,194 @@
+! Particles in HDF5 files (design.md "Files"): the group /particles with the dataset position
+! (N x 3 as seen from C/Python, units of a) and the attribute box (Lx, Ly, Lz) in every file that
+! holds particles, plus in checkpoints the state an exact restart needs (velocity, omega, the
+! Adams-Bashforth history). Reading is done by rank 0 and broadcast; a bad file stops the run
+! with one message naming the file and the item.
+module mod_particles_io
+  use hdf5
+  use mpi
+  use mod_kinds, only: dp
+  use mod_params, only: config_t
+  use mod_particles, only: particles_t, particles_init, motion_code, configuration_fault
+  use mod_h5util, only: write_attribute, read_attribute, has_object
+  use mod_errors, only: is_root, input_error, file_error, abort_run
+  implicit none
+  private
+  public :: particles_load, particles_write, particles_read_state
+
+contains
+
+  ! The particles of the deck: inline (&particles number, position, ...) or from position_file.
+  ! Collective. Checks the configuration (inside the box, off the walls, no overlap).
+  subroutine particles_load(cfg, parts)
+    type(config_t), intent(in) :: cfg
+    type(particles_t), intent(out) :: parts
+    real(dp), allocatable :: position(:, :)
+    character(len=400) :: message
+    integer :: n, culprit, ierr
+    character(len=32) :: item
+
+    if (len_trim(cfg%position_file) == 0) then
+      n = cfg%particle_number
+      call particles_init(parts, n, cfg%radius, motion_code(cfg%motion))
+      parts%position = cfg%particle_position(:, 1:n)
+      parts%prescribed_velocity = cfg%particle_velocity(:, 1:n)
+      parts%prescribed_omega = cfg%particle_omega(:, 1:n)
+      parts%external_force = cfg%external_force(:, 1:n)
+      parts%external_torque = cfg%external_torque(:, 1:n)
+      message = configuration_fault(parts%position, parts%radius, cfg%box, cfg%walls, culprit)
+      if (len_trim(message) > 0) then
+        write(item, '(a,i0,a)') 'position(:,', culprit, ')'
+        call input_error(cfg%deck_file, 'particles', trim(item), trim(message))
+      end if
+      return
+    end if
+
+    message = ''
+    n = 0
+    if (is_root()) call read_positions(trim(cfg%position_file), position, message)
+    call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, MPI_COMM_WORLD, ierr)
+    if (len_trim(message) > 0) call file_error(trim(cfg%position_file), 'particles/position', trim(message))
+    if (is_root()) n = size(position, 2)
+    call MPI_Bcast(n, 1, MPI_INTEGER, 0, MPI_COMM_WORLD, ierr)
+    if (.not. is_root()) allocate(position(3, n))
+    call MPI_Bcast(position, 3 * n, MPI_DOUBLE_PRECISION, 0, MPI_COMM_WORLD, ierr)
+    call particles_init(parts, n, cfg%radius, motion_code(cfg%motion))
+    parts%position = position
+    message = configuration_fault(parts%position, parts%radius, cfg%box, cfg%walls, culprit)
+    if (len_trim(message) > 0) call file_error(trim(cfg%position_file), 'particles/position', trim(message))
+  end subroutine particles_load
+
+  subroutine read_positions(path, position, message)
+    character(len=*), intent(in) :: path
+    real(dp), allocatable, intent(out) :: position(:, :)
+    character(len=*), intent(out) :: message
+    integer(HID_T) :: file, dset, space
+    integer(HSIZE_T) :: dims(2), maxdims(2)
+    integer :: err, rank
+    message = ''
+    call h5fopen_f(path, H5F_ACC_RDONLY_F, file, err)
+    if (err /= 0) then
+      message = 'cannot be opened as HDF5'
+      return
+    end if
+    if (.not. has_object(file, 'particles') .or. .not. has_object(file, 'particles/position')) then
+      message = 'dataset missing'
+      call h5fclose_f(file, err)
+      return
+    end if
+    call h5dopen_f(file, 'particles/position', dset, err)
+    call h5dget_space_f(dset, space, err)
+    call h5sget_simple_extent_ndims_f(space, rank, err)
+    if (rank == 2) call h5sget_simple_extent_dims_f(space, dims, maxdims, err)
+    call h5sclose_f(space, err)
+    if (rank /= 2 .or. dims(1) /= 3) then
+      message = 'must be an N x 3 dataset'
+    else
+      allocate(position(3, dims(2)))
+      call h5dread_f(dset, H5T_NATIVE_DOUBLE, position, dims, err)
+      if (err /= 0) message = 'cannot be read'
+    end if
+    call h5dclose_f(dset, err)
+    call h5fclose_f(file, err)
+  end subroutine read_positions
+
+  ! Write /particles into an open file (rank 0 only): position with attribute box, and with
+  ! state = .true. everything an exact restart needs.
+  subroutine particles_write(file, parts, box, state)
+    integer(HID_T), intent(in) :: file
+    type(particles_t), intent(in) :: parts
+    real(dp), intent(in) :: box(3)
+    logical, intent(in) :: state
+    integer(HID_T) :: group, dset
+    integer :: err, e
+    call h5gcreate_f(file, 'particles', group, err)
+    if (err /= 0) call abort_run('cannot create the group /particles')
+    call write_matrix(group, 'position', parts%position)
+    call h5dopen_f(group, 'position', dset, err)
+    call write_attribute(dset, 'box', box, e)
+    call h5dclose_f(dset, err)
+    call write_attribute(group, 'box', box, e)
+    call write_attribute(group, 'radius', [parts%radius], e)
+    if (state) then
+      call write_matrix(group, 'velocity', parts%velocity)
+      call write_matrix(group, 'omega', parts%omega)
+      call write_matrix(group, 'velocity_prev', parts%velocity_prev)
+      call write_attribute(group, 'have_prev', [merge(1, 0, parts%have_prev)], e)
+      call write_attribute(group, 'motion', [parts%motion], e)
+    end if
+    call h5gclose_f(group, err)
+  end subroutine particles_write
+
+  subroutine write_matrix(group, name, values)
+    integer(HID_T), intent(in) :: group
+    character(len=*), intent(in) :: name
+    real(dp), intent(in) :: values(:, :)
+    integer(HID_T) :: space, dset
+    integer(HSIZE_T) :: dims(2)
+    integer :: err
+    dims = shape(values, kind=HSIZE_T)
+    call h5screate_simple_f(2, dims, space, err)
+    call h5dcreate_f(group, name, H5T_NATIVE_DOUBLE, space, dset, err)
+    if (err /= 0) call abort_run('cannot create /particles/'//name)
+    call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, dims, err)
+    call h5dclose_f(dset, err)
+    call h5sclose_f(space, err)
+  end subroutine write_matrix
+
+  ! Restart: positions, velocities and history from a checkpoint (collective). The particle count
+  ! must match the deck's.
+  subroutine particles_read_state(path, parts)
+    character(len=*), intent(in) :: path
+    type(particles_t), intent(inout) :: parts
+    integer(HID_T) :: file, group, dset, space
+    integer(HSIZE_T) :: dims(2), fdims(2), maxdims(2)
+    real(dp) :: buffer(3, parts%n, 4)
+    integer :: err, e, flag(1), ierr
+    character(len=200) :: message
+    character(len=16), parameter :: names(4) = [character(len=16) :: 'position', 'velocity', 'omega', &
+         'velocity_prev']
+    message = ''
+    flag = 0
+    if (is_root()) then
+      call h5fopen_f(path, H5F_ACC_RDONLY_F, file, err)
+      if (.not. has_object(file, 'particles')) then
+        message = 'the checkpoint holds no particles but the deck has some'
+      else
+        call h5gopen_f(file, 'particles', group, err)
+        dims = [3_HSIZE_T, int(parts%n, HSIZE_T)]
+        do e = 1, 4
+          if (.not. has_object(group, trim(names(e)))) then
+            message = 'dataset /particles/'//trim(names(e))//' missing'
+            exit
+          end if
+          call h5dopen_f(group, trim(names(e)), dset, err)
+          call h5dget_space_f(dset, space, err)
+          fdims = 0
+          call h5sget_simple_extent_dims_f(space, fdims, maxdims, err)
+          call h5sclose_f(space, err)
+          if (any(fdims /= dims)) then
+            write(message, '(a,i0,a,i0)') 'the checkpoint has ', fdims(2), ' particles, the deck ', parts%n
+            call h5dclose_f(dset, err)
+            exit
+          end if
+          call h5dread_f(dset, H5T_NATIVE_DOUBLE, buffer(:, :, e), dims, err)
+          call h5dclose_f(dset, err)
+          if (err /= 0) message = 'cannot read /particles/'//trim(names(e))//' (another particle count?)'
+        end do
+        call read_attribute(group, 'have_prev', flag, err)
+        call h5gclose_f(group, err)
+      end if
+      call h5fclose_f(file, err)
+    end if
+    call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, MPI_COMM_WORLD, ierr)
+    if (len_trim(message) > 0) call file_error(path, 'particles', trim(message))
+    call MPI_Bcast(buffer, size(buffer), MPI_DOUBLE_PRECISION, 0, MPI_COMM_WORLD, ierr)
+    call MPI_Bcast(flag, 1, MPI_INTEGER, 0, MPI_COMM_WORLD, ierr)
+    parts%position = buffer(:, :, 1)
+    parts%velocity = buffer(:, :, 2)
+    parts%omega = buffer(:, :, 3)
+    parts%velocity_prev = buffer(:, :, 4)
+    parts%have_prev = (flag(1) == 1)
+  end subroutine particles_read_state
+
+end module mod_particles_io
