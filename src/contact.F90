@@ -1,0 +1,412 @@
+! Contact law of Gallier et al. (2014, JFM) §2.4 (method.md §1.7); pure kernels, no PETSc.
+! Documented in doc/CONTACT.md (parameters, units, the k_t interpretation, the history).
+!
+! Conventions. For a pair i < j: r = x_j - x_i (minimum image), n = r/|r|, F = force on i by j;
+! j receives -F. A wall is a partner of infinite radius: n is the unit normal from the centre
+! towards the wall (-e_y for the lower wall y = 0, +e_y for the upper wall y = Ly), the gap is the
+! centre-to-plane distance minus a, the wall translates with its own velocity and does not rotate.
+!   normal    F_n = -k_n |delta'|^{3/2} n,  delta' = |r| - 2a - h_r, contact iff delta' <= 0  (2.17)
+!   stiffness 6 pi eta gamma_dot a^2 = k_n (eps_bar h_r)^{3/2}, unless k_n is prescribed     (§2.4)
+!   slip      U^s = (U_i - U_j) - [(U_i - U_j).n] n + a (Omega_i + Omega_j) x n              (2.21)
+!   spring    Upsilon = int U^s dt over the contact, rotated into the current tangent plane
+!             (length kept) before each increment; F_t = -k_t Upsilon                       (2.19-20)
+!             k_t = (2/7) k_n |delta'|^{1/2}  (paper: k_t/k_n = 2 delta^{1/2}/7, delta -> |delta'|)
+!   Coulomb   |F_t| <= mu_d |F_n|; when capped, Upsilon = -F_t/k_t (spring consistent)     (2.22)
+!   torque    T_i = T_j = a n x F                                                           (2.23)
+!   stresslet S_i = S_j = 1/2 (F (x) r/2 + r/2 (x) F); wall: r/2 -> (a + gap/2) n           (2.24)
+! Contact history: Upsilon per open contact, keyed by pair identity (i, partner) with i < partner
+! for a particle pair and partner = -1 (wall y = 0) or -2 (wall y = Ly) for a wall. Entries are
+! rebuilt every step from the contacts found, so a contact that opens is forgotten (Upsilon
+! restarts at 0). With mu_d = 0 the history is never touched: no tangential state exists.
+! The image shift is deliberately not part of the key: the neighbour search requires every
+! periodic length >= 2 x cutoff, so at most one image of j can touch i, and the shift of a pair
+! changes when a particle is wrapped into the box during a contact.
+module mod_contact
+  use mod_kinds, only: dp, pi
+  implicit none
+  private
+  public :: contact_params_t, contact_setup, contact_stats_t
+  public :: contact_history_t, history_size, history_pack, history_unpack, history_clear
+  public :: history_lookup, contact_pair, contact_forces, contact_stresslet
+  public :: wall_lower, wall_upper
+
+  integer, parameter :: wall_lower = -1, wall_upper = -2   ! history partner ids of the walls
+
+  type :: contact_params_t
+    real(dp) :: a = 1                   ! sphere radius [a]
+    real(dp) :: h_r = 0                 ! roughness height eps_r a [a]
+    real(dp) :: eps_bar = 0.05_dp       ! roughness deformation under 6 pi eta gamma_dot a^2 [-]
+    real(dp) :: k_n = 0                 ! Hertz stiffness [eta gamma_dot a^(1/2)]
+    real(dp) :: kt_coeff = 2.0_dp / 7   ! k_t = kt_coeff k_n |delta'|^(1/2) [-]
+    real(dp) :: mu_d = 0                ! dynamic (= static) friction coefficient [-]
+    real(dp) :: eta = 1, gamma_dot = 1  ! force scale 6 pi eta gamma_dot a^2 [eta, gamma_dot]
+  end type contact_params_t
+
+  !> Per-step diagnostics of contact_forces.
+  type :: contact_stats_t
+    integer :: pair_contacts = 0, wall_contacts = 0
+    integer :: sliding = 0              ! contacts at the Coulomb limit
+    real(dp) :: max_overlap = 0         ! max |delta'| / h_r (/ a when h_r = 0)
+    real(dp) :: max_normal_force = 0
+  end type contact_stats_t
+
+  !> Tangential springs of the open contacts, in compressed-row form over the owner particle:
+  !> the contacts owned by particle i (i < partner, or i with a wall) are entries
+  !> first(i) .. first(i+1)-1, sorted by partner. A plain data structure: history_pack and
+  !> history_unpack convert it to and from flat arrays for checkpoints.
+  type :: contact_history_t
+    integer :: np = 0                   ! particle count it was built for (0: empty)
+    integer :: n = 0                    ! stored contacts
+    integer, allocatable :: first(:)    ! (np + 1)
+    integer, allocatable :: partner(:)  ! (n)
+    real(dp), allocatable :: ups(:,:)   ! (3, n): Upsilon [a]
+  end type contact_history_t
+
+contains
+
+  !> Parameters from the deck quantities. eps_r = h_r/a. k_n_prescribed > 0 overrides the eps_bar
+  !> rule. info: 0 ok; 1 a <= 0, eta <= 0 or a negative eps_r, mu_d; 2 k_n cannot be derived
+  !> (h_r = 0, eps_bar <= 0 or gamma_dot = 0) and none is prescribed.
+  subroutine contact_setup(p, a, eps_r, mu_d, eps_bar, k_n_prescribed, eta, gamma_dot, info, msg)
+    type(contact_params_t), intent(out) :: p
+    real(dp), intent(in) :: a, eps_r, mu_d, eps_bar, k_n_prescribed, eta, gamma_dot
+    integer, intent(out) :: info
+    character(len=*), intent(out) :: msg
+    info = 0
+    msg = ''
+    p%a = a
+    p%h_r = eps_r * a
+    p%mu_d = mu_d
+    p%eps_bar = eps_bar
+    p%eta = eta
+    p%gamma_dot = abs(gamma_dot)
+    if (.not. (a > 0) .or. .not. (eta > 0) .or. .not. (eps_r >= 0) .or. .not. (mu_d >= 0)) then
+      info = 1
+      msg = 'contact: a and eta must be > 0, eps_r and mu_d >= 0'
+    else if (k_n_prescribed > 0) then
+      p%k_n = k_n_prescribed
+    else if (p%h_r <= 0) then
+      info = 2
+      msg = 'contact: smooth spheres (eps_r = 0) need a prescribed k_n > 0'
+    else if (.not. (eps_bar > 0) .or. p%gamma_dot <= 0) then
+      info = 2
+      msg = 'contact: k_n from eps_bar needs eps_bar > 0 and a non-zero shear rate'
+    else
+      p%k_n = 6 * pi * eta * p%gamma_dot * a**2 / (eps_bar * p%h_r)**1.5_dp
+    end if
+  end subroutine contact_setup
+
+  ! ---- one contact -----------------------------------------------------------------------
+
+  !> One contact. n: unit normal from i towards the partner; dlt = delta' (contact iff <= 0);
+  !> du = U_i - U_partner; om_sum = Omega_i + Omega_partner (wall: Omega_i); dt: time step.
+  !> ups: the spring, in: the previous step's (0 for a new contact), out: updated (0 if open or
+  !> mu_d = 0). f: force on i; tq: torque on i (the partner sphere gets -f and the same tq);
+  !> fn: |F_n|; sliding: the Coulomb cap was applied.
+  pure subroutine contact_pair(p, n, dlt, du, om_sum, dt, ups, f, tq, fn, sliding)
+    type(contact_params_t), intent(in) :: p
+    real(dp), intent(in) :: n(3), dlt, du(3), om_sum(3), dt
+    real(dp), intent(inout) :: ups(3)
+    real(dp), intent(out) :: f(3), tq(3), fn
+    logical, intent(out) :: sliding
+    real(dp) :: us(3), len0, len1, k_t, ft(3), ftm
+    f = 0
+    tq = 0
+    fn = 0
+    sliding = .false.
+    if (dlt > 0 .or. p%mu_d <= 0) ups = 0
+    if (dlt > 0) return
+    fn = p%k_n * abs(dlt)**1.5_dp                                  ! (2.17)
+    f = -fn * n
+    if (p%mu_d > 0) then
+      ! rotate the old spring into the current tangent plane, keeping its length
+      len0 = norm2(ups)
+      ups = ups - dot_product(ups, n) * n
+      len1 = norm2(ups)
+      if (len1 > 0) then
+        ups = ups * (len0 / len1)
+      else
+        ups = 0
+      end if
+      us = du - dot_product(du, n) * n + p%a * cross(om_sum, n)     ! (2.21)
+      ups = ups + us * dt                                           ! (2.20)
+      k_t = p%kt_coeff * p%k_n * sqrt(abs(dlt))
+      ft = -k_t * ups                                               ! (2.19)
+      ftm = norm2(ft)
+      if (fn <= 0) then
+        ups = 0                                   ! delta' = 0 exactly: the Coulomb limit is 0
+        ft = 0
+      else if (ftm > p%mu_d * fn) then            ! (2.22), spring reset to match
+        ft = ft * (p%mu_d * fn / ftm)
+        ups = -ft / k_t
+        sliding = .true.
+      end if
+      f = f + ft
+      tq = p%a * cross(n, f)                                        ! (2.23)
+    end if                                     ! frictionless: F parallel to n, no torque
+  end subroutine contact_pair
+
+  !> Symmetric contact stresslet (2.24) of a force f applied with lever l (centre to contact).
+  pure function contact_stresslet(f, l) result(s)
+    real(dp), intent(in) :: f(3), l(3)
+    real(dp) :: s(3, 3)
+    integer :: k, m
+    do m = 1, 3
+      do k = 1, 3
+        s(k, m) = 0.5_dp * (f(k) * l(m) + l(k) * f(m))
+      end do
+    end do
+  end function contact_stresslet
+
+  pure function cross(u, v) result(w)
+    real(dp), intent(in) :: u(3), v(3)
+    real(dp) :: w(3)
+    w = [u(2) * v(3) - u(3) * v(2), u(3) * v(1) - u(1) * v(3), u(1) * v(2) - u(2) * v(1)]
+  end function cross
+
+  ! ---- all contacts of one step ------------------------------------------------------------
+
+  !> All contacts of one step. x, u, om: (3, np) positions, velocities, angular velocities;
+  !> box, periodic: the domain (walls at y = 0 and y = box(2) when .not. periodic(2));
+  !> vw(3, 2): velocities of the lower and upper walls; pairs(2, npairs): candidate pairs (any
+  !> order, each pair once, e.g. from mod_neighbours); walls(2, nwalls): candidates (particle,
+  !> wall 1 = lower | 2 = upper). Outputs per particle: force, torque (3, np), symmetric contact
+  !> stresslet (3, 3, np); stats. The history h advances by one step (not touched if mu_d = 0).
+  !> info: 0 ok; 1 the history was built for another particle count.
+  subroutine contact_forces(p, h, x, u, om, box, periodic, vw, pairs, npairs, walls, nwalls, dt, &
+                            force, torque, stresslet, stats, info)
+    type(contact_params_t), intent(in) :: p
+    type(contact_history_t), intent(inout) :: h
+    real(dp), intent(in) :: x(:,:), u(:,:), om(:,:), box(3), vw(3, 2), dt
+    logical, intent(in) :: periodic(3)
+    integer, intent(in) :: pairs(:,:), npairs, walls(:,:), nwalls
+    real(dp), intent(out) :: force(:,:), torque(:,:), stresslet(:,:,:)
+    type(contact_stats_t), intent(out) :: stats
+    integer, intent(out) :: info
+    integer :: m, i, j, k, w, np, nnew
+    integer, allocatable :: new_owner(:), new_partner(:)
+    real(dp), allocatable :: new_ups(:,:)
+    real(dp) :: r(3), d, n(3), dlt, ups(3), f(3), tq(3), fn, scale, s(3, 3)
+    logical :: tangential, sliding
+
+    info = 0
+    np = size(x, 2)
+    force = 0
+    torque = 0
+    stresslet = 0
+    tangential = p%mu_d > 0
+    if (tangential .and. h%np /= 0 .and. h%np /= np) then
+      info = 1
+      return
+    end if
+    if (tangential) allocate(new_owner(npairs + nwalls), new_partner(npairs + nwalls), &
+                             new_ups(3, npairs + nwalls))
+    nnew = 0
+    scale = p%h_r
+    if (scale <= 0) scale = p%a
+
+    do m = 1, npairs
+      i = min(pairs(1, m), pairs(2, m))
+      j = max(pairs(1, m), pairs(2, m))
+      r = x(:, j) - x(:, i)
+      do k = 1, 3
+        if (periodic(k)) r(k) = r(k) - box(k) * anint(r(k) / box(k))
+      end do
+      d = norm2(r)
+      dlt = d - 2 * p%a - p%h_r
+      if (dlt > 0) cycle
+      n = r / d
+      ups = 0
+      if (tangential) ups = history_lookup(h, i, j)
+      call contact_pair(p, n, dlt, u(:, i) - u(:, j), om(:, i) + om(:, j), dt, ups, f, tq, fn, &
+                        sliding)
+      if (tangential) call append(i, j)
+      force(:, i) = force(:, i) + f
+      force(:, j) = force(:, j) - f
+      torque(:, i) = torque(:, i) + tq
+      torque(:, j) = torque(:, j) + tq
+      s = contact_stresslet(f, 0.5_dp * r)
+      stresslet(:, :, i) = stresslet(:, :, i) + s
+      stresslet(:, :, j) = stresslet(:, :, j) + s
+      call tally(.false.)
+    end do
+
+    do m = 1, nwalls
+      i = walls(1, m)
+      w = walls(2, m)
+      if (w == 1) then
+        d = x(2, i)
+        n = [0.0_dp, -1.0_dp, 0.0_dp]
+      else
+        d = box(2) - x(2, i)
+        n = [0.0_dp, 1.0_dp, 0.0_dp]
+      end if
+      dlt = d - p%a - p%h_r
+      if (dlt > 0) cycle
+      ups = 0
+      if (tangential) ups = history_lookup(h, i, -w)
+      call contact_pair(p, n, dlt, u(:, i) - vw(:, w), om(:, i), dt, ups, f, tq, fn, sliding)
+      if (tangential) call append(i, -w)
+      force(:, i) = force(:, i) + f
+      torque(:, i) = torque(:, i) + tq
+      stresslet(:, :, i) = stresslet(:, :, i) + contact_stresslet(f, 0.5_dp * (p%a + d) * n)
+      call tally(.true.)
+    end do
+
+    if (tangential) call history_build(h, np, nnew, new_owner, new_partner, new_ups, info)
+
+  contains
+
+    subroutine append(owner, other)
+      integer, intent(in) :: owner, other
+      nnew = nnew + 1
+      new_owner(nnew) = owner
+      new_partner(nnew) = other
+      new_ups(:, nnew) = ups
+    end subroutine append
+
+    subroutine tally(wall)
+      logical, intent(in) :: wall
+      if (wall) then
+        stats%wall_contacts = stats%wall_contacts + 1
+      else
+        stats%pair_contacts = stats%pair_contacts + 1
+      end if
+      if (sliding) stats%sliding = stats%sliding + 1
+      stats%max_overlap = max(stats%max_overlap, -dlt / scale)
+      stats%max_normal_force = max(stats%max_normal_force, fn)
+    end subroutine tally
+
+  end subroutine contact_forces
+
+  ! ---- the history -------------------------------------------------------------------------
+
+  integer function history_size(h)
+    type(contact_history_t), intent(in) :: h
+    history_size = h%n
+  end function history_size
+
+  subroutine history_clear(h)
+    type(contact_history_t), intent(inout) :: h
+    h%np = 0
+    h%n = 0
+    if (allocated(h%first)) deallocate(h%first)
+    if (allocated(h%partner)) deallocate(h%partner)
+    if (allocated(h%ups)) deallocate(h%ups)
+  end subroutine history_clear
+
+  !> The stored spring of contact (i, partner), i < partner or partner < 0; 0 if none.
+  pure function history_lookup(h, i, partner) result(ups)
+    type(contact_history_t), intent(in) :: h
+    integer, intent(in) :: i, partner
+    real(dp) :: ups(3)
+    integer :: k
+    ups = 0
+    if (h%n == 0 .or. i < 1 .or. i > h%np) return
+    do k = h%first(i), h%first(i + 1) - 1
+      if (h%partner(k) == partner) then
+        ups = h%ups(:, k)
+        return
+      end if
+    end do
+  end function history_lookup
+
+  !> (Re)build h from an unordered list of contacts: bucket by owner, sort each owner's
+  !> partners. info = 2 for an invalid id, 3 for a duplicate contact (h is then left empty).
+  subroutine history_build(h, np, n, owner, partner, ups, info)
+    type(contact_history_t), intent(inout) :: h
+    integer, intent(in) :: np, n
+    integer, intent(in) :: owner(:), partner(:)
+    real(dp), intent(in) :: ups(:,:)
+    integer, intent(out) :: info
+    integer :: k, i, pos, a, b, q, tmp_p
+    integer, allocatable :: fill(:)
+    real(dp) :: tmp_u(3)
+    info = 0
+    call history_clear(h)
+    if (np < 1) then
+      if (n > 0) info = 2
+      return
+    end if
+    do k = 1, n
+      i = owner(k)
+      if (i < 1 .or. i > np .or. .not. (partner(k) == wall_lower .or. partner(k) == wall_upper &
+          .or. (partner(k) > i .and. partner(k) <= np))) then
+        info = 2
+        return
+      end if
+    end do
+    h%np = np
+    h%n = n
+    allocate(h%first(np + 1), h%partner(n), h%ups(3, n), fill(np))
+    h%first = 0
+    do k = 1, n
+      h%first(owner(k) + 1) = h%first(owner(k) + 1) + 1
+    end do
+    h%first(1) = 1
+    do i = 1, np
+      h%first(i + 1) = h%first(i + 1) + h%first(i)
+    end do
+    fill = h%first(1:np)
+    do k = 1, n
+      pos = fill(owner(k))
+      fill(owner(k)) = pos + 1
+      h%partner(pos) = partner(k)
+      h%ups(:, pos) = ups(:, k)
+    end do
+    ! insertion sort of each owner's few partners: a canonical order, whatever the input order
+    do i = 1, np
+      a = h%first(i)
+      b = h%first(i + 1) - 1
+      do k = a + 1, b
+        tmp_p = h%partner(k)
+        tmp_u = h%ups(:, k)
+        q = k - 1
+        do while (q >= a)
+          if (h%partner(q) <= tmp_p) exit
+          h%partner(q + 1) = h%partner(q)
+          h%ups(:, q + 1) = h%ups(:, q)
+          q = q - 1
+        end do
+        h%partner(q + 1) = tmp_p
+        h%ups(:, q + 1) = tmp_u
+      end do
+      do k = a + 1, b
+        if (h%partner(k) == h%partner(k - 1)) info = 3
+      end do
+    end do
+    if (info /= 0) call history_clear(h)
+  end subroutine history_build
+
+  !> Flat arrays for a checkpoint: ids(1:2, k) = (owner, partner), ups(1:3, k), k = 1..history_size,
+  !> in canonical order (owner, then partner). np is the particle count the history belongs to.
+  !> The arrays must hold at least history_size(h) columns.
+  subroutine history_pack(h, np, ids, ups)
+    type(contact_history_t), intent(in) :: h
+    integer, intent(out) :: np
+    integer, intent(out) :: ids(:,:)
+    real(dp), intent(out) :: ups(:,:)
+    integer :: i, k
+    np = h%np
+    do i = 1, h%np
+      do k = h%first(i), h%first(i + 1) - 1
+        ids(1, k) = i
+        ids(2, k) = h%partner(k)
+        ups(:, k) = h%ups(:, k)
+      end do
+    end do
+  end subroutine history_pack
+
+  !> Inverse of history_pack: n contacts ids(2, n), ups(3, n) of a system of np particles, in any
+  !> order. info: 0 ok; 2 an id is invalid (owner outside 1..np, partner not > owner nor a wall);
+  !> 3 a contact appears twice. On error h is empty.
+  subroutine history_unpack(h, np, n, ids, ups, info)
+    type(contact_history_t), intent(inout) :: h
+    integer, intent(in) :: np, n
+    integer, intent(in) :: ids(:,:)
+    real(dp), intent(in) :: ups(:,:)
+    integer, intent(out) :: info
+    call history_build(h, np, n, ids(1, 1:n), ids(2, 1:n), ups(:, 1:n), info)
+  end subroutine history_unpack
+
+end module mod_contact

@@ -1,0 +1,537 @@
+! Random hard-sphere configurations (doc/PACKING_INPUT.md): equal spheres of radius a at a
+! target volume fraction in a triply periodic box or in the Couette cell (x, z periodic; walls at
+! y = 0 and y = Ly, which no sphere overlaps: a <= y <= Ly - a). Pure: no PETSc, MPI or HDF5.
+! An optional minimum gap g_min keeps every surface-to-surface gap >= g_min (spheres of radius
+! a + g_min/2 for the pairs, centres in [a + g_min, Ly - a - g_min] for the walls).
+!
+! Algorithm
+!   1. n centres uniformly at random in the accessible region.
+!   2. Compression by growing radii with overlap relaxation and Monte Carlo mixing. The radius
+!      starts at the value giving phi = 0.1 and grows stage by stage; the diameter grows each
+!      stage by 0.1 x the mean-gap estimate 2 rad ((0.64/phi_s)^(1/3) - 1), a fraction of the
+!      room left before random close packing (0.64), so the steps shrink as phi_s rises. After
+!      each growth, overlaps are relaxed away by Gauss-Seidel sweeps over cell lists (each
+!      overlapping pair pushed apart along its line of centres, walls clamp the centres) with
+!      radius rad (1 + 0.03), until no overlap exceeds 0.015 rad: every gap ends >= 0.045 rad.
+!      Relaxing with that margin, rather than to bare contact, leaves no contact network (which
+!      would freeze the Monte Carlo below); 5 Monte Carlo sweeps at radius rad then mix the
+!      structure before the next growth.
+!   3. Equilibration: hard-sphere Metropolis Monte Carlo at the final radius, n_sweeps sweeps of
+!      n trial displacements of a sphere chosen at random, uniform in a cube of side 2 step; a
+!      move is rejected when it overlaps another sphere or a wall. The step is tuned towards
+!      40 % acceptance in the first half of the sweeps and then frozen, so that detailed balance
+!      holds in the second half. The equilibrium hard-sphere fluid is reached in about 100
+!      sweeps at phi = 0.4 (g(2a) is tested against Carnahan-Starling at 0.2, 0.3, 0.4).
+! Reproducible: the generator (MRG32k3a, L'Ecuyer 1999) runs in exact integer(8) arithmetic,
+! so a seed gives the same stream with every compiler; positions are identical for a given build.
+module mod_packing
+  use mod_kinds, only: dp, i8, pi
+  implicit none
+  private
+  public :: rng_t, rng_seed, rng_uniform, packing_count, packing_box_for
+  public :: packing_report_t, random_packing, hs_monte_carlo, min_separation, phi_max
+
+  real(dp), parameter :: phi_max = 0.55_dp     ! highest target accepted
+
+  type :: rng_t
+    integer(i8) :: s(6) = 12345_i8             ! MRG32k3a state: s(1:3) component 1, s(4:6) 2
+  end type rng_t
+  integer(i8), parameter :: m1 = 4294967087_i8, m2 = 4294944443_i8
+
+  real(dp), parameter :: margin = 3.0e-2_dp    ! relaxation radius rad (1 + margin)
+  real(dp), parameter :: phi_start = 0.1_dp    ! volume fraction of the first stage
+  real(dp), parameter :: phi_rcp = 0.64_dp     ! random close packing, for the growth schedule
+  real(dp), parameter :: growth = 0.1_dp       ! diameter growth per stage / mean gap estimate
+  integer, parameter :: max_stages = 1000
+  integer, parameter :: stage_sweeps = 5       ! Monte Carlo sweeps after each stage
+  integer, parameter :: max_relax = 20000      ! relaxation sweeps per stage
+
+  type :: packing_report_t
+    integer :: n = 0
+    real(dp) :: phi = 0                        ! n (4/3) pi a^3 / (Lx Ly Lz)
+    integer :: stages = 0                      ! compression stages
+    integer :: relax_sweeps = 0                ! total overlap-relaxation sweeps
+    real(dp) :: acceptance = 0                 ! Monte Carlo acceptance over the frozen-step half
+    real(dp) :: step = 0                       ! final Monte Carlo step [a]
+    real(dp) :: min_pair_gap = 0               ! min |r| - 2a [a]
+    real(dp) :: min_wall_gap = 0               ! min distance to a wall - a [a] (huge if periodic)
+  end type packing_report_t
+
+  !> Cell lists for spheres of diameter <= cell side, kept up to date under single moves.
+  type :: cells_t
+    integer :: nc(3) = 1
+    real(dp) :: box(3) = 1
+    logical :: periodic(3) = .true.
+    logical :: dedup = .false.          ! a periodic direction has < 3 cells: neighbours repeat
+    integer, allocatable :: head(:), next(:), prev(:), cell(:)
+  end type cells_t
+
+contains
+
+  ! ---- random numbers ------------------------------------------------------------------------
+
+  !> Seed MRG32k3a from an integer (any value) by a Lehmer scramble. Every product stays below
+  !> 2^63, so the stream is exact and compiler independent.
+  subroutine rng_seed(g, seed)
+    type(rng_t), intent(out) :: g
+    integer, intent(in) :: seed
+    integer(i8) :: x
+    integer :: k
+    real(dp) :: dummy
+    x = 1 + modulo(int(seed, i8) * 69069_i8 + 1234567_i8, 2147483646_i8)
+    do k = 1, 6
+      x = modulo(x * 48271_i8, 2147483647_i8)
+      if (k <= 3) then
+        g%s(k) = 1 + modulo(x, m1 - 1)
+      else
+        g%s(k) = 1 + modulo(x, m2 - 1)
+      end if
+    end do
+    do k = 1, 16
+      dummy = rng_uniform(g)
+    end do
+  end subroutine rng_seed
+
+  !> MRG32k3a, uniform in (0, 1): L'Ecuyer's recurrence; the output is (z + 1)/(m1 + 1) with
+  !> z = (p1 - p2) mod m1, never 0 or 1.
+  real(dp) function rng_uniform(g) result(r)
+    type(rng_t), intent(inout) :: g
+    integer(i8) :: p1, p2
+    p1 = modulo(1403580_i8 * g%s(2) - 810728_i8 * g%s(1), m1)
+    g%s(1:2) = g%s(2:3)
+    g%s(3) = p1
+    p2 = modulo(527612_i8 * g%s(6) - 1370589_i8 * g%s(4), m2)
+    g%s(4:5) = g%s(5:6)
+    g%s(6) = p2
+    r = real(modulo(p1 - p2, m1) + 1, dp) / real(m1 + 1, dp)
+  end function rng_uniform
+
+  ! ---- sizes --------------------------------------------------------------------------------
+
+  !> Number of spheres of radius a closest to volume fraction phi in box.
+  pure integer function packing_count(phi, box, a) result(n)
+    real(dp), intent(in) :: phi, box(3), a
+    n = nint(phi * product(box) / (4.0_dp / 3 * pi * a**3))
+  end function packing_count
+
+  !> The box of the shape of box that holds n spheres of radius a at volume fraction phi exactly.
+  pure function packing_box_for(n, phi, box, a) result(b)
+    integer, intent(in) :: n
+    real(dp), intent(in) :: phi, box(3), a
+    real(dp) :: b(3)
+    b = box * (n * (4.0_dp / 3 * pi * a**3) / (phi * product(box)))**(1.0_dp / 3)
+  end function packing_box_for
+
+  ! ---- cell lists ---------------------------------------------------------------------------
+
+  subroutine cells_init(cl, box, periodic, side, n)
+    type(cells_t), intent(inout) :: cl
+    real(dp), intent(in) :: box(3), side
+    logical, intent(in) :: periodic(3)
+    integer, intent(in) :: n
+    cl%box = box
+    cl%periodic = periodic
+    cl%nc = max(1, int(box / side))
+    cl%dedup = any(periodic .and. cl%nc < 3)
+    if (allocated(cl%head)) deallocate(cl%head, cl%next, cl%prev, cl%cell)
+    allocate(cl%head(product(cl%nc)), cl%next(n), cl%prev(n), cl%cell(n))
+  end subroutine cells_init
+
+  pure integer function cell_of(cl, x) result(idx)
+    type(cells_t), intent(in) :: cl
+    real(dp), intent(in) :: x(3)
+    integer :: c(3), k
+    real(dp) :: s
+    do k = 1, 3
+      s = x(k) / cl%box(k)
+      if (cl%periodic(k)) s = s - floor(s)
+      c(k) = min(cl%nc(k) - 1, max(0, int(s * cl%nc(k))))
+    end do
+    idx = 1 + c(1) + cl%nc(1) * (c(2) + cl%nc(2) * c(3))
+  end function cell_of
+
+  subroutine cells_fill(cl, x, n)
+    type(cells_t), intent(inout) :: cl
+    real(dp), intent(in) :: x(:,:)
+    integer, intent(in) :: n
+    integer :: i
+    cl%head = 0
+    do i = n, 1, -1
+      call cells_insert(cl, i, cell_of(cl, x(:, i)))
+    end do
+  end subroutine cells_fill
+
+  subroutine cells_insert(cl, i, c)
+    type(cells_t), intent(inout) :: cl
+    integer, intent(in) :: i, c
+    cl%cell(i) = c
+    cl%prev(i) = 0
+    cl%next(i) = cl%head(c)
+    if (cl%head(c) > 0) cl%prev(cl%head(c)) = i
+    cl%head(c) = i
+  end subroutine cells_insert
+
+  subroutine cells_remove(cl, i)
+    type(cells_t), intent(inout) :: cl
+    integer, intent(in) :: i
+    if (cl%prev(i) > 0) then
+      cl%next(cl%prev(i)) = cl%next(i)
+    else
+      cl%head(cl%cell(i)) = cl%next(i)
+    end if
+    if (cl%next(i) > 0) cl%prev(cl%next(i)) = cl%prev(i)
+  end subroutine cells_remove
+
+  !> The distinct cells around the cell of position x.
+  pure subroutine cells_around(cl, x, cells, nu)
+    type(cells_t), intent(in) :: cl
+    real(dp), intent(in) :: x(3)
+    integer, intent(out) :: cells(27), nu
+    integer :: c(3), cn(3), k, o1, o2, o3, idx
+    real(dp) :: s
+    logical :: out
+    do k = 1, 3
+      s = x(k) / cl%box(k)
+      if (cl%periodic(k)) s = s - floor(s)
+      c(k) = min(cl%nc(k) - 1, max(0, int(s * cl%nc(k))))
+    end do
+    nu = 0
+    cells = 0
+    do o3 = -1, 1
+      do o2 = -1, 1
+        do o1 = -1, 1
+          cn = c + [o1, o2, o3]
+          out = .false.
+          do k = 1, 3
+            if (cn(k) < 0 .or. cn(k) >= cl%nc(k)) then
+              if (cl%periodic(k)) then
+                cn(k) = modulo(cn(k), cl%nc(k))
+              else
+                out = .true.
+              end if
+            end if
+          end do
+          if (out) cycle
+          idx = 1 + cn(1) + cl%nc(1) * (cn(2) + cl%nc(2) * cn(3))
+          if (cl%dedup) then
+            if (any(cells(1:nu) == idx)) cycle
+          end if
+          nu = nu + 1
+          cells(nu) = idx
+        end do
+      end do
+    end do
+  end subroutine cells_around
+
+  pure function mimg(d, box, periodic) result(r)
+    real(dp), intent(in) :: d(3), box(3)
+    logical, intent(in) :: periodic(3)
+    real(dp) :: r(3)
+    integer :: k
+    r = d
+    do k = 1, 3
+      if (periodic(k)) r(k) = r(k) - box(k) * anint(r(k) / box(k))
+    end do
+  end function mimg
+
+  ! ---- the packing --------------------------------------------------------------------------
+
+  !> n spheres of radius a at random in box (periodic(2) = .false.: walls at y = 0, Ly), every
+  !> gap >= min_gap, then n_sweeps Monte Carlo sweeps. x(3, n) is allocated here, positions in
+  !> [0, L) per periodic direction.
+  !> info: 0 ok; 1 n < 1, min_gap < 0, or phi (1 + min_gap/2a)^3 above phi_max by more than one
+  !> sphere; 2 a box length
+  !> below 4 (a + min_gap); 3 the compression did not remove every overlap (target not
+  !> reached). msg says which.
+  subroutine random_packing(n, box, periodic, a, min_gap, seed, n_sweeps, x, info, msg, rep)
+    integer, intent(in) :: n, seed, n_sweeps
+    real(dp), intent(in) :: box(3), a, min_gap
+    logical, intent(in) :: periodic(3)
+    real(dp), allocatable, intent(out) :: x(:,:)
+    integer, intent(out) :: info
+    character(len=*), intent(out) :: msg
+    type(packing_report_t), intent(out) :: rep
+    type(rng_t) :: g
+    integer :: i, k, stage, its
+    real(dp) :: ae, rad, lo(3), hi(3), step, acc, phi, phie, phis
+    logical :: ok
+
+    info = 0
+    msg = ''
+    allocate(x(3, 0))
+    if (n < 1 .or. .not. (min_gap >= 0)) then
+      info = 1
+      msg = 'packing: no sphere to place, or a negative minimum gap'
+      return
+    end if
+    ae = a + 0.5_dp * min_gap                  ! hard-sphere radius of the pairs
+    phi = n * (4.0_dp / 3 * pi * a**3) / product(box)
+    phie = phi * (ae / a)**3
+    rep%n = n
+    rep%phi = phi
+    ! (one sphere of slack: the count closest to phi_max V / v may round up)
+    if (phie - (4.0_dp / 3 * pi * ae**3) / product(box) > phi_max * (1 + 1.0e-12_dp)) then
+      info = 1
+      if (min_gap > 0) then
+        write(msg, '(a,f6.4,a,f4.2)') 'packing: volume fraction with the minimum gap ', phie, &
+          ' above the supported ', phi_max
+      else
+        write(msg, '(a,f6.4,a,f4.2)') 'packing: volume fraction ', phi, ' above the supported ', phi_max
+      end if
+      return
+    end if
+    if (any(box < 4 * (a + min_gap))) then
+      info = 2
+      msg = 'packing: every box length must be at least 4 (a + min_gap)'
+      return
+    end if
+    deallocate(x)
+    allocate(x(3, n))
+
+    ! centres are confined to [lo, hi]: the walls exclude a layer a + min_gap thick
+    call rng_seed(g, seed)
+    lo = 0
+    hi = box
+    if (.not. periodic(2)) then
+      lo(2) = a + min_gap
+      hi(2) = box(2) - a - min_gap
+    end if
+    do i = 1, n
+      do k = 1, 3
+        x(k, i) = lo(k) + (hi(k) - lo(k)) * rng_uniform(g)
+      end do
+    end do
+
+    ! --- compression (see the module header)
+    step = 0.1_dp * ae
+    rad = ae * (min(phie, phi_start) / phie)**(1.0_dp / 3)
+    ok = .false.
+    do stage = 1, max_stages
+      call relax_overlaps(x, box, periodic, rad, lo, hi, its, ok)
+      rep%relax_sweeps = rep%relax_sweeps + its
+      rep%stages = stage
+      if (.not. ok) exit
+      call mc_core(x, box, periodic, rad, lo(2), hi(2), g, step, stage_sweeps, .true., acc)
+      if (rad >= ae) exit
+      phis = phie * (rad / ae)**3
+      rad = min(ae, rad * (1 + growth * ((phi_rcp / phis)**(1.0_dp / 3) - 1)))
+    end do
+
+    ! --- exact check: every gap >= min_gap (up to rounding of a + min_gap - a at a clamped wall)
+    call min_separation(x, box, periodic, a, rep%min_pair_gap, rep%min_wall_gap)
+    if (.not. ok .or. rad < ae .or. rep%min_pair_gap < min_gap - 1.0e-12_dp * a .or. &
+        rep%min_wall_gap < min_gap - 1.0e-12_dp * a) then
+      info = 3
+      write(msg, '(a,f6.4,a)') 'packing: compression could not remove every overlap at phi = ', &
+        phi, ' (target not reached)'
+      return
+    end if
+
+    ! --- equilibration
+    call mc_core(x, box, periodic, ae, lo(2), hi(2), g, step, n_sweeps, .true., acc)
+    rep%acceptance = acc
+    rep%step = step
+    call min_separation(x, box, periodic, a, rep%min_pair_gap, rep%min_wall_gap)
+  end subroutine random_packing
+
+  !> Push overlapping spheres of radius rad apart until every gap is positive: Gauss-Seidel
+  !> sweeps in which each overlapping pair in turn is separated along its line of centres by
+  !> 1.05 x its overlap (the small excess ends pairs with a gap rather than at contact), the
+  !> centres clamped to [lo, hi] in bounded directions, with radius rad (1 + margin) and
+  !> tolerance margin rad / 2, so that every gap at radius rad ends >= 1.5 margin rad.
+  !> its: sweeps done; ok: converged.
+  subroutine relax_overlaps(x, box, periodic, rad, lo, hi, its, ok)
+    real(dp), intent(inout) :: x(:,:)
+    real(dp), intent(in) :: box(3), rad, lo(3), hi(3)
+    logical, intent(in) :: periodic(3)
+    integer, intent(out) :: its
+    logical, intent(out) :: ok
+    type(cells_t) :: cl
+    integer :: n, i, j, k, m, cells(27), nu
+    real(dp) :: rr, tol, r(3), d, ov, maxov, push(3)
+    n = size(x, 2)
+    rr = rad * (1 + margin)
+    tol = 0.5_dp * margin * rad
+    call cells_init(cl, box, periodic, 2 * rr, n)
+    ok = .false.
+    do its = 1, max_relax
+      call cells_fill(cl, x, n)
+      maxov = 0
+      do i = 1, n
+        call cells_around(cl, x(:, i), cells, nu)
+        do m = 1, nu
+          j = cl%head(cells(m))
+          do while (j > 0)
+            if (j > i) then
+              r = mimg(x(:, j) - x(:, i), box, periodic)
+              d = norm2(r)
+              ov = 2 * rr - d
+              if (ov > 0) then
+                maxov = max(maxov, ov)
+                if (d > 1.0e-12_dp * rad) then
+                  push = (0.5_dp * 1.05_dp * ov / d) * r
+                else
+                  push = [0.5_dp * ov, 0.0_dp, 0.0_dp]   ! coincident centres: any direction
+                end if
+                x(:, i) = x(:, i) - push
+                x(:, j) = x(:, j) + push
+                if (.not. periodic(2)) then
+                  x(2, i) = min(max(x(2, i), lo(2)), hi(2))
+                  x(2, j) = min(max(x(2, j), lo(2)), hi(2))
+                end if
+              end if
+            end if
+            j = cl%next(j)
+          end do
+        end do
+      end do
+      ! wrap (the cells of this sweep were built before the moves: a pair missed because of
+      ! that is caught by the next sweep, and the final check of random_packing is exact)
+      do i = 1, n
+        do k = 1, 3
+          if (periodic(k)) then
+            x(k, i) = x(k, i) - box(k) * floor(x(k, i) / box(k))
+            if (x(k, i) >= box(k)) x(k, i) = 0          ! -tiny wraps to box(k) in rounding
+          end if
+        end do
+      end do
+      if (maxov <= tol) then
+        ok = .true.
+        exit
+      end if
+    end do
+    its = min(its, max_relax)
+  end subroutine relax_overlaps
+
+  !> Hard-sphere Metropolis Monte Carlo on spheres of radius a, centres confined to
+  !> a <= y <= Ly - a when y is bounded: n_sweeps sweeps of size(x, 2) trial moves of a sphere
+  !> chosen at random, displaced uniformly in a cube of side 2 step. x must be overlap-free.
+  !> adapt: tune step towards 40 % acceptance during the first half, then keep it; acc is the
+  !> acceptance ratio over the sweeps with a fixed step.
+  subroutine hs_monte_carlo(x, box, periodic, a, g, step, n_sweeps, adapt, acc)
+    real(dp), intent(inout) :: x(:,:)
+    real(dp), intent(in) :: box(3), a
+    logical, intent(in) :: periodic(3), adapt
+    type(rng_t), intent(inout) :: g
+    real(dp), intent(inout) :: step
+    integer, intent(in) :: n_sweeps
+    real(dp), intent(out) :: acc
+    call mc_core(x, box, periodic, a, a, box(2) - a, g, step, n_sweeps, adapt, acc)
+  end subroutine hs_monte_carlo
+
+  !> hs_monte_carlo for spheres of radius rad with the centres confined to ylo <= y <= yhi.
+  subroutine mc_core(x, box, periodic, rad, ylo, yhi, g, step, n_sweeps, adapt, acc)
+    real(dp), intent(inout) :: x(:,:)
+    real(dp), intent(in) :: box(3), rad, ylo, yhi
+    logical, intent(in) :: periodic(3), adapt
+    type(rng_t), intent(inout) :: g
+    real(dp), intent(inout) :: step
+    integer, intent(in) :: n_sweeps
+    real(dp), intent(out) :: acc
+    type(cells_t) :: cl
+    integer :: n, sweep, m, i, k, c, nacc
+    integer(i8) :: nacc_fixed, ntry_fixed
+    real(dp) :: xn(3), d2
+    logical :: tuning
+    n = size(x, 2)
+    acc = 0
+    if (n < 1 .or. n_sweeps < 1) return
+    ! cells of side >= 2 rad: a sphere can only overlap spheres in the 27 cells around it
+    call cells_init(cl, box, periodic, 2 * rad, n)
+    call cells_fill(cl, x, n)
+    d2 = 4 * rad * rad
+    nacc_fixed = 0
+    ntry_fixed = 0
+    do sweep = 1, n_sweeps
+      tuning = adapt .and. 2 * sweep <= n_sweeps
+      nacc = 0
+      do m = 1, n
+        i = 1 + min(n - 1, int(n * rng_uniform(g)))
+        do k = 1, 3
+          xn(k) = x(k, i) + step * (2 * rng_uniform(g) - 1)
+          if (periodic(k)) then
+            xn(k) = xn(k) - box(k) * floor(xn(k) / box(k))
+            if (xn(k) >= box(k)) xn(k) = 0
+          end if
+        end do
+        if (.not. periodic(2)) then
+          if (xn(2) < ylo .or. xn(2) > yhi) cycle
+        end if
+        if (.not. fits(i, xn)) cycle
+        nacc = nacc + 1
+        x(:, i) = xn
+        c = cell_of(cl, xn)
+        if (c /= cl%cell(i)) then
+          call cells_remove(cl, i)
+          call cells_insert(cl, i, c)
+        end if
+      end do
+      if (tuning) then
+        ! acceptance falls monotonically with the step: scale it by (acceptance / 0.4), at most
+        ! by a factor 2 per sweep
+        step = step * min(2.0_dp, max(0.5_dp, real(nacc, dp) / (0.4_dp * n)))
+        step = min(max(step, 1.0e-4_dp * rad), rad)
+      else
+        nacc_fixed = nacc_fixed + nacc
+        ntry_fixed = ntry_fixed + n
+      end if
+    end do
+    if (ntry_fixed > 0) acc = real(nacc_fixed, dp) / real(ntry_fixed, dp)
+  contains
+    logical function fits(ip, y) result(yes)
+      integer, intent(in) :: ip
+      real(dp), intent(in) :: y(3)
+      integer :: cells(27), nu, mm, jj
+      yes = .true.
+      call cells_around(cl, y, cells, nu)
+      do mm = 1, nu
+        jj = cl%head(cells(mm))
+        do while (jj > 0)
+          if (jj /= ip) then
+            if (sum(mimg(x(:, jj) - y, box, periodic)**2) < d2) then
+              yes = .false.
+              return
+            end if
+          end if
+          jj = cl%next(jj)
+        end do
+      end do
+    end function fits
+  end subroutine mc_core
+
+  !> Smallest gap between spheres of radius a (min |r| - 2a over pairs, minimum image) and to the
+  !> walls (min over spheres of min(y, Ly - y) - a; huge(1.0) if y is periodic). O(n) with cells.
+  subroutine min_separation(x, box, periodic, a, pair_gap, wall_gap)
+    real(dp), intent(in) :: x(:,:), box(3), a
+    logical, intent(in) :: periodic(3)
+    real(dp), intent(out) :: pair_gap, wall_gap
+    type(cells_t) :: cl
+    integer :: n, i, j, m, cells(27), nu
+    real(dp) :: d2min, side
+    n = size(x, 2)
+    d2min = huge(1.0_dp)
+    ! cells of side >= 2.5a: any pair closer than 2.5a is seen; a farther closest pair means
+    ! no sphere has a neighbour within 0.5a, reported as a gap of >= 0.5a
+    side = 2.5_dp * a
+    call cells_init(cl, box, periodic, min(side, minval(box) / 2), n)
+    call cells_fill(cl, x, n)
+    do i = 1, n
+      call cells_around(cl, x(:, i), cells, nu)
+      do m = 1, nu
+        j = cl%head(cells(m))
+        do while (j > 0)
+          if (j > i) d2min = min(d2min, sum(mimg(x(:, j) - x(:, i), box, periodic)**2))
+          j = cl%next(j)
+        end do
+      end do
+    end do
+    pair_gap = min(sqrt(d2min), side) - 2 * a
+    wall_gap = huge(1.0_dp)
+    if (.not. periodic(2)) then
+      do i = 1, n
+        wall_gap = min(wall_gap, x(2, i) - a, box(2) - x(2, i) - a)
+      end do
+    end if
+  end subroutine min_separation
+
+end module mod_packing

@@ -1,0 +1,253 @@
+! Unit test of mod_contact, one rule at a time (issue 4 acceptance; paper §2.4, doc/CONTACT.md).
+! a = eta = gamma_dot = 1, eps_r = 5e-3 (h_r = 5e-3 a), eps_bar = 0.05, mu_d = 0.5 unless said.
+! Tolerances: results built from a few O(1) products and one power are exact to a few ulps, so
+! 1e-13 relative is used where the reference is computed along another path, 0 (bitwise) where
+! the code must produce the very same numbers (action = reaction, T_i = T_j, frictionless).
+!   1. Stiffness: k_n (eps_bar h_r)^{3/2} = 6 pi eta gamma_dot a^2 (1e-13).
+!   2. Hertz: F = -k_n |delta'|^{3/2} n at delta' = -0.01, -0.05, -0.3, -1 h_r (1e-13), along -n.
+!   3. Onset exactly at gap h_r (exact binary positions, h_r = 2^-8): at |r| = 2a + h_r the
+!      contact exists with zero force; one ulp farther there is no contact; one ulp closer the
+!      force is repulsive.
+!   4. Coulomb: under a large slip |F_t| = mu_d |F_n| (1e-13) and F_t is antiparallel to the slip
+!      (1 + cos < 1e-13); the spring is reset so that k_t |Upsilon| = |F_t| (1e-13).
+!   5. Rotation of the spring: when n turns, Upsilon . n = 0 (1e-15 |Upsilon|) and |Upsilon| is
+!      kept (1e-14), with zero slip.
+!   6. Reset on opening: the history forgets a contact that opens; a reopened contact restarts
+!      from Upsilon = 0 (its force after one step is half the force after two steps of the same
+!      constant slip, 1e-12).
+!   7. Action = reaction and T_i = T_j = a n x F bitwise; the total torque about the midpoint is
+!      the lever-arm defect (2a - |r|) n x F_t (1e-13 |F|).
+!   8. Stresslet (2.24): symmetric, equal to 1/2 (F r/2 + r/2 F) (1e-15 |F||r|), trace F.r/2
+!      (1e-13), the same on both spheres; wall contact with lever (a + gap/2) n.
+!   9. mu_d = 0: no tangential state (the history stays unallocated, size 0), F parallel to n
+!      bitwise (F = -|F_n| n) and zero torque whatever the slip.
+!  10. Walls by the same law: the normal force on a sphere at wall gap g equals the pair force
+!      at pair gap g (bitwise), pointing away from the wall.
+!  11. Set-up refusals: eps_r = 0 without a prescribed k_n; negative mu_d; a prescribed k_n wins.
+program test_contact
+  use mod_kinds, only: dp, pi
+  use mod_contact, only: contact_params_t, contact_setup, contact_history_t, history_size, &
+                         contact_pair, contact_forces, contact_stats_t, history_lookup
+  implicit none
+  type(contact_params_t) :: p, p0, pb
+  type(contact_history_t) :: h
+  type(contact_stats_t) :: st
+  integer :: info, nfail, k, step
+  integer :: pairs(2, 1), walls(2, 1)
+  character(len=200) :: msg
+  real(dp) :: n(3), ups(3), f(3), tq(3), fn, dlt, x(3, 2), u(3, 2), om(3, 2), box(3), vw(3, 2)
+  real(dp) :: force(3, 2), torque(3, 2), ss(3, 3, 2), r(3), ft(3), d, kt, l0, err, tot(3)
+  real(dp) :: fsave(3), slip(3), frac(4) = [0.01_dp, 0.05_dp, 0.3_dp, 1.0_dp], fwall(3)
+  logical :: per(3), sliding
+
+  nfail = 0
+  call contact_setup(p, 1.0_dp, 5.0e-3_dp, 0.5_dp, 0.05_dp, 0.0_dp, 1.0_dp, 1.0_dp, info, msg)
+  call check('set-up accepted', info == 0)
+
+  ! 1. stiffness
+  err = abs(p%k_n * (p%eps_bar * p%h_r)**1.5_dp / (6 * pi) - 1)
+  print '(a,es12.5,a,es9.2)', '1. k_n = ', p%k_n, ' eta gd a^1/2; balance rel. error ', err
+  call check('k_n from eps_bar', err < 1e-13_dp)
+
+  ! 2. Hertz value and direction
+  n = [1.0_dp, 2.0_dp, -2.0_dp] / 3
+  err = 0
+  do k = 1, size(frac)
+    dlt = frac(k) * p%h_r
+    ups = 0
+    call contact_pair(p, n, -dlt, [0.0_dp, 0.0_dp, 0.0_dp], [0.0_dp, 0.0_dp, 0.0_dp], 1e-3_dp, &
+                      ups, f, tq, fn, sliding)
+    err = max(err, norm2(f + p%k_n * dlt**1.5_dp * n) / (p%k_n * dlt**1.5_dp))
+  end do
+  print '(a,es9.2)', '2. Hertz force, max rel. error over 4 overlaps ', err
+  call check('Hertz force value and direction', err < 1e-13_dp)
+
+  ! 3. onset exactly at |r| = 2a + h_r, through contact_forces with exact binary positions
+  call contact_setup(pb, 1.0_dp, 2.0_dp**(-8), 0.5_dp, 0.05_dp, 0.0_dp, 1.0_dp, 1.0_dp, info, msg)
+  box = 20
+  per = [.true., .false., .true.]
+  vw = 0
+  u = 0
+  om = 0
+  pairs(:, 1) = [1, 2]
+  x(:, 1) = [4.0_dp, 10.0_dp, 5.0_dp]
+  x(:, 2) = x(:, 1) + [2 + pb%h_r, 0.0_dp, 0.0_dp]
+  call cf(pb, x)
+  print '(a,i0,a,es10.3)', '3. at gap h_r: contacts ', st%pair_contacts, ', |F| ', norm2(force(:, 1))
+  call check('contact with zero force at gap = h_r', st%pair_contacts == 1 .and. all(force == 0))
+  x(1, 2) = nearest(x(1, 2), 1.0_dp)
+  call cf(pb, x)
+  call check('no contact one ulp farther', st%pair_contacts == 0 .and. all(force == 0))
+  x(1, 2) = nearest(nearest(x(1, 2), -1.0_dp), -1.0_dp)
+  call cf(pb, x)
+  print '(a,es10.3)', '   one ulp closer: F_x on sphere 1 ', force(1, 1)
+  call check('repulsive one ulp closer', st%pair_contacts == 1 .and. force(1, 1) < 0)
+
+  ! 4. Coulomb cap under a large slip
+  dlt = 0.3_dp * p%h_r
+  ups = 0
+  call contact_pair(p, n, -dlt, [3.0_dp, 0.0_dp, 1.0_dp], [0.0_dp, 0.0_dp, 0.0_dp], 1.0_dp, ups, &
+                    f, tq, fn, sliding)
+  ft = f - dot_product(f, n) * n
+  slip = [3.0_dp, 0.0_dp, 1.0_dp]
+  slip = slip - dot_product(slip, n) * n
+  kt = (2.0_dp / 7) * p%k_n * sqrt(dlt)
+  err = abs(norm2(ft) / (p%mu_d * fn) - 1)
+  print '(a,es9.2,a,es9.2,a,es9.2)', '4. |F_t|/(mu_d|F_n|) - 1 = ', err, ', 1 + cos(F_t, slip) = ', &
+    1 + dot_product(ft, slip) / (norm2(ft) * norm2(slip)), ', k_t|Ups|/|F_t| - 1 = ', &
+    kt * norm2(ups) / norm2(ft) - 1
+  call check('Coulomb cap exact', err < 1e-13_dp .and. sliding)
+  call check('F_t opposes the slip', 1 + dot_product(ft, slip) / (norm2(ft) * norm2(slip)) < 1e-13_dp)
+  call check('spring reset to the cap', abs(kt * norm2(ups) / norm2(ft) - 1) < 1e-13_dp)
+
+  ! 5. rotation of the spring into a new tangent plane (the old spring has a normal part)
+  ups = [1e-6_dp, 2e-6_dp, 0.5e-6_dp]
+  l0 = norm2(ups)
+  call contact_pair(p, n, -dlt, [0.0_dp, 0.0_dp, 0.0_dp], [0.0_dp, 0.0_dp, 0.0_dp], 1e-3_dp, ups, &
+                    f, tq, fn, sliding)
+  print '(a,es9.2,a,es9.2)', '5. after rotation |Ups.n|/|Ups| = ', abs(dot_product(ups, n)) / l0, &
+    ', |Ups|/l0 - 1 = ', norm2(ups) / l0 - 1
+  call check('rotated spring is tangent', abs(dot_product(ups, n)) < 1e-15_dp * l0)
+  call check('rotated spring keeps its length', abs(norm2(ups) / l0 - 1) < 1e-14_dp)
+
+  ! 6. reset on opening (history through contact_forces)
+  x(:, 1) = [5.0_dp, 10.0_dp, 5.0_dp]
+  x(:, 2) = x(:, 1) + [2 + 0.5_dp * p%h_r, 0.0_dp, 0.0_dp]
+  u(:, 1) = [0.0_dp, 0.0_dp, 1.0_dp]
+  call cf(p, x)
+  call cf(p, x)
+  fsave = force(:, 1)
+  call check('history holds the contact', history_size(h) == 1)
+  x(1, 2) = x(1, 2) + p%h_r
+  call cf(p, x)
+  call check('history forgets an open contact', history_size(h) == 0 .and. &
+             all(history_lookup(h, 1, 2) == 0))
+  x(1, 2) = x(1, 2) - p%h_r
+  call cf(p, x)
+  print '(a,es11.4,a,es11.4)', '6. F_t,z after 2 steps ', fsave(3), ', after reopening, 1 step ', &
+    force(3, 1)
+  call check('reopened spring restarts at zero', &
+             abs(force(3, 1) - 0.5_dp * fsave(3)) < 1e-12_dp * abs(fsave(3)))
+
+  ! 7. action-reaction, torque rule, midpoint torque
+  call clear_history()
+  x(:, 2) = x(:, 1) + (2 + 0.4_dp * p%h_r) * n
+  u(:, 1) = [0.3_dp, -0.1_dp, 0.2_dp]
+  u(:, 2) = [-0.2_dp, 0.1_dp, 0.4_dp]
+  om(:, 1) = [0.1_dp, 0.5_dp, -0.3_dp]
+  om(:, 2) = [0.2_dp, -0.1_dp, 0.3_dp]
+  do step = 1, 5
+    call cf(p, x)
+  end do
+  r = x(:, 2) - x(:, 1)
+  d = norm2(r)
+  n = r / d
+  f = force(:, 1)
+  ft = f - dot_product(f, n) * n
+  print '(a,es9.2,a,es9.2)', '7. |F_i + F_j| = ', norm2(force(:, 1) + force(:, 2)), &
+    ', |F_t|/|F_n| = ', norm2(ft) / abs(dot_product(f, n))
+  call check('action = reaction (bitwise)', all(force(:, 1) == -force(:, 2)) .and. norm2(ft) > 0)
+  call check('T_i = T_j (bitwise)', all(torque(:, 1) == torque(:, 2)))
+  call check('torque = a n x F', norm2(torque(:, 1) - cross(n, f)) <= 1e-15_dp * norm2(f))
+  tot = torque(:, 1) + torque(:, 2) + cross(-0.5_dp * r, force(:, 1)) + cross(0.5_dp * r, force(:, 2))
+  err = norm2(tot - (2 - d) * cross(n, ft)) / norm2(f)
+  print '(a,es9.2,a,es9.2)', '   midpoint torque |T_tot|/|F| = ', norm2(tot) / norm2(f), &
+    ', minus (2a - |r|) n x F_t: ', err
+  call check('midpoint torque = lever defect', err < 1e-13_dp)
+
+  ! 8. stresslet
+  err = 0
+  do k = 1, 2
+    err = max(err, maxval(abs(ss(:, :, k) - transpose(ss(:, :, k)))))
+  end do
+  err = max(err, maxval(abs(ss(:, :, 1) - 0.5_dp * (spread(f, 2, 3) * spread(0.5_dp * r, 1, 3) + &
+                                                    spread(0.5_dp * r, 2, 3) * spread(f, 1, 3)))))
+  print '(a,es9.2,a,es9.2)', '8. stresslet formula/symmetry error ', err / (norm2(f) * d), &
+    ', trace rel. error ', (ss(1, 1, 1) + ss(2, 2, 1) + ss(3, 3, 1)) / (dot_product(f, r) / 2) - 1
+  call check('stresslet (2.24), symmetric', err < 1e-15_dp * norm2(f) * d)
+  call check('stresslet trace F.r/2', &
+             abs((ss(1, 1, 1) + ss(2, 2, 1) + ss(3, 3, 1)) / (dot_product(f, r) / 2) - 1) < 1e-13_dp)
+  call check('same stresslet on both spheres', all(ss(:, :, 1) == ss(:, :, 2)))
+
+  ! 9. mu_d = 0: no tangential state at all
+  call contact_setup(p0, 1.0_dp, 5.0e-3_dp, 0.0_dp, 0.05_dp, 0.0_dp, 1.0_dp, 1.0_dp, info, msg)
+  call clear_history()
+  do step = 1, 3
+    call cf(p0, x)
+  end do
+  print '(a,i0,a,l1,a,es9.2)', '9. mu_d = 0: stored ', history_size(h), ', allocated ', &
+    allocated(h%partner), ', |F + |F_n| n| = ', norm2(force(:, 1) + norm2(force(:, 1)) * n)
+  call check('mu_d = 0 keeps no tangential state', history_size(h) == 0 .and. &
+             .not. allocated(h%partner) .and. .not. allocated(h%ups))
+  call check('mu_d = 0: F along -n, no torque', all(force(:, 1) == -st%max_normal_force * n) .and. &
+             all(torque == 0))
+
+  ! 10. walls by the same law (exact binary gap 2^-9 < h_r = 2^-8); stresslet lever (a + gap/2) n
+  call clear_history()
+  x(:, 1) = [5.0_dp, 1 + 2.0_dp**(-9), 5.0_dp]
+  walls(:, 1) = [1, 1]
+  u = 0
+  om = 0
+  call contact_forces(pb, h, x(:, 1:1), u(:, 1:1), om(:, 1:1), box, per, vw, pairs, 0, walls, 1, &
+                      1e-3_dp, force(:, 1:1), torque(:, 1:1), ss(:, :, 1:1), st, info)
+  fwall = force(:, 1)
+  err = abs(ss(2, 2, 1) - fwall(2) * (-(1 + 0.5_dp * 2.0_dp**(-9)))) / abs(ss(2, 2, 1))
+  call clear_history()
+  x(:, 1) = [5.0_dp, 10.0_dp, 5.0_dp]
+  x(:, 2) = x(:, 1) - [0.0_dp, 2 + 2.0_dp**(-9), 0.0_dp]
+  call cf(pb, x)
+  print '(a,es12.5,a,es12.5)', '10. wall F_y = ', fwall(2), ', pair F_y at the same gap = ', force(2, 1)
+  call check('wall force = pair force at the same gap', fwall(2) == force(2, 1) .and. fwall(2) > 0 &
+             .and. fwall(1) == 0 .and. fwall(3) == 0)
+  call check('wall stresslet with lever (a + gap/2) n', err < 1e-15_dp)
+
+  ! 11. refusals
+  call contact_setup(p0, 1.0_dp, 0.0_dp, 0.5_dp, 0.05_dp, 0.0_dp, 1.0_dp, 1.0_dp, info, msg)
+  print '(2a)', '11. eps_r = 0 without k_n: ', trim(msg)
+  call check('smooth spheres need a prescribed k_n', info /= 0)
+  call contact_setup(p0, 1.0_dp, 0.0_dp, 0.5_dp, 0.05_dp, 1.0e6_dp, 1.0_dp, 1.0_dp, info, msg)
+  call check('a prescribed k_n is accepted', info == 0 .and. p0%k_n == 1e6_dp)
+  call contact_setup(p0, 1.0_dp, 5.0e-3_dp, -0.1_dp, 0.05_dp, 0.0_dp, 1.0_dp, 1.0_dp, info, msg)
+  call check('negative mu_d refused', info /= 0)
+  call contact_setup(p0, 1.0_dp, 5.0e-3_dp, 0.5_dp, 0.05_dp, 2.0e5_dp, 1.0_dp, 1.0_dp, info, msg)
+  call check('a prescribed k_n overrides eps_bar', info == 0 .and. p0%k_n == 2e5_dp)
+
+  if (nfail > 0) then
+    print '(i0,a)', nfail, ' check(s) FAILED'
+    error stop 1
+  end if
+  print '(a)', 'test_contact: all checks passed'
+
+contains
+
+  subroutine cf(pp, xx)
+    type(contact_params_t), intent(in) :: pp
+    real(dp), intent(in) :: xx(:,:)
+    call contact_forces(pp, h, xx, u, om, box, per, vw, pairs, 1, walls, 0, 1e-3_dp, force, &
+                        torque, ss, st, info)
+    if (info /= 0) call check('contact_forces info', .false.)
+  end subroutine cf
+
+  subroutine clear_history()
+    type(contact_history_t) :: empty
+    h = empty
+  end subroutine clear_history
+
+  subroutine check(what, ok)
+    character(len=*), intent(in) :: what
+    logical, intent(in) :: ok
+    if (ok) then
+      print '(2a)', '  ok    ', what
+    else
+      print '(2a)', '  FAIL  ', what
+      nfail = nfail + 1
+    end if
+  end subroutine check
+
+  pure function cross(a, b) result(c)
+    real(dp), intent(in) :: a(3), b(3)
+    real(dp) :: c(3)
+    c = [a(2) * b(3) - a(3) * b(2), a(3) * b(1) - a(1) * b(3), a(1) * b(2) - a(2) * b(1)]
+  end function cross
+
+end program test_contact
