@@ -50,7 +50,7 @@ CFLAGS_ALL := $(CC_FLAGS) $(COPTFLAGS) -Wall -Wextra $(PETSC_CC_INCLUDES)
 LIBS := $(HDF5_FC_LIB) $(PETSC_LIB)
 
 # Program sources: everything else in src/ is a module linked into every program.
-PROGRAM_SRC := src/main.F90
+PROGRAM_SRC := src/main.F90 src/pack_main.F90
 SRC_F90 := $(filter-out $(PROGRAM_SRC),$(wildcard src/*.F90))
 SRC_C := $(wildcard src/*.c)
 REF_F90 := $(wildcard ref/*.F90)
@@ -66,7 +66,7 @@ PURE_OBJ := $(call obj,$(PURE_F90))
 PAIRTRAJ_OBJ := $(call obj,$(REF_F90) src/kinds.F90 $(wildcard src/resistance*.F90))
 UNIT_BIN := $(patsubst tests/unit/%.F90,$(BUILD)/tests/%,$(UNIT_F90))
 
-PROGRAMS := $(BIN)/fdsusp $(if $(REF_F90),$(BIN)/pairtraj)
+PROGRAMS := $(BIN)/fdsusp $(BIN)/fdsusp-pack $(if $(REF_F90),$(BIN)/pairtraj)
 
 .PHONY: all debug check run bench clean tests-build
 all: $(PROGRAMS) $(UNIT_BIN)
@@ -86,7 +86,9 @@ $(BUILD)/src_%.o: src/%.c | $(BUILD)
 $(BUILD)/tests_unit_%.o: tests/unit/%.F90 | $(BUILD)
 	$(FC) $(FCFLAGS_ALL) -c $< -o $@
 
-$(BIN)/fdsusp: $(call obj,$(PROGRAM_SRC)) $(LIB_OBJ) | $(BIN)
+$(BIN)/fdsusp: $(call obj,src/main.F90) $(LIB_OBJ) | $(BIN)
+	$(FC_LINKER) $(OPTFLAGS) -o $@ $^ $(LIBS)
+$(BIN)/fdsusp-pack: $(call obj,src/pack_main.F90) $(LIB_OBJ) | $(BIN)
 	$(FC_LINKER) $(OPTFLAGS) -o $@ $^ $(LIBS)
 $(BIN)/pairtraj: $(PAIRTRAJ_OBJ) | $(BIN)
 	$(FC_LINKER) $(OPTFLAGS) -o $@ $^

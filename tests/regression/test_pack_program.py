@@ -1,0 +1,139 @@
+"""Invariants of bin/fdsusp-pack (issue 4):
+1. The shipped decks run: input/pack_periodic.nml writes out/pack_periodic/packing.h5 with 2000
+   spheres in a triply periodic cube at phi = 0.3, input/pack_couette.nml writes
+   out/pack_couette/packing.h5 with 859 spheres in the 20a Couette cube (phi = 0.45 within the
+   rounding of N, 0.5 %). Each file holds particles/position (N x 3, units of a) with attribute
+   box (Lx, Ly, Lz); no two spheres overlap (|r| >= 2a, minimum image, O(N^2) numpy check
+   independent of the Fortran code) and in the Couette cell a <= y <= Ly - a; every periodic
+   coordinate lies in [0, L). Wall-clock times are printed (the acceptance asks under a minute
+   for N = 1000 at phi = 0.45).
+2. Reproducible from the seed: the same deck gives bit-identical positions; another seed does not.
+3. fdsusp loads the file (&particles position_file) and takes a step.
+4. Bad decks stop before any work, non-zero status, one message naming the file, the group and
+   the variable (as for fdsusp's deck); no packing file is written."""
+import os
+import shutil
+import subprocess
+import sys
+import time
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
+import fdsusp_testlib as T
+import h5py
+import numpy as np
+
+PACK = os.path.join(T.BIN, 'fdsusp-pack')
+d = T.scratch('pack_program')
+
+
+def pack(deck, expect_ok=True):
+    t0 = time.time()
+    p = subprocess.run([PACK, deck], cwd=d, env=T.ENV, capture_output=True, text=True, timeout=300)
+    if expect_ok and p.returncode != 0:
+        print(p.stdout[-2000:], p.stderr[-2000:])
+        raise SystemExit('fdsusp-pack failed on %s' % deck)
+    return p, time.time() - t0
+
+
+def load(path):
+    with h5py.File(path, 'r') as f:
+        x = np.array(f['particles/position'])
+        box = np.array(f['particles/position'].attrs['box'])
+    return x, box
+
+
+def min_pair_distance(x, box, periodic):
+    best = np.inf
+    for i in range(len(x) - 1):
+        r = x[i + 1:] - x[i]
+        for k in range(3):
+            if periodic[k]:
+                r[:, k] -= box[k] * np.round(r[:, k] / box[k])
+        best = min(best, np.sqrt((r * r).sum(axis=1)).min())
+    return best
+
+
+# ---- 1. the shipped decks
+for name, n_expected, phi, periodic in [('pack_periodic', 2000, 0.3, (True, True, True)),
+                                        ('pack_couette', 859, 0.45, (True, False, True))]:
+    shutil.copy(os.path.join(T.ROOT, 'input', name + '.nml'), d)
+    p, seconds = pack(name + '.nml')
+    path = os.path.join(d, 'out', name, 'packing.h5')
+    T.check(os.path.exists(path), '%s: wrote out/%s/packing.h5 (%.1f s)' % (name, name, seconds))
+    x, box = load(path)
+    n = len(x)
+    phin = n * 4 * np.pi / 3 / box.prod()
+    dmin = min_pair_distance(x, box, periodic)
+    print('%s: N = %d, box = %s, phi = %.5f, min |r| = %.6f a, %.1f s' % (name, n, box, phin, dmin, seconds))
+    T.check(x.shape == (n_expected, 3), '%s: particles/position is N x 3 with N = %d' % (name, n_expected))
+    T.check(abs(phin / phi - 1) < 0.005, '%s: phi within 0.5 %% of %.2f' % (name, phi))
+    T.check(dmin >= 2.0, '%s: no overlapping spheres' % name)
+    inside = all((x[:, k] >= 0).all() and (x[:, k] < box[k]).all() for k in range(3) if periodic[k])
+    T.check(inside, '%s: periodic coordinates in [0, L)' % name)
+    if not periodic[1]:
+        T.check(x[:, 1].min() >= 1.0 and x[:, 1].max() <= box[1] - 1.0, '%s: no sphere overlaps a wall' % name)
+    if name == 'pack_periodic':
+        T.check(np.allclose(box, (2000 * 4 * np.pi / 3 / 0.3) ** (1 / 3), rtol=1e-12), '%s: cube side for 2000 spheres' % name)
+    else:
+        T.check((box == 20).all(), '%s: box attribute (20, 20, 20)' % name)
+
+# ---- 2. reproducible
+first, _ = load(os.path.join(d, 'out', 'pack_couette', 'packing.h5'))
+pack('pack_couette.nml')
+again, _ = load(os.path.join(d, 'out', 'pack_couette', 'packing.h5'))
+T.check(np.array_equal(first, again), 'same deck, bit-identical positions')
+with open(os.path.join(d, 'pack_couette.nml')) as f:
+    text = f.read()
+T.write_deck(d, 'seed2.nml', text.replace('seed = 1', 'seed = 2').replace("'out/pack_couette'", "'out/seed2'"))
+pack('seed2.nml')
+other, _ = load(os.path.join(d, 'out', 'seed2', 'packing.h5'))
+T.check(not np.allclose(first, other), 'another seed, other positions')
+
+# ---- 3. fdsusp reads the packing
+T.write_deck(d, 'run.nml', """&domain box = 20, 20, 20, cells_per_radius = 2 /
+&time dt = 0.001, steps = 1 /
+&output directory = 'run_out', progress_every = 1 /
+&particles position_file = 'out/pack_couette/packing.h5', motion = 'free' /
+""")
+status, out, err = T.run('run.nml', d, expect_ok=False)
+T.check(status == 0 and '859 rigid spheres' in out, 'fdsusp loads the packing (859 spheres) and steps')
+
+# ---- 4. bad decks
+GOOD = """&packing
+  box = 12, 12, 12
+  y_boundary = 'walls'
+  phi = 0.3
+  seed = 3
+  mc_sweeps = 10
+  directory = 'bad_out'
+/
+"""
+with open(os.path.join(d, 'a_file'), 'w') as f:
+    f.write('not a directory')
+cases = [
+    ('unknown variable', GOOD.replace('phi = 0.3', 'phii = 0.3'), ['bad.nml', '&packing', 'phii', 'unknown variable']),
+    ('phi out of range', GOOD.replace('phi = 0.3', 'phi = 0.6'), ['bad.nml', '&packing', 'phi', 'out of range']),
+    ('wrong type', GOOD.replace('seed = 3', "seed = 'x'"), ['bad.nml', '&packing', 'seed', 'cannot read']),
+    ('bad y_boundary', GOOD.replace("'walls'", "'wall'"), ['bad.nml', '&packing', 'y_boundary']),
+    ('box too small', GOOD.replace('box = 12, 12, 12', 'box = 12, 3, 12'), ['bad.nml', '&packing', 'box(y)', 'at least 4']),
+    ('negative sweeps', GOOD.replace('mc_sweeps = 10', 'mc_sweeps = -1'), ['bad.nml', '&packing', 'mc_sweeps', 'out of range']),
+    ('min_gap too large for phi', GOOD.replace('phi = 0.3', 'phi = 0.55, min_gap = 0.1'), ['bad.nml', '&packing', 'min_gap']),
+    ('no sphere', GOOD.replace('phi = 0.3', 'phi = 1e-4'), ['bad.nml', '&packing', 'phi', 'no sphere']),
+    ('file with a directory', GOOD.replace("directory = 'bad_out'", "directory = 'bad_out', file = 'x/p.h5'"), ['bad.nml', '&packing', 'file']),
+    ('unwritable directory', GOOD.replace("'bad_out'", "'a_file/out'"), ['bad.nml', '&packing', 'directory', 'cannot be created']),
+    ('unknown group', GOOD + '&domain box = 1, 1, 1 /\n', ['bad.nml', '&domain', 'unknown group']),
+    ('missing group', '! nothing here\n', ['bad.nml', '&packing', 'missing']),
+    ('missing deck', None, ['bad.nml', 'does not exist']),
+]
+for name, text, words in cases:
+    deck = os.path.join(d, 'bad.nml')
+    if os.path.exists(deck):
+        os.remove(deck)
+    if text is not None:
+        T.write_deck(d, 'bad.nml', text)
+    p, _ = pack('bad.nml', expect_ok=False)
+    messages = [l for l in p.stderr.splitlines() if l.startswith('fdsusp')]
+    T.check(p.returncode != 0, '%s: exit status %d != 0' % (name, p.returncode))
+    T.check(len(messages) == 1, '%s: one message: %s' % (name, messages[:1]))
+    T.check(all(w in p.stderr for w in words), '%s: the message names %s' % (name, ', '.join(words)))
+    T.check(not os.path.exists(os.path.join(d, 'bad_out', 'packing.h5')), '%s: no packing written' % name)
+T.finish()
