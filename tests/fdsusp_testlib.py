@@ -88,8 +88,12 @@ def h5_attr(path, name):
 
 
 def series(outdir):
+    """Every dataset of series.h5 by its path ('time', 'particles/velocity', ...)."""
+    out = {}
     with h5py.File(os.path.join(outdir, 'series.h5'), 'r') as f:
-        return {k: np.array(f[k]) for k in f.keys()}
+        f.visititems(lambda name, obj: out.__setitem__(name, np.array(obj))
+                     if isinstance(obj, h5py.Dataset) else None)
+    return out
 
 
 def check(condition, message):

@@ -1,0 +1,38 @@
+"""Invariant: a sphere dragged at constant velocity across the grid feels a force that does not
+depend on where its centre sits in a cell (translation invariance of Stokes flow in a box that is
+periodic along the motion). The solid fraction varies continuously with the position and the
+relaxed constraint of method.md §1.5b keeps the effective sphere position-independent, so the
+drag's ripple as the centre crosses cells must stay small: issue 9 asks for at most 2 % of the
+mean peak to peak. Set-up: prescribed U = 2 along x in a 6.4a cube, walls at rest in y (they
+take the momentum, so the flow reaches a steady state), a/Delta = 5, Re = 0.01, dt = 1e-3: the
+centre crosses one cell every 100 steps. After 200 steps of start-up the drag is steady to 1e-4
+(measured); steps 201-400 cover two cells. Also asserted: the force is along -x (symmetry: the
+sphere sits at mid-height, so the walls push no lift; |F_y|, |F_z| < 1e-6 |F_x|) and the torque
+is zero to the same level."""
+import os
+import sys
+import numpy as np
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
+import fdsusp_testlib as T
+
+DECK = """&domain box = 6.4, 6.4, 6.4, cells_per_radius = 5, y_boundary = 'walls', shear_rate = 0 /
+&fluid reynolds = 0.01 /
+&time dt = 1e-3, steps = 400 /
+&output directory = 'out', progress_every = 100 /
+&particles number = 1, motion = 'prescribed', position(:,1) = 3.2, 3.2, 3.2, velocity(:,1) = 2, 0, 0 /
+"""
+d = T.scratch('fd_moving_sphere')
+T.run(T.write_deck(d, 'm.nml', DECK), d, np_ranks=2)
+s = T.series(os.path.join(d, 'out'))
+f = s['particles/force_hydro'][:, 0, :]
+t = s['particles/torque_hydro'][:, 0, :]
+x = s['particles/position'][:, 0, 0]
+fx = f[200:400, 0]
+ripple = (fx.max() - fx.min()) / abs(fx.mean())
+T.check(x[399] - x[200] > 0.39, 'the centre crossed %.2f cells in steps 201-400' % ((x[399] - x[200]) / 0.2))
+T.check(ripple <= 0.02, 'drag %.4f, ripple peak to peak %.2e of the mean <= 2e-2' % (fx.mean(), ripple))
+side = np.abs(f[200:400, 1:]).max() / abs(fx.mean())
+T.check(side < 1e-6, 'no lift or side force: max(|F_y|,|F_z|)/|F_x| = %.1e < 1e-6' % side)
+tq = np.abs(t[200:400]).max() / abs(fx.mean())
+T.check(tq < 1e-6, 'no torque: max|T|/|F_x| = %.1e < 1e-6' % tq)
+T.finish()
