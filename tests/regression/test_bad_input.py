@@ -42,6 +42,17 @@ cases = [
     ('checkpoint from another box', GOOD.replace('box = 3.2, 3.2, 3.2', 'box = 3.2, 6.4, 3.2').replace('cells_per_radius = 5', 'cells_per_radius = 5'),
      ['-restart', 'good_run/checkpoint.h5'], ['good_run/checkpoint.h5', 'item cells']),
     ('not a checkpoint', GOOD, ['-restart', 'bad.nml'], ['bad.nml', 'cannot be opened as HDF5']),
+    ('unknown particle motion', GOOD + "&particles number = 1, position(:,1) = 1.6, 1.6, 1.6, motion = 'fixed' /\n", [],
+     ['bad.nml', '&particles', 'motion']),
+    ('overlapping particles', GOOD.replace('3.2, 3.2, 3.2', '6.4, 6.4, 6.4') +
+     '&particles number = 2, position(:,1) = 2, 3, 3, position(:,2) = 3.5, 3, 3 /\n', [],
+     ['bad.nml', '&particles', 'position(:,1)', 'overlap']),
+    ('particle through a wall', GOOD + '&particles number = 1, position(:,1) = 1.6, 0.5, 1.6 /\n', [],
+     ['bad.nml', '&particles', 'position(:,1)', 'crosses a wall']),
+    ('missing position file', GOOD + "&particles position_file = 'nowhere.h5' /\n", [],
+     ['bad.nml', '&particles', 'position_file', 'does not exist']),
+    ('position file without particles', GOOD + "&particles position_file = 'good_run/checkpoint.h5' /\n", [],
+     ['good_run/checkpoint.h5', 'particles/position', 'missing']),
 ]
 for name, text, args, words in cases:
     deck = os.path.join(d, 'bad.nml')
