@@ -1,5 +1,5 @@
 ! Bench of the neighbour search (mod_neighbours) and of one contact evaluation (mod_contact) versus
-! the number of spheres N, for scripts/bench_neighbours.sh (results in doc/BENCHMARKS_contacts.md).
+! the number of spheres N, for scripts/bench_neighbours.sh (results in doc/BENCHMARKS.md §3).
 ! Configurations: hard-sphere packings (mod_packing, no Monte Carlo) at phi = 0.4 in a Couette
 ! cell of shape 2:1:1 (x, z periodic, walls in y); cutoff 2a + h_r + skin with h_r = 0.005a,
 ! skin = 0.2a. Each timing is the best of 5 means over repetitions lasting at least 0.1 s.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Neighbour-search (and contact-evaluation) cost versus N, for doc/BENCHMARKS_contacts.md.
+# Neighbour-search (and contact-evaluation) cost versus N, for doc/BENCHMARKS.md §3.
 #   bash scripts/bench_neighbours.sh
 # Builds the optimised objects with make, compiles scripts/bench_neighbours.F90 against the pure
 # modules (kinds, neighbours, packing, contact) and prints a Markdown table and the fitted
