@@ -223,7 +223,7 @@ contains
     real(dp), allocatable :: moments(:, :), rhs(:, :), x(:, :), lambda_new(:), sums(:, :)
     type(field_pointer) :: u(3), lam(3)
     PetscScalar, pointer :: p(:,:,:)
-    real(dp) :: g(6), dv, b, l_old, rigid, s(3, 3), r(3), e(3), integral
+    real(dp) :: g(6), dv, b, rigid, s(3, 3), r(3), e(3), integral
     integer :: f, c, q, i, j, k, n
     logical :: ok
     character(len=200) :: text

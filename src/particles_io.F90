@@ -65,13 +65,16 @@ contains
     integer(HID_T) :: file, dset, space
     integer(HSIZE_T) :: dims(2), maxdims(2)
     integer :: err, rank
+    logical :: exists
     message = ''
     call h5fopen_f(path, H5F_ACC_RDONLY_F, file, err)
     if (err /= 0) then
       message = 'cannot be opened as HDF5'
       return
     end if
-    if (.not. has_object(file, 'particles') .or. .not. has_object(file, 'particles/position')) then
+    exists = has_object(file, 'particles')
+    if (exists) exists = has_object(file, 'particles/position')
+    if (.not. exists) then
       message = 'dataset missing'
       call h5fclose_f(file, err)
       return
