@@ -84,6 +84,10 @@ contains
     PetscCall(set_default_option(prefix//'ksp_divtol', '1e100', ierr))
     if (grid%mg_levels >= 2) then
       PetscCall(set_default_option(prefix//'pc_type', 'mg', ierr))
+      ! The Chebyshev smoothers estimate eigenvalues with GMRES by default, which keeps ~12
+      ! Krylov vectors per level and solver; the operators are SPD, so CG estimates as well with
+      ! 4 (-20 % memory, same iterations: doc/BENCHMARKS.md).
+      PetscCall(set_default_option(prefix//'mg_levels_esteig_ksp_type', 'cg', ierr))
       write(text, '(i0)') grid%mg_levels
       PetscCall(set_default_option(prefix//'pc_mg_levels', trim(text), ierr))
     else
