@@ -1,5 +1,5 @@
 # fdsusp build. Uses PETSc's own make variables (compilers, flags, include and link lines).
-#   make            build bin/fdsusp, bin/pairtraj and the unit-test programs (optimised)
+#   make            build bin/fdsusp, bin/fdsusp-pack, bin/pairtraj and the unit-test programs (optimised)
 #   make debug      the same in bin/debug/ with bounds checks and floating-point traps
 #   make check      build and run the whole test suite; last line "N passed, N failed"
 #   make run        run input/demo.nml on 2 ranks
