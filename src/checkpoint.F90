@@ -5,6 +5,7 @@
 !             with particles also /lambda_u /lambda_v /lambda_w (the fictitious-domain force
 !             density Lambda^n, a source of the next fluid step) and the group /particles
 !             (mod_particles_io: positions with attribute box, velocities, Adams-Bashforth history)
+!             with contacts also the group /contacts (mod_contacts_io: the tangential springs)
 !   attributes format_version, step, time, cells, box, walls, reynolds, dt, shear_rate
 ! Written in parallel to NAME.tmp by PETSc's HDF5 viewer, completed by rank 0, flushed to disk
 ! and renamed over NAME: the previous checkpoint survives until the new one is whole.
@@ -21,6 +22,8 @@ module mod_checkpoint
   use mod_errors, only: is_root, abort_run, file_error
   use mod_particles, only: particles_t
   use mod_particles_io, only: particles_write, particles_read_state
+  use mod_contact, only: contact_history_t
+  use mod_contacts_io, only: contacts_write, contacts_read
   implicit none
   private
   public :: checkpoint_write, checkpoint_check, checkpoint_read, checkpoint_format_version
@@ -30,8 +33,8 @@ module mod_checkpoint
 
 contains
 
-  ! lambda and parts: present when the run has particles.
-  subroutine checkpoint_write(path, cfg, fl, step, time, ierr, lambda, parts)
+  ! lambda and parts: present when the run has particles; history: when it has contacts.
+  subroutine checkpoint_write(path, cfg, fl, step, time, ierr, lambda, parts, history)
     character(len=*), intent(in) :: path
     type(config_t), intent(in) :: cfg
     type(fluid_t), intent(inout) :: fl
@@ -40,6 +43,7 @@ contains
     PetscErrorCode, intent(out) :: ierr
     Vec, intent(in), optional :: lambda(3)
     type(particles_t), intent(in), optional :: parts
+    type(contact_history_t), intent(in), optional :: history
     PetscViewer :: viewer
     integer(HID_T) :: file
     integer :: err, e(10), c, walls
@@ -76,6 +80,7 @@ contains
       call write_attribute(file, 'shear_rate', [cfg%shear_rate], e(9))
       call write_string_attribute(file, 'program', 'fdsusp', e(10))
       if (present(parts)) call particles_write(file, parts, cfg%box, .true.)
+      if (present(history) .and. present(parts)) call contacts_write(file, history, parts%n)
       call h5fclose_f(file, err)
       if (any(e /= 0) .or. err /= 0) call abort_run('cannot write the attributes of '//trim(tmp))
       err = publish_file(tmp, path)
@@ -199,12 +204,14 @@ contains
     call h5fclose_f(file, err)
   end subroutine inspect
 
-  subroutine checkpoint_read(path, fl, ierr, lambda, parts)
+  ! history (with parts): the contact history, when the run has contacts.
+  subroutine checkpoint_read(path, fl, ierr, lambda, parts, history)
     character(len=*), intent(in) :: path
     type(fluid_t), intent(inout) :: fl
     PetscErrorCode, intent(out) :: ierr
     Vec, intent(inout), optional :: lambda(3)
     type(particles_t), intent(inout), optional :: parts
+    type(contact_history_t), intent(inout), optional :: history
     PetscViewer :: viewer
     integer :: c
     PetscCall(PetscViewerHDF5Open(PETSC_COMM_WORLD, trim(path), FILE_MODE_READ, viewer, ierr))
@@ -220,6 +227,7 @@ contains
     end if
     PetscCall(PetscViewerDestroy(viewer, ierr))
     if (present(parts)) call particles_read_state(path, parts)
+    if (present(history) .and. present(parts)) call contacts_read(path, history, parts%n)
   end subroutine checkpoint_read
 
 end module mod_checkpoint

@@ -213,13 +213,16 @@ contains
 
   ! The particle sub-problem after the fluid step: velocities, lambda^{n+1}, u^{n+1}, and the
   ! resolved force, torque and stresslet. vel: the projected velocity u~ on entry, u^{n+1} on exit.
-  subroutine fd_particle_step(grid, fd, vel, pressure, parts, ierr)
+  ! extra_force, extra_torque (3, n), optional: further forces on the particles (contacts), added
+  ! to the right-hand side next to external_force/external_torque (free motion only).
+  subroutine fd_particle_step(grid, fd, vel, pressure, parts, ierr, extra_force, extra_torque)
     type(grid_t), intent(in) :: grid
     type(fd_t), intent(inout) :: fd
     Vec, intent(inout) :: vel(3)
     Vec, intent(in) :: pressure
     type(particles_t), intent(inout) :: parts
     PetscErrorCode, intent(out) :: ierr
+    real(dp), intent(in), optional :: extra_force(:, :), extra_torque(:, :)
     real(dp), allocatable :: moments(:, :), rhs(:, :), x(:, :), lambda_new(:), sums(:, :)
     type(field_pointer) :: u(3), lam(3)
     PetscScalar, pointer :: p(:,:,:)
@@ -257,6 +260,8 @@ contains
         call psys_add_diagonal(fd%system, q, fd%beta * fd%rigid_matrix(:, :, q))
         rhs(:, q) = fd%beta * moments(1:6, q) - moments(7:12, q) &
              + [parts%external_force(:, q), parts%external_torque(:, q)]
+        if (present(extra_force)) rhs(1:3, q) = rhs(1:3, q) + extra_force(:, q)
+        if (present(extra_torque)) rhs(4:6, q) = rhs(4:6, q) + extra_torque(:, q)
       end do
       call psys_solve(fd%system, rhs, x, 1.0e-12_dp, fd%solver_iterations, ok)
       if (.not. ok) then

@@ -16,10 +16,11 @@ program fdsusp
   use mod_checkpoint, only: checkpoint_write, checkpoint_check, checkpoint_read
   use mod_system, only: install_signal_handlers, stop_signal, make_directory, probe_directory
   use mod_timers, only: timers_register, stage_push, stage_pop, STAGE_SETUP, STAGE_FLUID, STAGE_OUTPUT, &
-                        STAGE_PARTICLES
+                        STAGE_PARTICLES, STAGE_CONTACTS
   use mod_particles, only: particles_t, advance_positions
   use mod_particles_io, only: particles_load
   use mod_fictitious_domain, only: fd_t, fd_create, fd_geometry, fd_particle_step, fd_destroy
+  use mod_particle_contacts, only: particle_contacts_t, pcontacts_create, pcontacts_step
   use mod_h5util, only: h5util_init
   use mod_solvers, only: solver_cold_solve
   use mod_grid, only: FIELD_P
@@ -32,10 +33,12 @@ program fdsusp
   type(series_t) :: series
   type(particles_t) :: parts
   type(fd_t) :: fd
-  logical :: has_particles
+  type(particle_contacts_t) :: pc
+  logical :: has_particles, has_contacts
+  integer :: info
   integer, allocatable :: shapes(:, :)
   character(len=max_line) :: deck, restart, checkpoint_path
-  character(len=200) :: text
+  character(len=400) :: text
   character(len=32), allocatable :: columns(:)
   integer :: step, first_step, stop_reason, cold_its
   integer :: iterations_sum(4)
@@ -57,6 +60,14 @@ program fdsusp
   call prepare_output_directory(cfg)
   call particles_load(cfg, parts)
   has_particles = parts%n > 0
+  ! contacts: the deck has &contact and the run has particles (doc/CONTACT.md)
+  has_contacts = has_particles .and. cfg%contact_group
+  if (has_contacts) then
+    call pcontacts_create(pc, parts%n, parts%radius, cfg%roughness, cfg%friction, cfg%eps_bar, &
+         cfg%normal_stiffness, cfg%neighbour_skin, 1.0_dp, cfg%shear_rate, cfg%box, cfg%walls, cfg%dt, &
+         info, text)
+    if (info /= 0) call input_error(cfg%deck_file, 'contact', '', trim(text))
+  end if
   checkpoint_path = trim(cfg%output_directory)//'/checkpoint.h5'
   step = 0
   time = 0.0_dp
@@ -75,7 +86,9 @@ program fdsusp
     PetscCallA(fd_create(grid, cfg%reynolds, cfg%dt, cfg%slip_kappa, cfg%radius_offset, fd, ierr))
   end if
   if (restarting) then
-    if (has_particles) then
+    if (has_contacts) then
+      PetscCallA(checkpoint_read(restart, fl, ierr, fd%lambda, parts, pc%history))
+    else if (has_particles) then
       PetscCallA(checkpoint_read(restart, fl, ierr, fd%lambda, parts))
     else
       PetscCallA(checkpoint_read(restart, fl, ierr))
@@ -93,12 +106,20 @@ program fdsusp
     shapes = reshape([shapes, [3, parts%n, 0], [3, parts%n, 0], [3, parts%n, 0], [3, parts%n, 0], &
                       [3, parts%n, 0], [3, 3, parts%n]], [3, size(columns)])
   end if
+  if (has_contacts) then
+    columns = [character(len=32) :: columns, 'contacts_pair', 'contacts_wall', 'contacts_sliding', &
+               'contact_max_overlap', 'particles/force_contact', 'particles/torque_contact', &
+               'particles/stresslet_contact']
+    shapes = reshape([shapes, [0, 0, 0], [0, 0, 0], [0, 0, 0], [0, 0, 0], [3, parts%n, 0], &
+                      [3, parts%n, 0], [3, 3, parts%n]], [3, size(columns)])
+  end if
   call series_open(series, cfg%output_directory, columns, merge(step, -1, restarting), shapes)
   call install_signal_handlers()
   PetscCallA(stage_pop(ierr))
   if (has_particles) then
     write(text, '(a,i0,a)') 'models: fluid (unsteady Stokes, projection); ', parts%n, &
-         ' rigid spheres (fictitious domain, motion '''//trim(cfg%motion)//'''); no contacts, no lubrication yet'
+         ' rigid spheres (fictitious domain, motion '''//trim(cfg%motion)//'''); '//trim(contact_models())// &
+         '; no lubrication yet'
     call log_line(text)
   else
     call log_line('models: fluid (unsteady Stokes, projection); no particles in this deck')
@@ -122,11 +143,22 @@ program fdsusp
       PetscCallA(stage_push(STAGE_PARTICLES, ierr))
       call fd_geometry(grid, fd, parts)
       PetscCallA(stage_pop(ierr))
+      if (has_contacts) then
+        ! contacts at X^n with the latest velocities (those of the previous step)
+        PetscCallA(stage_push(STAGE_CONTACTS, ierr))
+        call pcontacts_step(pc, parts%position, parts%velocity, parts%omega, info)
+        if (info /= 0) call contact_failure(info)
+        PetscCallA(stage_pop(ierr))
+      end if
       PetscCallA(stage_push(STAGE_FLUID, ierr))
       PetscCallA(fluid_step(grid, fl, ierr, fd%lambda))
       PetscCallA(stage_pop(ierr))
       PetscCallA(stage_push(STAGE_PARTICLES, ierr))
-      PetscCallA(fd_particle_step(grid, fd, fl%vel, fl%pressure, parts, ierr))
+      if (has_contacts) then
+        PetscCallA(fd_particle_step(grid, fd, fl%vel, fl%pressure, parts, ierr, pc%force, pc%torque))
+      else
+        PetscCallA(fd_particle_step(grid, fd, fl%vel, fl%pressure, parts, ierr))
+      end if
       call advance_positions(parts, cfg%dt, cfg%box, [.true., .not. cfg%walls, .true.])
       PetscCallA(stage_pop(ierr))
     else
@@ -265,6 +297,9 @@ contains
       row = [values(1:n), reshape(parts%position, [3 * parts%n]), reshape(parts%velocity, [3 * parts%n]), &
              reshape(parts%omega, [3 * parts%n]), reshape(parts%force_hydro, [3 * parts%n]), &
              reshape(parts%torque_hydro, [3 * parts%n]), reshape(parts%stresslet_hydro, [9 * parts%n])]
+      if (has_contacts) row = [row, real(pc%stats%pair_contacts, dp), real(pc%stats%wall_contacts, dp), &
+             real(pc%stats%sliding, dp), pc%max_overlap, reshape(pc%force, [3 * parts%n]), &
+             reshape(pc%torque, [3 * parts%n]), reshape(pc%stresslet, [9 * parts%n])]
       call series_record(series, row)
     else
       call series_record(series, values(1:n))
@@ -273,12 +308,41 @@ contains
 
   subroutine checkpoint()
     call series_flush(series)
-    if (has_particles) then
+    if (has_contacts) then
+      PetscCallA(checkpoint_write(checkpoint_path, cfg, fl, step, time, ierr, fd%lambda, parts, pc%history))
+    else if (has_particles) then
       PetscCallA(checkpoint_write(checkpoint_path, cfg, fl, step, time, ierr, fd%lambda, parts))
     else
       PetscCallA(checkpoint_write(checkpoint_path, cfg, fl, step, time, ierr))
     end if
   end subroutine checkpoint
+
+  ! The contact part of the run log's 'models:' line.
+  function contact_models() result(line)
+    character(len=200) :: line
+    character(len=32) :: friction
+    if (.not. has_contacts) then
+      line = 'no contacts'
+      return
+    end if
+    friction = 'friction off'
+    if (pc%params%mu_d > 0) write(friction, '(a,f5.3,a)') 'friction on (mu_d = ', pc%params%mu_d, ')'
+    write(line, '(a,es10.3,a,es10.3,a)') 'contacts on (Hertz, h_r = ', pc%params%h_r, ' a, k_n = ', &
+         pc%params%k_n, '), '//trim(friction)
+  end function contact_models
+
+  ! Collective (every rank holds the same contacts): stop with a diagnostic.
+  subroutine contact_failure(code)
+    integer, intent(in) :: code
+    if (code == 2) then
+      write(text, '(a,i0,a,es10.3,a,es10.3,a)') 'fdsusp: fatal: at step ', step + 1, ' a contact overlap |delta''| = ', &
+           pc%max_overlap, ' a exceeds ', pc%overlap_limit, &
+           ' a (far beyond the roughness): lower &time dt or raise &contact normal_stiffness'
+    else
+      text = 'fdsusp: fatal: the contact history does not belong to this particle set'
+    end if
+    call fatal_error(text, 4)
+  end subroutine contact_failure
 
   ! Collective: every rank takes the same decision.
   integer function why_stop()

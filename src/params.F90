@@ -16,9 +16,9 @@ module mod_params
 
   integer, parameter :: max_line = 1024
   integer, parameter :: max_inline_particles = 64
-  integer, parameter :: ngroups = 7
+  integer, parameter :: ngroups = 8
   character(len=16), parameter :: known_groups(ngroups) = [character(len=16) :: &
-       'domain', 'fluid', 'time', 'output', 'run', 'verification', 'particles']
+       'domain', 'fluid', 'time', 'output', 'run', 'verification', 'particles', 'contact']
 
   type :: config_t
     character(len=max_line) :: deck_file = ''
@@ -61,6 +61,13 @@ module mod_params
     real(dp) :: external_torque(3, max_inline_particles) = 0.0_dp      ! [eta*gamma_dot*a^3]
     real(dp) :: radius_offset = 0.38_dp                 ! alpha radius = radius + offset*h [h]
     real(dp) :: slip_kappa = 0.5_dp                     ! relaxation on partly covered faces [-]
+    ! &contact (doc/CONTACT.md; active when the group is present and the run has particles)
+    logical :: contact_group = .false.                  ! the deck has a &contact group (derived)
+    real(dp) :: roughness = 0.0_dp                      ! eps_r = h_r/a [-]
+    real(dp) :: eps_bar = 0.05_dp                       ! roughness deformation under 6 pi eta gamma_dot a^2 [-]
+    real(dp) :: friction = 0.0_dp                       ! mu_d [-]
+    real(dp) :: normal_stiffness = 0.0_dp               ! k_n [eta gamma_dot a^(1/2)] (0: from eps_bar)
+    real(dp) :: neighbour_skin = 0.2_dp                 ! neighbour-list skin [a]
     ! derived, not read
     integer :: cells(3) = 0
     logical :: walls = .true.
@@ -127,7 +134,7 @@ contains
       if (.not. any(known_groups == name)) then
         write(lnum, '(i0)') l
         call input_error(deck, trim(name), '', 'unknown group (line '//trim(lnum)// &
-             '); known groups: &domain &fluid &time &output &run &verification &particles')
+             '); known groups: &domain &fluid &time &output &run &verification &particles &contact')
       end if
     end do
   end subroutine check_group_names
@@ -297,8 +304,11 @@ contains
     real(dp) :: external_force(3, max_inline_particles), external_torque(3, max_inline_particles)
     character(len=max_line) :: position_file
     character(len=16) :: motion
+    ! &contact
+    real(dp) :: roughness, eps_bar, friction, normal_stiffness, neighbour_skin
     namelist /particles/ number, position, position_file, radius, motion, velocity, omega, &
          external_force, external_torque, radius_offset, slip_kappa
+    namelist /contact/ roughness, eps_bar, friction, normal_stiffness, neighbour_skin
     namelist /domain/ box, cells_per_radius, y_boundary, shear_rate
     namelist /fluid/ reynolds, body_force, velocity_tolerance, pressure_tolerance, viscous_theta, initial_flow
     namelist /time/ dt, steps, steady_tolerance
@@ -323,6 +333,8 @@ contains
     omega = cfg%particle_omega; external_force = cfg%external_force
     external_torque = cfg%external_torque; radius_offset = cfg%radius_offset
     slip_kappa = cfg%slip_kappa
+    roughness = cfg%roughness; eps_bar = cfg%eps_bar; friction = cfg%friction
+    normal_stiffness = cfg%normal_stiffness; neighbour_skin = cfg%neighbour_skin
 
     stat = 0
     if (present(src)) then
@@ -334,6 +346,7 @@ contains
       case ('run');          read(src, nml=run, iostat=stat, iomsg=msg)
       case ('verification'); read(src, nml=verification, iostat=stat, iomsg=msg)
       case ('particles');    read(src, nml=particles, iostat=stat, iomsg=msg)
+      case ('contact');      read(src, nml=contact, iostat=stat, iomsg=msg)
       end select
       if (present(ios)) ios = stat
       if (stat /= 0) return
@@ -353,6 +366,9 @@ contains
       cfg%particle_velocity = velocity; cfg%particle_omega = omega
       cfg%external_force = external_force; cfg%external_torque = external_torque
       cfg%radius_offset = radius_offset; cfg%slip_kappa = slip_kappa
+      cfg%roughness = roughness; cfg%eps_bar = eps_bar; cfg%friction = friction
+      cfg%normal_stiffness = normal_stiffness; cfg%neighbour_skin = neighbour_skin
+      if (group == 'contact') cfg%contact_group = .true.
     end if
     if (present(echo_unit)) then
       select case (group)
@@ -363,6 +379,13 @@ contains
       case ('run');          write(echo_unit, nml=run)
       case ('verification'); write(echo_unit, nml=verification)
       case ('particles');    call echo_particles(echo_unit, cfg)
+      case ('contact')
+        ! only when given: an absent &contact means no contacts, not these defaults
+        if (cfg%contact_group) then
+          write(echo_unit, nml=contact)
+        else
+          write(echo_unit, '(a)') '! &contact absent: no contact forces'
+        end if
       end select
     end if
   end subroutine group_io
@@ -510,6 +533,7 @@ contains
     call check_real(cfg, 'run', 'max_wall_hours', cfg%max_wall_hours, 0.0_dp, 1.0e5_dp)
 
     call validate_particles(cfg)
+    call validate_contact(cfg)
 
     if (cfg%manufactured_solution .and. any(cfg%body_force /= 0.0_dp)) &
       call input_error(cfg%deck_file, 'verification', 'manufactured_solution', &
@@ -542,5 +566,39 @@ contains
       call input_error(cfg%deck_file, 'particles', 'radius', &
            'the sphere must span at least 1.5 grid cells in radius (raise &domain cells_per_radius)')
   end subroutine validate_particles
+
+  ! Ranges of &contact, and what the contact law and the neighbour search need (doc/CONTACT.md).
+  ! Checked whenever the group is present, even in a deck without particles.
+  subroutine validate_contact(cfg)
+    type(config_t), intent(inout) :: cfg
+    character(len=*), parameter :: xyz = 'xyz'
+    character(len=200) :: text
+    real(dp) :: cutoff
+    integer :: d
+    if (.not. cfg%contact_group) return
+    call check_real(cfg, 'contact', 'roughness', cfg%roughness, 0.0_dp, 0.5_dp)
+    call check_real(cfg, 'contact', 'eps_bar', cfg%eps_bar, 0.0_dp, 1.0_dp, .true.)
+    call check_real(cfg, 'contact', 'friction', cfg%friction, 0.0_dp, 10.0_dp)
+    call check_real(cfg, 'contact', 'normal_stiffness', cfg%normal_stiffness, 0.0_dp, 1.0e15_dp)
+    call check_real(cfg, 'contact', 'neighbour_skin', cfg%neighbour_skin, 0.0_dp, 2.0_dp, .true.)
+    if (cfg%normal_stiffness <= 0.0_dp) then
+      if (cfg%roughness <= 0.0_dp) &
+        call input_error(cfg%deck_file, 'contact', 'normal_stiffness', &
+             'smooth spheres (roughness = 0) need a prescribed normal_stiffness > 0')
+      if (cfg%shear_rate == 0.0_dp) &
+        call input_error(cfg%deck_file, 'contact', 'normal_stiffness', &
+             'k_n from eps_bar needs a non-zero &domain shear_rate: prescribe normal_stiffness > 0')
+    end if
+    ! the neighbour search needs every periodic length >= 2 x cutoff (one image in range)
+    cutoff = cfg%radius * (2.0_dp + cfg%roughness) + cfg%neighbour_skin
+    do d = 1, 3
+      if (d == 2 .and. cfg%walls) cycle
+      if (cfg%box(d) < 2.0_dp * cutoff) then
+        write(text, '(a,f0.4,a)') 'with contacts every periodic length must be >= 2 (2a + h_r + neighbour_skin) = ', &
+             2.0_dp * cutoff, ' (lower &contact neighbour_skin or enlarge the box)'
+        call input_error(cfg%deck_file, 'domain', 'box('//xyz(d:d)//')', trim(text))
+      end if
+    end do
+  end subroutine validate_contact
 
 end module mod_params

@@ -6,11 +6,13 @@ module mod_timers
   implicit none
   private
   public :: timers_register, stage_push, stage_pop
-  public :: STAGE_SETUP, STAGE_FLUID, STAGE_OUTPUT, STAGE_PARTICLES
+  public :: STAGE_SETUP, STAGE_FLUID, STAGE_OUTPUT, STAGE_PARTICLES, STAGE_CONTACTS
 
-  integer, parameter :: STAGE_SETUP = 1, STAGE_FLUID = 2, STAGE_OUTPUT = 3, STAGE_PARTICLES = 4
-  character(len=*), parameter :: stage_names(4) = ['Setup    ', 'Fluid    ', 'Output   ', 'Particles']
-  PetscLogStage, save :: stages(4)
+  integer, parameter :: STAGE_SETUP = 1, STAGE_FLUID = 2, STAGE_OUTPUT = 3, STAGE_PARTICLES = 4, &
+                        STAGE_CONTACTS = 5
+  character(len=*), parameter :: stage_names(5) = ['Setup    ', 'Fluid    ', 'Output   ', 'Particles', &
+                                                   'Contacts ']
+  PetscLogStage, save :: stages(5)
 
 contains
 

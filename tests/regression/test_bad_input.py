@@ -53,6 +53,14 @@ cases = [
      ['bad.nml', '&particles', 'position_file', 'does not exist']),
     ('position file without particles', GOOD + "&particles position_file = 'good_run/checkpoint.h5' /\n", [],
      ['good_run/checkpoint.h5', 'particles/position', 'missing']),
+    ('smooth spheres without stiffness', GOOD + "&contact roughness = 0, friction = 0.3 /\n", [],
+     ['bad.nml', '&contact', 'normal_stiffness', 'roughness = 0']),
+    ('negative friction', GOOD + "&contact roughness = 0.01, friction = -0.1 /\n", [],
+     ['bad.nml', '&contact', 'friction', 'out of range']),
+    ('eps_bar rule without shear', GOOD.replace('cells_per_radius = 5', 'cells_per_radius = 5, shear_rate = 0') +
+     "&contact roughness = 0.01 /\n", [], ['bad.nml', '&contact', 'normal_stiffness', 'shear_rate']),
+    ('contact range beyond the periodic box', GOOD + "&contact roughness = 0.01, neighbour_skin = 0.5 /\n", [],
+     ['bad.nml', '&domain', 'box(x)', 'neighbour_skin']),
 ]
 for name, text, args, words in cases:
     deck = os.path.join(d, 'bad.nml')

@@ -1,0 +1,168 @@
+! The contact history in checkpoints (doc/CONTACT.md, "Checkpoint format"): the group /contacts
+! with attributes np (particle count) and count (open contacts with a spring), and, when
+! count > 0, the datasets ids (count x 2 integers as seen from C/Python: owner, partner; partner
+! -1 / -2 is the lower / upper wall) and spring (count x 3 doubles: Upsilon in units of a), in
+! the canonical order of history_pack. Written by rank 0 into the open checkpoint; read by rank 0
+! and broadcast, every rank then unpacks the same history.
+module mod_contacts_io
+  use hdf5
+  use mpi
+  use mod_kinds, only: dp
+  use mod_contact, only: contact_history_t, history_size, history_pack, history_unpack, history_clear
+  use mod_h5util, only: write_attribute, read_attribute, has_object
+  use mod_errors, only: is_root, file_error, abort_run, warn_line
+  implicit none
+  private
+  public :: contacts_write, contacts_read
+
+contains
+
+  ! Write /contacts into an open file (rank 0 only). np: the particle count of the run (the
+  ! history may be empty, np = 0, before the first contact).
+  subroutine contacts_write(file, h, np)
+    integer(HID_T), intent(in) :: file
+    type(contact_history_t), intent(in) :: h
+    integer, intent(in) :: np
+    integer(HID_T) :: group, space, dset
+    integer(HSIZE_T) :: dims(2)
+    integer :: err, e(2), n, hnp
+    integer, allocatable :: ids(:,:)
+    real(dp), allocatable :: ups(:,:)
+    n = history_size(h)
+    allocate(ids(2, max(1, n)), ups(3, max(1, n)))
+    call history_pack(h, hnp, ids, ups)
+    call h5gcreate_f(file, 'contacts', group, err)
+    if (err /= 0) call abort_run('cannot create the group /contacts')
+    call write_attribute(group, 'np', [np], e(1))
+    call write_attribute(group, 'count', [n], e(2))
+    if (any(e /= 0)) call abort_run('cannot write the attributes of /contacts')
+    if (n > 0) then
+      dims = [2_HSIZE_T, int(n, HSIZE_T)]
+      call h5screate_simple_f(2, dims, space, err)
+      call h5dcreate_f(group, 'ids', H5T_NATIVE_INTEGER, space, dset, err)
+      if (err /= 0) call abort_run('cannot create /contacts/ids')
+      call h5dwrite_f(dset, H5T_NATIVE_INTEGER, ids(:, 1:n), dims, err)
+      call h5dclose_f(dset, err)
+      call h5sclose_f(space, err)
+      dims = [3_HSIZE_T, int(n, HSIZE_T)]
+      call h5screate_simple_f(2, dims, space, err)
+      call h5dcreate_f(group, 'spring', H5T_NATIVE_DOUBLE, space, dset, err)
+      if (err /= 0) call abort_run('cannot create /contacts/spring')
+      call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, ups(:, 1:n), dims, err)
+      call h5dclose_f(dset, err)
+      call h5sclose_f(space, err)
+    end if
+    call h5gclose_f(group, err)
+  end subroutine contacts_write
+
+  ! Restart: the history from the checkpoint PATH (collective). np: the particle count of the
+  ! run. A checkpoint without /contacts (written by a run without contacts) gives an empty
+  ! history and a warning; a damaged or inconsistent group stops the run.
+  subroutine contacts_read(path, h, np)
+    character(len=*), intent(in) :: path
+    type(contact_history_t), intent(inout) :: h
+    integer, intent(in) :: np
+    integer(HID_T) :: file, group
+    integer :: err, ierr, info, a(1), meta(3)
+    integer, allocatable :: ids(:,:)
+    real(dp), allocatable :: ups(:,:)
+    character(len=200) :: message
+    message = ''
+    meta = 0          ! present, np, count
+    if (is_root()) then
+      call h5fopen_f(path, H5F_ACC_RDONLY_F, file, err)
+      if (has_object(file, 'contacts')) then
+        meta(1) = 1
+        call h5gopen_f(file, 'contacts', group, err)
+        call read_attribute(group, 'np', a, err)
+        meta(2) = a(1)
+        if (err == 0) call read_attribute(group, 'count', a, err)
+        meta(3) = a(1)
+        if (err /= 0) then
+          message = 'attribute np or count missing'
+        else if (meta(2) /= np .and. meta(3) > 0) then
+          write(message, '(a,i0,a,i0)') 'the contact history is for ', meta(2), ' particles, the run has ', np
+        else if (meta(3) < 0) then
+          message = 'negative count'
+        else if (meta(3) > 0) then
+          allocate(ids(2, meta(3)), ups(3, meta(3)))
+          call read_matrix_int(group, 'ids', ids, err)
+          if (err == 0) call read_matrix_real(group, 'spring', ups, err)
+          if (err /= 0) message = 'dataset ids or spring missing or of the wrong shape'
+        end if
+        call h5gclose_f(group, err)
+      end if
+      call h5fclose_f(file, err)
+    end if
+    call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, MPI_COMM_WORLD, ierr)
+    if (len_trim(message) > 0) call file_error(path, 'contacts', trim(message))
+    call MPI_Bcast(meta, 3, MPI_INTEGER, 0, MPI_COMM_WORLD, ierr)
+    call history_clear(h)
+    if (meta(1) == 0) then
+      call warn_line(trim(path)//' holds no contact history (/contacts): the tangential springs start at zero')
+      return
+    end if
+    if (meta(3) == 0) return
+    if (.not. is_root()) allocate(ids(2, meta(3)), ups(3, meta(3)))
+    call MPI_Bcast(ids, 2 * meta(3), MPI_INTEGER, 0, MPI_COMM_WORLD, ierr)
+    call MPI_Bcast(ups, 3 * meta(3), MPI_DOUBLE_PRECISION, 0, MPI_COMM_WORLD, ierr)
+    call history_unpack(h, np, meta(3), ids, ups, info)
+    if (info /= 0) call file_error(path, 'contacts/ids', 'invalid or repeated contact ids')
+  end subroutine contacts_read
+
+  subroutine read_matrix_int(group, name, values, err)
+    integer(HID_T), intent(in) :: group
+    character(len=*), intent(in) :: name
+    integer, intent(out) :: values(:,:)
+    integer, intent(out) :: err
+    integer(HID_T) :: dset
+    integer(HSIZE_T) :: dims(2)
+    integer :: e2
+    err = 1
+    if (.not. same_shape(group, name, shape(values))) return
+    dims = shape(values, kind=HSIZE_T)
+    call h5dopen_f(group, name, dset, err)
+    if (err /= 0) return
+    call h5dread_f(dset, H5T_NATIVE_INTEGER, values, dims, err)
+    call h5dclose_f(dset, e2)
+  end subroutine read_matrix_int
+
+  subroutine read_matrix_real(group, name, values, err)
+    integer(HID_T), intent(in) :: group
+    character(len=*), intent(in) :: name
+    real(dp), intent(out) :: values(:,:)
+    integer, intent(out) :: err
+    integer(HID_T) :: dset
+    integer(HSIZE_T) :: dims(2)
+    integer :: e2
+    err = 1
+    if (.not. same_shape(group, name, shape(values))) return
+    dims = shape(values, kind=HSIZE_T)
+    call h5dopen_f(group, name, dset, err)
+    if (err /= 0) return
+    call h5dread_f(dset, H5T_NATIVE_DOUBLE, values, dims, err)
+    call h5dclose_f(dset, e2)
+  end subroutine read_matrix_real
+
+  ! The dataset exists and is 2-D of the given (Fortran) shape.
+  logical function same_shape(group, name, expected)
+    integer(HID_T), intent(in) :: group
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: expected(2)
+    integer(HID_T) :: dset, space
+    integer(HSIZE_T) :: dims(2), maxdims(2)
+    integer :: err, rank
+    same_shape = .false.
+    if (.not. has_object(group, name)) return
+    call h5dopen_f(group, name, dset, err)
+    if (err /= 0) return
+    call h5dget_space_f(dset, space, err)
+    call h5sget_simple_extent_ndims_f(space, rank, err)
+    dims = 0
+    if (rank == 2) call h5sget_simple_extent_dims_f(space, dims, maxdims, err)
+    call h5sclose_f(space, err)
+    call h5dclose_f(dset, err)
+    same_shape = rank == 2 .and. all(dims == int(expected, HSIZE_T))
+  end function same_shape
+
+end module mod_contacts_io
