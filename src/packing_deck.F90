@@ -2,18 +2,19 @@
 ! variable with its default, unit and range; keep the two in step).
 !
 ! Errors stop the program before any work with one message naming the file, the group and the
-! variable (mod_errors::input_error), as for fdsusp's own deck (mod_params, whose line-by-line
-! diagnosis of a failed namelist read is reproduced here for this group).
+! variable (mod_errors::input_error), as for fdsusp's own deck; the line-by-line diagnosis of a
+! failed namelist read is shared with mod_params (mod_deck_text).
 ! Units: radius a = 1; lengths in a.
 module mod_packing_deck
   use mod_kinds, only: dp, pi
   use mod_errors, only: input_error
+  use mod_deck_text, only: deck_line_length, load_lines, group_on_line, to_lower, diagnose_group
   use mod_packing, only: phi_max, packing_count, packing_box_for
   implicit none
   private
   public :: pack_config_t, read_pack_deck, pack_deck_lines, max_line
 
-  integer, parameter :: max_line = 1024
+  integer, parameter :: max_line = deck_line_length
 
   type :: pack_config_t
     character(len=max_line) :: deck_file = ''
@@ -30,6 +31,8 @@ module mod_packing_deck
     integer :: n = 0                                    ! number of spheres
     logical :: periodic(3) = [.true., .false., .true.]
   end type pack_config_t
+
+  type(pack_config_t), save :: diagnosis_base   ! the configuration a diagnosis starts from
 
 contains
 
@@ -80,83 +83,33 @@ contains
 
   ! ---- reading ----------------------------------------------------------------------------
 
-  subroutine load_lines(deck, lines)
-    character(len=*), intent(in) :: deck
-    character(len=max_line), allocatable, intent(out) :: lines(:)
-    character(len=max_line) :: buf
-    character(len=256) :: msg
-    integer :: unit, ios, n
-    logical :: exists
-    inquire(file=deck, exist=exists)
-    if (.not. exists) call input_error(deck, '', '', 'the deck does not exist')
-    open(newunit=unit, file=deck, status='old', action='read', iostat=ios, iomsg=msg)
-    if (ios /= 0) call input_error(deck, '', '', 'cannot open the deck: '//trim(msg))
-    n = 0
-    do
-      read(unit, '(a)', iostat=ios) buf
-      if (ios /= 0) exit
-      n = n + 1
-    end do
-    allocate(lines(n + 1))
-    rewind(unit)
-    do n = 1, size(lines) - 1
-      read(unit, '(a)', iostat=ios, iomsg=msg) lines(n)
-      if (ios /= 0) call input_error(deck, '', '', 'cannot read the deck: '//trim(msg))
-    end do
-    close(unit)
-    lines(size(lines)) = ''
-  end subroutine load_lines
-
-  !> The group name if the line opens a namelist group ('&name'), else ''.
-  function group_on_line(line) result(name)
-    character(len=*), intent(in) :: line
-    character(len=64) :: name
-    character(len=max_line) :: s
-    integer :: e
-    name = ''
-    s = adjustl(line)
-    if (s(1:1) /= '&' .and. s(1:1) /= '$') return
-    e = scan(s(2:), ' ,!/')
-    if (e == 0) e = len_trim(s)
-    name = to_lower(s(2:e))
-  end function group_on_line
-
-  function to_lower(s) result(t)
-    character(len=*), intent(in) :: s
-    character(len=len(s)) :: t
-    integer :: i
-    t = s
-    do i = 1, len(s)
-      if (s(i:i) >= 'A' .and. s(i:i) <= 'Z') t(i:i) = achar(iachar(s(i:i)) + 32)
-    end do
-  end function to_lower
-
-  !> Read &packing starting at line first. If reading fails, read ever longer prefixes of the
-  !> group to find the line at fault, and name its variable.
+  !> Read &packing starting at line first; if reading fails, mod_deck_text names the variable
+  !> and the line at fault.
   subroutine read_group(deck, lines, first, cfg)
     character(len=*), intent(in) :: deck
     character(len=*), intent(in) :: lines(:)
     integer, intent(in) :: first
     type(pack_config_t), intent(inout) :: cfg
-    type(pack_config_t) :: trial
-    character(len=max_line), allocatable :: prefix(:)
     character(len=512) :: msg
-    character(len=16) :: lnum
-    integer :: ios, k
+    integer :: ios
     msg = ''
     call group_io(cfg, lines(first:), ios, msg)
-    if (ios == 0) return
-    do k = first, size(lines)
-      prefix = [lines(first:k), '/']
-      trial = cfg
-      call group_io(trial, prefix, ios, msg)
-      if (ios /= 0) exit
-    end do
-    k = min(k, size(lines))
-    write(lnum, '(i0)') k
-    call input_error(deck, 'packing', item_name(lines(k), msg), trim(explain(lines(k), msg))// &
-         ' (line '//trim(lnum)//': "'//trim(adjustl(lines(k)))//'")')
+    if (ios /= 0) then
+      diagnosis_base = cfg
+      call diagnose_group(deck, 'packing', lines, first, read_into_copy)
+    end if
   end subroutine read_group
+
+  !> The reader mod_deck_text calls while diagnosing (a module procedure: passing an internal
+  !> one would need an executable stack).
+  subroutine read_into_copy(src, ios, msg)
+    character(len=*), intent(in) :: src(:)
+    integer, intent(out) :: ios
+    character(len=*), intent(inout) :: msg
+    type(pack_config_t) :: trial
+    trial = diagnosis_base
+    call group_io(trial, src, ios, msg)
+  end subroutine read_into_copy
 
   subroutine group_io(cfg, src, ios, msg)
     type(pack_config_t), intent(inout) :: cfg
@@ -191,74 +144,6 @@ contains
     cfg%file = file
   end subroutine group_io
 
-  !> The variable a failed read is about: from the compiler's message if it names it (unless
-  !> that "name" is really a value given to a variable), else the name before '=' on the line.
-  function item_name(line, msg) result(name)
-    character(len=*), intent(in) :: line, msg
-    character(len=128) :: name
-    character(len=*), parameter :: unknown = 'Cannot match namelist object name'
-    integer :: p
-    p = index(msg, unknown)
-    if (p > 0) then
-      name = to_lower(adjustl(msg(p + len(unknown):)))
-      if (.not. follows_equals(to_lower(line), trim(name))) return
-      name = variable_before(to_lower(line), index(to_lower(line), trim(name)))
-      return
-    end if
-    name = variable_before(to_lower(line), len_trim(line) + 1)
-  end function item_name
-
-  !> True if token stands on the line as (part of) a value: right after an '=' (spaces and
-  !> quotes skipped), or glued to the characters before it.
-  logical function follows_equals(line, token)
-    character(len=*), intent(in) :: line, token
-    integer :: p, q
-    follows_equals = .false.
-    p = index(line, token)
-    if (p == 0) return
-    q = p - 1
-    if (q > 0) then
-      if (scan(line(q:q), ' ,''"') == 0) then
-        follows_equals = .true.
-        return
-      end if
-    end if
-    do while (q > 0)
-      if (scan(line(q:q), ' ''"') == 0) exit
-      q = q - 1
-    end do
-    follows_equals = (q > 0 .and. line(q:q) == '=')
-  end function follows_equals
-
-  !> The name before the last '=' that comes before position last on the line.
-  function variable_before(line, last) result(name)
-    character(len=*), intent(in) :: line
-    integer, intent(in) :: last
-    character(len=128) :: name
-    character(len=max_line) :: s
-    integer :: e, b
-    name = '?'
-    e = index(line(1:last - 1), '=', back=.true.)
-    if (e <= 1) return
-    s = line(1:e - 1)
-    b = scan(trim(s), ' ,&', back=.true.)
-    name = adjustl(s(b + 1:))
-    b = index(name, '(')
-    if (b > 1) name = name(1:b - 1)
-  end function variable_before
-
-  function explain(line, msg) result(text)
-    character(len=*), intent(in) :: line, msg
-    character(len=:), allocatable :: text
-    character(len=*), parameter :: unknown = 'Cannot match namelist object name'
-    integer :: p
-    p = index(msg, unknown)
-    text = 'cannot read its value: '//trim(msg)
-    if (p > 0) then
-      if (.not. follows_equals(to_lower(line), trim(to_lower(adjustl(msg(p + len(unknown):)))))) &
-        text = 'unknown variable in this group (see doc/PACKING_INPUT.md)'
-    end if
-  end function explain
 
   ! ---- validation -------------------------------------------------------------------------
 

@@ -10,11 +10,12 @@
 module mod_params
   use mod_kinds, only: dp
   use mod_errors, only: input_error, log_line, is_root
+  use mod_deck_text, only: deck_line_length, load_lines, group_on_line, to_lower, diagnose_group
   implicit none
   private
   public :: config_t, read_deck, echo_deck, max_line, max_inline_particles
 
-  integer, parameter :: max_line = 1024
+  integer, parameter :: max_line = deck_line_length
   integer, parameter :: max_inline_particles = 64
   integer, parameter :: ngroups = 8
   character(len=16), parameter :: known_groups(ngroups) = [character(len=16) :: &
@@ -75,6 +76,10 @@ module mod_params
     real(dp) :: wall_speed = 0.0_dp                     ! top wall +U, bottom wall -U [a*gamma_dot]
   end type config_t
 
+  ! state of a diagnosis in progress (read_group -> mod_deck_text -> read_into_copy)
+  type(config_t), save :: diagnosis_base
+  character(len=16), save :: diagnosis_group = ''
+
 contains
 
   ! Read, validate and derive the whole configuration from DECK. Collective.
@@ -92,34 +97,6 @@ contains
     end do
     call validate(cfg)
   end subroutine read_deck
-
-  subroutine load_lines(deck, lines)
-    character(len=*), intent(in) :: deck
-    character(len=max_line), allocatable, intent(out) :: lines(:)
-    character(len=max_line) :: buf
-    character(len=256) :: msg
-    integer :: unit, ios, n
-    logical :: exists
-
-    inquire(file=deck, exist=exists)
-    if (.not. exists) call input_error(deck, '', '', 'the deck does not exist')
-    open(newunit=unit, file=deck, status='old', action='read', iostat=ios, iomsg=msg)
-    if (ios /= 0) call input_error(deck, '', '', 'cannot open the deck: '//trim(msg))
-    n = 0
-    do
-      read(unit, '(a)', iostat=ios) buf
-      if (ios /= 0) exit
-      n = n + 1
-    end do
-    allocate(lines(n + 1))
-    rewind(unit)
-    do n = 1, size(lines) - 1
-      read(unit, '(a)', iostat=ios, iomsg=msg) lines(n)
-      if (ios /= 0) call input_error(deck, '', '', 'cannot read the deck: '//trim(msg))
-    end do
-    close(unit)
-    lines(size(lines)) = ''
-  end subroutine load_lines
 
   ! Every '&name' in the deck must be a group this program knows.
   subroutine check_group_names(deck, lines)
@@ -139,41 +116,14 @@ contains
     end do
   end subroutine check_group_names
 
-  ! The group name if the line opens a namelist group ('&name'), else ''.
-  function group_on_line(line) result(name)
-    character(len=*), intent(in) :: line
-    character(len=64) :: name
-    character(len=max_line) :: s
-    integer :: e
-    name = ''
-    s = adjustl(line)
-    if (s(1:1) /= '&' .and. s(1:1) /= '$') return
-    e = scan(s(2:), ' ,!/') 
-    if (e == 0) e = len_trim(s)
-    name = to_lower(s(2:e))
-  end function group_on_line
-
-  function to_lower(s) result(t)
-    character(len=*), intent(in) :: s
-    character(len=len(s)) :: t
-    integer :: i
-    t = s
-    do i = 1, len(s)
-      if (s(i:i) >= 'A' .and. s(i:i) <= 'Z') t(i:i) = achar(iachar(s(i:i)) + 32)
-    end do
-  end function to_lower
-
   ! Read one group from the deck text. If it is absent, the defaults stand. If reading fails,
-  ! read ever longer prefixes of the group to find the line at fault, and name its variable.
+  ! mod_deck_text finds the line at fault and names its variable.
   subroutine read_group(deck, lines, group, cfg)
     character(len=*), intent(in) :: deck, group
     character(len=*), intent(in) :: lines(:)
     type(config_t), intent(inout) :: cfg
-    type(config_t) :: trial
-    character(len=max_line), allocatable :: prefix(:)
     character(len=512) :: msg
-    character(len=16) :: lnum
-    integer :: first, l, ios, k
+    integer :: first, l, ios
 
     first = 0
     do l = 1, size(lines)
@@ -183,94 +133,26 @@ contains
       end if
     end do
     if (first == 0) return
-
+    msg = ''
     call group_io(group, cfg, lines(first:), ios, msg)
-    if (ios == 0) return
-
-    ! Diagnose: the first prefix (closed by '/') that fails holds the bad item.
-    do k = first, size(lines)
-      prefix = [lines(first:k), '/']
-      trial = cfg
-      call group_io(group, trial, prefix, ios, msg)
-      if (ios /= 0) exit
-    end do
-    k = min(k, size(lines))
-    write(lnum, '(i0)') k
-    call input_error(deck, group, item_name(lines(k), msg), trim(explain(lines(k), msg))// &
-         ' (line '//trim(lnum)//': "'//trim(adjustl(lines(k)))//'")')
+    if (ios /= 0) then
+      diagnosis_base = cfg
+      diagnosis_group = group
+      call diagnose_group(deck, group, lines, first, read_into_copy)
+    end if
   end subroutine read_group
 
-  ! The variable a failed read is about: from the compiler's message if it names it, else the
-  ! name before '=' on the line at fault.
-  function item_name(line, msg) result(name)
-    character(len=*), intent(in) :: line, msg
-    character(len=128) :: name
-    character(len=*), parameter :: unknown = 'Cannot match namelist object name'
-    integer :: p
-    p = index(msg, unknown)
-    if (p > 0) then
-      name = to_lower(adjustl(msg(p + len(unknown):)))
-      ! A value the compiler could not read may be taken for a name ("steps = 'many'"): then
-      ! the item is the variable the value was given to.
-      if (.not. follows_equals(to_lower(line), trim(name))) return
-      name = variable_before(to_lower(line), index(to_lower(line), trim(name)))
-      return
-    end if
-    name = variable_before(to_lower(line), len_trim(line) + 1)
-  end function item_name
-
-  ! True if token stands on the line as (part of) a value: right after an '=' (spaces and
-  ! quotes skipped), or glued to the characters before it.
-  logical function follows_equals(line, token)
-    character(len=*), intent(in) :: line, token
-    integer :: p, q
-    follows_equals = .false.
-    p = index(line, token)
-    if (p == 0) return
-    q = p - 1
-    ! glued to what precedes it ("1e-3x"): part of a value
-    if (q > 0) then
-      if (scan(line(q:q), ' ,''"') == 0) then
-        follows_equals = .true.
-        return
-      end if
-    end if
-    do while (q > 0)
-      if (scan(line(q:q), ' ''"') == 0) exit
-      q = q - 1
-    end do
-    follows_equals = (q > 0 .and. line(q:q) == '=')
-  end function follows_equals
-
-  ! The name before the last '=' that comes before position last on the line.
-  function variable_before(line, last) result(name)
-    character(len=*), intent(in) :: line
-    integer, intent(in) :: last
-    character(len=128) :: name
-    character(len=max_line) :: s
-    integer :: e, b
-    name = '?'
-    e = index(line(1:last - 1), '=', back=.true.)
-    if (e <= 1) return
-    s = line(1:e - 1)
-    b = scan(trim(s), ' ,&', back=.true.)
-    name = adjustl(s(b + 1:))
-    b = index(name, '(')
-    if (b > 1) name = name(1:b - 1)
-  end function variable_before
-
-  function explain(line, msg) result(text)
-    character(len=*), intent(in) :: line, msg
-    character(len=:), allocatable :: text
-    character(len=*), parameter :: unknown = 'Cannot match namelist object name'
-    integer :: p
-    p = index(msg, unknown)
-    text = 'cannot read its value: '//trim(msg)
-    if (p > 0) then
-      if (.not. follows_equals(to_lower(line), trim(to_lower(adjustl(msg(p + len(unknown):)))))) &
-        text = 'unknown variable in this group (see doc/INPUT.md)'
-    end if
-  end function explain
+  ! The reader mod_deck_text calls while diagnosing: reads group diagnosis_group from src into a
+  ! copy of diagnosis_base. (A module procedure, not an internal one: passing an internal
+  ! procedure would need an executable stack.)
+  subroutine read_into_copy(src, ios, msg)
+    character(len=*), intent(in) :: src(:)
+    integer, intent(out) :: ios
+    character(len=*), intent(inout) :: msg
+    type(config_t) :: trial
+    trial = diagnosis_base
+    call group_io(trim(diagnosis_group), trial, src, ios, msg)
+  end subroutine read_into_copy
 
   ! One place per group declares its namelist: used to read it (src present) and to echo it.
   subroutine group_io(group, cfg, src, ios, msg, echo_unit)
