@@ -4,9 +4,10 @@
 ! field snapshots and checkpoints the deck asks for. SIGTERM or SIGUSR1 (what batch schedulers
 ! send before the kill) ends the run at the end of the current step with a checkpoint, status 0.
 program fdsusp
-#include <petsc/finclude/petscsys.h>
-  use petscsys
+#include <petsc/finclude/petscvec.h>
+  use petscvec
   use mod_kinds, only: dp
+  use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
   use mod_params, only: config_t, read_deck, echo_deck, max_line
   use mod_errors, only: log_line, input_error, fatal_error
   use mod_grid, only: grid_t, grid_create, grid_destroy
@@ -43,7 +44,8 @@ program fdsusp
   integer :: step, first_step, stop_reason, cold_its
   integer :: iterations_sum(4)
   real(dp) :: time, wall_start, wall_now, wall_per_step, wall_loop, cold_seconds
-  PetscBool :: bench_cold
+  PetscBool :: bench_cold, fault_set
+  PetscInt :: fault_nan_step
   real(dp) :: err_vel, err_p_max, err_p_rms
   logical :: restarting
   integer, parameter :: RUNNING = 0, DONE = 1, SIGNALLED = 2, WALL_LIMIT = 3, STEADY = 4
@@ -131,6 +133,9 @@ program fdsusp
     write(text, '(a,f10.5,a,i0,a)') 'bench: cold Poisson solve to 1e-8:', cold_seconds, ' s, ', cold_its, ' iterations'
     call log_line(text)
   end if
+  ! -fault_nan_step N: poison the velocity at step N (tests of the runtime guard only)
+  fault_nan_step = -1
+  PetscCallA(PetscOptionsGetInt(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-fault_nan_step', fault_nan_step, fault_set, ierr))
   iterations_sum = 0
   wall_loop = MPI_Wtime()
 
@@ -188,6 +193,11 @@ program fdsusp
       if (mod(step, cfg%checkpoint_every) == 0) call checkpoint()
     end if
     PetscCallA(stage_pop(ierr))
+
+    if (step == fault_nan_step) then
+      PetscCallA(VecScale(fl%vel(1), ieee_value(1.0_dp, ieee_quiet_nan), ierr))
+    end if
+    call check_health()
 
     stop_reason = why_stop()
   end do
@@ -343,6 +353,49 @@ contains
     end if
     call fatal_error(text, 4)
   end subroutine contact_failure
+
+  ! Runtime guard (design.md "Errors"): a non-finite velocity, pressure or particle quantity stops
+  ! the run at once, collectively, with a diagnostic; the state is written to failed_state.h5
+  ! beside the last good checkpoint, which is never overwritten. The norms are global reductions
+  ! and particle data is replicated, so every rank takes the same decision.
+  subroutine check_health()
+    PetscReal :: norms(5)
+    integer :: c, q
+    character(len=400) :: what
+    what = ''
+    do c = 1, 3
+      PetscCallA(VecNorm(fl%vel(c), NORM_INFINITY, norms(c), ierr))
+    end do
+    PetscCallA(VecNorm(fl%pressure, NORM_INFINITY, norms(4), ierr))
+    norms(5) = 0.0_dp
+    do c = 1, 4
+      if (.not. ieee_is_finite(norms(c))) then
+        write(what, '(a,a,a,es10.3)') 'the fluid ', trim(merge('velocity', 'pressure', c <= 3)), &
+             ' is not finite: max norm ', norms(c)
+        exit
+      end if
+    end do
+    if (len_trim(what) == 0 .and. has_particles) then
+      do q = 1, parts%n
+        if (.not. (all(ieee_is_finite(parts%velocity(:, q))) .and. all(ieee_is_finite(parts%omega(:, q))) &
+                   .and. all(ieee_is_finite(parts%position(:, q))))) then
+          write(what, '(a,i0,a,3es10.3,a,3es10.3)') 'particle ', q, ' is not finite: velocity ', &
+               parts%velocity(:, q), ' omega ', parts%omega(:, q)
+          exit
+        end if
+      end do
+    end if
+    if (len_trim(what) == 0) return
+    call series_flush(series)
+    if (has_particles) then
+      PetscCallA(checkpoint_write(trim(cfg%output_directory)//'/failed_state.h5', cfg, fl, step, time, ierr, fd%lambda, parts))
+    else
+      PetscCallA(checkpoint_write(trim(cfg%output_directory)//'/failed_state.h5', cfg, fl, step, time, ierr))
+    end if
+    write(text, '(a,i0,a)') 'fdsusp: fatal: at step ', step, ': '//trim(what)// &
+         '; state written to '//trim(cfg%output_directory)//'/failed_state.h5, the last good checkpoint is kept'
+    call fatal_error(text, 5)
+  end subroutine check_health
 
   ! Collective: every rank takes the same decision.
   integer function why_stop()

@@ -1,0 +1,38 @@
+"""Invariant: a run that goes wrong stops with a diagnostic and never destroys its last good
+checkpoint (design.md "Errors", issue 8 runtime guards). The velocity is poisoned with NaN at
+step 12 through the test-only option -fault_nan_step (a stand-in for any blow-up); the guard
+checks the fluid velocity, pressure and the particle state after every step. Asserted, on 2
+ranks with one particle: non-zero exit status 5 at step 12, one message naming the step and the
+quantity, failed_state.h5 written beside checkpoint.h5, and checkpoint.h5 still the good one of
+step 10 (checkpoint_every = 10), from which a restart runs on cleanly to step 14 without the
+fault; series.h5 holds the steps up to the failure."""
+import os
+import sys
+import numpy as np
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
+import fdsusp_testlib as T
+
+DECK = """&domain box = 3.2, 6.4, 3.2, cells_per_radius = 5, y_boundary = 'walls', shear_rate = 1 /
+&fluid reynolds = 0.01, initial_flow = 'shear' /
+&time dt = 1e-3, steps = {steps} /
+&output directory = 'out', progress_every = 1, checkpoint_every = 10 /
+&particles number = 1, position(:,1) = 1.6, 3.2, 1.6 /
+"""
+d = T.scratch('runtime_guard')
+deck = T.write_deck(d, 'g.nml', DECK.format(steps=20))
+status, out, err = T.run(deck, d, np_ranks=2, args=['-fault_nan_step', '12'], expect_ok=False)
+messages = [l for l in err.splitlines() if l.startswith('fdsusp:')]
+T.check(status == 5, 'the run stops with status 5 (got %d)' % status)
+T.check(len(messages) == 1 and 'step 12' in messages[0] and 'velocity' in messages[0],
+        'one message naming the step and the quantity: %s' % messages[:1])
+T.check(os.path.exists(os.path.join(d, 'out', 'failed_state.h5')), 'failed_state.h5 written')
+ck = os.path.join(d, 'out', 'checkpoint.h5')
+step = int(T.h5_attr(ck, 'step'))
+u = T.read_h5(ck, ['u'])['u']
+T.check(step == 10 and np.isfinite(u).all(), 'checkpoint.h5 is still the good one of step %d, finite' % step)
+s = T.series(os.path.join(d, 'out'))
+T.check(s['step'].max() <= 12, 'series.h5 ends at the failure (last step %d)' % s['step'].max())
+deck = T.write_deck(d, 'g.nml', DECK.format(steps=14))
+status, out, err = T.run(deck, d, np_ranks=2, args=['-restart', ck], expect_ok=False)
+T.check(status == 0 and 'finished at step 14' in out, 'restart from the kept checkpoint runs to step 14 (status %d)' % status)
+T.finish()
