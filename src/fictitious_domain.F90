@@ -316,12 +316,11 @@ contains
       b = lambda_new(f)
       lam(c)%ptr(i, j, k) = b
       u(c)%ptr(i, j, k) = u(c)%ptr(i, j, k) + b / fd%beta
+      ! force -Lambda e_c dV and torque -r x (Lambda e_c) dV are -Lambda dV times g = (e_c, r x e_c)
       r = fd%f_r(:, f)
-      e = 0.0_dp
-      e(c) = 1.0_dp
-      sums(1:3, q) = sums(1:3, q) - b * dv * e
-      sums(4:6, q) = sums(4:6, q) - b * dv * [r(2) * e(3) - r(3) * e(2), r(3) * e(1) - r(1) * e(3), &
-                                              r(1) * e(2) - r(2) * e(1)]
+      g = rigid_row(c, r)
+      sums(1:6, q) = sums(1:6, q) - b * dv * g
+      e = g(1:3)
       s = -0.5_dp * b * dv * (spread(r, 2, 3) * spread(e, 1, 3) + spread(e, 2, 3) * spread(r, 1, 3))
       sums(7:15, q) = sums(7:15, q) + reshape(s, [9])
     end do

@@ -3,9 +3,10 @@
 ! Pure: no PETSc, MPI or files.
 module mod_particles
   use mod_kinds, only: dp
+  use mod_neighbours, only: min_image
   implicit none
   private
-  public :: particles_t, particles_init, advance_positions, configuration_fault, minimum_image
+  public :: particles_t, particles_init, advance_positions, configuration_fault
   public :: MOTION_FREE, MOTION_PRESCRIBED, MOTION_FROZEN, motion_code
 
   integer, parameter :: MOTION_FREE = 1, MOTION_PRESCRIBED = 2, MOTION_FROZEN = 3
@@ -83,18 +84,6 @@ contains
     end do
   end subroutine advance_positions
 
-  ! r wrapped to the nearest periodic image.
-  pure function minimum_image(r, box, periodic) result(s)
-    real(dp), intent(in) :: r(3), box(3)
-    logical, intent(in) :: periodic(3)
-    real(dp) :: s(3)
-    integer :: d
-    s = r
-    do d = 1, 3
-      if (periodic(d)) s(d) = s(d) - box(d) * anint(s(d) / box(d))
-    end do
-  end function minimum_image
-
   ! '' if the configuration is acceptable, else what is wrong (and the particle at fault):
   ! a centre outside the box, a sphere crossing a wall, or two spheres overlapping by more than
   ! 5 % of the radius (far beyond any roughness overlap; an O(N^2) check, done once at start-up).
@@ -125,7 +114,7 @@ contains
     end do
     do i = 1, size(position, 2)
       do j = i + 1, size(position, 2)
-        dist = norm2(minimum_image(position(:, j) - position(:, i), box, periodic))
+        dist = norm2(min_image(position(:, j) - position(:, i), box, periodic))
         if (dist < 1.95_dp * radius) then
           write(message, '(a,i0,a,i0,a,f10.5,a)') 'particles ', i, ' and ', j, ' overlap (centre distance ', &
                dist / radius, ' radii)'
