@@ -9,7 +9,7 @@ module mod_contacts_io
   use mpi
   use mod_kinds, only: dp
   use mod_contact, only: contact_history_t, history_size, history_pack, history_unpack, history_clear
-  use mod_h5util, only: write_attribute, read_attribute, has_object
+  use mod_h5util, only: write_attribute, read_attribute, has_object, write_dataset, read_dataset
   use mod_errors, only: is_root, file_error, abort_run, warn_line
   implicit none
   private
@@ -23,8 +23,7 @@ contains
     integer(HID_T), intent(in) :: file
     type(contact_history_t), intent(in) :: h
     integer, intent(in) :: np
-    integer(HID_T) :: group, space, dset
-    integer(HSIZE_T) :: dims(2)
+    integer(HID_T) :: group
     integer :: err, e(2), n, hnp
     integer, allocatable :: ids(:,:)
     real(dp), allocatable :: ups(:,:)
@@ -37,20 +36,10 @@ contains
     call write_attribute(group, 'count', [n], e(2))
     if (any(e /= 0)) call abort_run('cannot write the attributes of /contacts')
     if (n > 0) then
-      dims = [2_HSIZE_T, int(n, HSIZE_T)]
-      call h5screate_simple_f(2, dims, space, err)
-      call h5dcreate_f(group, 'ids', H5T_NATIVE_INTEGER, space, dset, err)
-      if (err /= 0) call abort_run('cannot create /contacts/ids')
-      call h5dwrite_f(dset, H5T_NATIVE_INTEGER, ids(:, 1:n), dims, err)
-      call h5dclose_f(dset, err)
-      call h5sclose_f(space, err)
-      dims = [3_HSIZE_T, int(n, HSIZE_T)]
-      call h5screate_simple_f(2, dims, space, err)
-      call h5dcreate_f(group, 'spring', H5T_NATIVE_DOUBLE, space, dset, err)
-      if (err /= 0) call abort_run('cannot create /contacts/spring')
-      call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, ups(:, 1:n), dims, err)
-      call h5dclose_f(dset, err)
-      call h5sclose_f(space, err)
+      call write_dataset(group, 'ids', ids(:, 1:n), err)
+      if (err /= 0) call abort_run('cannot write /contacts/ids')
+      call write_dataset(group, 'spring', ups(:, 1:n), err)
+      if (err /= 0) call abort_run('cannot write /contacts/spring')
     end if
     call h5gclose_f(group, err)
   end subroutine contacts_write
@@ -86,8 +75,8 @@ contains
           message = 'negative count'
         else if (meta(3) > 0) then
           allocate(ids(2, meta(3)), ups(3, meta(3)))
-          call read_matrix_int(group, 'ids', ids, err)
-          if (err == 0) call read_matrix_real(group, 'spring', ups, err)
+          call read_dataset(group, 'ids', ids, err)
+          if (err == 0) call read_dataset(group, 'spring', ups, err)
           if (err /= 0) message = 'dataset ids or spring missing or of the wrong shape'
         end if
         call h5gclose_f(group, err)
@@ -109,60 +98,5 @@ contains
     call history_unpack(h, np, meta(3), ids, ups, info)
     if (info /= 0) call file_error(path, 'contacts/ids', 'invalid or repeated contact ids')
   end subroutine contacts_read
-
-  subroutine read_matrix_int(group, name, values, err)
-    integer(HID_T), intent(in) :: group
-    character(len=*), intent(in) :: name
-    integer, intent(out) :: values(:,:)
-    integer, intent(out) :: err
-    integer(HID_T) :: dset
-    integer(HSIZE_T) :: dims(2)
-    integer :: e2
-    err = 1
-    if (.not. same_shape(group, name, shape(values))) return
-    dims = shape(values, kind=HSIZE_T)
-    call h5dopen_f(group, name, dset, err)
-    if (err /= 0) return
-    call h5dread_f(dset, H5T_NATIVE_INTEGER, values, dims, err)
-    call h5dclose_f(dset, e2)
-  end subroutine read_matrix_int
-
-  subroutine read_matrix_real(group, name, values, err)
-    integer(HID_T), intent(in) :: group
-    character(len=*), intent(in) :: name
-    real(dp), intent(out) :: values(:,:)
-    integer, intent(out) :: err
-    integer(HID_T) :: dset
-    integer(HSIZE_T) :: dims(2)
-    integer :: e2
-    err = 1
-    if (.not. same_shape(group, name, shape(values))) return
-    dims = shape(values, kind=HSIZE_T)
-    call h5dopen_f(group, name, dset, err)
-    if (err /= 0) return
-    call h5dread_f(dset, H5T_NATIVE_DOUBLE, values, dims, err)
-    call h5dclose_f(dset, e2)
-  end subroutine read_matrix_real
-
-  ! The dataset exists and is 2-D of the given (Fortran) shape.
-  logical function same_shape(group, name, expected)
-    integer(HID_T), intent(in) :: group
-    character(len=*), intent(in) :: name
-    integer, intent(in) :: expected(2)
-    integer(HID_T) :: dset, space
-    integer(HSIZE_T) :: dims(2), maxdims(2)
-    integer :: err, rank
-    same_shape = .false.
-    if (.not. has_object(group, name)) return
-    call h5dopen_f(group, name, dset, err)
-    if (err /= 0) return
-    call h5dget_space_f(dset, space, err)
-    call h5sget_simple_extent_ndims_f(space, rank, err)
-    dims = 0
-    if (rank == 2) call h5sget_simple_extent_dims_f(space, dims, maxdims, err)
-    call h5sclose_f(space, err)
-    call h5dclose_f(dset, err)
-    same_shape = rank == 2 .and. all(dims == int(expected, HSIZE_T))
-  end function same_shape
 
 end module mod_contacts_io

@@ -1,4 +1,5 @@
-! Small helpers over HDF5's Fortran API: attributes and extendible 1-D series datasets.
+! Small helpers over HDF5's Fortran API: attributes, and 2-D datasets written whole and read back
+! with their shape checked (particles, contact history).
 ! Used by one rank at a time (series.h5 and checkpoint attributes are written by rank 0);
 ! parallel field I/O goes through PETSc's HDF5 viewer instead.
 module mod_h5util
@@ -7,7 +8,7 @@ module mod_h5util
   implicit none
   private
   public :: h5util_init, write_attribute, read_attribute, has_attribute, has_object
-  public :: write_string_attribute
+  public :: write_string_attribute, write_dataset, read_dataset, dataset_dims
   public :: HID_T, HSIZE_T
 
   interface write_attribute
@@ -16,6 +17,12 @@ module mod_h5util
   interface read_attribute
     module procedure read_attr_real, read_attr_int
   end interface read_attribute
+  interface write_dataset
+    module procedure write_dataset_real, write_dataset_int
+  end interface write_dataset
+  interface read_dataset
+    module procedure read_dataset_real, read_dataset_int
+  end interface read_dataset
 
 contains
 
@@ -141,5 +148,101 @@ contains
     end if
     call h5aclose_f(attr, e2)
   end subroutine read_attr_int
+
+  ! A whole 2-D dataset (Fortran shape (m, n); C and Python see n x m). err /= 0 on failure.
+  subroutine write_dataset_real(loc, name, values, err)
+    integer(HID_T), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    real(dp), intent(in) :: values(:, :)
+    integer, intent(out) :: err
+    call write_dataset_2d(loc, name, H5T_NATIVE_DOUBLE, shape(values, kind=HSIZE_T), err, real_values=values)
+  end subroutine write_dataset_real
+
+  subroutine write_dataset_int(loc, name, values, err)
+    integer(HID_T), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: values(:, :)
+    integer, intent(out) :: err
+    call write_dataset_2d(loc, name, H5T_NATIVE_INTEGER, shape(values, kind=HSIZE_T), err, int_values=values)
+  end subroutine write_dataset_int
+
+  subroutine write_dataset_2d(loc, name, dtype, dims, err, real_values, int_values)
+    integer(HID_T), intent(in) :: loc, dtype
+    character(len=*), intent(in) :: name
+    integer(HSIZE_T), intent(in) :: dims(2)
+    integer, intent(out) :: err
+    real(dp), intent(in), optional :: real_values(:, :)
+    integer, intent(in), optional :: int_values(:, :)
+    integer(HID_T) :: space, dset
+    integer :: e
+    call h5screate_simple_f(2, dims, space, err)
+    if (err /= 0) return
+    call h5dcreate_f(loc, name, dtype, space, dset, err)
+    if (err == 0) then
+      if (present(real_values)) call h5dwrite_f(dset, dtype, real_values, dims, err)
+      if (present(int_values)) call h5dwrite_f(dset, dtype, int_values, dims, err)
+      call h5dclose_f(dset, e)
+    end if
+    call h5sclose_f(space, e)
+  end subroutine write_dataset_2d
+
+  ! Rank and (Fortran-order) dimensions of dataset name; rank 0 when it does not exist.
+  subroutine dataset_dims(loc, name, rank, dims)
+    integer(HID_T), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    integer, intent(out) :: rank
+    integer(HSIZE_T), intent(out) :: dims(2)
+    integer(HID_T) :: dset, space
+    integer(HSIZE_T) :: maxdims(2)
+    integer :: err
+    rank = 0
+    dims = 0
+    if (.not. has_object(loc, name)) return
+    call h5dopen_f(loc, name, dset, err)
+    if (err /= 0) return
+    call h5dget_space_f(dset, space, err)
+    call h5sget_simple_extent_ndims_f(space, rank, err)
+    if (rank == 2) call h5sget_simple_extent_dims_f(space, dims, maxdims, err)
+    call h5sclose_f(space, err)
+    call h5dclose_f(dset, err)
+  end subroutine dataset_dims
+
+  ! Read a whole 2-D dataset into values; err /= 0 when it is missing, not 2-D, of another shape
+  ! than values, or unreadable.
+  subroutine read_dataset_real(loc, name, values, err)
+    integer(HID_T), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    real(dp), intent(out) :: values(:, :)
+    integer, intent(out) :: err
+    call read_dataset_2d(loc, name, H5T_NATIVE_DOUBLE, shape(values, kind=HSIZE_T), err, real_values=values)
+  end subroutine read_dataset_real
+
+  subroutine read_dataset_int(loc, name, values, err)
+    integer(HID_T), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    integer, intent(out) :: values(:, :)
+    integer, intent(out) :: err
+    call read_dataset_2d(loc, name, H5T_NATIVE_INTEGER, shape(values, kind=HSIZE_T), err, int_values=values)
+  end subroutine read_dataset_int
+
+  subroutine read_dataset_2d(loc, name, dtype, dims, err, real_values, int_values)
+    integer(HID_T), intent(in) :: loc, dtype
+    character(len=*), intent(in) :: name
+    integer(HSIZE_T), intent(in) :: dims(2)
+    integer, intent(out) :: err
+    real(dp), intent(out), optional :: real_values(:, :)
+    integer, intent(out), optional :: int_values(:, :)
+    integer(HID_T) :: dset
+    integer(HSIZE_T) :: found(2)
+    integer :: rank, e
+    err = 1
+    call dataset_dims(loc, name, rank, found)
+    if (rank /= 2 .or. any(found /= dims)) return
+    call h5dopen_f(loc, name, dset, err)
+    if (err /= 0) return
+    if (present(real_values)) call h5dread_f(dset, dtype, real_values, dims, err)
+    if (present(int_values)) call h5dread_f(dset, dtype, int_values, dims, err)
+    call h5dclose_f(dset, e)
+  end subroutine read_dataset_2d
 
 end module mod_h5util

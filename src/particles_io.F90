@@ -9,7 +9,7 @@ module mod_particles_io
   use mod_kinds, only: dp
   use mod_params, only: config_t
   use mod_particles, only: particles_t, particles_init, motion_code, configuration_fault
-  use mod_h5util, only: write_attribute, read_attribute, has_object
+  use mod_h5util, only: write_attribute, read_attribute, has_object, write_dataset, read_dataset, dataset_dims
   use mod_errors, only: is_root, input_error, file_error, abort_run
   implicit none
   private
@@ -62,8 +62,8 @@ contains
     character(len=*), intent(in) :: path
     real(dp), allocatable, intent(out) :: position(:, :)
     character(len=*), intent(out) :: message
-    integer(HID_T) :: file, dset, space
-    integer(HSIZE_T) :: dims(2), maxdims(2)
+    integer(HID_T) :: file
+    integer(HSIZE_T) :: dims(2)
     integer :: err, rank
     logical :: exists
     message = ''
@@ -79,19 +79,14 @@ contains
       call h5fclose_f(file, err)
       return
     end if
-    call h5dopen_f(file, 'particles/position', dset, err)
-    call h5dget_space_f(dset, space, err)
-    call h5sget_simple_extent_ndims_f(space, rank, err)
-    if (rank == 2) call h5sget_simple_extent_dims_f(space, dims, maxdims, err)
-    call h5sclose_f(space, err)
+    call dataset_dims(file, 'particles/position', rank, dims)
     if (rank /= 2 .or. dims(1) /= 3) then
       message = 'must be an N x 3 dataset'
     else
       allocate(position(3, dims(2)))
-      call h5dread_f(dset, H5T_NATIVE_DOUBLE, position, dims, err)
+      call read_dataset(file, 'particles/position', position, err)
       if (err /= 0) message = 'cannot be read'
     end if
-    call h5dclose_f(dset, err)
     call h5fclose_f(file, err)
   end subroutine read_positions
 
@@ -126,16 +121,9 @@ contains
     integer(HID_T), intent(in) :: group
     character(len=*), intent(in) :: name
     real(dp), intent(in) :: values(:, :)
-    integer(HID_T) :: space, dset
-    integer(HSIZE_T) :: dims(2)
     integer :: err
-    dims = shape(values, kind=HSIZE_T)
-    call h5screate_simple_f(2, dims, space, err)
-    call h5dcreate_f(group, name, H5T_NATIVE_DOUBLE, space, dset, err)
-    if (err /= 0) call abort_run('cannot create /particles/'//name)
-    call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, dims, err)
-    call h5dclose_f(dset, err)
-    call h5sclose_f(space, err)
+    call write_dataset(group, name, values, err)
+    if (err /= 0) call abort_run('cannot write /particles/'//name)
   end subroutine write_matrix
 
   ! Restart: positions, velocities and history from a checkpoint (collective). The particle count
@@ -143,10 +131,10 @@ contains
   subroutine particles_read_state(path, parts)
     character(len=*), intent(in) :: path
     type(particles_t), intent(inout) :: parts
-    integer(HID_T) :: file, group, dset, space
-    integer(HSIZE_T) :: dims(2), fdims(2), maxdims(2)
+    integer(HID_T) :: file, group
+    integer(HSIZE_T) :: fdims(2)
     real(dp) :: buffer(3, parts%n, 4)
-    integer :: err, e, flag(1), ierr
+    integer :: err, e, flag(1), ierr, rank
     character(len=200) :: message
     character(len=16), parameter :: names(4) = [character(len=16) :: 'position', 'velocity', 'omega', &
          'velocity_prev']
@@ -158,25 +146,18 @@ contains
         message = 'the checkpoint holds no particles but the deck has some'
       else
         call h5gopen_f(file, 'particles', group, err)
-        dims = [3_HSIZE_T, int(parts%n, HSIZE_T)]
         do e = 1, 4
-          if (.not. has_object(group, trim(names(e)))) then
+          call dataset_dims(group, trim(names(e)), rank, fdims)
+          if (rank == 0) then
             message = 'dataset /particles/'//trim(names(e))//' missing'
             exit
           end if
-          call h5dopen_f(group, trim(names(e)), dset, err)
-          call h5dget_space_f(dset, space, err)
-          fdims = 0
-          call h5sget_simple_extent_dims_f(space, fdims, maxdims, err)
-          call h5sclose_f(space, err)
-          if (any(fdims /= dims)) then
+          if (rank /= 2 .or. any(fdims /= [3_HSIZE_T, int(parts%n, HSIZE_T)])) then
             write(message, '(a,i0,a,i0)') 'the checkpoint has ', fdims(2), ' particles, the deck ', parts%n
-            call h5dclose_f(dset, err)
             exit
           end if
-          call h5dread_f(dset, H5T_NATIVE_DOUBLE, buffer(:, :, e), dims, err)
-          call h5dclose_f(dset, err)
-          if (err /= 0) message = 'cannot read /particles/'//trim(names(e))//' (another particle count?)'
+          call read_dataset(group, trim(names(e)), buffer(:, :, e), err)
+          if (err /= 0) message = 'cannot read /particles/'//trim(names(e))
         end do
         call read_attribute(group, 'have_prev', flag, err)
         call h5gclose_f(group, err)
