@@ -44,7 +44,10 @@ else
 endif
 WARN := -Wall -Wextra -Wno-unused-dummy-argument -Wno-compare-reals \
         -Wno-maybe-uninitialized -Wno-conversion
+# the shipped lubrication tables are found from the build tree (doc/LUBRICATION.md)
+TABLE_DIR := $(CURDIR)/input/lubrication
 FCFLAGS_ALL := $(FC_FLAGS) $(OPTFLAGS) $(WARN) -fimplicit-none -std=f2018 -fall-intrinsics \
+               -ffree-line-length-none -DFDSUSP_TABLE_DIR='"$(TABLE_DIR)"' \
                -J $(BUILD) -I $(BUILD) $(PETSC_FC_INCLUDES)
 CFLAGS_ALL := $(CC_FLAGS) $(COPTFLAGS) -Wall -Wextra $(PETSC_CC_INCLUDES)
 LIBS := $(HDF5_FC_LIB) $(PETSC_LIB)
@@ -93,7 +96,7 @@ $(BIN)/fdsusp-pack: $(call obj,src/pack_main.F90) $(LIB_OBJ) | $(BIN)
 $(BIN)/pairtraj: $(PAIRTRAJ_OBJ) | $(BIN)
 	$(FC_LINKER) $(OPTFLAGS) -o $@ $^
 $(BUILD)/tests/%: $(BUILD)/tests_unit_%.o $(PURE_OBJ) | $(BUILD)/tests
-	$(FC_LINKER) $(OPTFLAGS) -o $@ $^
+	$(FC_LINKER) $(OPTFLAGS) -o $@ $^ -llapack -lblas
 
 # Module dependencies, regenerated whenever a source changes.
 $(BUILD)/deps.mk: $(SRC_F90) $(PROGRAM_SRC) $(REF_F90) $(UNIT_F90) scripts/f90deps | $(BUILD)

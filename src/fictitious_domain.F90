@@ -5,7 +5,12 @@
 ! rho = Re). One time step, given the geometry at X^n:
 !   geometry   solid fraction alpha of every face control volume for a sphere of radius
 !              a + radius_offset*h (§1.5b: the relaxed constraint shrinks the effective sphere);
-!              each face goes to the particle covering most of it (one owner, so sum alpha <= 1);
+!              each face goes to the particle covering most of it (one owner, so sum alpha <= 1),
+!              and where two inflated spheres overlap (gaps below 2 radius_offset) the owner's
+!              weight is alpha_1 - alpha_2, the excess of its cover over the runner-up's: the gap
+!              fluid stays free, so two faces a cell apart never carry opposing fully rigid
+!              constraints (with alpha = 1 on both there is no relaxation and no steady state:
+!              Lambda then grows linearly in time; doc/DESIGN.md "Close pairs").
 !              gamma = kappa (1 - alpha) beta h^2 / eta, beta = rho/dt, weight w = alpha/(1+gamma);
 !              the discrete rigid-body matrix M_p = sum_f w g g^T dV with g the 6-vector such that
 !              (U + Omega x r)_c = g . (U, Omega), i.e. g = (e_c, r x e_c).
@@ -26,8 +31,9 @@ module mod_fictitious_domain
   use petscdmda
   use mod_kinds, only: dp
   use mod_grid, only: grid_t, FIELD_U, FIELD_V, FIELD_W, FIELD_P
-  use mod_particles, only: particles_t, MOTION_FREE, MOTION_PRESCRIBED, MOTION_FROZEN
-  use mod_particle_system, only: particle_system_t, psys_reset, psys_add_diagonal, psys_solve
+  use mod_particles, only: particles_t, MOTION_FREE, MOTION_PRESCRIBED, MOTION_FROZEN, MOTION_RESISTANCE
+  use mod_particle_system, only: particle_system_t, psys_reset, psys_add_diagonal, psys_add_pair, psys_solve
+  use mod_particle_lubrication, only: particle_lubrication_t, plub_corrections
   use mod_solid_fraction, only: cube_fraction, relaxation_gamma
   use mod_errors, only: fatal_error
   implicit none
@@ -43,6 +49,7 @@ module mod_fictitious_domain
     ! ownership of the owned faces (and cell centres, c = 4): particle index, alpha
     integer, allocatable :: owner(:, :, :, :)   ! (lo1:hi1, lo2:hi2, lo3:hi3, 4)
     real(dp), allocatable :: alpha(:, :, :, :)
+    real(dp), allocatable :: alpha_second(:, :, :, :)   ! the runner-up's cover of the same face
     ! the covered faces and cells of this rank, grouped by nothing (one list)
     integer :: nf = 0
     integer, allocatable :: f_comp(:), f_ijk(:, :), f_part(:)
@@ -79,6 +86,7 @@ contains
     end do
     allocate(fd%owner(grid%lo(1):grid%hi(1), grid%lo(2):grid%hi(2), grid%lo(3):grid%hi(3), 4))
     allocate(fd%alpha(grid%lo(1):grid%hi(1), grid%lo(2):grid%hi(2), grid%lo(3):grid%hi(3), 4))
+    allocate(fd%alpha_second, mold=fd%alpha)
     allocate(fd%f_comp(1024), fd%f_ijk(3, 1024), fd%f_part(1024), fd%f_r(3, 1024), &
              fd%f_alpha(1024), fd%f_relax(1024))
   end subroutine fd_create
@@ -95,6 +103,7 @@ contains
     radius = parts%radius + fd%radius_offset * grid%h
     fd%owner = 0
     fd%alpha = 0.0_dp
+    fd%alpha_second = 0.0_dp
     fd%nf = 0
     ! pass 1: ownership (the largest alpha wins; ties to the lower index); pass 2: the face list
     do pass = 1, 2
@@ -161,11 +170,15 @@ contains
           if (pass == 1) then
             a = cube_fraction(r, radius, h)
             if (a > fd%alpha(ijk(1), ijk(2), ijk(3), c)) then
+              fd%alpha_second(ijk(1), ijk(2), ijk(3), c) = fd%alpha(ijk(1), ijk(2), ijk(3), c)
               fd%alpha(ijk(1), ijk(2), ijk(3), c) = a
               fd%owner(ijk(1), ijk(2), ijk(3), c) = q
+            else if (a > fd%alpha_second(ijk(1), ijk(2), ijk(3), c)) then
+              fd%alpha_second(ijk(1), ijk(2), ijk(3), c) = a
             end if
           else if (fd%owner(ijk(1), ijk(2), ijk(3), c) == q) then
-            a = fd%alpha(ijk(1), ijk(2), ijk(3), c)
+            a = fd%alpha(ijk(1), ijk(2), ijk(3), c) - fd%alpha_second(ijk(1), ijk(2), ijk(3), c)
+            if (a <= 0.0_dp) cycle
             gamma = 0.0_dp
             if (c /= FIELD_P) gamma = relaxation_gamma(a, fd%kappa, fd%beta, h, fd%eta)
             call push_face(fd, c, ijk, q, r, a, 1.0_dp / (1.0_dp + gamma))
@@ -215,7 +228,10 @@ contains
   ! resolved force, torque and stresslet. vel: the projected velocity u~ on entry, u^{n+1} on exit.
   ! extra_force, extra_torque (3, n), optional: further forces on the particles (contacts), added
   ! to the right-hand side next to external_force/external_torque (free motion only).
-  subroutine fd_particle_step(grid, fd, vel, pressure, parts, ierr, extra_force, extra_torque)
+  ! lubrication, optional: the links of this configuration (mod_particle_lubrication); their
+  ! resistance enters the 6N system implicitly (method.md §1.5 eq. (1)) and their corrections are
+  ! added to the resolved force, torque and stresslet, which then hold the total hydrodynamics.
+  subroutine fd_particle_step(grid, fd, vel, pressure, parts, ierr, extra_force, extra_torque, lubrication)
     type(grid_t), intent(in) :: grid
     type(fd_t), intent(inout) :: fd
     Vec, intent(inout) :: vel(3)
@@ -223,6 +239,7 @@ contains
     type(particles_t), intent(inout) :: parts
     PetscErrorCode, intent(out) :: ierr
     real(dp), intent(in), optional :: extra_force(:, :), extra_torque(:, :)
+    type(particle_lubrication_t), intent(inout), optional :: lubrication
     real(dp), allocatable :: moments(:, :), rhs(:, :), x(:, :), lambda_new(:), sums(:, :)
     type(field_pointer) :: u(3), lam(3)
     PetscScalar, pointer :: p(:,:,:)
@@ -263,6 +280,7 @@ contains
         if (present(extra_force)) rhs(1:3, q) = rhs(1:3, q) + extra_force(:, q)
         if (present(extra_torque)) rhs(4:6, q) = rhs(4:6, q) + extra_torque(:, q)
       end do
+      if (present(lubrication)) call add_lubrication(fd, lubrication, rhs)
       call psys_solve(fd%system, rhs, x, 1.0e-12_dp, fd%solver_iterations, ok)
       if (.not. ok) then
         write(text, '(a,i0,a)') 'fdsusp: fatal: the particle system is not positive definite or did not '// &
@@ -271,7 +289,7 @@ contains
       end if
       parts%velocity = x(1:3, :)
       parts%omega = x(4:6, :)
-    case (MOTION_PRESCRIBED)
+    case (MOTION_PRESCRIBED, MOTION_RESISTANCE)
       parts%velocity = parts%prescribed_velocity
       parts%omega = parts%prescribed_omega
     case (MOTION_FROZEN)
@@ -330,6 +348,7 @@ contains
       PetscCall(DMDAVecRestoreArrayF90(grid%da(c), vel(c), u(c)%ptr, ierr))
     end do
     call MPI_Allreduce(MPI_IN_PLACE, sums, 16 * n, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
+    if (present(lubrication)) call plub_corrections(lubrication, parts%velocity, parts%omega)
     do q = 1, n
       parts%force_hydro(:, q) = sums(1:3, q)
       parts%torque_hydro(:, q) = sums(4:6, q)
@@ -339,7 +358,36 @@ contains
         parts%stresslet_hydro(c, c, q) = parts%stresslet_hydro(c, c, q) - integral
       end do
     end do
+    if (present(lubrication)) then
+      parts%force_hydro = parts%force_hydro + lubrication%force
+      parts%torque_hydro = parts%torque_hydro + lubrication%torque
+      parts%stresslet_hydro = parts%stresslet_hydro + lubrication%stresslet
+    end if
   end subroutine fd_particle_step
+
+  ! The lubrication links into the 6N system: each pair's 12x12 R_sub_FU as two diagonal blocks and
+  ! one coupling block, each wall link's 6x6 on its particle's diagonal; their velocity-independent
+  ! parts (R.U_inf + R_FE:E_inf) on the right-hand side.
+  subroutine add_lubrication(fd, pl, rhs)
+    type(fd_t), intent(inout) :: fd
+    type(particle_lubrication_t), intent(in) :: pl
+    real(dp), intent(inout) :: rhs(:, :)
+    integer :: l, i, j
+    do l = 1, pl%npairs
+      i = pl%pair(1, l)
+      j = pl%pair(2, l)
+      call psys_add_diagonal(fd%system, i, pl%pair_r(1:6, 1:6, l))
+      call psys_add_diagonal(fd%system, j, pl%pair_r(7:12, 7:12, l))
+      call psys_add_pair(fd%system, i, j, pl%pair_r(1:6, 7:12, l))
+      rhs(:, i) = rhs(:, i) + pl%pair_drive(1:6, l)
+      rhs(:, j) = rhs(:, j) + pl%pair_drive(7:12, l)
+    end do
+    do l = 1, pl%nwalls
+      i = pl%wall_part(l)
+      call psys_add_diagonal(fd%system, i, pl%wall_r(:, :, l))
+      rhs(:, i) = rhs(:, i) + pl%wall_drive(:, l)
+    end do
+  end subroutine add_lubrication
 
   subroutine fd_destroy(fd, ierr)
     type(fd_t), intent(inout) :: fd

@@ -17,11 +17,14 @@ program fdsusp
   use mod_checkpoint, only: checkpoint_write, checkpoint_check, checkpoint_read
   use mod_system, only: install_signal_handlers, stop_signal, make_directory, probe_directory
   use mod_timers, only: timers_register, stage_push, stage_pop, STAGE_SETUP, STAGE_FLUID, STAGE_OUTPUT, &
-                        STAGE_PARTICLES, STAGE_CONTACTS
+                        STAGE_PARTICLES, STAGE_CONTACTS, STAGE_LUBRICATION
   use mod_particles, only: particles_t, advance_positions
   use mod_particles_io, only: particles_load
   use mod_fictitious_domain, only: fd_t, fd_create, fd_geometry, fd_particle_step, fd_destroy
   use mod_particle_contacts, only: particle_contacts_t, pcontacts_create, pcontacts_step
+  use mod_lubrication, only: lubrication_t, LUB_NONE, LUB_SIMPLE
+  use mod_lubrication_io, only: lubrication_load
+  use mod_particle_lubrication, only: particle_lubrication_t, plub_create, plub_links
   use mod_h5util, only: h5util_init
   use mod_solvers, only: solver_cold_solve
   use mod_grid, only: FIELD_P
@@ -35,7 +38,9 @@ program fdsusp
   type(particles_t) :: parts
   type(fd_t) :: fd
   type(particle_contacts_t) :: pc
-  logical :: has_particles, has_contacts
+  type(lubrication_t) :: lub
+  type(particle_lubrication_t) :: pl
+  logical :: has_particles, has_contacts, has_lubrication
   integer :: info
   integer, allocatable :: shapes(:, :)
   character(len=max_line) :: deck, restart, checkpoint_path
@@ -69,6 +74,13 @@ program fdsusp
          cfg%normal_stiffness, cfg%neighbour_skin, 1.0_dp, cfg%shear_rate, cfg%box, cfg%walls, cfg%dt, &
          info, text)
     if (info /= 0) call input_error(cfg%deck_file, 'contact', '', trim(text))
+  end if
+  ! lubrication: pairs or walls to lubricate (doc/LUBRICATION.md); the table is read and checked now
+  call lubrication_load(cfg, has_particles .and. (parts%n >= 2 .or. cfg%walls), lub)
+  has_lubrication = lub%model /= LUB_NONE
+  if (has_lubrication) then
+    call plub_create(pl, lub, parts%n, cfg%box, cfg%walls, cfg%shear_rate, cfg%lubrication_skin, info, text)
+    if (info /= 0) call input_error(cfg%deck_file, 'lubrication', 'skin', trim(text))
   end if
   checkpoint_path = trim(cfg%output_directory)//'/checkpoint.h5'
   step = 0
@@ -108,6 +120,10 @@ program fdsusp
     shapes = reshape([shapes, [3, parts%n, 0], [3, parts%n, 0], [3, parts%n, 0], [3, parts%n, 0], &
                       [3, parts%n, 0], [3, 3, parts%n]], [3, size(columns)])
   end if
+  if (has_lubrication) then
+    columns = [character(len=32) :: columns, 'lubrication_pairs', 'lubrication_walls', 'min_gap']
+    shapes = reshape([shapes, [0, 0, 0], [0, 0, 0], [0, 0, 0]], [3, size(columns)])
+  end if
   if (has_contacts) then
     columns = [character(len=32) :: columns, 'contacts_pair', 'contacts_wall', 'contacts_sliding', &
                'contact_max_overlap', 'particles/force_contact', 'particles/torque_contact', &
@@ -121,7 +137,7 @@ program fdsusp
   if (has_particles) then
     write(text, '(a,i0,a)') 'models: fluid (unsteady Stokes, projection); ', parts%n, &
          ' rigid spheres (fictitious domain, motion '''//trim(cfg%motion)//'''); '//trim(contact_models())// &
-         '; no lubrication yet'
+         '; '//trim(lubrication_models())
     call log_line(text)
   else
     call log_line('models: fluid (unsteady Stokes, projection); no particles in this deck')
@@ -155,12 +171,22 @@ program fdsusp
         if (info /= 0) call contact_failure(info)
         PetscCallA(stage_pop(ierr))
       end if
+      if (has_lubrication) then
+        ! the lubrication links at X^n, taken implicitly in the particle problem below
+        PetscCallA(stage_push(STAGE_LUBRICATION, ierr))
+        call plub_links(pl, parts%position)
+        PetscCallA(stage_pop(ierr))
+      end if
       PetscCallA(stage_push(STAGE_FLUID, ierr))
       PetscCallA(fluid_step(grid, fl, ierr, fd%lambda))
       PetscCallA(stage_pop(ierr))
       PetscCallA(stage_push(STAGE_PARTICLES, ierr))
-      if (has_contacts) then
+      if (has_contacts .and. has_lubrication) then
+        PetscCallA(fd_particle_step(grid, fd, fl%vel, fl%pressure, parts, ierr, pc%force, pc%torque, pl))
+      else if (has_contacts) then
         PetscCallA(fd_particle_step(grid, fd, fl%vel, fl%pressure, parts, ierr, pc%force, pc%torque))
+      else if (has_lubrication) then
+        PetscCallA(fd_particle_step(grid, fd, fl%vel, fl%pressure, parts, ierr, lubrication=pl))
       else
         PetscCallA(fd_particle_step(grid, fd, fl%vel, fl%pressure, parts, ierr))
       end if
@@ -307,6 +333,7 @@ contains
       row = [values(1:n), reshape(parts%position, [3 * parts%n]), reshape(parts%velocity, [3 * parts%n]), &
              reshape(parts%omega, [3 * parts%n]), reshape(parts%force_hydro, [3 * parts%n]), &
              reshape(parts%torque_hydro, [3 * parts%n]), reshape(parts%stresslet_hydro, [9 * parts%n])]
+      if (has_lubrication) row = [row, real(pl%npairs, dp), real(pl%nwalls, dp), pl%min_gap]
       if (has_contacts) row = [row, real(pc%stats%pair_contacts, dp), real(pc%stats%wall_contacts, dp), &
              real(pc%stats%sliding, dp), pc%max_overlap, reshape(pc%force, [3 * parts%n]), &
              reshape(pc%torque, [3 * parts%n]), reshape(pc%stresslet, [9 * parts%n])]
@@ -340,6 +367,20 @@ contains
     write(line, '(a,es10.3,a,es10.3,a)') 'contacts on (Hertz, h_r = ', pc%params%h_r, ' a, k_n = ', &
          pc%params%k_n, '), '//trim(friction)
   end function contact_models
+
+  ! The lubrication part of the run log's 'models:' line.
+  function lubrication_models() result(line)
+    character(len=200) :: line
+    select case (lub%model)
+    case (LUB_NONE)
+      line = 'no lubrication correction'
+    case (LUB_SIMPLE)
+      write(line, '(a,f6.3,a)') 'lubrication simple (singular terms, outer cut-off ', lub%outer_cutoff, ' a)'
+    case default
+      write(line, '(a,f6.3,a,i0,a)') 'lubrication full (calibrated, outer cut-off ', lub%outer_cutoff, &
+           ' a, ', size(lub%pair_gap), ' tabulated gaps)'
+    end select
+  end function lubrication_models
 
   ! Collective (every rank holds the same contacts): stop with a diagnostic.
   subroutine contact_failure(code)

@@ -17,9 +17,9 @@ module mod_params
 
   integer, parameter :: max_line = deck_line_length
   integer, parameter :: max_inline_particles = 64
-  integer, parameter :: ngroups = 8
+  integer, parameter :: ngroups = 9
   character(len=16), parameter :: known_groups(ngroups) = [character(len=16) :: &
-       'domain', 'fluid', 'time', 'output', 'run', 'verification', 'particles', 'contact']
+       'domain', 'fluid', 'time', 'output', 'run', 'verification', 'particles', 'contact', 'lubrication']
 
   type :: config_t
     character(len=max_line) :: deck_file = ''
@@ -55,7 +55,7 @@ module mod_params
     real(dp) :: particle_position(3, max_inline_particles) = 0.0_dp     ! centres [a]
     character(len=max_line) :: position_file = ''       ! HDF5 file with particles/position
     real(dp) :: radius = 1.0_dp                         ! sphere radius [a]
-    character(len=16) :: motion = 'free'                ! 'free', 'prescribed' or 'frozen'
+    character(len=16) :: motion = 'free'                ! 'free', 'prescribed', 'resistance' or 'frozen'
     real(dp) :: particle_velocity(3, max_inline_particles) = 0.0_dp    ! prescribed U [a*gamma_dot]
     real(dp) :: particle_omega(3, max_inline_particles) = 0.0_dp       ! prescribed Omega [gamma_dot]
     real(dp) :: external_force(3, max_inline_particles) = 0.0_dp       ! [eta*gamma_dot*a^2]
@@ -69,6 +69,12 @@ module mod_params
     real(dp) :: friction = 0.0_dp                       ! mu_d [-]
     real(dp) :: normal_stiffness = 0.0_dp               ! k_n [eta gamma_dot a^(1/2)] (0: from eps_bar)
     real(dp) :: neighbour_skin = 0.2_dp                 ! neighbour-list skin [a]
+    ! &lubrication (doc/LUBRICATION.md)
+    character(len=16) :: lubrication_model = 'full'     ! 'none', 'simple' or 'full'
+    character(len=max_line) :: lubrication_table = ''   ! '' = the shipped table for this a/Delta
+    real(dp) :: outer_cutoff = 0.0_dp                   ! gap where the correction ends [a] (0: model default)
+    real(dp) :: inner_cutoff = 1.0e-4_dp                ! smallest gap the correction is evaluated at [a]
+    real(dp) :: lubrication_skin = 0.2_dp               ! neighbour-list skin of lubricating pairs [a]
     ! derived, not read
     integer :: cells(3) = 0
     logical :: walls = .true.
@@ -111,7 +117,7 @@ contains
       if (.not. any(known_groups == name)) then
         write(lnum, '(i0)') l
         call input_error(deck, trim(name), '', 'unknown group (line '//trim(lnum)// &
-             '); known groups: &domain &fluid &time &output &run &verification &particles &contact')
+             '); known groups: &domain &fluid &time &output &run &verification &particles &contact &lubrication')
       end if
     end do
   end subroutine check_group_names
@@ -191,6 +197,11 @@ contains
     namelist /particles/ number, position, position_file, radius, motion, velocity, omega, &
          external_force, external_torque, radius_offset, slip_kappa
     namelist /contact/ roughness, eps_bar, friction, normal_stiffness, neighbour_skin
+    ! &lubrication
+    character(len=16) :: model
+    character(len=max_line) :: table
+    real(dp) :: outer_cutoff, inner_cutoff, skin
+    namelist /lubrication/ model, table, outer_cutoff, inner_cutoff, skin
     namelist /domain/ box, cells_per_radius, y_boundary, shear_rate
     namelist /fluid/ reynolds, body_force, velocity_tolerance, pressure_tolerance, viscous_theta, initial_flow
     namelist /time/ dt, steps, steady_tolerance
@@ -217,6 +228,8 @@ contains
     slip_kappa = cfg%slip_kappa
     roughness = cfg%roughness; eps_bar = cfg%eps_bar; friction = cfg%friction
     normal_stiffness = cfg%normal_stiffness; neighbour_skin = cfg%neighbour_skin
+    model = cfg%lubrication_model; table = cfg%lubrication_table; outer_cutoff = cfg%outer_cutoff
+    inner_cutoff = cfg%inner_cutoff; skin = cfg%lubrication_skin
 
     stat = 0
     if (present(src)) then
@@ -229,6 +242,7 @@ contains
       case ('verification'); read(src, nml=verification, iostat=stat, iomsg=msg)
       case ('particles');    read(src, nml=particles, iostat=stat, iomsg=msg)
       case ('contact');      read(src, nml=contact, iostat=stat, iomsg=msg)
+      case ('lubrication');  read(src, nml=lubrication, iostat=stat, iomsg=msg)
       end select
       if (present(ios)) ios = stat
       if (stat /= 0) return
@@ -250,6 +264,8 @@ contains
       cfg%radius_offset = radius_offset; cfg%slip_kappa = slip_kappa
       cfg%roughness = roughness; cfg%eps_bar = eps_bar; cfg%friction = friction
       cfg%normal_stiffness = normal_stiffness; cfg%neighbour_skin = neighbour_skin
+      cfg%lubrication_model = to_lower(model); cfg%lubrication_table = table
+      cfg%outer_cutoff = outer_cutoff; cfg%inner_cutoff = inner_cutoff; cfg%lubrication_skin = skin
       if (group == 'contact') cfg%contact_group = .true.
     end if
     if (present(echo_unit)) then
@@ -261,6 +277,7 @@ contains
       case ('run');          write(echo_unit, nml=run)
       case ('verification'); write(echo_unit, nml=verification)
       case ('particles');    call echo_particles(echo_unit, cfg)
+      case ('lubrication');  write(echo_unit, nml=lubrication)
       case ('contact')
         ! only when given: an absent &contact means no contacts, not these defaults
         if (cfg%contact_group) then
@@ -416,6 +433,7 @@ contains
 
     call validate_particles(cfg)
     call validate_contact(cfg)
+    call validate_lubrication(cfg)
 
     if (cfg%manufactured_solution .and. any(cfg%body_force /= 0.0_dp)) &
       call input_error(cfg%deck_file, 'verification', 'manufactured_solution', &
@@ -429,8 +447,9 @@ contains
     logical :: exists
     call check_int(cfg, 'particles', 'number', cfg%particle_number, 0, max_inline_particles)
     call check_real(cfg, 'particles', 'radius', cfg%radius, 0.0_dp, 100.0_dp, .true.)
-    if (all(cfg%motion /= [character(len=16) :: 'free', 'prescribed', 'frozen'])) &
-      call input_error(cfg%deck_file, 'particles', 'motion', 'must be ''free'', ''prescribed'' or ''frozen'', not '''// &
+    if (all(cfg%motion /= [character(len=16) :: 'free', 'prescribed', 'resistance', 'frozen'])) &
+      call input_error(cfg%deck_file, 'particles', 'motion', &
+           'must be ''free'', ''prescribed'', ''resistance'' or ''frozen'', not '''// &
            trim(cfg%motion)//'''')
     call check_real(cfg, 'particles', 'radius_offset', cfg%radius_offset, -2.0_dp, 2.0_dp)
     call check_real(cfg, 'particles', 'slip_kappa', cfg%slip_kappa, 0.0_dp, 100.0_dp)
@@ -441,13 +460,28 @@ contains
       inquire(file=trim(cfg%position_file), exist=exists)
       if (.not. exists) call input_error(cfg%deck_file, 'particles', 'position_file', &
            '"'//trim(cfg%position_file)//'" does not exist')
-      if (cfg%motion == 'prescribed') call input_error(cfg%deck_file, 'particles', 'motion', &
+      if (cfg%motion == 'prescribed' .or. cfg%motion == 'resistance') &
+        call input_error(cfg%deck_file, 'particles', 'motion', &
            'prescribed velocities are given inline: use number and position, not position_file')
     end if
     if (cfg%radius + cfg%radius_offset * cfg%h < 1.5_dp * cfg%h) &
       call input_error(cfg%deck_file, 'particles', 'radius', &
            'the sphere must span at least 1.5 grid cells in radius (raise &domain cells_per_radius)')
   end subroutine validate_particles
+
+  ! Ranges of &lubrication; whether a table exists for this resolution is checked where it is read
+  ! (mod_lubrication_io), still before any work.
+  subroutine validate_lubrication(cfg)
+    type(config_t), intent(in) :: cfg
+    if (all(cfg%lubrication_model /= [character(len=16) :: 'none', 'simple', 'full'])) &
+      call input_error(cfg%deck_file, 'lubrication', 'model', &
+           'must be ''none'', ''simple'' or ''full'', not '''//trim(cfg%lubrication_model)//'''')
+    call check_real(cfg, 'lubrication', 'outer_cutoff', cfg%outer_cutoff, 0.0_dp, 2.0_dp)
+    call check_real(cfg, 'lubrication', 'inner_cutoff', cfg%inner_cutoff, 1.0e-8_dp, 0.1_dp)
+    call check_real(cfg, 'lubrication', 'skin', cfg%lubrication_skin, 0.0_dp, 2.0_dp, .true.)
+    if (cfg%outer_cutoff > 0.0_dp .and. cfg%outer_cutoff <= cfg%inner_cutoff) &
+      call input_error(cfg%deck_file, 'lubrication', 'outer_cutoff', 'must exceed inner_cutoff')
+  end subroutine validate_lubrication
 
   ! Ranges of &contact, and what the contact law and the neighbour search need (doc/CONTACT.md).
   ! Checked whenever the group is present, even in a deck without particles.

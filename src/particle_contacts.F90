@@ -19,7 +19,7 @@ module mod_particle_contacts
   use mod_neighbours, only: nlist_t, nlist_init, nlist_build, nlist_needs_rebuild
   implicit none
   private
-  public :: particle_contacts_t, pcontacts_create, pcontacts_step
+  public :: particle_contacts_t, pcontacts_create, pcontacts_step, canonical_order
 
   type :: particle_contacts_t
     type(contact_params_t) :: params

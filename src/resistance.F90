@@ -71,7 +71,7 @@ module mod_resistance
   real(dp), parameter, public :: zm_join_gap = 0.1_dp
 
   public :: resistance_init, resistance_scalars, near_field_scalars, far_field_scalars, &
-            series_scalars, contact_constants
+            series_scalars, contact_constants, leading_singular_part
   public :: pair_shear_functions
   public :: pair_resistance_fu, pair_resistance_fe, pair_resistance_su, pair_resistance_se
   public :: pair_force_torque_from_strain, pair_stresslets
@@ -290,6 +290,14 @@ contains
     log_inv = log(1.0_dp / xi)
     f = near_g1 / xi + near_g2 * log_inv + near_g3 * xi * log_inv
   end function singular_part
+
+  !> The lubrication singularities alone, g1/xi + g2 ln(1/xi) (method.md 3.1): what the 'simple'
+  !> lubrication model corrects with.
+  pure function leading_singular_part(xi) result(f)
+    real(dp), intent(in) :: xi
+    real(dp) :: f(n_pair_scalars)
+    f = near_g1 / xi + near_g2 * log(1.0_dp / xi)
+  end function leading_singular_part
 
   !> Build the interpolation data now (otherwise done on the first call of resistance_scalars).
   !> Call it once before any threaded region: the data are saved module state.

@@ -6,13 +6,13 @@ module mod_timers
   implicit none
   private
   public :: timers_register, stage_push, stage_pop
-  public :: STAGE_SETUP, STAGE_FLUID, STAGE_OUTPUT, STAGE_PARTICLES, STAGE_CONTACTS
+  public :: STAGE_SETUP, STAGE_FLUID, STAGE_OUTPUT, STAGE_PARTICLES, STAGE_CONTACTS, STAGE_LUBRICATION
 
   integer, parameter :: STAGE_SETUP = 1, STAGE_FLUID = 2, STAGE_OUTPUT = 3, STAGE_PARTICLES = 4, &
-                        STAGE_CONTACTS = 5
-  character(len=*), parameter :: stage_names(5) = ['Setup    ', 'Fluid    ', 'Output   ', 'Particles', &
-                                                   'Contacts ']
-  PetscLogStage, save :: stages(5)
+                        STAGE_CONTACTS = 5, STAGE_LUBRICATION = 6
+  character(len=*), parameter :: stage_names(6) = ['Setup      ', 'Fluid      ', 'Output     ', 'Particles  ', &
+                                                   'Contacts   ', 'Lubrication']
+  PetscLogStage, save :: stages(6)
 
 contains
 

@@ -1,0 +1,303 @@
+#!/usr/bin/env python3
+"""Measure the resolved two-sphere and sphere-wall resistance of fdsusp at one resolution and write
+the lubrication table input/lubrication/resolved_a<N>.h5 (method.md §2.4; doc/LUBRICATION.md).
+
+    scripts/calibrate.py CELLS_PER_RADIUS [--samples S] [--jobs J] [--work DIR]
+
+Every measurement is a run of bin/fdsusp in resistance mode (velocities imposed, configuration
+held, no lubrication correction): the steady resolved force, torque and stresslet of each sphere
+are read from series.h5 and extrapolated to pseudo-time infinity (Aitken, below). For each gap
+and each of S samples (a random sub-cell offset of the pair centre and a random direction d of
+the line of centres):
+  mode A (periodic 8a cube): sphere 1 translates along d and spins about d, sphere 2 at rest
+         -> XA11, XA12, XC11, XC12, XG11, XG12
+  mode B (periodic): sphere 1 translates along e1 and spins about e1 (e1 perpendicular to d)
+         -> YA11, YA12, YC11, YC12, YB11, YB12 (torques; the forces check reciprocity),
+            YG11, YG12, YH11, YH12
+  mode C (Couette cell, shear rate 1): both spheres move with the undisturbed flow
+         -> the sums XM11+XM12, YM11+YM12, ZM11+ZM12 (least squares over the stresslet)
+and, per sample, the same three modes for one sphere alone (the one-body part, subtracted from
+the 11 functions so that only the pair interaction is corrected). The table holds, per gap, the
+sample mean and standard deviation of the resolved pair part R~2B - R~1B for the 22 scalars (M
+sums in the 11 slots, 0 in the 12 slots).
+Sphere-wall (walls at rest, Ly = 10a): mode W1 (translate and spin along the normal n) and W2
+(translate and spin along a tangent t), at each gap and, as the far reference, at the centre of
+the cell; the resolved single-wall part is num(gap) - num(centre) corrected by the superposed
+single-wall theory for the walls' far-field effects (doc/LUBRICATION.md).
+
+Modes are separable because the cross terms land on other components (method.md §2.1 tensor
+forms): translation along d gives no torque, rotation about d no force; translation along e1
+torques about e2 = d x e1 and rotation about e1 forces along e2.
+"""
+import argparse, json, math, os, subprocess, sys, time
+import numpy as np
+import h5py
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+GAPS = [0.001, 0.01, 0.05, 0.1, 0.2, 0.35, 0.6, 1.0]
+WALL_GAPS = [0.001, 0.01, 0.05, 0.1, 0.2, 0.35, 0.6, 1.0]
+NAMES = ["XA11", "YA11", "YB11", "XC11", "YC11", "XG11", "YG11", "YH11", "XM11", "YM11", "ZM11",
+         "XA12", "YA12", "YB12", "XC12", "YC12", "XG12", "YG12", "YH12", "XM12", "YM12", "ZM12"]
+IDX = {n: i for i, n in enumerate(NAMES)}
+WALL_NAMES = ["lambda_perp", "f_tt", "f_tr", "f_rr", "x_w"]
+REYNOLDS = 0.01
+BETA = 30.0          # rho/dt: the steady state does not depend on it (method.md §1.5b); 30 converges fastest
+STEPS = 100
+EVERY = 20
+PI = math.pi
+ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT='1', OMPI_ALLOW_RUN_AS_ROOT_CONFIRM='1')
+
+
+def deck(path, out, box, walls, shear, spheres, h):
+    """spheres: list of (position, velocity, omega)."""
+    lines = [f"&domain box = {box[0]}, {box[1]}, {box[2]}, cells_per_radius = {round(1 / h)},",
+             f"  y_boundary = '{'walls' if walls else 'periodic'}', shear_rate = {shear} /",
+             f"&fluid reynolds = {REYNOLDS}, viscous_theta = 1.0, initial_flow = 'shear',",
+             f"  velocity_tolerance = 1e-6, pressure_tolerance = 1e-8 /",
+             f"&time dt = {REYNOLDS / BETA!r}, steps = {STEPS} /",
+             f"&output directory = '{out}', progress_every = {STEPS}, series_every = {EVERY} /",
+             f"&lubrication model = 'none' /",
+             f"&particles number = {len(spheres)}, motion = 'resistance'"]
+    for i, (x, u, w) in enumerate(spheres, 1):
+        lines.append(f"  position(:,{i}) = {x[0]!r}, {x[1]!r}, {x[2]!r}")
+        lines.append(f"  velocity(:,{i}) = {u[0]!r}, {u[1]!r}, {u[2]!r}")
+        lines.append(f"  omega(:,{i}) = {w[0]!r}, {w[1]!r}, {w[2]!r}")
+    lines.append("/")
+    with open(path, 'w') as f:
+        f.write("\n".join(lines) + "\n")
+
+
+def aitken(x):
+    """Steady value of a geometrically converging sequence from its last three samples."""
+    a, b, c = x[-3], x[-2], x[-1]
+    d1, d2 = b - a, c - b
+    den = d2 - d1
+    with np.errstate(divide='ignore', invalid='ignore'):
+        ratio = np.where(d1 != 0, d2 / d1, 0.0)
+        est = np.where((np.abs(den) > 1e-14 * (np.abs(c) + 1)) & (ratio > 0) & (ratio < 0.95),
+                       c - d2 * d2 / den, c)
+    return est
+
+
+def steady(out):
+    with h5py.File(os.path.join(out, 'series.h5'), 'r') as f:
+        F = aitken(f['particles/force_hydro'][:])
+        T = aitken(f['particles/torque_hydro'][:])
+        S = aitken(f['particles/stresslet_hydro'][:])
+    S = np.asarray(S)
+    tr = np.trace(S, axis1=-2, axis2=-1)
+    Sdev = S - tr[..., None, None] * np.eye(3) / 3.0
+    return np.asarray(F), np.asarray(T), Sdev
+
+
+def strain_basis(d, E):
+    ed = E @ d
+    ded = d @ ed
+    I = np.eye(3)
+    dd = np.outer(d, d)
+    d0 = 1.5 * (dd - I / 3) * ded
+    d1 = np.outer(d, ed) + np.outer(ed, d) - 2 * dd * ded
+    d2 = E + 0.5 * (I + dd) * ded - np.outer(d, ed) - np.outer(ed, d)
+    return d0, d1, d2
+
+
+def m_fit(S, d, E):
+    """(XM, YM, ZM) such that S = (20/3) pi sum_k M_k D_k(d, E), least squares."""
+    basis = np.array([b.ravel() for b in strain_basis(d, E)]).T * (20.0 / 3.0 * PI)
+    coef, *_ = np.linalg.lstsq(basis, S.ravel(), rcond=None)
+    return coef
+
+
+def frame(rng):
+    d = rng.normal(size=3)
+    d /= np.linalg.norm(d)
+    e1 = np.cross(d, rng.normal(size=3))
+    e1 /= np.linalg.norm(e1)
+    return d, e1, np.cross(d, e1)
+
+
+class Runner:
+    def __init__(self, work, jobs):
+        self.work, self.jobs, self.queue, self.count = work, jobs, [], 0
+
+    def add(self, name, **kw):
+        out = os.path.join(self.work, name)
+        path = out + '.nml'
+        deck(path, out, **kw)
+        self.queue.append((name, path, out))
+        return out
+
+    def run(self):
+        pending = list(self.queue)
+        running = []
+        t0 = time.time()
+        done = 0
+        while pending or running:
+            while pending and len(running) < self.jobs:
+                name, path, out = pending.pop(0)
+                if os.path.exists(os.path.join(out, 'done')):
+                    done += 1
+                    continue
+                log = open(out + '.log', 'w')
+                p = subprocess.Popen(['mpiexec', '--oversubscribe', '-n', '1', os.path.join(ROOT, 'bin/fdsusp'), path],
+                                     stdout=log, stderr=subprocess.STDOUT, env=ENV)
+                running.append((p, out, log))
+            time.sleep(0.2)
+            for item in list(running):
+                p, out, log = item
+                if p.poll() is not None:
+                    log.close()
+                    running.remove(item)
+                    if p.returncode != 0:
+                        sys.exit(f'calibrate: run {out} failed (status {p.returncode}), see {out}.log')
+                    open(os.path.join(out, 'done'), 'w').close()
+                    done += 1
+                    if done % 10 == 0:
+                        print(f'calibrate: {done}/{len(self.queue)} runs, {time.time() - t0:.0f} s', flush=True)
+        self.queue = []
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument('cells_per_radius', type=int)
+    ap.add_argument('--samples', type=int, default=2)
+    ap.add_argument('--jobs', type=int, default=2)
+    ap.add_argument('--work', default=None)
+    ap.add_argument('--output', default=None)
+    args = ap.parse_args()
+    if args.samples < 2:
+        ap.error('--samples must be at least 2 (the table keeps the scatter)')
+    n = args.cells_per_radius
+    h = 1.0 / n
+    work = args.work or os.path.join(ROOT, 'out', f'calibrate_a{n}')
+    os.makedirs(work, exist_ok=True)
+    rng = np.random.default_rng(20261123 + n)
+    L = 8.0
+    LW = 10.0
+    E = np.array([[0, 0.5, 0], [0.5, 0, 0], [0, 0, 0]])
+    om_inf = np.array([0, 0, -0.5])
+    zero = np.zeros(3)
+    runner = Runner(work, args.jobs)
+    samples = []
+    for s in range(args.samples):
+        off = rng.uniform(0, h, size=3)
+        d, e1, e2 = frame(rng)
+        t = np.array([math.cos(rng.uniform(0, 2 * PI)), 0.0, 0.0])
+        ang = rng.uniform(0, 2 * PI)
+        t = np.array([math.cos(ang), 0.0, math.sin(ang)])
+        samples.append((off, d, e1, e2, t))
+        c = np.array([L / 2, L / 2, L / 2]) + off
+        cc = np.array([L / 2, LW / 2, L / 2]) + off
+        uc = lambda x: np.array([x[1] - LW / 2, 0.0, 0.0])
+        runner.add(f's{s}_one_A', box=(L, L, L), walls=False, shear=0.0, spheres=[(c, d, d)], h=h)
+        runner.add(f's{s}_one_B', box=(L, L, L), walls=False, shear=0.0, spheres=[(c, e1, e1)], h=h)
+        runner.add(f's{s}_one_C', box=(L, LW, L), walls=True, shear=1.0, spheres=[(cc, uc(cc), om_inf)], h=h)
+        for g in GAPS:
+            x1, x2 = c - (1 + g / 2) * d, c + (1 + g / 2) * d
+            runner.add(f's{s}_g{g}_A', box=(L, L, L), walls=False, shear=0.0,
+                       spheres=[(x1, d, d), (x2, zero, zero)], h=h)
+            runner.add(f's{s}_g{g}_B', box=(L, L, L), walls=False, shear=0.0,
+                       spheres=[(x1, e1, e1), (x2, zero, zero)], h=h)
+            y1, y2 = cc - (1 + g / 2) * d, cc + (1 + g / 2) * d
+            runner.add(f's{s}_g{g}_C', box=(L, LW, L), walls=True, shear=1.0,
+                       spheres=[(y1, uc(y1), om_inf), (y2, uc(y2), om_inf)], h=h)
+        n_wall = np.array([0.0, 1.0, 0.0])
+        for g in WALL_GAPS + ['centre']:
+            y = LW / 2 if g == 'centre' else 1.0 + g
+            x = np.array([L / 2 + off[0], y, L / 2 + off[2]])
+            runner.add(f's{s}_w{g}_W1', box=(L, LW, L), walls=True, shear=0.0, spheres=[(x, n_wall, n_wall)], h=h)
+            runner.add(f's{s}_w{g}_W2', box=(L, LW, L), walls=True, shear=0.0, spheres=[(x, t, t)], h=h)
+    runner.run()
+
+    # ---- reduce ----
+    pair = np.zeros((args.samples, len(GAPS), 22))
+    recip = []
+    wall = np.zeros((args.samples, len(WALL_GAPS), 5))
+    one_body = []
+    sys.path.insert(0, os.path.join(ROOT, 'scripts'))
+    from wall_theory import wall_functions
+    for s, (off, d, e1, e2, t) in enumerate(samples):
+        o = {}
+        F, T, S = steady(os.path.join(work, f's{s}_one_A'))
+        o['XA'] = -F[0] @ d / (6 * PI); o['XC'] = -T[0] @ d / (8 * PI); o['XG'] = -1.5 * (d @ S[0] @ d) / (4 * PI)
+        F, T, S = steady(os.path.join(work, f's{s}_one_B'))
+        o['YA'] = -F[0] @ e1 / (6 * PI); o['YC'] = -T[0] @ e1 / (8 * PI)
+        o['YB'] = T[0] @ e2 / (4 * PI); o['YG'] = -(e1 @ S[0] @ d) / (4 * PI); o['YH'] = (e2 @ S[0] @ d) / (8 * PI)
+        F, T, S = steady(os.path.join(work, f's{s}_one_C'))
+        o['XM'], o['YM'], o['ZM'] = m_fit(S[0], d, E)
+        one_body.append(o)
+        for k, g in enumerate(GAPS):
+            f = np.zeros(22)
+            F, T, S = steady(os.path.join(work, f's{s}_g{g}_A'))
+            f[IDX['XA11']] = -F[0] @ d / (6 * PI) - o['XA']
+            f[IDX['XA12']] = -F[1] @ d / (6 * PI)
+            f[IDX['XC11']] = -T[0] @ d / (8 * PI) - o['XC']
+            f[IDX['XC12']] = -T[1] @ d / (8 * PI)
+            f[IDX['XG11']] = -1.5 * (d @ S[0] @ d) / (4 * PI) - o['XG']
+            f[IDX['XG12']] = +1.5 * (d @ S[1] @ d) / (4 * PI)          # XG12 = -XG21
+            F, T, S = steady(os.path.join(work, f's{s}_g{g}_B'))
+            f[IDX['YA11']] = -F[0] @ e1 / (6 * PI) - o['YA']
+            f[IDX['YA12']] = -F[1] @ e1 / (6 * PI)
+            f[IDX['YC11']] = -T[0] @ e1 / (8 * PI) - o['YC']
+            f[IDX['YC12']] = -T[1] @ e1 / (8 * PI)
+            f[IDX['YB11']] = T[0] @ e2 / (4 * PI) - o['YB']
+            f[IDX['YB12']] = -T[1] @ e2 / (4 * PI)                      # YB12 = -YB21
+            recip.append((g, f[IDX['YB11']] + o['YB'], -F[0] @ e2 / (4 * PI), f[IDX['YB12']], -F[1] @ e2 / (4 * PI)))
+            f[IDX['YG11']] = -(e1 @ S[0] @ d) / (4 * PI) - o['YG']
+            f[IDX['YG12']] = +(e1 @ S[1] @ d) / (4 * PI)                # YG12 = -YG21
+            f[IDX['YH11']] = (e2 @ S[0] @ d) / (8 * PI) - o['YH']
+            f[IDX['YH12']] = (e2 @ S[1] @ d) / (8 * PI)
+            F, T, S = steady(os.path.join(work, f's{s}_g{g}_C'))
+            m = 0.5 * (m_fit(S[0], d, E) + m_fit(S[1], d, E))
+            f[IDX['XM11']] = m[0] - o['XM']
+            f[IDX['YM11']] = m[1] - o['YM']
+            f[IDX['ZM11']] = m[2] - o['ZM']
+            pair[s, k] = f
+        n_wall = np.array([0.0, 1.0, 0.0])
+        b = np.cross(n_wall, t)
+
+        def wall_values(tag):
+            F, T, S = steady(os.path.join(work, f's{s}_w{tag}_W1'))
+            lam = -F[0] @ n_wall / (6 * PI)
+            xw = -T[0] @ n_wall / (8 * PI)
+            F, T, S = steady(os.path.join(work, f's{s}_w{tag}_W2'))
+            ftt = -F[0] @ t / (6 * PI)
+            ftr = T[0] @ b / (6 * PI)
+            frr = -T[0] @ t / (8 * PI)
+            return np.array([lam, ftt, ftr, frr, xw])
+        centre = wall_values('centre')
+        for k, g in enumerate(WALL_GAPS):
+            # single-wall resolved part: remove the far wall at distance LW - 2 - g and the two
+            # walls seen from the centre by superposing single-wall theory (doc/LUBRICATION.md)
+            far = wall_functions(LW - 2.0 - g) - wall_functions(1e9)
+            mid = 2.0 * (wall_functions(LW / 2 - 1.0) - wall_functions(1e9))
+            wall[s, k] = wall_values(g) - centre - far + mid
+    out = args.output or os.path.join(ROOT, 'input', 'lubrication', f'resolved_a{n}.h5')
+    os.makedirs(os.path.dirname(out), exist_ok=True)
+    with h5py.File(out, 'w') as f:
+        f.attrs['cells_per_radius'] = n
+        f.attrs['radius_offset'] = 0.38
+        f.attrs['slip_kappa'] = 0.5
+        f.attrs['command'] = f'scripts/calibrate.py {n} --samples {args.samples}'
+        f.attrs['description'] = ('resolved pair part R~2B - R~1B of the 22 equal-sphere scalars '
+                                  '(Kim & Karrila normalisation; M sums in the 11 slots) and of the '
+                                  'sphere-wall functions, measured by fdsusp in resistance mode')
+        # rows: gap, then the scalars (Fortran reads them as (1 + n, ngaps))
+        g = np.array(GAPS)[:, None]
+        f.create_dataset('pair/resolved', data=np.hstack([g, pair.mean(axis=0)]))
+        f.create_dataset('pair/scatter', data=np.hstack([g, pair.std(axis=0, ddof=1)]))
+        f['pair'].attrs['columns'] = 'gap,' + ','.join(NAMES)
+        g = np.array(WALL_GAPS)[:, None]
+        f.create_dataset('wall/resolved', data=np.hstack([g, wall.mean(axis=0)]))
+        f.create_dataset('wall/scatter', data=np.hstack([g, wall.std(axis=0, ddof=1)]))
+        f['wall'].attrs['columns'] = 'gap,' + ','.join(WALL_NAMES)
+        f.create_dataset('one_body', data=np.array([[o[k] for k in ('XA', 'YA', 'XC', 'YC', 'XM', 'YM', 'ZM')]
+                                                    for o in one_body]))
+        f['one_body'].attrs['names'] = 'XA,YA,XC,YC,XM,YM,ZM'
+        f.create_dataset('reciprocity_yb', data=np.array(recip))
+        f['reciprocity_yb'].attrs['columns'] = 'gap,YB11 from torque,YB11 from force,YB12 from torque,YB12 from force'
+    print(f'calibrate: wrote {out}')
+
+
+if __name__ == '__main__':
+    main()

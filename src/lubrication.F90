@@ -1,0 +1,276 @@
+! The subgrid lubrication correction (method.md §2; doc/LUBRICATION.md): what the grid cannot
+! resolve of the two-sphere and sphere-wall resistance, added pairwise to the particle problem.
+!
+!   R_sub = [R_theo - R_theo(one body)] - [R~ - R~(one body)]          (§2.2, §2.4 item 4)
+!
+! per pair (12x12 in (U_1, Om_1, U_2, Om_2)) and per sphere-wall link (6x6), so that
+!   (F, T)_lub = R_sub_FU . (U_inf - U) + R_sub_FE : E_inf     (forces on the spheres)
+!   S_lub      = R_sub_SU . (U_inf - U) + R_sub_SE : E_inf + trace part (§2.7)
+! Models:
+!   none    no correction.
+!   simple  singular terms only, as in lattice-Boltzmann practice (§2.5 fallback; Nguyen & Ladd
+!           2002, Dance & Maxey 2003): f(max(xi, xi_sat)) - f(xi_c) for xi < xi_c, f the g1/xi +
+!           g2 ln(1/xi) part of each scalar, xi_c from Grains3D's rule (0.185 at a/Delta = 5) for
+!           translation, 0.05 for rotation, and a saturation gap xi_sat = 0.02 below which the
+!           singular terms are held.
+!   full    the exact functions of mod_resistance minus the resolved part measured by fdsusp
+!           itself at this resolution (scripts/calibrate.py, tables in input/lubrication),
+!           interpolated linearly in ln(gap); below the smallest calibrated gap the resolved part
+!           is held (it saturates once the gap is below the grid spacing).
+! Safeguards (§2.5): gaps below inner_cutoff are evaluated at inner_cutoff; a C1 taper takes the
+! correction to zero at outer_cutoff over its last 30 %; every pair block of R_sub_FU is made
+! positive semi-definite by clipping its negative eigenvalues (LAPACK dsyev), so the implicit
+! 6N system stays symmetric positive definite.
+! Pure: no PETSc, MPI or files (the tables are read by mod_lubrication_io).
+module mod_lubrication
+  use mod_kinds, only: dp, pi
+  use mod_resistance, only: n_pair_scalars, resistance_scalars, leading_singular_part, &
+       pair_resistance_fu, pair_force_torque_from_strain, pair_stresslets, wall_resistance_block, &
+       wall_normal_resistance, wall_tangential_resistance, &
+       i_xa11, i_ya11, i_xc11, i_yc11, i_xm11, i_ym11, i_zm11, i_xm12, i_ym12, i_zm12, &
+       i_xa12, i_xg11, i_xg12, i_yh11, i_yh12, i_xc12, i_yc12
+  implicit none
+  private
+  public :: lubrication_t, lub_setup, lub_pair_scalars, lub_wall_scalars, lub_pair_link, lub_wall_link, &
+            lub_pair_stresslets, lub_wall_stresslet, clip_to_psd, lub_taper, model_code, grains3d_cutoff
+  integer, parameter, public :: LUB_NONE = 0, LUB_SIMPLE = 1, LUB_FULL = 2
+  integer, parameter, public :: n_wall_scalars = 5    ! lambda_perp, f_tt, f_tr, f_rr, x_w
+
+  type :: lubrication_t
+    integer :: model = LUB_NONE
+    real(dp) :: radius = 1.0_dp, viscosity = 1.0_dp
+    real(dp) :: outer_cutoff = 0.0_dp          ! gap [a] where the correction has tapered to zero
+    real(dp) :: inner_cutoff = 1.0e-4_dp       ! gaps below are evaluated here [a]
+    real(dp) :: simple_cutoff = 0.185_dp       ! simple model: xi_c of translation
+    real(dp) :: simple_cutoff_rotation = 0.05_dp
+    real(dp) :: simple_saturation = 0.02_dp
+    ! full model: resolved pair and wall parts on their gap grids (ascending)
+    real(dp), allocatable :: pair_gap(:), pair_resolved(:, :)    ! (ng), (ng, 22)
+    real(dp), allocatable :: wall_gap(:), wall_resolved(:, :)    ! (ng), (ng, 5)
+  end type lubrication_t
+
+  real(dp), parameter :: taper_fraction = 0.3_dp
+  ! the scalars whose one-body (isolated sphere) value is 1
+  integer, parameter :: one_body_scalars(7) = [i_xa11, i_ya11, i_xc11, i_yc11, i_xm11, i_ym11, i_zm11]
+
+contains
+
+  integer function model_code(name)
+    character(len=*), intent(in) :: name
+    select case (name)
+    case ('simple'); model_code = LUB_SIMPLE
+    case ('full');   model_code = LUB_FULL
+    case default;    model_code = LUB_NONE
+    end select
+  end function model_code
+
+  !> Grains3D's cut-off of the simple model (method.md §2.5): xi_c = (Delta/a)[1 + (2a/Delta - 16) 0.1/8].
+  pure real(dp) function grains3d_cutoff(cells_per_radius)
+    real(dp), intent(in) :: cells_per_radius
+    grains3d_cutoff = (1.0_dp + (2.0_dp * cells_per_radius - 16.0_dp) * 0.1_dp / 8.0_dp) / cells_per_radius
+  end function grains3d_cutoff
+
+  !> model: LUB_*; outer_cutoff 0 = the model's default (simple: xi_c; full: the last calibrated
+  !> gap, where the resolved part has met the theory within its scatter).
+  subroutine lub_setup(lub, model, radius, viscosity, cells_per_radius, outer_cutoff, inner_cutoff)
+    type(lubrication_t), intent(inout) :: lub
+    integer, intent(in) :: model
+    real(dp), intent(in) :: radius, viscosity, cells_per_radius, outer_cutoff, inner_cutoff
+    lub%model = model
+    lub%radius = radius
+    lub%viscosity = viscosity
+    lub%inner_cutoff = inner_cutoff
+    lub%simple_cutoff = grains3d_cutoff(cells_per_radius)
+    select case (model)
+    case (LUB_SIMPLE)
+      lub%outer_cutoff = lub%simple_cutoff
+    case (LUB_FULL)
+      lub%outer_cutoff = lub%pair_gap(size(lub%pair_gap))
+    case default
+      lub%outer_cutoff = 0.0_dp
+    end select
+    if (outer_cutoff > 0.0_dp) lub%outer_cutoff = outer_cutoff
+  end subroutine lub_setup
+
+  !> C1 taper: 1 below (1 - taper_fraction) outer, 0 at and beyond outer (smoothstep between).
+  pure real(dp) function lub_taper(gap, outer)
+    real(dp), intent(in) :: gap, outer
+    real(dp) :: s
+    s = (outer - gap) / (taper_fraction * outer)
+    if (s >= 1.0_dp) then
+      lub_taper = 1.0_dp
+    else if (s <= 0.0_dp) then
+      lub_taper = 0.0_dp
+    else
+      lub_taper = s * s * (3.0_dp - 2.0_dp * s)
+    end if
+  end function lub_taper
+
+  !> Linear interpolation of table rows in ln(gap), held constant outside the grid.
+  pure function interpolate(gaps, rows, gap) result(v)
+    real(dp), intent(in) :: gaps(:), rows(:, :), gap
+    real(dp) :: v(size(rows, 2)), w
+    integer :: k, n
+    n = size(gaps)
+    if (gap <= gaps(1)) then
+      v = rows(1, :)
+    else if (gap >= gaps(n)) then
+      v = rows(n, :)
+    else
+      k = 1
+      do while (gaps(k + 1) < gap)
+        k = k + 1
+      end do
+      w = log(gap / gaps(k)) / log(gaps(k + 1) / gaps(k))
+      v = (1.0_dp - w) * rows(k, :) + w * rows(k + 1, :)
+    end if
+  end function interpolate
+
+  !> The 22 subgrid scalars at this gap (tapered; zero beyond the outer cut-off). The M functions
+  !> enter R_SE only through the sums M11 + M12, which 'full' carries in the 11 slots.
+  function lub_pair_scalars(lub, gap) result(f)
+    type(lubrication_t), intent(in) :: lub
+    real(dp), intent(in) :: gap
+    real(dp) :: f(n_pair_scalars), xi, taper
+    f = 0.0_dp
+    if (lub%model == LUB_NONE .or. gap >= lub%outer_cutoff) return
+    xi = max(gap, lub%inner_cutoff)
+    taper = lub_taper(gap, lub%outer_cutoff)
+    select case (lub%model)
+    case (LUB_SIMPLE)
+      f = simple_difference(leading_singular_part(max(xi, lub%simple_saturation)), &
+                            leading_singular_part(lub%simple_cutoff), &
+                            leading_singular_part(lub%simple_cutoff_rotation), &
+                            xi < lub%simple_cutoff, xi < lub%simple_cutoff_rotation)
+    case (LUB_FULL)
+      f = resistance_scalars(xi)
+      f(one_body_scalars) = f(one_body_scalars) - 1.0_dp
+      f([i_xm11, i_ym11, i_zm11]) = f([i_xm11, i_ym11, i_zm11]) + f([i_xm12, i_ym12, i_zm12])
+      f([i_xm12, i_ym12, i_zm12]) = 0.0_dp
+      f = f - interpolate(lub%pair_gap, lub%pair_resolved, xi)
+    end select
+    f = taper * f
+  end function lub_pair_scalars
+
+  ! simple model: rotation scalars (XC, YC, YH) use their own cut-off (Grains3D).
+  pure function simple_difference(at_gap, at_cut, at_cut_rot, inside, inside_rot) result(f)
+    real(dp), intent(in) :: at_gap(n_pair_scalars), at_cut(n_pair_scalars), at_cut_rot(n_pair_scalars)
+    logical, intent(in) :: inside, inside_rot
+    real(dp) :: f(n_pair_scalars)
+    integer, parameter :: rotation(6) = [i_xc11, i_yc11, i_yh11, i_xc12, i_yc12, i_yh12]
+    f = 0.0_dp
+    if (inside) f = at_gap - at_cut
+    f(rotation) = 0.0_dp
+    if (inside_rot) f(rotation) = at_gap(rotation) - at_cut_rot(rotation)
+  end function simple_difference
+
+  !> The subgrid sphere-wall scalars (lambda_perp, f_tt, f_tr, f_rr, x_w) at this gap. The twist
+  !> x_w is not singular and is left to the grid (method.md §2.8).
+  function lub_wall_scalars(lub, gap) result(w)
+    type(lubrication_t), intent(in) :: lub
+    real(dp), intent(in) :: gap
+    real(dp) :: w(n_wall_scalars), eps, e, ec
+    w = 0.0_dp
+    if (lub%model == LUB_NONE .or. gap >= lub%outer_cutoff) return
+    eps = max(gap, lub%inner_cutoff)
+    select case (lub%model)
+    case (LUB_SIMPLE)
+      if (eps < lub%simple_cutoff) then
+        e = max(eps, lub%simple_saturation)
+        ec = lub%simple_cutoff
+        w(1) = (1.0_dp / e + 0.2_dp * log(1.0_dp / e)) - (1.0_dp / ec + 0.2_dp * log(1.0_dp / ec))
+        w(2:4) = [8.0_dp / 15, 2.0_dp / 15, 0.4_dp] * log(ec / e)
+      end if
+    case (LUB_FULL)
+      w(1) = wall_normal_resistance(eps) - 1.0_dp
+      call wall_tangential_resistance(eps, w(2), w(3), w(4))
+      w(2) = w(2) - 1.0_dp
+      w(4) = w(4) - 1.0_dp
+      w(1:4) = w(1:4) - interpolate(lub%wall_gap, lub%wall_resolved(:, 1:4), eps)
+    end select
+    w(5) = 0.0_dp
+    w = lub_taper(gap, lub%outer_cutoff) * w
+  end function lub_wall_scalars
+
+  !> One lubricating pair: d unit vector from sphere 1 to 2, f its subgrid scalars, u_inf (3, 2)
+  !> the undisturbed velocity at the two centres, om_inf and e_inf the undisturbed rotation and
+  !> strain rate. r (12x12): R_sub_FU made positive semi-definite; drive (12): the part of the
+  !> correction that does not depend on the particle velocities, R.U_inf + R_FE : E_inf, so that
+  !> (F_1, T_1, F_2, T_2)_lub = drive - r . (U_1, Om_1, U_2, Om_2).
+  subroutine lub_pair_link(lub, f, d, u_inf, om_inf, e_inf, r, drive)
+    type(lubrication_t), intent(in) :: lub
+    real(dp), intent(in) :: f(n_pair_scalars), d(3), u_inf(3, 2), om_inf(3), e_inf(3, 3)
+    real(dp), intent(out) :: r(12, 12), drive(12)
+    r = clip_to_psd(pair_resistance_fu(f, d, lub%radius, lub%viscosity))
+    drive = matmul(r, [u_inf(:, 1), om_inf, u_inf(:, 2), om_inf]) &
+          + pair_force_torque_from_strain(f, d, e_inf, lub%radius, lub%viscosity)
+  end subroutine lub_pair_link
+
+  !> One sphere-wall link: normal n from the wall into the fluid, w the subgrid wall scalars,
+  !> u_wall the wall velocity. (F, T)_lub = drive - r . (U, Om), drive = r . (u_wall, 0).
+  subroutine lub_wall_link(lub, w, normal, u_wall, r, drive)
+    type(lubrication_t), intent(in) :: lub
+    real(dp), intent(in) :: w(n_wall_scalars), normal(3), u_wall(3)
+    real(dp), intent(out) :: r(6, 6), drive(6)
+    r = clip_to_psd(wall_resistance_block(w(1), w(2), w(3), w(4), w(5), normal, lub%radius, lub%viscosity))
+    drive = matmul(r(:, 1:3), u_wall)
+  end subroutine lub_wall_link
+
+  !> Stresslet corrections of a pair (3, 3, 2): R_sub_SU . w + R_sub_SE : E (deviatoric, §2.6)
+  !> plus the particle-pressure part (§2.7): the near-contact traction sits in the gap, at a d
+  !> from sphere 1 and -a d from sphere 2, so tr S_alpha = a n_alpha . F^X_alpha with F^X the
+  !> squeeze (X-type) part of the corrected force. w = (U_inf - U, Om_inf - Om) of both spheres.
+  function lub_pair_stresslets(lub, f, d, w, e_inf) result(s)
+    type(lubrication_t), intent(in) :: lub
+    real(dp), intent(in) :: f(n_pair_scalars), d(3), w(12), e_inf(3, 3)
+    real(dp) :: s(3, 3, 2), squeeze, ded
+    integer :: k
+    s = pair_stresslets(f, d, w, e_inf, lub%radius, lub%viscosity)
+    ded = dot_product(d, matmul(e_inf, d))
+    ! d . F^X_1 = -d . F^X_2 (XA, XG parts; XA21 = XA12, XG21 = -XG12)
+    squeeze = 6.0_dp * pi * lub%viscosity * lub%radius * (f(i_xa11) * dot_product(d, w(1:3)) &
+              + f(i_xa12) * dot_product(d, w(7:9))) &
+              + 4.0_dp * pi * lub%viscosity * lub%radius**2 * (f(i_xg11) - f(i_xg12)) * ded
+    do k = 1, 3
+      s(k, k, 1) = s(k, k, 1) + lub%radius * squeeze / 3.0_dp
+    end do
+    ! sphere 2: d . F^X_2 with its own velocities: the same form with 1 <-> 2 and d -> -d
+    squeeze = 6.0_dp * pi * lub%viscosity * lub%radius * (f(i_xa11) * dot_product(-d, w(7:9)) &
+              + f(i_xa12) * dot_product(-d, w(1:3))) &
+              + 4.0_dp * pi * lub%viscosity * lub%radius**2 * (f(i_xg11) - f(i_xg12)) * ded
+    do k = 1, 3
+      s(k, k, 2) = s(k, k, 2) + lub%radius * squeeze / 3.0_dp
+    end do
+  end function lub_pair_stresslets
+
+  !> Stresslet of a sphere-wall correction force f_lub acting at the gap point -a n:
+  !> S = -a sym(n f_n) with f_n the normal (squeeze) part, so tr S = -a n . f_lub.
+  pure function lub_wall_stresslet(lub, normal, f_lub) result(s)
+    type(lubrication_t), intent(in) :: lub
+    real(dp), intent(in) :: normal(3), f_lub(3)
+    real(dp) :: s(3, 3), fn(3)
+    fn = dot_product(normal, f_lub) * normal
+    s = -0.5_dp * lub%radius * (spread(normal, 2, 3) * spread(fn, 1, 3) + spread(fn, 2, 3) * spread(normal, 1, 3))
+  end function lub_wall_stresslet
+
+  !> The nearest positive semi-definite matrix (Frobenius norm) of a symmetric matrix:
+  !> negative eigenvalues set to zero.
+  function clip_to_psd(a) result(b)
+    real(dp), intent(in) :: a(:, :)
+    real(dp) :: b(size(a, 1), size(a, 2))
+    real(dp) :: v(size(a, 1), size(a, 1)), ev(size(a, 1)), work(64 * size(a, 1))
+    integer :: n, info, k
+    external :: dsyev
+    n = size(a, 1)
+    b = 0.5_dp * (a + transpose(a))
+    v = b
+    call dsyev('V', 'U', n, v, n, ev, work, size(work), info)
+    if (info /= 0) error stop 'clip_to_psd: dsyev failed'
+    if (ev(1) >= 0.0_dp) return
+    b = 0.0_dp
+    do k = 1, n
+      if (ev(k) > 0.0_dp) b = b + ev(k) * spread(v(:, k), 2, n) * spread(v(:, k), 1, n)
+    end do
+  end function clip_to_psd
+
+end module mod_lubrication

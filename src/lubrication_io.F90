@@ -1,0 +1,151 @@
+! Reading the lubrication model of a run (doc/LUBRICATION.md): the &lubrication choice and, for
+! the 'full' model, the table of the resolved resistance that scripts/calibrate.py measured at
+! this resolution (input/lubrication/resolved_a<N>.h5, found through the path compiled in as
+! FDSUSP_TABLE_DIR, or &lubrication table). Everything is checked before any work: a resolution
+! with no table, a table calibrated with another fictitious-domain set-up (radius_offset,
+! slip_kappa) or an unreadable file stops the run with one message. Collective.
+module mod_lubrication_io
+  use hdf5
+  use mpi
+  use mod_kinds, only: dp
+  use mod_params, only: config_t
+  use mod_lubrication, only: lubrication_t, lub_setup, model_code, LUB_FULL, LUB_NONE, n_wall_scalars
+  use mod_resistance, only: n_pair_scalars
+  use mod_h5util, only: read_attribute, read_dataset, dataset_dims, has_attribute
+  use mod_errors, only: is_root, input_error, file_error
+  implicit none
+  private
+  public :: lubrication_load, default_table_path
+
+#ifndef FDSUSP_TABLE_DIR
+#define FDSUSP_TABLE_DIR "input/lubrication"
+#endif
+  character(len=*), parameter :: table_dir = FDSUSP_TABLE_DIR
+
+contains
+
+  !> The shipped table for a/Delta = n.
+  function default_table_path(cells_per_radius) result(path)
+    real(dp), intent(in) :: cells_per_radius
+    character(len=:), allocatable :: path
+    character(len=16) :: tag
+    write(tag, '(i0)') nint(cells_per_radius)
+    path = table_dir//'/resolved_a'//trim(tag)//'.h5'
+  end function default_table_path
+
+  !> lub configured from cfg. needed: the run has pairs or walls to lubricate (else 'none' is
+  !> used silently, whatever the deck says, since there is nothing to correct).
+  subroutine lubrication_load(cfg, needed, lub)
+    type(config_t), intent(in) :: cfg
+    logical, intent(in) :: needed
+    type(lubrication_t), intent(inout) :: lub
+    character(len=:), allocatable :: path
+    character(len=300) :: message
+    integer :: model, dims(2), ierr
+    real(dp), allocatable :: pair(:, :), wall(:, :)
+    logical :: exists
+
+    model = model_code(trim(cfg%lubrication_model))
+    if (.not. needed) model = LUB_NONE
+    if (model == LUB_FULL) then
+      path = trim(cfg%lubrication_table)
+      if (len(path) == 0) then
+        path = default_table_path(cfg%cells_per_radius)
+        inquire(file=path, exist=exists)
+        if (abs(cfg%cells_per_radius - nint(cfg%cells_per_radius)) > 1.0e-9_dp .or. .not. exists) &
+          call input_error(cfg%deck_file, 'lubrication', 'model', 'the full model has no table for '// &
+               'cells_per_radius = '//trim(number(cfg%cells_per_radius))//' ('//path//' is missing): '// &
+               'calibrate it (make calibrate CELLS_PER_RADIUS=n), use a calibrated resolution, '// &
+               'or model = ''simple''')
+      else
+        inquire(file=path, exist=exists)
+        if (.not. exists) call input_error(cfg%deck_file, 'lubrication', 'table', '"'//path//'" does not exist')
+      end if
+      message = ''
+      dims = 0
+      if (is_root()) call read_table(path, cfg, pair, wall, message)
+      call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, MPI_COMM_WORLD, ierr)
+      if (len_trim(message) > 0) call file_error(path, 'lubrication table', trim(message))
+      if (is_root()) dims = [size(pair, 2), size(wall, 2)]
+      call MPI_Bcast(dims, 2, MPI_INTEGER, 0, MPI_COMM_WORLD, ierr)
+      if (.not. is_root()) allocate(pair(1 + n_pair_scalars, dims(1)), wall(1 + n_wall_scalars, dims(2)))
+      call MPI_Bcast(pair, size(pair), MPI_DOUBLE_PRECISION, 0, MPI_COMM_WORLD, ierr)
+      call MPI_Bcast(wall, size(wall), MPI_DOUBLE_PRECISION, 0, MPI_COMM_WORLD, ierr)
+      lub%pair_gap = pair(1, :)
+      lub%pair_resolved = transpose(pair(2:, :))
+      lub%wall_gap = wall(1, :)
+      lub%wall_resolved = transpose(wall(2:, :))
+    end if
+    call lub_setup(lub, model, cfg%radius, 1.0_dp, cfg%cells_per_radius, cfg%outer_cutoff, cfg%inner_cutoff)
+  end subroutine lubrication_load
+
+  subroutine read_table(path, cfg, pair, wall, message)
+    character(len=*), intent(in) :: path
+    type(config_t), intent(in) :: cfg
+    real(dp), allocatable, intent(out) :: pair(:, :), wall(:, :)
+    character(len=*), intent(out) :: message
+    integer(HID_T) :: file
+    integer(HSIZE_T) :: d(2)
+    integer :: err, rank
+    real(dp) :: value(1)
+    message = ''
+    call h5fopen_f(path, H5F_ACC_RDONLY_F, file, err)
+    if (err /= 0) then
+      message = 'cannot be opened as HDF5'
+      return
+    end if
+    block
+      character(len=16), parameter :: names(3) = [character(len=16) :: 'cells_per_radius', 'radius_offset', &
+                                                  'slip_kappa']
+      real(dp) :: expected(3)
+      integer :: k
+      expected = [cfg%cells_per_radius, cfg%radius_offset, cfg%slip_kappa]
+      do k = 1, 3
+        if (.not. has_attribute(file, trim(names(k)))) then
+          message = 'attribute '//trim(names(k))//' missing'
+        else
+          call read_attribute(file, trim(names(k)), value, err)
+          if (err /= 0) then
+            message = 'attribute '//trim(names(k))//' unreadable'
+          else if (abs(value(1) - expected(k)) > 1.0e-9_dp * max(1.0_dp, abs(expected(k)))) then
+            message = 'calibrated with '//trim(names(k))//' = '//trim(number(value(1)))// &
+                      ', the deck has '//trim(number(expected(k)))//' (recalibrate: scripts/calibrate.py)'
+          end if
+        end if
+        if (len_trim(message) > 0) exit
+      end do
+    end block
+    if (len_trim(message) == 0) then
+      call dataset_dims(file, 'pair/resolved', rank, d)
+      if (rank /= 2 .or. d(1) /= 1 + n_pair_scalars .or. d(2) < 2) then
+        message = 'pair/resolved must be an n x 23 dataset with n >= 2'
+      else
+        allocate(pair(d(1), d(2)))
+        call read_dataset(file, 'pair/resolved', pair, err)
+        if (err /= 0) message = 'pair/resolved cannot be read'
+      end if
+    end if
+    if (len_trim(message) == 0) then
+      call dataset_dims(file, 'wall/resolved', rank, d)
+      if (rank /= 2 .or. d(1) /= 1 + n_wall_scalars .or. d(2) < 2) then
+        message = 'wall/resolved must be an n x 6 dataset with n >= 2'
+      else
+        allocate(wall(d(1), d(2)))
+        call read_dataset(file, 'wall/resolved', wall, err)
+        if (err /= 0) message = 'wall/resolved cannot be read'
+      end if
+    end if
+    if (len_trim(message) == 0) then
+      if (any(pair(1, 2:) <= pair(1, :size(pair, 2) - 1)) .or. any(wall(1, 2:) <= wall(1, :size(wall, 2) - 1)) &
+          .or. pair(1, 1) <= 0 .or. wall(1, 1) <= 0) message = 'the gaps must be positive and increasing'
+    end if
+    call h5fclose_f(file, err)
+  end subroutine read_table
+
+  function number(x) result(text)
+    real(dp), intent(in) :: x
+    character(len=24) :: text
+    write(text, '(g0.6)') x
+  end function number
+
+end module mod_lubrication_io

@@ -1,0 +1,230 @@
+! Lubrication in the particle time step (doc/LUBRICATION.md): the model, the neighbour list of
+! lubricating pairs and sphere-wall links, and per step the 6x6 / 12x12 blocks that the implicit
+! particle system takes (method.md §1.5 equation (1)) and the corrections once the velocities are
+! known. Pure: no PETSc, MPI or files; particle data is replicated, so every rank computes the
+! same blocks in the same order.
+!
+! The undisturbed flow is the imposed shear of the Couette cell: U_inf = shear_rate (y - Ly/2) e_x,
+! Om_inf = -shear_rate/2 e_z, E_inf = shear_rate/2 (e_x e_y + e_y e_x); at rest in a periodic box.
+module mod_particle_lubrication
+  use mod_kinds, only: dp
+  use mod_resistance, only: n_pair_scalars
+  use mod_lubrication, only: lubrication_t, lub_pair_scalars, lub_wall_scalars, lub_pair_link, &
+       lub_wall_link, lub_pair_stresslets, lub_wall_stresslet, n_wall_scalars, LUB_NONE
+  use mod_neighbours, only: nlist_t, nlist_init, nlist_build, nlist_needs_rebuild
+  use mod_particle_contacts, only: canonical_order
+  implicit none
+  private
+  public :: particle_lubrication_t, plub_create, plub_links, plub_corrections
+
+  type :: particle_lubrication_t
+    type(lubrication_t) :: lub
+    type(nlist_t) :: nlist
+    integer :: np = 0
+    real(dp) :: box(3) = 0, shear_rate = 0
+    logical :: walls = .false., periodic(3) = .true., built = .false.
+    integer :: rebuilds = 0
+    integer :: ncand = 0, ncand_walls = 0
+    integer, allocatable :: cand(:, :), cand_walls(:, :)        ! canonical candidate lists
+    ! links of the current configuration
+    integer :: npairs = 0, nwalls = 0
+    integer, allocatable :: pair(:, :)                         ! (2, npairs)
+    real(dp), allocatable :: pair_d(:, :), pair_f(:, :)        ! (3, :), (22, :)
+    real(dp), allocatable :: pair_uinf(:, :)                   ! (6, :) U_inf at both centres
+    real(dp), allocatable :: pair_r(:, :, :), pair_drive(:, :) ! (12, 12, :), (12, :)
+    integer, allocatable :: wall_part(:)
+    real(dp), allocatable :: wall_n(:, :), wall_r(:, :, :), wall_drive(:, :)   ! (3, :), (6, 6, :), (6, :)
+    real(dp) :: min_gap = huge(1.0_dp)                         ! smallest pair or wall gap [a]
+    ! corrections of the last step, on each particle
+    real(dp), allocatable :: force(:, :), torque(:, :), stresslet(:, :, :)
+  end type particle_lubrication_t
+
+contains
+
+  !> lub: the configured model (mod_lubrication lub_setup); skin: neighbour-list skin [a].
+  subroutine plub_create(pl, lub, np, box, walls, shear_rate, skin, info, msg)
+    type(particle_lubrication_t), intent(out) :: pl
+    type(lubrication_t), intent(in) :: lub
+    integer, intent(in) :: np
+    real(dp), intent(in) :: box(3), shear_rate, skin
+    logical, intent(in) :: walls
+    integer, intent(out) :: info
+    character(len=*), intent(out) :: msg
+    real(dp) :: reach
+    pl%lub = lub
+    pl%np = np
+    pl%box = box
+    pl%walls = walls
+    pl%shear_rate = shear_rate
+    pl%periodic = [.true., .not. walls, .true.]
+    allocate(pl%force(3, np), pl%torque(3, np), pl%stresslet(3, 3, np))
+    pl%force = 0
+    pl%torque = 0
+    pl%stresslet = 0
+    allocate(pl%pair(2, 16), pl%pair_d(3, 16), pl%pair_f(n_pair_scalars, 16), pl%pair_uinf(6, 16), pl%pair_r(12, 12, 16), &
+             pl%pair_drive(12, 16), pl%wall_part(16), pl%wall_n(3, 16), pl%wall_r(6, 6, 16), pl%wall_drive(6, 16))
+    info = 0
+    msg = ''
+    if (lub%model == LUB_NONE) return
+    reach = lub%outer_cutoff * lub%radius
+    call nlist_init(pl%nlist, np, box, pl%periodic, 2 * lub%radius + reach + skin, lub%radius + reach + skin, &
+                    skin, info)
+    if (info /= 0) msg = 'lubrication: the neighbour search refuses this box (a periodic length below '// &
+                         '2 x (2a + outer_cutoff + skin))'
+  end subroutine plub_create
+
+  pure function ambient_velocity(pl, x) result(u)
+    type(particle_lubrication_t), intent(in) :: pl
+    real(dp), intent(in) :: x(3)
+    real(dp) :: u(3)
+    u = 0
+    if (pl%walls) u(1) = pl%shear_rate * (x(2) - 0.5_dp * pl%box(2))
+  end function ambient_velocity
+
+  subroutine ambient_gradients(pl, om, e)
+    type(particle_lubrication_t), intent(in) :: pl
+    real(dp), intent(out) :: om(3), e(3, 3)
+    real(dp) :: g
+    g = 0
+    if (pl%walls) g = pl%shear_rate
+    om = [0.0_dp, 0.0_dp, -0.5_dp * g]
+    e = 0
+    e(1, 2) = 0.5_dp * g
+    e(2, 1) = 0.5_dp * g
+  end subroutine ambient_gradients
+
+  !> The lubrication links at positions x (3, np): which pairs and walls are within the outer
+  !> cut-off, and their blocks. Call once per step before the particle problem.
+  subroutine plub_links(pl, x)
+    type(particle_lubrication_t), intent(inout) :: pl
+    real(dp), intent(in) :: x(:, :)
+    integer :: c, i, j, side
+    real(dp) :: r(3), dist, gap, d(3), om_inf(3), e_inf(3, 3), u_inf(3, 2), normal(3), u_wall(3), w(n_wall_scalars)
+    pl%npairs = 0
+    pl%nwalls = 0
+    pl%min_gap = huge(1.0_dp)
+    if (pl%lub%model == LUB_NONE) return
+    if (.not. pl%built) then
+      call rebuild()
+    else if (nlist_needs_rebuild(pl%nlist, x)) then
+      call rebuild()
+    end if
+    call ambient_gradients(pl, om_inf, e_inf)
+    do c = 1, pl%ncand
+      i = pl%cand(1, c)
+      j = pl%cand(2, c)
+      r = x(:, j) - x(:, i)
+      where (pl%periodic) r = r - pl%box * anint(r / pl%box)
+      dist = norm2(r)
+      gap = dist / pl%lub%radius - 2.0_dp
+      pl%min_gap = min(pl%min_gap, gap)
+      if (gap >= pl%lub%outer_cutoff) cycle
+      call grow_pairs()
+      pl%npairs = pl%npairs + 1
+      d = r / dist
+      ! the undisturbed velocity at sphere 2 as seen from sphere 1 (same image)
+      u_inf(:, 1) = ambient_velocity(pl, x(:, i))
+      u_inf(:, 2) = ambient_velocity(pl, x(:, i) + r)
+      pl%pair(:, pl%npairs) = [i, j]
+      pl%pair_d(:, pl%npairs) = d
+      pl%pair_uinf(:, pl%npairs) = [u_inf(:, 1), u_inf(:, 2)]
+      pl%pair_f(:, pl%npairs) = lub_pair_scalars(pl%lub, gap)
+      call lub_pair_link(pl%lub, pl%pair_f(:, pl%npairs), d, u_inf, om_inf, e_inf, &
+                         pl%pair_r(:, :, pl%npairs), pl%pair_drive(:, pl%npairs))
+    end do
+    do c = 1, pl%ncand_walls
+      i = pl%cand_walls(1, c)
+      side = pl%cand_walls(2, c)
+      if (side == 1) then
+        gap = x(2, i) / pl%lub%radius - 1.0_dp
+        normal = [0.0_dp, 1.0_dp, 0.0_dp]
+        u_wall = [-0.5_dp * pl%shear_rate * pl%box(2), 0.0_dp, 0.0_dp]
+      else
+        gap = (pl%box(2) - x(2, i)) / pl%lub%radius - 1.0_dp
+        normal = [0.0_dp, -1.0_dp, 0.0_dp]
+        u_wall = [0.5_dp * pl%shear_rate * pl%box(2), 0.0_dp, 0.0_dp]
+      end if
+      pl%min_gap = min(pl%min_gap, gap)
+      if (gap >= pl%lub%outer_cutoff) cycle
+      call grow_walls()
+      pl%nwalls = pl%nwalls + 1
+      w = lub_wall_scalars(pl%lub, gap)
+      pl%wall_part(pl%nwalls) = i
+      pl%wall_n(:, pl%nwalls) = normal
+      call lub_wall_link(pl%lub, w, normal, u_wall, pl%wall_r(:, :, pl%nwalls), pl%wall_drive(:, pl%nwalls))
+    end do
+
+  contains
+
+    subroutine rebuild()
+      call nlist_build(pl%nlist, x)
+      pl%built = .true.
+      pl%rebuilds = pl%rebuilds + 1
+      call canonical_order(pl%nlist%pair, pl%nlist%npairs, pl%cand, pl%ncand)
+      call canonical_order(pl%nlist%wall, pl%nlist%nwalls, pl%cand_walls, pl%ncand_walls)
+    end subroutine rebuild
+
+    subroutine grow_pairs()
+      integer :: m
+      integer, allocatable :: ip(:, :)
+      real(dp), allocatable :: t2(:, :), t3(:, :, :)
+      if (pl%npairs < size(pl%pair, 2)) return
+      m = 2 * size(pl%pair, 2)
+      allocate(ip(2, m)); ip(:, 1:pl%npairs) = pl%pair(:, 1:pl%npairs); call move_alloc(ip, pl%pair)
+      allocate(t2(3, m)); t2(:, 1:pl%npairs) = pl%pair_d(:, 1:pl%npairs); call move_alloc(t2, pl%pair_d)
+      allocate(t2(n_pair_scalars, m)); t2(:, 1:pl%npairs) = pl%pair_f(:, 1:pl%npairs); call move_alloc(t2, pl%pair_f)
+      allocate(t2(6, m)); t2(:, 1:pl%npairs) = pl%pair_uinf(:, 1:pl%npairs); call move_alloc(t2, pl%pair_uinf)
+      allocate(t3(12, 12, m)); t3(:, :, 1:pl%npairs) = pl%pair_r(:, :, 1:pl%npairs); call move_alloc(t3, pl%pair_r)
+      allocate(t2(12, m)); t2(:, 1:pl%npairs) = pl%pair_drive(:, 1:pl%npairs); call move_alloc(t2, pl%pair_drive)
+    end subroutine grow_pairs
+
+    subroutine grow_walls()
+      integer :: m
+      integer, allocatable :: ip(:)
+      real(dp), allocatable :: t2(:, :), t3(:, :, :)
+      if (pl%nwalls < size(pl%wall_part)) return
+      m = 2 * size(pl%wall_part)
+      allocate(ip(m)); ip(1:pl%nwalls) = pl%wall_part(1:pl%nwalls); call move_alloc(ip, pl%wall_part)
+      allocate(t2(3, m)); t2(:, 1:pl%nwalls) = pl%wall_n(:, 1:pl%nwalls); call move_alloc(t2, pl%wall_n)
+      allocate(t3(6, 6, m)); t3(:, :, 1:pl%nwalls) = pl%wall_r(:, :, 1:pl%nwalls); call move_alloc(t3, pl%wall_r)
+      allocate(t2(6, m)); t2(:, 1:pl%nwalls) = pl%wall_drive(:, 1:pl%nwalls); call move_alloc(t2, pl%wall_drive)
+    end subroutine grow_walls
+
+  end subroutine plub_links
+
+  !> The corrections with the velocities of this step, u and om (3, np): force, torque and
+  !> stresslet on each particle (pl%force, pl%torque, pl%stresslet).
+  subroutine plub_corrections(pl, u, om)
+    type(particle_lubrication_t), intent(inout) :: pl
+    real(dp), intent(in) :: u(:, :), om(:, :)
+    integer :: l, i, j
+    real(dp) :: ft(12), ft6(6), v(12), w(12), om_inf(3), e_inf(3, 3), s(3, 3, 2)
+    pl%force = 0
+    pl%torque = 0
+    pl%stresslet = 0
+    if (pl%npairs + pl%nwalls == 0) return
+    call ambient_gradients(pl, om_inf, e_inf)
+    do l = 1, pl%npairs
+      i = pl%pair(1, l)
+      j = pl%pair(2, l)
+      v = [u(:, i), om(:, i), u(:, j), om(:, j)]
+      ft = pl%pair_drive(:, l) - matmul(pl%pair_r(:, :, l), v)
+      pl%force(:, i) = pl%force(:, i) + ft(1:3)
+      pl%torque(:, i) = pl%torque(:, i) + ft(4:6)
+      pl%force(:, j) = pl%force(:, j) + ft(7:9)
+      pl%torque(:, j) = pl%torque(:, j) + ft(10:12)
+      w = [pl%pair_uinf(1:3, l) - u(:, i), om_inf - om(:, i), pl%pair_uinf(4:6, l) - u(:, j), om_inf - om(:, j)]
+      s = lub_pair_stresslets(pl%lub, pl%pair_f(:, l), pl%pair_d(:, l), w, e_inf)
+      pl%stresslet(:, :, i) = pl%stresslet(:, :, i) + s(:, :, 1)
+      pl%stresslet(:, :, j) = pl%stresslet(:, :, j) + s(:, :, 2)
+    end do
+    do l = 1, pl%nwalls
+      i = pl%wall_part(l)
+      ft6 = pl%wall_drive(:, l) - matmul(pl%wall_r(:, :, l), [u(:, i), om(:, i)])
+      pl%force(:, i) = pl%force(:, i) + ft6(1:3)
+      pl%torque(:, i) = pl%torque(:, i) + ft6(4:6)
+      pl%stresslet(:, :, i) = pl%stresslet(:, :, i) + lub_wall_stresslet(pl%lub, pl%wall_n(:, l), ft6(1:3))
+    end do
+  end subroutine plub_corrections
+
+end module mod_particle_lubrication
