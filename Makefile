@@ -53,7 +53,7 @@ CFLAGS_ALL := $(CC_FLAGS) $(COPTFLAGS) -Wall -Wextra $(PETSC_CC_INCLUDES)
 LIBS := $(HDF5_FC_LIB) $(PETSC_LIB)
 
 # Program sources: everything else in src/ is a module linked into every program.
-PROGRAM_SRC := src/main.F90 src/pack_main.F90
+PROGRAM_SRC := src/main.F90 src/pack_main.F90 src/resistance_main.F90
 SRC_F90 := $(filter-out $(PROGRAM_SRC),$(wildcard src/*.F90))
 SRC_C := $(wildcard src/*.c)
 REF_F90 := $(wildcard ref/*.F90)
@@ -66,12 +66,13 @@ LIB_OBJ := $(call obj,$(SRC_F90) $(SRC_C))
 PURE_F90 := $(shell python3 scripts/pure-modules $(SRC_F90))
 PURE_OBJ := $(call obj,$(PURE_F90))
 # pairtraj shares only kinds and the resistance module with the solver (design.md).
-PAIRTRAJ_OBJ := $(call obj,$(REF_F90) src/kinds.F90 $(wildcard src/resistance*.F90))
+RESISTANCE_F90 := src/kinds.F90 src/resistance.F90 src/resistance_table.F90
+PAIRTRAJ_OBJ := $(call obj,$(REF_F90) $(RESISTANCE_F90))
 UNIT_BIN := $(patsubst tests/unit/%.F90,$(BUILD)/tests/%,$(UNIT_F90))
 
-PROGRAMS := $(BIN)/fdsusp $(BIN)/fdsusp-pack $(if $(REF_F90),$(BIN)/pairtraj)
+PROGRAMS := $(BIN)/fdsusp $(BIN)/fdsusp-pack $(BIN)/fdsusp-resistance $(if $(REF_F90),$(BIN)/pairtraj)
 
-.PHONY: all debug check run bench clean tests-build
+.PHONY: all debug check run bench calibrate clean tests-build
 all: $(PROGRAMS) $(UNIT_BIN)
 
 debug:
@@ -93,6 +94,8 @@ $(BIN)/fdsusp: $(call obj,src/main.F90) $(LIB_OBJ) | $(BIN)
 	$(FC_LINKER) $(OPTFLAGS) -o $@ $^ $(LIBS)
 $(BIN)/fdsusp-pack: $(call obj,src/pack_main.F90) $(LIB_OBJ) | $(BIN)
 	$(FC_LINKER) $(OPTFLAGS) -o $@ $^ $(LIBS)
+$(BIN)/fdsusp-resistance: $(call obj,src/resistance_main.F90 $(RESISTANCE_F90)) | $(BIN)
+	$(FC_LINKER) $(OPTFLAGS) -o $@ $^
 $(BIN)/pairtraj: $(PAIRTRAJ_OBJ) | $(BIN)
 	$(FC_LINKER) $(OPTFLAGS) -o $@ $^
 $(BUILD)/tests/%: $(BUILD)/tests_unit_%.o $(PURE_OBJ) | $(BUILD)/tests
@@ -114,6 +117,13 @@ check: all
 
 bench: all
 	@bash scripts/bench.sh
+
+# Lubrication tables (doc/LUBRICATION.md): the resolved resistance measured at each a/Delta and
+# written to input/lubrication/resolved_a<N>.h5. CELLS_PER_RADIUS="5" redoes one resolution.
+CELLS_PER_RADIUS ?= 4 5 6 8
+PYTHON := $(shell [ -x /usr/bin/python3 ] && echo /usr/bin/python3 || echo python3)
+calibrate: all
+	@for n in $(CELLS_PER_RADIUS); do $(PYTHON) scripts/calibrate.py $$n || exit 1; done
 
 clean:
 	rm -rf build bin

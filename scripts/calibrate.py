@@ -29,7 +29,7 @@ Modes are separable because the cross terms land on other components (method.md 
 forms): translation along d gives no torque, rotation about d no force; translation along e1
 torques about e2 = d x e1 and rotation about e1 forces along e2.
 """
-import argparse, json, math, os, subprocess, sys, time
+import argparse, math, os, shutil, subprocess, sys, time
 import numpy as np
 import h5py
 
@@ -48,15 +48,16 @@ PI = math.pi
 ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT='1', OMPI_ALLOW_RUN_AS_ROOT_CONFIRM='1')
 
 
-def deck(path, out, box, walls, shear, spheres, h):
-    """spheres: list of (position, velocity, omega)."""
+def deck(path, out, box, walls, shear, spheres, h, model='none'):
+    """spheres: list of (position, velocity, omega); model: the lubrication model (calibration
+    measures the resolved part alone, so 'none')."""
     lines = [f"&domain box = {box[0]}, {box[1]}, {box[2]}, cells_per_radius = {round(1 / h)},",
              f"  y_boundary = '{'walls' if walls else 'periodic'}', shear_rate = {shear} /",
              f"&fluid reynolds = {REYNOLDS}, viscous_theta = 1.0, initial_flow = 'shear',",
              f"  velocity_tolerance = 1e-6, pressure_tolerance = 1e-8 /",
              f"&time dt = {REYNOLDS / BETA!r}, steps = {STEPS} /",
              f"&output directory = '{out}', progress_every = {STEPS}, series_every = {EVERY} /",
-             f"&lubrication model = 'none' /",
+             f"&lubrication model = '{model}' /",
              f"&particles number = {len(spheres)}, motion = 'resistance'"]
     for i, (x, u, w) in enumerate(spheres, 1):
         lines.append(f"  position(:,{i}) = {x[0]!r}, {x[1]!r}, {x[2]!r}")
@@ -119,6 +120,9 @@ def frame(rng):
 class Runner:
     def __init__(self, work, jobs):
         self.work, self.jobs, self.queue, self.count = work, jobs, [], 0
+        # one binary for the whole set of runs, even if bin/ is rebuilt meanwhile
+        self.binary = os.path.join(work, 'fdsusp')
+        shutil.copy2(os.path.join(ROOT, 'bin', 'fdsusp'), self.binary)
 
     def add(self, name, **kw):
         out = os.path.join(self.work, name)
@@ -139,7 +143,7 @@ class Runner:
                     done += 1
                     continue
                 log = open(out + '.log', 'w')
-                p = subprocess.Popen(['mpiexec', '--oversubscribe', '-n', '1', os.path.join(ROOT, 'bin/fdsusp'), path],
+                p = subprocess.Popen(['mpiexec', '--oversubscribe', '-n', '1', self.binary, path],
                                      stdout=log, stderr=subprocess.STDOUT, env=ENV)
                 running.append((p, out, log))
             time.sleep(0.2)

@@ -121,8 +121,9 @@ program fdsusp
                       [3, parts%n, 0], [3, 3, parts%n]], [3, size(columns)])
   end if
   if (has_lubrication) then
-    columns = [character(len=32) :: columns, 'lubrication_pairs', 'lubrication_walls', 'min_gap']
-    shapes = reshape([shapes, [0, 0, 0], [0, 0, 0], [0, 0, 0]], [3, size(columns)])
+    columns = [character(len=32) :: columns, 'lubrication_pairs', 'lubrication_walls', 'min_gap', &
+               'particles/force_lubrication', 'particles/torque_lubrication']
+    shapes = reshape([shapes, [0, 0, 0], [0, 0, 0], [0, 0, 0], [3, parts%n, 0], [3, parts%n, 0]], [3, size(columns)])
   end if
   if (has_contacts) then
     columns = [character(len=32) :: columns, 'contacts_pair', 'contacts_wall', 'contacts_sliding', &
@@ -333,7 +334,8 @@ contains
       row = [values(1:n), reshape(parts%position, [3 * parts%n]), reshape(parts%velocity, [3 * parts%n]), &
              reshape(parts%omega, [3 * parts%n]), reshape(parts%force_hydro, [3 * parts%n]), &
              reshape(parts%torque_hydro, [3 * parts%n]), reshape(parts%stresslet_hydro, [9 * parts%n])]
-      if (has_lubrication) row = [row, real(pl%npairs, dp), real(pl%nwalls, dp), pl%min_gap]
+      if (has_lubrication) row = [row, real(pl%npairs, dp), real(pl%nwalls, dp), pl%min_gap, &
+                                  reshape(pl%force, [3 * parts%n]), reshape(pl%torque, [3 * parts%n])]
       if (has_contacts) row = [row, real(pc%stats%pair_contacts, dp), real(pc%stats%wall_contacts, dp), &
              real(pc%stats%sliding, dp), pc%max_overlap, reshape(pc%force, [3 * parts%n]), &
              reshape(pc%torque, [3 * parts%n]), reshape(pc%stresslet, [9 * parts%n])]

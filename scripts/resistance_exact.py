@@ -1,0 +1,24 @@
+"""The exact resistance functions of mod_resistance, from bin/fdsusp-resistance (doc/RESISTANCE.md)."""
+import os
+import subprocess
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+NAMES = ["XA11", "YA11", "YB11", "XC11", "YC11", "XG11", "YG11", "YH11", "XM11", "YM11", "ZM11",
+         "XA12", "YA12", "YB12", "XC12", "YC12", "XG12", "YG12", "YH12", "XM12", "YM12", "ZM12"]
+
+
+def _table(kind, gaps):
+    out = subprocess.run([os.path.join(ROOT, 'bin', 'fdsusp-resistance'), kind] + ['%.17g' % g for g in gaps],
+                         check=True, capture_output=True, text=True).stdout
+    return np.array([[float(v) for v in line.split()] for line in out.splitlines() if not line.startswith('#')])
+
+
+def pair_scalars(gap):
+    """The 22 equal-sphere scalars at this gap, in the order of NAMES."""
+    return _table('pair', [gap])[0, 1:]
+
+
+def wall_scalars(gap):
+    """[lambda_perp, f_tt, f_tr, f_rr, x_w] at this gap."""
+    return _table('wall', [gap])[0, 1:]

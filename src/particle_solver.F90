@@ -1,0 +1,125 @@
+! The implicit 6N particle system (method.md §1.5 eq. (1)) once lubrication couples the spheres:
+! the blocks assembled by mod_particle_system go into a sparse PETSc matrix (AIJ, block size 6) and
+! are solved by a KSP with the options prefix particles_. Defaults: CG preconditioned by the exact
+! inverse of each 6x6 diagonal block (PCPBJACOBI), relative tolerance 1e-12. A sparse Cholesky
+! through MUMPS ordered by METIS is one option away:
+!   -particles_ksp_type preonly -particles_pc_type cholesky
+!   -particles_pc_factor_mat_solver_type mumps -particles_mat_mumps_icntl_7 5
+! (doc/BENCHMARKS.md compares the two at 1000 particles). Particle data is replicated, so every
+! rank assembles and solves the same sequential system and gets the same answer.
+! Without pair blocks the system is block diagonal and mod_particle_system solves it directly.
+#include <petsc/finclude/petscksp.h>
+module mod_particle_solver
+  use petscksp
+  use mod_kinds, only: dp
+  use mod_particle_system, only: particle_system_t
+  use mod_solvers, only: set_default_option
+  implicit none
+  private
+  public :: particle_solver_t, psolver_create, psolver_solve, psolver_destroy
+
+  type :: particle_solver_t
+    KSP :: ksp
+    logical :: created = .false.
+    integer :: solves = 0
+    real(dp) :: seconds = 0.0_dp        ! assembly + solve, summed over the run
+  end type particle_solver_t
+
+contains
+
+  subroutine psolver_create(ps, ierr)
+    type(particle_solver_t), intent(inout) :: ps
+    PetscErrorCode, intent(out) :: ierr
+    PetscCall(set_default_option('-particles_ksp_type', 'cg', ierr))
+    PetscCall(set_default_option('-particles_pc_type', 'pbjacobi', ierr))
+    PetscCall(set_default_option('-particles_ksp_rtol', '1e-12', ierr))
+    PetscCall(set_default_option('-particles_ksp_max_it', '10000', ierr))
+    PetscCall(KSPCreate(PETSC_COMM_SELF, ps%ksp, ierr))
+    PetscCall(KSPSetOptionsPrefix(ps%ksp, 'particles_', ierr))
+    PetscCall(KSPSetFromOptions(ps%ksp, ierr))
+    ps%created = .true.
+  end subroutine psolver_create
+
+  !> Solve sys x = rhs (both 6 x n). ok is false when the solve did not converge (the converged
+  !> reason is returned in reason; iterations as KSP counts them).
+  subroutine psolver_solve(ps, sys, rhs, x, iterations, reason, ierr)
+    type(particle_solver_t), intent(inout) :: ps
+    type(particle_system_t), intent(in) :: sys
+    real(dp), intent(in) :: rhs(:, :)
+    real(dp), intent(out) :: x(:, :)
+    integer, intent(out) :: iterations
+    KSPConvergedReason, intent(out) :: reason
+    PetscErrorCode, intent(out) :: ierr
+    Mat :: a
+    Vec :: vx, vb
+    PetscInt :: n6, row(1), col(1), its
+    PetscInt, parameter :: zero = 0, one = 1, six = 6
+    PetscInt, allocatable :: nnz(:)
+    PetscScalar, pointer :: p(:)
+    integer :: q, i, j
+    real(dp) :: t0
+
+    t0 = MPI_Wtime()
+    n6 = 6 * sys%n
+    ! rows of particle i hold its diagonal block and one block per pair it belongs to
+    allocate(nnz(n6))
+    nnz = 6
+    do q = 1, sys%npairs
+      do i = 1, 2
+        j = sys%pair(i, q)
+        nnz(6 * j - 5:6 * j) = nnz(6 * j - 5:6 * j) + 6
+      end do
+    end do
+    PetscCall(MatCreateSeqAIJ(PETSC_COMM_SELF, n6, n6, zero, nnz, a, ierr))
+    PetscCall(MatSetBlockSize(a, six, ierr))
+    PetscCall(MatSetOption(a, MAT_SYMMETRIC, PETSC_TRUE, ierr))
+    do q = 1, sys%n
+      row(1) = q - 1
+      PetscCall(MatSetValuesBlocked(a, one, row, one, row, row_major(sys%diag(:, :, q)), ADD_VALUES, ierr))
+    end do
+    do q = 1, sys%npairs
+      row(1) = sys%pair(1, q) - 1
+      col(1) = sys%pair(2, q) - 1
+      PetscCall(MatSetValuesBlocked(a, one, row, one, col, row_major(sys%block(:, :, q)), ADD_VALUES, ierr))
+      PetscCall(MatSetValuesBlocked(a, one, col, one, row, row_major(transpose(sys%block(:, :, q))), ADD_VALUES, ierr))
+    end do
+    PetscCall(MatAssemblyBegin(a, MAT_FINAL_ASSEMBLY, ierr))
+    PetscCall(MatAssemblyEnd(a, MAT_FINAL_ASSEMBLY, ierr))
+    PetscCall(VecCreateSeq(PETSC_COMM_SELF, n6, vb, ierr))
+    PetscCall(VecDuplicate(vb, vx, ierr))
+    PetscCall(VecGetArrayF90(vb, p, ierr))
+    p = reshape(rhs(:, 1:sys%n), [6 * sys%n])
+    PetscCall(VecRestoreArrayF90(vb, p, ierr))
+    PetscCall(KSPSetOperators(ps%ksp, a, a, ierr))
+    PetscCall(KSPSolve(ps%ksp, vb, vx, ierr))
+    PetscCall(KSPGetConvergedReason(ps%ksp, reason, ierr))
+    PetscCall(KSPGetIterationNumber(ps%ksp, its, ierr))
+    iterations = int(its)
+    PetscCall(VecGetArrayReadF90(vx, p, ierr))
+    x(:, 1:sys%n) = reshape(p, [6, sys%n])
+    PetscCall(VecRestoreArrayReadF90(vx, p, ierr))
+    PetscCall(VecDestroy(vx, ierr))
+    PetscCall(VecDestroy(vb, ierr))
+    PetscCall(MatDestroy(a, ierr))
+    ps%solves = ps%solves + 1
+    ps%seconds = ps%seconds + (MPI_Wtime() - t0)
+  end subroutine psolver_solve
+
+  ! PETSc takes a block row by row
+  pure function row_major(b) result(v)
+    real(dp), intent(in) :: b(6, 6)
+    PetscScalar :: v(36)
+    v = reshape(transpose(b), [36])
+  end function row_major
+
+  subroutine psolver_destroy(ps, ierr)
+    type(particle_solver_t), intent(inout) :: ps
+    PetscErrorCode, intent(out) :: ierr
+    ierr = 0
+    if (ps%created) then
+      PetscCall(KSPDestroy(ps%ksp, ierr))
+    end if
+    ps%created = .false.
+  end subroutine psolver_destroy
+
+end module mod_particle_solver

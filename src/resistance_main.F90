@@ -1,0 +1,39 @@
+! fdsusp-resistance: the exact two-sphere and sphere-wall resistance functions of mod_resistance
+! (the ones the lubrication correction and bin/pairtraj use) at the gaps given, for scripts and
+! tests that compare fdsusp with theory (doc/RESISTANCE.md).
+!   bin/fdsusp-resistance pair GAP [GAP ...]   one line per gap: gap XA11 YA11 ... ZM12 (22 scalars,
+!                                              Kim & Karrila normalisation, order of the header)
+!   bin/fdsusp-resistance wall GAP [GAP ...]   one line per gap: gap lambda_perp f_tt f_tr f_rr x_w
+program fdsusp_resistance
+  use mod_kinds, only: dp
+  use mod_resistance, only: resistance_scalars, pair_scalar_names, n_pair_scalars, wall_normal_resistance, &
+       wall_tangential_resistance, wall_twist_resistance
+  implicit none
+  character(len=64) :: kind, arg
+  real(dp) :: gap, f_tt, f_tr, f_rr
+  integer :: k, stat
+  call get_command_argument(1, kind)
+  if (command_argument_count() < 2 .or. (kind /= 'pair' .and. kind /= 'wall')) then
+    write(0, '(a)') 'usage: fdsusp-resistance pair|wall GAP [GAP ...]'
+    stop 2
+  end if
+  if (kind == 'pair') then
+    write(*, '(a,22(1x,a))') '# gap', (trim(pair_scalar_names(k)), k = 1, n_pair_scalars)
+  else
+    write(*, '(a)') '# gap lambda_perp f_tt f_tr f_rr x_w'
+  end if
+  do k = 2, command_argument_count()
+    call get_command_argument(k, arg)
+    read(arg, *, iostat=stat) gap
+    if (stat /= 0 .or. .not. (gap > 0)) then
+      write(0, '(a)') 'fdsusp-resistance: a gap must be a positive number, not '//trim(arg)
+      stop 2
+    end if
+    if (kind == 'pair') then
+      write(*, '(23es24.15e3)') gap, resistance_scalars(gap)
+    else
+      call wall_tangential_resistance(gap, f_tt, f_tr, f_rr)
+      write(*, '(6es24.15e3)') gap, wall_normal_resistance(gap), f_tt, f_tr, f_rr, wall_twist_resistance(gap)
+    end if
+  end do
+end program fdsusp_resistance
