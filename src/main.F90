@@ -235,6 +235,13 @@ program fdsusp
     write(text, '(a,i0,a,f10.5,a,4(f6.1))') 'steps run: ', step - first_step, '  wall time per step:', wall_loop, &
          ' s  mean iterations u v w p:', real(iterations_sum, dp) / (step - first_step)
     call log_line(text)
+    if (has_particles) then
+      if (fd%solver%solves > 0) then
+        write(text, '(a,i0,a,f10.3,a)') 'particle system with lubrication pairs: ', fd%solver%solves, &
+             ' sparse solves, mean ', 1.0e3_dp * fd%solver%seconds / fd%solver%solves, ' ms (assembly + solve)'
+        call log_line(text)
+      end if
+    end if
   end if
   PetscCallA(stage_push(STAGE_OUTPUT, ierr))
   if (step > first_step .and. mod(step, cfg%series_every) /= 0) call record()

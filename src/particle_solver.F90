@@ -2,10 +2,10 @@
 ! the blocks assembled by mod_particle_system go into a sparse PETSc matrix (AIJ, block size 6) and
 ! are solved by a KSP with the options prefix particles_. Defaults: CG preconditioned by the exact
 ! inverse of each 6x6 diagonal block (PCPBJACOBI), relative tolerance 1e-12. A sparse Cholesky
-! through MUMPS ordered by METIS is one option away:
-!   -particles_ksp_type preonly -particles_pc_type cholesky
-!   -particles_pc_factor_mat_solver_type mumps -particles_mat_mumps_icntl_7 5
-! (doc/BENCHMARKS.md compares the two at 1000 particles). Particle data is replicated, so every
+! ordered by METIS (SuiteSparse CHOLMOD's nested dissection) is one option away:
+!   -particles_ksp_type preonly -particles_pc_type cholesky -particles_pc_factor_mat_solver_type cholmod
+! At 1000 spheres (phi = 0.4, ~2900 lubricating pairs) CG takes ~46 iterations and is ~20 times
+! faster than the factorisation (doc/BENCHMARKS.md, scripts/bench_particle_solver.sh). Particle data is replicated, so every
 ! rank assembles and solves the same sequential system and gets the same answer.
 ! Without pair blocks the system is block diagonal and mod_particle_system solves it directly.
 #include <petsc/finclude/petscksp.h>
