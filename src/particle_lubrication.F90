@@ -66,6 +66,19 @@ contains
     info = 0
     msg = ''
     if (lub%model == LUB_NONE) return
+    if (np == 1) then
+      ! one sphere: no pairs, and its two wall candidates need no search (nor a box large
+      ! enough for one)
+      pl%built = .true.
+      pl%ncand = 0
+      pl%ncand_walls = 0
+      allocate(pl%cand(2, 0), pl%cand_walls(2, 2))
+      if (walls) then
+        pl%ncand_walls = 2
+        pl%cand_walls = reshape([1, 1, 1, 2], [2, 2])
+      end if
+      return
+    end if
     reach = lub%outer_cutoff * lub%radius
     call nlist_init(pl%nlist, np, box, pl%periodic, 2 * lub%radius + reach + skin, lub%radius + reach + skin, &
                     skin, info)
@@ -106,8 +119,8 @@ contains
     if (pl%lub%model == LUB_NONE) return
     if (.not. pl%built) then
       call rebuild()
-    else if (nlist_needs_rebuild(pl%nlist, x)) then
-      call rebuild()
+    else if (pl%np > 1) then
+      if (nlist_needs_rebuild(pl%nlist, x)) call rebuild()
     end if
     call ambient_gradients(pl, om_inf, e_inf)
     do c = 1, pl%ncand

@@ -15,7 +15,9 @@ apart by O(phi) = 0.4 %. For the off-centre sphere (y = Ly/2 + 3a, 7a from the t
 slows the translation by (5/16)(a/7a)^3 = 0.1 % (Goldman, Cox & Brenner 1967), well inside the
 1 % asserted. The moving sphere is run at dt = 1e-3 (Crank-Nicolson): it must move a small
 fraction of a cell per relaxation time of lambda (at dt = 5e-3 it moves 0.06 Delta per step and
-its rotation is noisy by 10 %, measured); its velocity settles within 50 steps."""
+its rotation is noisy by 10 %, measured); its velocity settles within 50 steps. The fictitious
+domain alone (&lubrication model = 'none'): the sphere stays >= 6a from the walls, beyond any
+lubrication cut-off."""
 import math
 import os
 import sys
@@ -28,6 +30,7 @@ DECK = """&domain box = 10, 20, 10, cells_per_radius = 4, y_boundary = 'walls', 
 &time dt = {dt}, steps = {steps} /
 &output directory = 'out', progress_every = 50 /
 &particles number = 1, position(:,1) = 5.0, {y}, 5.0 /
+&lubrication model = 'none' /
 """
 S_EXACT = 10 / 3 * math.pi
 

@@ -61,6 +61,16 @@ cases = [
      "&contact roughness = 0.01 /\n", [], ['bad.nml', '&contact', 'normal_stiffness', 'shear_rate']),
     ('contact range beyond the periodic box', GOOD + "&contact roughness = 0.01, neighbour_skin = 0.5 /\n", [],
      ['bad.nml', '&domain', 'box(x)', 'neighbour_skin']),
+    ('unknown lubrication model', GOOD + "&lubrication model = 'exact' /\n", [], ['bad.nml', '&lubrication', 'model']),
+    ('lubrication cut-offs crossed', GOOD + "&lubrication outer_cutoff = 1e-5 /\n", [],
+     ['bad.nml', '&lubrication', 'outer_cutoff', 'inner_cutoff']),
+    ('resolution with no lubrication table', GOOD.replace('cells_per_radius = 5', 'cells_per_radius = 10') +
+     '&particles number = 1, position(:,1) = 1.6, 1.6, 1.6 /\n', [], ['bad.nml', '&lubrication', 'model', 'no table']),
+    ('lubrication table of another fictitious domain', GOOD +
+     '&particles number = 1, position(:,1) = 1.6, 1.6, 1.6, radius_offset = 0.3 /\n', [],
+     ['resolved_a5.h5', 'radius_offset']),
+    ('lubricating pairs beyond the periodic box', GOOD + '&particles number = 2, position(:,1) = 0.8, 1.05, 0.8, ' +
+     'position(:,2) = 2.4, 2.15, 2.4 /\n', [], ['bad.nml', '&lubrication', 'periodic length']),
 ]
 for name, text, args, words in cases:
     deck = os.path.join(d, 'bad.nml')
