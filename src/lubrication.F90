@@ -20,7 +20,10 @@
 ! Safeguards (§2.5): gaps below inner_cutoff are evaluated at inner_cutoff; a C1 taper takes the
 ! correction to zero at outer_cutoff over its last 30 %; every pair block of R_sub_FU is made
 ! positive semi-definite by clipping its negative eigenvalues (LAPACK dsyev), so the implicit
-! 6N system stays symmetric positive definite.
+! 6N system stays symmetric positive definite. Wall blocks may keep eigenvalues down to
+! wall_floor < 0, a quarter of the smallest fictitious-fluid mass eigenvalue (rho/dt) J_p: the grid
+! over-resolves the tangential wall resistance by ~6 % at gaps 0.35-1 (doc/VALIDATION.md), which
+! only a negative correction removes, and a particle has at most two wall links.
 ! Pure: no PETSc, MPI or files (the tables are read by mod_lubrication_io).
 module mod_lubrication
   use mod_kinds, only: dp, pi
@@ -44,6 +47,10 @@ module mod_lubrication
     real(dp) :: simple_cutoff = 0.185_dp       ! simple model: xi_c of translation
     real(dp) :: simple_cutoff_rotation = 0.05_dp
     real(dp) :: simple_saturation = 0.02_dp
+    ! lowest eigenvalue a wall block may keep (<= 0): where the grid over-resolves the wall
+    ! resistance the correction must be negative; set by the caller from the fictitious-fluid
+    ! mass so that (rho/dt) M_p + the wall blocks stays positive definite (doc/LUBRICATION.md)
+    real(dp) :: wall_floor = 0.0_dp
     ! full model: resolved pair and wall parts on their gap grids (ascending)
     real(dp), allocatable :: pair_gap(:), pair_resolved(:, :)    ! (ng), (ng, 22)
     real(dp), allocatable :: wall_gap(:), wall_resolved(:, :)    ! (ng), (ng, 5)
@@ -212,7 +219,8 @@ contains
     type(lubrication_t), intent(in) :: lub
     real(dp), intent(in) :: w(n_wall_scalars), normal(3), u_wall(3)
     real(dp), intent(out) :: r(6, 6), drive(6)
-    r = clip_to_psd(wall_resistance_block(w(1), w(2), w(3), w(4), w(5), normal, lub%radius, lub%viscosity))
+    r = clip_to_psd(wall_resistance_block(w(1), w(2), w(3), w(4), w(5), normal, lub%radius, lub%viscosity), &
+                    lub%wall_floor)
     drive = matmul(r(:, 1:3), u_wall)
   end subroutine lub_wall_link
 
@@ -253,11 +261,12 @@ contains
     s = -0.5_dp * lub%radius * (spread(normal, 2, 3) * spread(fn, 1, 3) + spread(fn, 2, 3) * spread(normal, 1, 3))
   end function lub_wall_stresslet
 
-  !> The nearest positive semi-definite matrix (Frobenius norm) of a symmetric matrix:
-  !> negative eigenvalues set to zero.
-  function clip_to_psd(a) result(b)
+  !> The nearest positive semi-definite matrix (Frobenius norm) of a symmetric matrix: negative
+  !> eigenvalues set to zero; with floor (<= 0), eigenvalues below floor set to floor instead.
+  function clip_to_psd(a, floor) result(b)
     real(dp), intent(in) :: a(:, :)
-    real(dp) :: b(size(a, 1), size(a, 2))
+    real(dp), intent(in), optional :: floor
+    real(dp) :: b(size(a, 1), size(a, 2)), lowest
     real(dp) :: v(size(a, 1), size(a, 1)), ev(size(a, 1)), work(64 * size(a, 1))
     integer :: n, info, k
     external :: dsyev
@@ -266,10 +275,12 @@ contains
     v = b
     call dsyev('V', 'U', n, v, n, ev, work, size(work), info)
     if (info /= 0) error stop 'clip_to_psd: dsyev failed'
-    if (ev(1) >= 0.0_dp) return
+    lowest = 0.0_dp
+    if (present(floor)) lowest = min(floor, 0.0_dp)
+    if (ev(1) >= lowest) return
     b = 0.0_dp
     do k = 1, n
-      if (ev(k) > 0.0_dp) b = b + ev(k) * spread(v(:, k), 2, n) * spread(v(:, k), 1, n)
+      b = b + max(ev(k), lowest) * spread(v(:, k), 2, n) * spread(v(:, k), 1, n)
     end do
   end function clip_to_psd
 

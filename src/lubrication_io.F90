@@ -7,7 +7,7 @@
 module mod_lubrication_io
   use hdf5
   use mpi
-  use mod_kinds, only: dp
+  use mod_kinds, only: dp, pi
   use mod_params, only: config_t
   use mod_lubrication, only: lubrication_t, lub_setup, model_code, LUB_FULL, LUB_NONE, n_wall_scalars
   use mod_resistance, only: n_pair_scalars
@@ -77,6 +77,8 @@ contains
       lub%wall_resolved = transpose(wall(2:, :))
     end if
     call lub_setup(lub, model, cfg%radius, 1.0_dp, cfg%cells_per_radius, cfg%outer_cutoff, cfg%inner_cutoff)
+    ! a quarter of (rho/dt) J, J = (2/5) a^2 (4/3) pi a^3 the smallest eigenvalue of M_p (rho = Re)
+    lub%wall_floor = -0.25_dp * (cfg%reynolds / cfg%dt) * 0.4_dp * cfg%radius**2 * (4.0_dp / 3.0_dp) * pi * cfg%radius**3
   end subroutine lubrication_load
 
   subroutine read_table(path, cfg, pair, wall, message)

@@ -13,7 +13,8 @@
 !     (smallest eigenvalue >= -1e-10 of the largest), for both models, also with a table that
 !     over-resolves (clip_to_psd at work);
 !  6. clip_to_psd leaves a positive definite matrix unchanged (1e-12) and returns the nearest
-!     PSD matrix otherwise (its negative eigenvalue removed, the rest kept to 1e-10);
+!     PSD matrix otherwise (its negative eigenvalue removed, the rest kept to 1e-10); with a floor
+!     the smallest eigenvalue becomes the floor (the wall blocks' allowance);
 !  7. wall link: a sphere moving with the wall feels no correction (drive = R.(u_wall, 0));
 !     the simple normal function equals 1/e + ln(1/e)/5 minus its value at the cut-off;
 !  8. pair stresslet: symmetric, and its trace is a d.F_1 for a squeeze (method.md §2.7).
@@ -91,8 +92,11 @@ program test_lubrication
   a = spd6()
   call check(maxval(abs(clip_to_psd(a) - a)) < 1.0e-12_dp * maxval(abs(a)), 'clip_to_psd: SPD unchanged')
   b = a - 2.0_dp * min_eig(a) * identity6() - 3.0_dp * outer6()
-  b = clip_to_psd(b)
+  a = b
+  b = clip_to_psd(a)
   call check(min_eig(b) > -1.0e-10_dp * maxval(abs(b)), 'clip_to_psd: result PSD')
+  b = clip_to_psd(a, -0.5_dp)
+  call check(abs(min_eig(b) + 0.5_dp) < 1.0e-10_dp * maxval(abs(b)), 'clip_to_psd: eigenvalues raised to the floor')
 
   ! 7. wall link
   w = lub_wall_scalars(simple, 0.01_dp)
