@@ -173,7 +173,7 @@ contains
     do k = 0, 60
       x = 1.0e-6_dp * (lub%outer_cutoff / 1.0e-6_dp)**(k / 60.0_dp)
       call lub_pair_link(lub, lub_pair_scalars(lub, x), d, u_inf, [0.0_dp, 0.0_dp, 0.0_dp], e0, rr, dr)
-      ev = min_eig12(rr)
+      ev = min_eig(rr)
       if (ev < -1.0e-10_dp * maxval(abs(rr)) .or. maxval(abs(rr - transpose(rr))) > 1.0e-12_dp * maxval(abs(rr))) then
         print '(a,es10.3,a,es10.3)', '  gap ', x, ': smallest eigenvalue ', ev
         psd_everywhere = .false.
@@ -181,23 +181,14 @@ contains
     end do
   end function psd_everywhere
 
-  real(dp) function min_eig12(m)
-    real(dp), intent(in) :: m(12, 12)
-    real(dp) :: v(12, 12), ev(12), work(800)
-    integer :: info
-    external :: dsyev
-    v = m
-    call dsyev('N', 'U', 12, v, 12, ev, work, 800, info)
-    min_eig12 = ev(1)
-  end function min_eig12
-
+  ! smallest eigenvalue of a symmetric matrix (LAPACK dsyev)
   real(dp) function min_eig(m)
-    real(dp), intent(in) :: m(6, 6)
-    real(dp) :: v(6, 6), ev(6), work(400)
+    real(dp), intent(in) :: m(:, :)
+    real(dp) :: v(size(m, 1), size(m, 1)), ev(size(m, 1)), work(64 * size(m, 1))
     integer :: info
     external :: dsyev
     v = m
-    call dsyev('N', 'U', 6, v, 6, ev, work, 400, info)
+    call dsyev('N', 'U', size(m, 1), v, size(m, 1), ev, work, size(work), info)
     min_eig = ev(1)
   end function min_eig
 
