@@ -12,7 +12,7 @@ module mod_neighbours
   use mod_kinds, only: dp, i8
   implicit none
   private
-  public :: nlist_t, nlist_init, nlist_build, nlist_needs_rebuild, min_image
+  public :: nlist_t, nlist_init, nlist_build, nlist_needs_rebuild, nlist_candidates, min_image
 
   type :: nlist_t
     integer :: np = 0
@@ -237,5 +237,45 @@ contains
       end if
     end do
   end function nlist_needs_rebuild
+
+  !> Build the list at x and return its candidates in canonical order (pairs by i then j, walls
+  !> by particle then wall), so that forces summed over them come out in the same order whatever
+  !> list is in use: a run restarted from a checkpoint (fresh list) repeats the arithmetic of an
+  !> uninterrupted one bitwise.
+  subroutine nlist_candidates(nl, x, pairs, npairs, walls, nwalls)
+    type(nlist_t), intent(inout) :: nl
+    real(dp), intent(in) :: x(:,:)
+    integer, allocatable, intent(inout) :: pairs(:,:), walls(:,:)
+    integer, intent(out) :: npairs, nwalls
+    call nlist_build(nl, x)
+    call canonical_order(nl%pair, nl%npairs, pairs, npairs)
+    call canonical_order(nl%wall, nl%nwalls, walls, nwalls)
+  end subroutine nlist_candidates
+
+  !> Copy the n columns of list (2, :) into sorted (2, n), ordered by (list(1, :), list(2, :)).
+  !> The neighbour search gives the first entries in ascending order already (pairs by i, walls by
+  !> particle); an insertion sort orders the few entries of each run by the second index.
+  subroutine canonical_order(list, n, sorted, nsorted)
+    integer, intent(in) :: list(:,:), n
+    integer, allocatable, intent(inout) :: sorted(:,:)
+    integer, intent(out) :: nsorted
+    integer :: k, q, key(2)
+    if (allocated(sorted)) then
+      if (size(sorted, 2) < max(1, n)) deallocate(sorted)
+    end if
+    if (.not. allocated(sorted)) allocate(sorted(2, max(16, n)))
+    nsorted = n
+    sorted(:, 1:n) = list(:, 1:n)
+    do k = 2, n
+      key = sorted(:, k)
+      q = k - 1
+      do while (q >= 1)
+        if (sorted(1, q) < key(1) .or. (sorted(1, q) == key(1) .and. sorted(2, q) <= key(2))) exit
+        sorted(:, q + 1) = sorted(:, q)
+        q = q - 1
+      end do
+      sorted(:, q + 1) = key
+    end do
+  end subroutine canonical_order
 
 end module mod_neighbours

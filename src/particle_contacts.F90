@@ -16,10 +16,10 @@ module mod_particle_contacts
   use mod_kinds, only: dp
   use mod_contact, only: contact_params_t, contact_setup, contact_stats_t, contact_history_t, &
                          contact_forces
-  use mod_neighbours, only: nlist_t, nlist_init, nlist_build, nlist_needs_rebuild
+  use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates, nlist_needs_rebuild
   implicit none
   private
-  public :: particle_contacts_t, pcontacts_create, pcontacts_step, canonical_order
+  public :: particle_contacts_t, pcontacts_create, pcontacts_step
 
   type :: particle_contacts_t
     type(contact_params_t) :: params
@@ -103,39 +103,12 @@ contains
   contains
 
     subroutine rebuild()
-      call nlist_build(pc%nlist, x)
+      call nlist_candidates(pc%nlist, x, pc%pairs, pc%npairs, pc%walls, pc%nwalls)
       pc%built = .true.
       pc%rebuilds = pc%rebuilds + 1
-      call canonical_order(pc%nlist%pair, pc%nlist%npairs, pc%pairs, pc%npairs)
-      call canonical_order(pc%nlist%wall, pc%nlist%nwalls, pc%walls, pc%nwalls)
     end subroutine rebuild
 
   end subroutine pcontacts_step
 
-  !> Copy the n columns of list (2, :) into sorted (2, n), ordered by (list(1, :), list(2, :)).
-  !> The neighbour search gives the first entries in ascending order already (pairs by i, walls by
-  !> particle); an insertion sort orders the few entries of each run by the second index.
-  subroutine canonical_order(list, n, sorted, nsorted)
-    integer, intent(in) :: list(:,:), n
-    integer, allocatable, intent(inout) :: sorted(:,:)
-    integer, intent(out) :: nsorted
-    integer :: k, q, key(2)
-    if (allocated(sorted)) then
-      if (size(sorted, 2) < max(1, n)) deallocate(sorted)
-    end if
-    if (.not. allocated(sorted)) allocate(sorted(2, max(16, n)))
-    nsorted = n
-    sorted(:, 1:n) = list(:, 1:n)
-    do k = 2, n
-      key = sorted(:, k)
-      q = k - 1
-      do while (q >= 1)
-        if (sorted(1, q) < key(1) .or. (sorted(1, q) == key(1) .and. sorted(2, q) <= key(2))) exit
-        sorted(:, q + 1) = sorted(:, q)
-        q = q - 1
-      end do
-      sorted(:, q + 1) = key
-    end do
-  end subroutine canonical_order
 
 end module mod_particle_contacts

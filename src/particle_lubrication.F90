@@ -11,8 +11,7 @@ module mod_particle_lubrication
   use mod_resistance, only: n_pair_scalars
   use mod_lubrication, only: lubrication_t, lub_pair_scalars, lub_wall_scalars, lub_pair_link, &
        lub_wall_link, lub_pair_stresslets, lub_wall_stresslet, n_wall_scalars, LUB_NONE
-  use mod_neighbours, only: nlist_t, nlist_init, nlist_build, nlist_needs_rebuild
-  use mod_particle_contacts, only: canonical_order
+  use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates, nlist_needs_rebuild
   implicit none
   private
   public :: particle_lubrication_t, plub_create, plub_links, plub_corrections
@@ -170,11 +169,9 @@ contains
   contains
 
     subroutine rebuild()
-      call nlist_build(pl%nlist, x)
+      call nlist_candidates(pl%nlist, x, pl%cand, pl%ncand, pl%cand_walls, pl%ncand_walls)
       pl%built = .true.
       pl%rebuilds = pl%rebuilds + 1
-      call canonical_order(pl%nlist%pair, pl%nlist%npairs, pl%cand, pl%ncand)
-      call canonical_order(pl%nlist%wall, pl%nlist%nwalls, pl%cand_walls, pl%ncand_walls)
     end subroutine rebuild
 
     subroutine grow_pairs()
