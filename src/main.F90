@@ -404,7 +404,8 @@ contains
     call fatal_error(text, 4)
   end subroutine contact_failure
 
-  ! Runtime guard (design.md "Errors"): a non-finite velocity, pressure or particle quantity stops
+  ! Runtime guard (design.md "Errors"): a non-finite velocity, pressure or particle quantity, or a
+  ! sphere half way through a wall, stops
   ! the run at once, collectively, with a diagnostic; the state is written to failed_state.h5
   ! beside the last good checkpoint, which is never overwritten. The norms are global reductions
   ! and particle data is replicated, so every rank takes the same decision.
@@ -431,6 +432,15 @@ contains
                    .and. all(ieee_is_finite(parts%position(:, q))))) then
           write(what, '(a,i0,a,3es10.3,a,3es10.3)') 'particle ', q, ' is not finite: velocity ', &
                parts%velocity(:, q), ' omega ', parts%omega(:, q)
+          exit
+        end if
+        ! a sphere half way through a wall: nothing physical holds it back any more (no wall
+        ! contacts or lubrication, or a step far too large for them)
+        if (cfg%walls .and. (parts%position(2, q) < 0.5_dp * parts%radius .or. &
+                             parts%position(2, q) > cfg%box(2) - 0.5_dp * parts%radius)) then
+          write(what, '(a,i0,a,f10.5,a,f10.5,a)') 'particle ', q, ' is half way through a wall (centre y = ', &
+               parts%position(2, q), ', walls at 0 and ', cfg%box(2), &
+               '): add &contact, keep &lubrication on, or lower &time dt'
           exit
         end if
       end do

@@ -5,7 +5,10 @@ checks the fluid velocity, pressure and the particle state after every step. Ass
 ranks with one particle: non-zero exit status 5 at step 12, one message naming the step and the
 quantity, failed_state.h5 written beside checkpoint.h5, and checkpoint.h5 still the good one of
 step 10 (checkpoint_every = 10), from which a restart runs on cleanly to step 14 without the
-fault; series.h5 holds the steps up to the failure."""
+fault; series.h5 holds the steps up to the failure.
+Second guard: a sphere driven into the lower wall by an external force (no contacts, no
+lubrication) stops the run (status 5) once its centre is half a radius from the wall, with a
+message naming the particle and the wall, and failed_state.h5."""
 import os
 import sys
 import numpy as np
@@ -35,4 +38,17 @@ T.check(s['step'].max() <= 12, 'series.h5 ends at the failure (last step %d)' % 
 deck = T.write_deck(d, 'g.nml', DECK.format(steps=14))
 status, out, err = T.run(deck, d, np_ranks=2, args=['-restart', ck], expect_ok=False)
 T.check(status == 0 and 'finished at step 14' in out, 'restart from the kept checkpoint runs to step 14 (status %d)' % status)
+
+d = T.scratch('runtime_guard_wall')
+deck = T.write_deck(d, 'w.nml', """&domain box = 3.2, 6.4, 3.2, cells_per_radius = 5, y_boundary = 'walls', shear_rate = 0 /
+&time dt = 1e-3, steps = 200 /
+&output directory = 'out', progress_every = 10 /
+&lubrication model = 'none' /
+&particles number = 1, position(:,1) = 1.6, 1.3, 1.6, external_force(:,1) = 0, -3000, 0 /
+""")
+status, out, err = T.run(deck, d, expect_ok=False)
+messages = [l for l in err.splitlines() if l.startswith('fdsusp:')]
+T.check(status == 5 and len(messages) == 1 and 'particle 1' in messages[0] and 'wall' in messages[0],
+        'a sphere pushed through the wall stops the run: status %d, %s' % (status, messages[:1]))
+T.check(os.path.exists(os.path.join(d, 'out', 'failed_state.h5')), 'failed_state.h5 written')
 T.finish()
