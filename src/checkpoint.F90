@@ -17,7 +17,7 @@ module mod_checkpoint
   use mod_params, only: config_t
   use mod_grid, only: grid_t, FIELD_U, FIELD_V, FIELD_W
   use mod_fluid, only: fluid_t
-  use mod_h5util, only: write_attribute, read_attribute, write_string_attribute, has_object
+  use mod_h5util, only: write_attribute, read_attribute, write_string_attribute, has_object, dataset_dims
   use mod_system, only: publish_file
   use mod_errors, only: is_root, abort_run, file_error
   use mod_particles, only: particles_t
@@ -95,9 +95,10 @@ contains
   ! Before any work: is PATH a checkpoint of this scene? Returns its step and time. Rank 0
   ! inspects the file, every rank learns the verdict, and a bad file stops the run with a message
   ! naming the file and the item at fault.
-  subroutine checkpoint_check(path, cfg, step, time)
+  subroutine checkpoint_check(path, cfg, particles, step, time)
     character(len=*), intent(in) :: path
     type(config_t), intent(in) :: cfg
+    integer, intent(in) :: particles        ! the run's particle count (0: none)
     integer, intent(out) :: step
     real(dp), intent(out) :: time
     character(len=400) :: item, message
@@ -107,7 +108,7 @@ contains
     item = ''
     message = ''
     values = 0.0_dp
-    if (is_root()) call inspect(path, cfg, item, message, values)
+    if (is_root()) call inspect(path, cfg, particles, item, message, values)
     call MPI_Bcast(item, len(item), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
     call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
     call MPI_Bcast(values, 2, MPI_DOUBLE_PRECISION, 0, PETSC_COMM_WORLD, ierr)
@@ -116,14 +117,15 @@ contains
     time = values(2)
   end subroutine checkpoint_check
 
-  subroutine inspect(path, cfg, item, message, values)
+  subroutine inspect(path, cfg, particles, item, message, values)
     character(len=*), intent(in) :: path
     type(config_t), intent(in) :: cfg
+    integer, intent(in) :: particles
     character(len=*), intent(out) :: item, message
     real(dp), intent(out) :: values(2)
     integer(HID_T) :: file, dset, space
-    integer(HSIZE_T) :: dims(3), maxdims(3)
-    integer :: err, version(1), cells(3), walls(1), istep(1), rank, d
+    integer(HSIZE_T) :: dims(3), maxdims(3), pdims(2)
+    integer :: err, version(1), cells(3), walls(1), istep(1), rank, d, n_saved
     real(dp) :: box(3), t(1)
     logical :: exists
 
@@ -201,6 +203,19 @@ contains
         item = '/'//trim(field_datasets(d)); message = 'dataset of the wrong shape for this grid'
       end if
     end do
+    ! the particles must be the deck's: the same count (the state, lambda and history follow them)
+    if (len_trim(message) == 0) then
+      n_saved = 0
+      if (has_object(file, 'particles')) then
+        call dataset_dims(file, 'particles/position', rank, pdims)
+        if (rank == 2) n_saved = int(pdims(2))
+      end if
+      if (n_saved /= particles) then
+        item = '/particles'
+        write(message, '(a,i0,a,i0,a)') 'the checkpoint holds ', n_saved, ' particles, the deck ', particles, &
+             ': restart with the deck that wrote it'
+      end if
+    end if
     call h5fclose_f(file, err)
   end subroutine inspect
 

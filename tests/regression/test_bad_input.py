@@ -41,6 +41,8 @@ cases = [
      ['-restart', 'good_run/checkpoint.h5'], ['good_run/checkpoint.h5', 'item cells', '16x16x16', '8x8x8']),
     ('checkpoint from another box', GOOD.replace('box = 3.2, 3.2, 3.2', 'box = 3.2, 6.4, 3.2').replace('cells_per_radius = 5', 'cells_per_radius = 5'),
      ['-restart', 'good_run/checkpoint.h5'], ['good_run/checkpoint.h5', 'item cells']),
+    ('restart with another particle count', GOOD + '&particles number = 1, position(:,1) = 1.6, 1.6, 1.6 /\n',
+     ['-restart', 'good_run/checkpoint.h5'], ['good_run/checkpoint.h5', '/particles', '0 particles', 'the deck 1']),
     ('not a checkpoint', GOOD, ['-restart', 'bad.nml'], ['bad.nml', 'cannot be opened as HDF5']),
     ('unknown particle motion', GOOD + "&particles number = 1, position(:,1) = 1.6, 1.6, 1.6, motion = 'fixed' /\n", [],
      ['bad.nml', '&particles', 'motion']),
