@@ -32,7 +32,7 @@ sums in the 11 slots, 0 in the 12 slots).
 Sphere-wall (walls at rest, Ly = 10a): mode W1 (translate and spin along the normal n) and W2
 (translate and spin along a tangent t), at each gap and, as the far reference, at the centre of
 the cell; the resolved single-wall part is num(gap) - num(centre) corrected by the superposed
-single-wall theory for the walls' far-field effects (doc/LUBRICATION.md).
+single-wall theory (bin/fdsusp-resistance) for the walls' far-field effects (doc/LUBRICATION.md).
 
 Modes are separable because the cross terms land on other components (method.md §2.1 tensor
 forms): translation along d gives no torque, rotation about d no force; translation along e1
@@ -230,15 +230,15 @@ def main():
     wall = np.zeros((args.samples, len(WALL_GAPS), 5))
     one_body = []
     sys.path.insert(0, os.path.join(ROOT, 'scripts'))
-    from wall_theory import wall_functions
-    from resistance_exact import pair_scalars
+    from resistance_exact import pair_scalars, wall_excess
     for s, (off, d, e1, e2, t) in enumerate(samples):
         o = {}
         F, T, S = steady(os.path.join(work, f's{s}_one_A'))
-        o['XA'] = -F[0] @ d / (6 * PI); o['XC'] = -T[0] @ d / (8 * PI); o['XG'] = -1.5 * (d @ S[0] @ d) / (4 * PI)
+        # rotation and strain one-body parts are subtracted; the translational ones are kept as a
+        # record only (a net force in a periodic box: see the module doc)
+        o['XA'] = -F[0] @ d / (6 * PI); o['XC'] = -T[0] @ d / (8 * PI)
         F, T, S = steady(os.path.join(work, f's{s}_one_B'))
-        o['YA'] = -F[0] @ e1 / (6 * PI); o['YC'] = -T[0] @ e1 / (8 * PI)
-        o['YB'] = T[0] @ e2 / (4 * PI); o['YG'] = -(e1 @ S[0] @ d) / (4 * PI); o['YH'] = (e2 @ S[0] @ d) / (8 * PI)
+        o['YA'] = -F[0] @ e1 / (6 * PI); o['YC'] = -T[0] @ e1 / (8 * PI); o['YH'] = (e2 @ S[0] @ d) / (8 * PI)
         F, T, S = steady(os.path.join(work, f's{s}_one_C'))
         o['XM'], o['YM'], o['ZM'] = m_fit(S[0], d, E)
         one_body.append(o)
@@ -291,8 +291,8 @@ def main():
         for k, g in enumerate(WALL_GAPS):
             # single-wall resolved part: remove the far wall at distance LW - 2 - g and the two
             # walls seen from the centre by superposing single-wall theory (doc/LUBRICATION.md)
-            far = wall_functions(LW - 2.0 - g) - wall_functions(1e9)
-            mid = 2.0 * (wall_functions(LW / 2 - 1.0) - wall_functions(1e9))
+            far = wall_excess(LW - 2.0 - g)
+            mid = 2.0 * wall_excess(LW / 2 - 1.0)
             wall[s, k] = wall_values(g) - centre - far + mid
     out = args.output or os.path.join(ROOT, 'input', 'lubrication', f'resolved_a{n}.h5')
     os.makedirs(os.path.dirname(out), exist_ok=True)

@@ -10,15 +10,15 @@ import h5py
 import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, 'scripts'))
-from resistance_exact import pair_scalars, wall_scalars, NAMES
+from resistance_exact import pair_scalars, wall_excess, NAMES
 
 I = {n: k for k, n in enumerate(NAMES)}
-COMBOS = [('XA11-XA12', lambda f: f[I['XA11']] - f[I['XA12']], 1.0),
-          ('YA11-YA12', lambda f: f[I['YA11']] - f[I['YA12']], 1.0),
-          ('YB11-YB12', lambda f: f[I['YB11']] - f[I['YB12']], 0.0),
-          ('XC11', lambda f: f[I['XC11']], 1.0), ('YC11', lambda f: f[I['YC11']], 1.0),
-          ('XM', lambda f: f[I['XM11']] + f[I['XM12']], 1.0), ('YM', lambda f: f[I['YM11']] + f[I['YM12']], 1.0),
-          ('ZM', lambda f: f[I['ZM11']] + f[I['ZM12']], 1.0)]
+COMBOS = [('XA11-XA12', lambda f: f[I['XA11']] - f[I['XA12']]),
+          ('YA11-YA12', lambda f: f[I['YA11']] - f[I['YA12']]),
+          ('YB11-YB12', lambda f: f[I['YB11']] - f[I['YB12']]),
+          ('XC11', lambda f: f[I['XC11']]), ('YC11', lambda f: f[I['YC11']]),
+          ('XM', lambda f: f[I['XM11']] + f[I['XM12']]), ('YM', lambda f: f[I['YM11']] + f[I['YM12']]),
+          ('ZM', lambda f: f[I['ZM11']] + f[I['ZM12']])]
 for path in sys.argv[1:] or sorted(glob.glob(os.path.join(ROOT, 'input', 'lubrication', 'resolved_a*.h5'))):
     with h5py.File(path, 'r') as h:
         n = h.attrs['cells_per_radius']
@@ -39,7 +39,7 @@ for path in sys.argv[1:] or sorted(glob.glob(os.path.join(ROOT, 'input', 'lubric
             ex_pair[I[m + '11']] = ex[I[m + '11']] + ex[I[m + '12']] - 1.0
             ex_pair[I[m + '12']] = 0.0
         cells = []
-        for name, fn, _ in COMBOS:
+        for name, fn in COMBOS:
             # relative combinations were measured as D and stored as (S +- D)/2: std(D) = 2 std(f11)
             spread = 2 * sf[I[name[:4]]] if '-' in name else abs(fn(sf))
             cells.append('%9.4f +-%6.4f %8.4f' % (fn(f), spread, fn(ex_pair)))
@@ -47,5 +47,5 @@ for path in sys.argv[1:] or sorted(glob.glob(os.path.join(ROOT, 'input', 'lubric
     print('%-10s' % 'wall gap' + ''.join('%26s' % c for c in ('lambda_perp', 'f_tt', 'f_tr', 'f_rr')))
     for row, srow in zip(wall, wscat):
         g = row[0]
-        ex = wall_scalars(g) - np.array([1.0, 1.0, 0.0, 1.0, 1.0])
+        ex = wall_excess(g)
         print('%-10g' % g + ''.join('%9.4f +-%6.4f %8.4f' % (row[1 + k], srow[1 + k], ex[k]) for k in range(4)))

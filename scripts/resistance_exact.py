@@ -22,3 +22,11 @@ def pair_scalars(gap):
 def wall_scalars(gap):
     """[lambda_perp, f_tt, f_tr, f_rr, x_w] at this gap."""
     return _table('wall', [gap])[0, 1:]
+
+
+FREE_SPHERE_WALL = np.array([1.0, 1.0, 0.0, 1.0, 1.0])
+
+
+def wall_excess(gap):
+    """What one wall adds to the free-sphere values: wall_scalars(gap) - [1, 1, 0, 1, 1]."""
+    return wall_scalars(gap) - FREE_SPHERE_WALL

@@ -87,8 +87,7 @@ contains
     real(dp), allocatable, intent(out) :: pair(:, :), wall(:, :)
     character(len=*), intent(out) :: message
     integer(HID_T) :: file
-    integer(HSIZE_T) :: d(2)
-    integer :: err, rank
+    integer :: err
     real(dp) :: value(1)
     message = ''
     call h5fopen_f(path, H5F_ACC_RDONLY_F, file, err)
@@ -117,32 +116,36 @@ contains
         if (len_trim(message) > 0) exit
       end do
     end block
-    if (len_trim(message) == 0) then
-      call dataset_dims(file, 'pair/resolved', rank, d)
-      if (rank /= 2 .or. d(1) /= 1 + n_pair_scalars .or. d(2) < 2) then
-        message = 'pair/resolved must be an n x 23 dataset with n >= 2'
-      else
-        allocate(pair(d(1), d(2)))
-        call read_dataset(file, 'pair/resolved', pair, err)
-        if (err /= 0) message = 'pair/resolved cannot be read'
-      end if
-    end if
-    if (len_trim(message) == 0) then
-      call dataset_dims(file, 'wall/resolved', rank, d)
-      if (rank /= 2 .or. d(1) /= 1 + n_wall_scalars .or. d(2) < 2) then
-        message = 'wall/resolved must be an n x 6 dataset with n >= 2'
-      else
-        allocate(wall(d(1), d(2)))
-        call read_dataset(file, 'wall/resolved', wall, err)
-        if (err /= 0) message = 'wall/resolved cannot be read'
-      end if
-    end if
-    if (len_trim(message) == 0) then
-      if (any(pair(1, 2:) <= pair(1, :size(pair, 2) - 1)) .or. any(wall(1, 2:) <= wall(1, :size(wall, 2) - 1)) &
-          .or. pair(1, 1) <= 0 .or. wall(1, 1) <= 0) message = 'the gaps must be positive and increasing'
-    end if
+    if (len_trim(message) == 0) call read_rows(file, 'pair/resolved', 1 + n_pair_scalars, pair, message)
+    if (len_trim(message) == 0) call read_rows(file, 'wall/resolved', 1 + n_wall_scalars, wall, message)
     call h5fclose_f(file, err)
   end subroutine read_table
+
+  ! One table: n >= 2 rows of width columns, a positive increasing gap first (HDF5 n x width,
+  ! read as (width, n)).
+  subroutine read_rows(file, name, width, rows, message)
+    integer(HID_T), intent(in) :: file
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: width
+    real(dp), allocatable, intent(out) :: rows(:, :)
+    character(len=*), intent(inout) :: message
+    integer(HSIZE_T) :: d(2)
+    integer :: rank, err, n
+    call dataset_dims(file, name, rank, d)
+    if (rank /= 2 .or. d(1) /= width .or. d(2) < 2) then
+      write(message, '(a,i0,a)') name//' must be an n x ', width, ' dataset with n >= 2'
+      return
+    end if
+    allocate(rows(d(1), d(2)))
+    call read_dataset(file, name, rows, err)
+    if (err /= 0) then
+      message = name//' cannot be read'
+      return
+    end if
+    n = size(rows, 2)
+    if (rows(1, 1) <= 0 .or. any(rows(1, 2:) <= rows(1, :n - 1))) &
+      message = name//': the gaps must be positive and increasing'
+  end subroutine read_rows
 
   function number(x) result(text)
     real(dp), intent(in) :: x

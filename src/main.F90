@@ -39,7 +39,7 @@ program fdsusp
   type(fd_t) :: fd
   type(particle_contacts_t) :: pc
   type(lubrication_t) :: lub
-  type(particle_lubrication_t) :: pl
+  type(particle_lubrication_t), allocatable :: pl   ! allocated when lubrication is on
   logical :: has_particles, has_contacts, has_lubrication
   integer :: info
   integer, allocatable :: shapes(:, :)
@@ -79,6 +79,7 @@ program fdsusp
   call lubrication_load(cfg, has_particles .and. (parts%n >= 2 .or. cfg%walls), lub)
   has_lubrication = lub%model /= LUB_NONE
   if (has_lubrication) then
+    allocate(pl)
     call plub_create(pl, lub, parts%n, cfg%box, cfg%walls, cfg%shear_rate, cfg%lubrication_skin, info, text)
     if (info /= 0) call input_error(cfg%deck_file, 'lubrication', 'skin', trim(text))
   end if
@@ -182,15 +183,8 @@ program fdsusp
       PetscCallA(fluid_step(grid, fl, ierr, fd%lambda))
       PetscCallA(stage_pop(ierr))
       PetscCallA(stage_push(STAGE_PARTICLES, ierr))
-      if (has_contacts .and. has_lubrication) then
-        PetscCallA(fd_particle_step(grid, fd, fl%vel, fl%pressure, parts, ierr, pc%force, pc%torque, pl))
-      else if (has_contacts) then
-        PetscCallA(fd_particle_step(grid, fd, fl%vel, fl%pressure, parts, ierr, pc%force, pc%torque))
-      else if (has_lubrication) then
-        PetscCallA(fd_particle_step(grid, fd, fl%vel, fl%pressure, parts, ierr, lubrication=pl))
-      else
-        PetscCallA(fd_particle_step(grid, fd, fl%vel, fl%pressure, parts, ierr))
-      end if
+      ! contact forces and lubrication links, each absent when not allocated (no such model)
+      PetscCallA(fd_particle_step(grid, fd, fl%vel, fl%pressure, parts, ierr, pc%force, pc%torque, pl))
       call advance_positions(parts, cfg%dt, cfg%box, [.true., .not. cfg%walls, .true.])
       PetscCallA(stage_pop(ierr))
     else

@@ -27,6 +27,7 @@ module mod_neighbours
     integer, allocatable :: order(:)         ! (np) particle indices sorted by cell
     integer, allocatable :: cell_of(:)       ! (np)
     real(dp), allocatable :: x_ref(:,:)      ! (3, np) positions at the last build
+    logical :: built = .false.               ! x_ref and the lists hold a build
     integer(i8) :: n_dist = 0                ! distance evaluations of the last build
   end type nlist_t
 
@@ -195,6 +196,7 @@ contains
       end do
     end if
     nl%x_ref(:, 1:nl%np) = x(:, 1:nl%np)
+    nl%built = .true.
 
   contains
 
@@ -238,15 +240,19 @@ contains
     end do
   end function nlist_needs_rebuild
 
-  !> Build the list at x and return its candidates in canonical order (pairs by i then j, walls
-  !> by particle then wall), so that forces summed over them come out in the same order whatever
-  !> list is in use: a run restarted from a checkpoint (fresh list) repeats the arithmetic of an
-  !> uninterrupted one bitwise.
+  !> The candidates at x in canonical order (pairs by i then j, walls by particle then wall), so
+  !> that forces summed over them come out in the same order whatever list is in use: a run
+  !> restarted from a checkpoint (fresh list) repeats the arithmetic of an uninterrupted one
+  !> bitwise. The list is rebuilt (and pairs, walls rewritten) only when it has never been built
+  !> or some particle has moved more than skin/2 since; otherwise pairs and walls are left as they are.
   subroutine nlist_candidates(nl, x, pairs, npairs, walls, nwalls)
     type(nlist_t), intent(inout) :: nl
     real(dp), intent(in) :: x(:,:)
     integer, allocatable, intent(inout) :: pairs(:,:), walls(:,:)
-    integer, intent(out) :: npairs, nwalls
+    integer, intent(inout) :: npairs, nwalls
+    if (nl%built) then
+      if (.not. nlist_needs_rebuild(nl, x)) return
+    end if
     call nlist_build(nl, x)
     call canonical_order(nl%pair, nl%npairs, pairs, npairs)
     call canonical_order(nl%wall, nl%nwalls, walls, nwalls)

@@ -16,7 +16,7 @@ module mod_particle_contacts
   use mod_kinds, only: dp
   use mod_contact, only: contact_params_t, contact_setup, contact_stats_t, contact_history_t, &
                          contact_forces
-  use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates, nlist_needs_rebuild
+  use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates
   implicit none
   private
   public :: particle_contacts_t, pcontacts_create, pcontacts_step
@@ -30,8 +30,6 @@ module mod_particle_contacts
     logical :: periodic(3) = .true.
     real(dp) :: wall_velocity(3, 2) = 0      ! lower, upper wall
     real(dp) :: overlap_limit = 0            ! |delta'| beyond which the run must stop [a]
-    logical :: built = .false.
-    integer :: rebuilds = 0                  ! neighbour-list builds so far in this run
     integer :: npairs = 0, nwalls = 0        ! candidates in canonical order
     integer, allocatable :: pairs(:,:), walls(:,:)
     type(contact_stats_t) :: stats           ! of the last step
@@ -87,11 +85,7 @@ contains
     type(particle_contacts_t), intent(inout) :: pc
     real(dp), intent(in) :: x(:,:), u(:,:), om(:,:)
     integer, intent(out) :: info
-    if (.not. pc%built) then
-      call rebuild()
-    else if (nlist_needs_rebuild(pc%nlist, x)) then
-      call rebuild()
-    end if
+    call nlist_candidates(pc%nlist, x, pc%pairs, pc%npairs, pc%walls, pc%nwalls)
     call contact_forces(pc%params, pc%history, x, u, om, pc%box, pc%periodic, pc%wall_velocity, &
                         pc%pairs, pc%npairs, pc%walls, pc%nwalls, pc%dt, pc%force, pc%torque, &
                         pc%stresslet, pc%stats, info)
@@ -99,15 +93,6 @@ contains
     pc%max_overlap = pc%stats%max_overlap * pc%params%h_r
     if (pc%params%h_r <= 0) pc%max_overlap = pc%stats%max_overlap * pc%params%a
     if (pc%max_overlap > pc%overlap_limit) info = 2
-
-  contains
-
-    subroutine rebuild()
-      call nlist_candidates(pc%nlist, x, pc%pairs, pc%npairs, pc%walls, pc%nwalls)
-      pc%built = .true.
-      pc%rebuilds = pc%rebuilds + 1
-    end subroutine rebuild
-
   end subroutine pcontacts_step
 
 

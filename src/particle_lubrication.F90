@@ -11,7 +11,7 @@ module mod_particle_lubrication
   use mod_resistance, only: n_pair_scalars
   use mod_lubrication, only: lubrication_t, lub_pair_scalars, lub_wall_scalars, lub_pair_link, &
        lub_wall_link, lub_pair_stresslets, lub_wall_stresslet, n_wall_scalars, LUB_NONE
-  use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates, nlist_needs_rebuild
+  use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates
   implicit none
   private
   public :: particle_lubrication_t, plub_create, plub_links, plub_corrections
@@ -21,8 +21,7 @@ module mod_particle_lubrication
     type(nlist_t) :: nlist
     integer :: np = 0
     real(dp) :: box(3) = 0, shear_rate = 0
-    logical :: walls = .false., periodic(3) = .true., built = .false.
-    integer :: rebuilds = 0
+    logical :: walls = .false., periodic(3) = .true.
     integer :: ncand = 0, ncand_walls = 0
     integer, allocatable :: cand(:, :), cand_walls(:, :)        ! canonical candidate lists
     ! links of the current configuration
@@ -68,7 +67,6 @@ contains
     if (np == 1) then
       ! one sphere: no pairs, and its two wall candidates need no search (nor a box large
       ! enough for one)
-      pl%built = .true.
       pl%ncand = 0
       pl%ncand_walls = 0
       allocate(pl%cand(2, 0), pl%cand_walls(2, 2))
@@ -116,11 +114,8 @@ contains
     pl%nwalls = 0
     pl%min_gap = huge(1.0_dp)
     if (pl%lub%model == LUB_NONE) return
-    if (.not. pl%built) then
-      call rebuild()
-    else if (pl%np > 1) then
-      if (nlist_needs_rebuild(pl%nlist, x)) call rebuild()
-    end if
+    ! one sphere: its wall candidates were set once by plub_create
+    if (pl%np > 1) call nlist_candidates(pl%nlist, x, pl%cand, pl%ncand, pl%cand_walls, pl%ncand_walls)
     call ambient_gradients(pl, om_inf, e_inf)
     do c = 1, pl%ncand
       i = pl%cand(1, c)
@@ -167,12 +162,6 @@ contains
     end do
 
   contains
-
-    subroutine rebuild()
-      call nlist_candidates(pl%nlist, x, pl%cand, pl%ncand, pl%cand_walls, pl%ncand_walls)
-      pl%built = .true.
-      pl%rebuilds = pl%rebuilds + 1
-    end subroutine rebuild
 
     subroutine grow_pairs()
       integer :: m
