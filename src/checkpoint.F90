@@ -6,6 +6,7 @@
 !             density Lambda^n, a source of the next fluid step) and the group /particles
 !             (mod_particles_io: positions with attribute box, velocities, Adams-Bashforth history)
 !             with contacts also the group /contacts (mod_contacts_io: the tangential springs)
+!             with statistics (&rheology) also /rheology/accumulators (mod_rheology::rheo_state)
 !   attributes format_version, step, time, cells, box, walls, reynolds, dt, shear_rate
 ! Written in parallel to NAME.tmp by PETSc's HDF5 viewer, completed by rank 0, flushed to disk
 ! and renamed over NAME: the previous checkpoint survives until the new one is whole.
@@ -17,7 +18,8 @@ module mod_checkpoint
   use mod_params, only: config_t
   use mod_grid, only: grid_t, FIELD_U, FIELD_V, FIELD_W
   use mod_fluid, only: fluid_t
-  use mod_h5util, only: write_attribute, read_attribute, write_string_attribute, has_object, dataset_dims
+  use mod_h5util, only: write_attribute, read_attribute, write_string_attribute, has_object, dataset_dims, &
+                        write_dataset, read_dataset
   use mod_system, only: publish_file
   use mod_errors, only: is_root, abort_run, file_error
   use mod_particles, only: particles_t
@@ -33,8 +35,9 @@ module mod_checkpoint
 
 contains
 
-  ! lambda and parts: present when the run has particles; history: when it has contacts.
-  subroutine checkpoint_write(path, cfg, fl, step, time, ierr, lambda, parts, history)
+  ! lambda and parts: present when the run has particles; history: when it has contacts;
+  ! statistics: the accumulators of &rheology.
+  subroutine checkpoint_write(path, cfg, fl, step, time, ierr, lambda, parts, history, statistics)
     character(len=*), intent(in) :: path
     type(config_t), intent(in) :: cfg
     type(fluid_t), intent(inout) :: fl
@@ -44,8 +47,9 @@ contains
     Vec, intent(in), optional :: lambda(3)
     type(particles_t), intent(in), optional :: parts
     type(contact_history_t), intent(in), optional :: history
+    real(dp), intent(in), optional :: statistics(:)
     PetscViewer :: viewer
-    integer(HID_T) :: file
+    integer(HID_T) :: file, group
     integer :: err, e(10), c, walls
     character(len=1100) :: tmp
     character(len=16) :: code
@@ -81,6 +85,12 @@ contains
       call write_string_attribute(file, 'program', 'fdsusp', e(10))
       if (present(parts)) call particles_write(file, parts, cfg%box, .true.)
       if (present(history) .and. present(parts)) call contacts_write(file, history, parts%n)
+      if (present(statistics)) then
+        call h5gcreate_f(file, 'rheology', group, err)
+        if (err == 0) call write_dataset(group, 'accumulators', reshape(statistics, [size(statistics), 1]), err)
+        if (err /= 0) call abort_run('cannot write /rheology/accumulators to '//trim(tmp))
+        call h5gclose_f(group, err)
+      end if
       call h5fclose_f(file, err)
       if (any(e /= 0) .or. err /= 0) call abort_run('cannot write the attributes of '//trim(tmp))
       err = publish_file(tmp, path)
@@ -219,16 +229,23 @@ contains
     call h5fclose_f(file, err)
   end subroutine inspect
 
-  ! history (with parts): the contact history, when the run has contacts.
-  subroutine checkpoint_read(path, fl, ierr, lambda, parts, history)
+  ! history (with parts): the contact history, when the run has contacts; statistics: the
+  ! accumulators of &rheology (its size is the run's; a checkpoint without them, or with another
+  ! size, stops the run).
+  subroutine checkpoint_read(path, fl, ierr, lambda, parts, history, statistics)
     character(len=*), intent(in) :: path
     type(fluid_t), intent(inout) :: fl
     PetscErrorCode, intent(out) :: ierr
     Vec, intent(inout), optional :: lambda(3)
     type(particles_t), intent(inout), optional :: parts
     type(contact_history_t), intent(inout), optional :: history
+    real(dp), intent(inout), optional :: statistics(:)
     PetscViewer :: viewer
-    integer :: c
+    integer :: c, rank, err
+    integer(HID_T) :: file
+    integer(HSIZE_T) :: dims(2)
+    character(len=200) :: message
+    real(dp), allocatable :: buffer(:, :)
     PetscCall(PetscViewerHDF5Open(PETSC_COMM_WORLD, trim(path), FILE_MODE_READ, viewer, ierr))
     do c = FIELD_U, FIELD_W
       PetscCall(VecLoad(fl%vel(c), viewer, ierr))
@@ -243,6 +260,29 @@ contains
     PetscCall(PetscViewerDestroy(viewer, ierr))
     if (present(parts)) call particles_read_state(path, parts)
     if (present(history) .and. present(parts)) call contacts_read(path, history, parts%n)
+    if (present(statistics)) then
+      message = ''
+      if (is_root()) then
+        call h5fopen_f(trim(path), H5F_ACC_RDONLY_F, file, err)
+        if (.not. has_object(file, 'rheology')) then
+          message = 'missing: the checkpoint was written by a run without &rheology'
+        else
+          call dataset_dims(file, 'rheology/accumulators', rank, dims)
+          if (rank /= 2 .or. dims(1) /= size(statistics) .or. dims(2) /= 1) then
+            message = 'does not fit this deck''s &rheology (blocks, profile_bins or angle_bins differ)'
+          else
+            allocate(buffer(size(statistics), 1))
+            call read_dataset(file, 'rheology/accumulators', buffer, err)
+            statistics = buffer(:, 1)
+            if (err /= 0) message = 'cannot be read'
+          end if
+        end if
+        call h5fclose_f(file, err)
+      end if
+      call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
+      if (len_trim(message) > 0) call file_error(path, 'rheology/accumulators', trim(message))
+      call MPI_Bcast(statistics, size(statistics), MPI_DOUBLE_PRECISION, 0, PETSC_COMM_WORLD, ierr)
+    end if
   end subroutine checkpoint_read
 
 end module mod_checkpoint

@@ -33,7 +33,8 @@ module mod_fictitious_domain
   use petscksp
   use mod_kinds, only: dp
   use mod_grid, only: grid_t, FIELD_U, FIELD_V, FIELD_W, FIELD_P
-  use mod_particles, only: particles_t, MOTION_FREE, MOTION_PRESCRIBED, MOTION_FROZEN, MOTION_RESISTANCE
+  use mod_particles, only: particles_t, MOTION_FREE, MOTION_PRESCRIBED, MOTION_FROZEN, MOTION_RESISTANCE, &
+                           MOTION_FIXED
   use mod_particle_system, only: particle_system_t, psys_reset, psys_add_diagonal, psys_add_pair, psys_solve
   use mod_particle_lubrication, only: particle_lubrication_t, plub_corrections
   use mod_particle_solver, only: particle_solver_t, psolver_create, psolver_solve, psolver_destroy
@@ -277,7 +278,7 @@ contains
 
     ! the 6N system (method.md eq. (1))
     select case (parts%motion)
-    case (MOTION_FREE)
+    case (MOTION_FREE, MOTION_FROZEN)
       call psys_reset(fd%system, n)
       do q = 1, n
         call psys_add_diagonal(fd%system, q, fd%beta * fd%rigid_matrix(:, :, q))
@@ -308,7 +309,7 @@ contains
     case (MOTION_PRESCRIBED, MOTION_RESISTANCE)
       parts%velocity = parts%prescribed_velocity
       parts%omega = parts%prescribed_omega
-    case (MOTION_FROZEN)
+    case (MOTION_FIXED)
       parts%velocity = 0.0_dp
       parts%omega = 0.0_dp
     end select

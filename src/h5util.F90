@@ -41,6 +41,7 @@ contains
     integer(HID_T) :: space, attr
     integer(HSIZE_T) :: dims(1)
     dims(1) = size(values)
+    if (has_attribute(loc, name)) call h5adelete_f(loc, name, err)   ! an attribute is replaced
     call h5screate_simple_f(1, dims, space, err)
     if (err /= 0) return
     call h5acreate_f(loc, name, H5T_NATIVE_DOUBLE, space, attr, err)
@@ -59,6 +60,7 @@ contains
     integer(HID_T) :: space, attr
     integer(HSIZE_T) :: dims(1)
     dims(1) = size(values)
+    if (has_attribute(loc, name)) call h5adelete_f(loc, name, err)   ! an attribute is replaced
     call h5screate_simple_f(1, dims, space, err)
     if (err /= 0) return
     call h5acreate_f(loc, name, H5T_NATIVE_INTEGER, space, attr, err)
@@ -202,7 +204,7 @@ contains
     if (err /= 0) return
     call h5dget_space_f(dset, space, err)
     call h5sget_simple_extent_ndims_f(space, rank, err)
-    if (rank == 2) call h5sget_simple_extent_dims_f(space, dims, maxdims, err)
+    if (rank == 1 .or. rank == 2) call h5sget_simple_extent_dims_f(space, dims, maxdims, err)
     call h5sclose_f(space, err)
     call h5dclose_f(dset, err)
   end subroutine dataset_dims

@@ -9,17 +9,19 @@ program fdsusp
   use mod_kinds, only: dp
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
   use mod_params, only: config_t, read_deck, echo_deck, max_line
-  use mod_errors, only: log_line, input_error, fatal_error
+  use mod_errors, only: log_line, warn_line, input_error, fatal_error, is_root
   use mod_grid, only: grid_t, grid_create, grid_destroy
   use mod_fluid, only: fluid_t, fluid_create, fluid_step, fluid_destroy, fluid_errors_vs_manufactured
-  use mod_series, only: series_t, series_open, series_record, series_flush
+  use mod_series, only: series_t, series_open, series_record, series_flush, series_attributes
   use mod_output, only: write_fields, progress_line
   use mod_checkpoint, only: checkpoint_write, checkpoint_check, checkpoint_read
   use mod_system, only: install_signal_handlers, stop_signal, make_directory, probe_directory
   use mod_timers, only: timers_register, stage_push, stage_pop, STAGE_SETUP, STAGE_FLUID, STAGE_OUTPUT, &
                         STAGE_PARTICLES, STAGE_CONTACTS, STAGE_LUBRICATION
   use mod_particles, only: particles_t, advance_positions
-  use mod_particles_io, only: particles_load
+  use mod_particles_io, only: particles_load, particles_snapshot
+  use mod_rheology, only: rheology_t, rheo_create, rheo_sample, rheo_accumulate, rheo_state, rheo_restore, &
+                          rheo_write_summary, rheo_summarise, summary_names, NSUMMARY
   use mod_fictitious_domain, only: fd_t, fd_create, fd_geometry, fd_particle_step, fd_destroy
   use mod_particle_contacts, only: particle_contacts_t, pcontacts_create, pcontacts_step
   use mod_lubrication, only: lubrication_t, LUB_NONE, LUB_SIMPLE
@@ -40,6 +42,9 @@ program fdsusp
   type(particle_contacts_t) :: pc
   type(lubrication_t) :: lub
   type(particle_lubrication_t), allocatable :: pl   ! allocated when lubrication is on
+  type(rheology_t), allocatable :: rh               ! allocated when the deck has &rheology
+  real(dp), allocatable :: statistics(:)            ! rh's accumulators, for checkpoints
+  real(dp), allocatable :: no_contact_stresslet(:, :, :)
   logical :: has_particles, has_contacts, has_lubrication
   integer :: info
   integer, allocatable :: shapes(:, :)
@@ -83,6 +88,24 @@ program fdsusp
     call plub_create(pl, lub, parts%n, cfg%box, cfg%walls, cfg%shear_rate, cfg%lubrication_skin, info, text)
     if (info /= 0) call input_error(cfg%deck_file, 'lubrication', 'skin', trim(text))
   end if
+  ! statistics of the core region (doc/RHEOLOGY.md)
+  if (cfg%rheology_group) then
+    allocate(rh)
+    call rheo_create(rh, parts%n, cfg%box, parts%radius, cfg%shear_rate, cfg%core, cfg%profile_bins, &
+         cfg%angle_bins, cfg%pair_shell, cfg%contact_shell, cfg%blocks, cfg%discard_step, cfg%block_steps, info)
+    if (info /= 0) call input_error(cfg%deck_file, 'domain', 'box', &
+         'with &rheology every periodic length must be >= 2 (pair_shell + 0.3) a')
+    if (.not. has_contacts) allocate(no_contact_stresslet(3, 3, parts%n), source=0.0_dp)
+    statistics = rheo_state(rh)
+    write(text, '(a,i0,a,i0,a,i0,a,i0)') 'statistics: discard ', cfg%discard_step, ' steps, then ', cfg%blocks, &
+         ' blocks of ', cfg%block_steps, ' steps, ending at step ', cfg%discard_step + cfg%blocks * cfg%block_steps
+    call log_line(text)
+    if (cfg%steps < cfg%discard_step + cfg%blocks * cfg%block_steps) then
+      write(text, '(a,i0,a)') '&time steps = ', cfg%steps, ' ends before the averaging window: the summary '// &
+           'will hold the blocks complete by then (restart with more steps to finish)'
+      call warn_line(text)
+    end if
+  end if
   checkpoint_path = trim(cfg%output_directory)//'/checkpoint.h5'
   step = 0
   time = 0.0_dp
@@ -101,13 +124,15 @@ program fdsusp
     PetscCallA(fd_create(grid, cfg%reynolds, cfg%dt, cfg%slip_kappa, cfg%radius_offset, fd, ierr))
   end if
   if (restarting) then
+    ! (statistics: absent when unallocated, i.e. without &rheology)
     if (has_contacts) then
-      PetscCallA(checkpoint_read(restart, fl, ierr, fd%lambda, parts, pc%history))
+      PetscCallA(checkpoint_read(restart, fl, ierr, fd%lambda, parts, pc%history, statistics=statistics))
     else if (has_particles) then
-      PetscCallA(checkpoint_read(restart, fl, ierr, fd%lambda, parts))
+      PetscCallA(checkpoint_read(restart, fl, ierr, fd%lambda, parts, statistics=statistics))
     else
       PetscCallA(checkpoint_read(restart, fl, ierr))
     end if
+    if (allocated(rh)) call rheo_restore(rh, statistics, info)
   end if
   columns = [character(len=32) :: 'step', 'time', 'wall_time', 'tau_wall_bottom', 'tau_wall_top', &
              'divergence', 'rate_of_change', 'iterations_u', 'iterations_v', 'iterations_w', 'iterations_p']
@@ -133,7 +158,26 @@ program fdsusp
     shapes = reshape([shapes, [0, 0, 0], [0, 0, 0], [0, 0, 0], [0, 0, 0], [3, parts%n, 0], &
                       [3, parts%n, 0], [3, 3, parts%n]], [3, size(columns)])
   end if
+  if (allocated(rh)) then
+    columns = [character(len=32) :: columns, 'core/stress_hydro', 'core/stress_contact', 'core/solid_fraction', &
+               'core/velocity_fit', 'core/shear_rate', 'min_pair_gap', 'pairs/references', 'pairs/shell', &
+               'pairs/contact', 'profiles/solid_fraction', 'profiles/momentum']
+    shapes = reshape([shapes, [5, 0, 0], [5, 0, 0], [0, 0, 0], [5, 0, 0], [0, 0, 0], [0, 0, 0], [0, 0, 0], &
+                      [cfg%angle_bins, 0, 0], [cfg%angle_bins, 0, 0], [cfg%profile_bins, 0, 0], &
+                      [cfg%profile_bins, 0, 0]], [3, size(columns)])
+    if (has_contacts) then
+      columns = [character(len=32) :: columns, 'contact_overlap_over_roughness']
+      shapes = reshape([shapes, [0, 0, 0]], [3, size(columns)])
+    end if
+  end if
   call series_open(series, cfg%output_directory, columns, merge(step, -1, restarting), shapes)
+  if (allocated(rh)) then
+    ! what scripts/rheology.py needs to repeat the statistics from series.h5 alone
+    call series_attributes(series, [character(len=32) :: 'box_x', 'box_y', 'box_z', 'radius', 'shear_rate', &
+         'dt', 'core_lo', 'core_hi', 'pair_radius', 'contact_radius', 'blocks', 'discard_step', 'block_steps', &
+         'series_every'], [cfg%box, parts%radius, cfg%shear_rate, cfg%dt, rh%core, rh%r_outer, rh%r_contact, &
+         real([cfg%blocks, cfg%discard_step, cfg%block_steps, cfg%series_every], dp)])
+  end if
   call install_signal_handlers()
   PetscCallA(stage_pop(ierr))
   if (has_particles) then
@@ -185,6 +229,14 @@ program fdsusp
       PetscCallA(stage_push(STAGE_PARTICLES, ierr))
       ! contact forces and lubrication links, each absent when not allocated (no such model)
       PetscCallA(fd_particle_step(grid, fd, fl%vel, fl%pressure, parts, ierr, pc%force, pc%torque, pl))
+      ! the core statistics of this configuration, before it moves on
+      if (allocated(rh)) then
+        if (has_contacts) then
+          call rheo_sample(rh, parts%position, parts%velocity, parts%stresslet_hydro, pc%stresslet)
+        else
+          call rheo_sample(rh, parts%position, parts%velocity, parts%stresslet_hydro, no_contact_stresslet)
+        end if
+      end if
       call advance_positions(parts, cfg%dt, cfg%box, [.true., .not. cfg%walls, .true.])
       PetscCallA(stage_pop(ierr))
     else
@@ -209,6 +261,9 @@ program fdsusp
       if (mod(step, cfg%fields_every) == 0) then
         PetscCallA(write_fields(cfg%output_directory, grid, fl, step, time, ierr))
       end if
+    end if
+    if (cfg%particles_every > 0 .and. has_particles) then
+      if (mod(step, cfg%particles_every) == 0) call particles_snapshot(cfg%output_directory, parts, cfg%box, step, time)
     end if
     if (cfg%checkpoint_every > 0) then
       if (mod(step, cfg%checkpoint_every) == 0) call checkpoint()
@@ -242,8 +297,10 @@ program fdsusp
   call series_flush(series)
   if (step > first_step) then
     PetscCallA(write_fields(cfg%output_directory, grid, fl, step, time, ierr))
+    if (has_particles) call particles_snapshot(cfg%output_directory, parts, cfg%box, step, time)
     call checkpoint()
   end if
+  if (allocated(rh)) call summary()
   PetscCallA(stage_pop(ierr))
   select case (stop_reason)
   case (SIGNALLED)
@@ -340,6 +397,14 @@ contains
       if (has_contacts) row = [row, real(pc%stats%pair_contacts, dp), real(pc%stats%wall_contacts, dp), &
              real(pc%stats%sliding, dp), pc%max_overlap, reshape(pc%force, [3 * parts%n]), &
              reshape(pc%torque, [3 * parts%n]), reshape(pc%stresslet, [9 * parts%n])]
+      if (allocated(rh)) then
+        row = [row, rh%values(1:11), rh%values(12:16), rh%shear_rate_core, rh%min_pair_gap, rh%references, &
+               rh%angles(:, 1), rh%angles(:, 2), rh%profile(:, 1), rh%profile(:, 2)]
+        if (has_contacts) row = [row, pc%max_overlap / max(pc%params%h_r, tiny(1.0_dp))]
+        ! only the records on the series_every grid enter the statistics (a restart then adds
+        ! exactly the records an uninterrupted run would)
+        if (mod(step, cfg%series_every) == 0) call rheo_accumulate(rh, step)
+      end if
       call series_record(series, row)
     else
       call series_record(series, values(1:n))
@@ -348,14 +413,39 @@ contains
 
   subroutine checkpoint()
     call series_flush(series)
+    if (allocated(rh)) statistics = rheo_state(rh)
     if (has_contacts) then
-      PetscCallA(checkpoint_write(checkpoint_path, cfg, fl, step, time, ierr, fd%lambda, parts, pc%history))
+      PetscCallA(checkpoint_write(checkpoint_path, cfg, fl, step, time, ierr, fd%lambda, parts, pc%history, statistics))
     else if (has_particles) then
-      PetscCallA(checkpoint_write(checkpoint_path, cfg, fl, step, time, ierr, fd%lambda, parts))
+      PetscCallA(checkpoint_write(checkpoint_path, cfg, fl, step, time, ierr, fd%lambda, parts, statistics=statistics))
     else
       PetscCallA(checkpoint_write(checkpoint_path, cfg, fl, step, time, ierr))
     end if
   end subroutine checkpoint
+
+  ! summary.json (rank 0) and the rheology in the run log: value +- standard error over the blocks.
+  subroutine summary()
+    integer :: err, k, q, complete
+    real(dp) :: value(NSUMMARY), error(NSUMMARY)
+    real(dp), allocatable :: profile(:, :), angles(:, :)
+    character(len=1100) :: path
+    character(len=20), parameter :: shown(14) = [character(len=20) :: 'eta_r', 'eta_h', 'eta_c', 'N1/tau', &
+         'N2/tau', 'Pi/tau', 'lambda_2', 'lambda_3', 'eta_n', 'I_v', 'mu', 'phi_core', 'gamma_dot_core', 'tau']
+    if (.not. is_root()) return
+    path = trim(cfg%output_directory)//'/summary.json'
+    call rheo_write_summary(rh, path, step, err)
+    if (err /= 0) call warn_line('cannot write '//trim(path))
+    call rheo_summarise(rh, step, complete, value, error, profile, angles)
+    write(text, '(a,i0,a,i0,a)') 'rheology of the core region (', complete, ' of ', cfg%blocks, &
+         ' blocks complete; value +- standard error; doc/RHEOLOGY.md):'
+    call log_line(text)
+    do k = 1, size(shown)
+      q = findloc(summary_names, shown(k), 1)
+      write(text, '(2x,a16,es13.5,a,es10.3)') shown(k), value(q), ' +- ', error(q)
+      call log_line(text)
+    end do
+    call log_line('summary written to '//trim(path))
+  end subroutine summary
 
   ! The contact part of the run log's 'models:' line.
   function contact_models() result(line)

@@ -11,15 +11,17 @@ module mod_params
   use mod_kinds, only: dp
   use mod_errors, only: input_error, log_line, is_root
   use mod_deck_text, only: deck_line_length, load_lines, group_on_line, to_lower, diagnose_group
+  use mod_packing, only: phi_max
   implicit none
   private
   public :: config_t, read_deck, echo_deck, max_line, max_inline_particles
 
   integer, parameter :: max_line = deck_line_length
   integer, parameter :: max_inline_particles = 64
-  integer, parameter :: ngroups = 9
+  integer, parameter :: ngroups = 10
   character(len=16), parameter :: known_groups(ngroups) = [character(len=16) :: &
-       'domain', 'fluid', 'time', 'output', 'run', 'verification', 'particles', 'contact', 'lubrication']
+       'domain', 'fluid', 'time', 'output', 'run', 'verification', 'particles', 'contact', 'lubrication', &
+       'rheology']
 
   type :: config_t
     character(len=max_line) :: deck_file = ''
@@ -37,7 +39,7 @@ module mod_params
     character(len=16) :: initial_flow = 'rest'          ! 'rest' or 'shear' (the linear Couette profile)
     ! &time
     real(dp) :: dt = 1.0e-3_dp                          ! time step [1/gamma_dot]
-    integer :: steps = 1000                             ! number of steps of this run [-]
+    integer :: steps = -1                               ! last step [-] (-1: 1000, or what &rheology needs)
     real(dp) :: steady_tolerance = 0.0_dp               ! stop when max|du|/dt < tol*U_ref (0: off)
     ! &output
     character(len=max_line) :: output_directory = 'out'
@@ -45,6 +47,7 @@ module mod_params
     integer :: series_every = 1                         ! steps between series.h5 records
     integer :: fields_every = 0                         ! steps between field snapshots (0: end only)
     integer :: checkpoint_every = 0                     ! steps between checkpoints (0: end only)
+    integer :: particles_every = 0                      ! steps between particle snapshots (0: end only)
     ! &run
     character(len=256) :: title = ''
     real(dp) :: max_wall_hours = 0.0_dp                 ! checkpoint and stop after this (0: never)
@@ -62,6 +65,10 @@ module mod_params
     real(dp) :: external_torque(3, max_inline_particles) = 0.0_dp      ! [eta*gamma_dot*a^3]
     real(dp) :: radius_offset = 0.38_dp                 ! alpha radius = radius + offset*h [h]
     real(dp) :: slip_kappa = 0.5_dp                     ! relaxation on partly covered faces [-]
+    real(dp) :: solid_fraction = 0.0_dp                 ! > 0: pack this volume fraction at start [-]
+    integer :: seed = 1                                 ! random seed of that packing [-]
+    integer :: packing_sweeps = 200                     ! its hard-sphere Monte Carlo sweeps [-]
+    real(dp) :: packing_min_gap = 0.0_dp                ! its smallest surface gap [a]
     ! &contact (doc/CONTACT.md; active when the group is present and the run has particles)
     logical :: contact_group = .false.                  ! the deck has a &contact group (derived)
     real(dp) :: roughness = 0.0_dp                      ! eps_r = h_r/a [-]
@@ -75,6 +82,17 @@ module mod_params
     real(dp) :: outer_cutoff = 0.0_dp                   ! gap where the correction ends [a] (0: model default)
     real(dp) :: inner_cutoff = 1.0e-4_dp                ! smallest gap the correction is evaluated at [a]
     real(dp) :: lubrication_skin = 0.2_dp               ! neighbour-list skin of lubricating pairs [a]
+    ! &rheology (doc/RHEOLOGY.md; statistics on when the group is present)
+    logical :: rheology_group = .false.                 ! the deck has a &rheology group (derived)
+    real(dp) :: discard_strain = 5.0_dp                 ! strain discarded before averaging [-]
+    real(dp) :: average_strain = 20.0_dp                ! strain averaged over [-]
+    integer :: blocks = 5                               ! averaging blocks [-]
+    real(dp) :: core(2) = [0.25_dp, 0.75_dp]            ! core region y/Ly [-] (paper eq. (4.10))
+    integer :: profile_bins = 0                         ! bins across y (0: 4 per radius)
+    integer :: angle_bins = 36                          ! bins of g(theta) over [0, 2 pi)
+    real(dp) :: pair_shell = 2.1_dp                     ! g(theta) counts pairs at r < pair_shell [a]
+    real(dp) :: contact_shell = 0.0_dp                  ! g_c(theta): r < 2a + contact_shell [a] (0: h_r or 0.005)
+    integer :: discard_step = 0, block_steps = 1        ! derived
     ! derived, not read
     integer :: cells(3) = 0
     logical :: walls = .true.
@@ -117,7 +135,8 @@ contains
       if (.not. any(known_groups == name)) then
         write(lnum, '(i0)') l
         call input_error(deck, trim(name), '', 'unknown group (line '//trim(lnum)// &
-             '); known groups: &domain &fluid &time &output &run &verification &particles &contact &lubrication')
+             '); known groups: &domain &fluid &time &output &run &verification &particles &contact &lubrication '// &
+             '&rheology')
       end if
     end do
   end subroutine check_group_names
@@ -179,7 +198,7 @@ contains
     integer :: steps
     ! &output
     character(len=max_line) :: directory
-    integer :: progress_every, series_every, fields_every, checkpoint_every
+    integer :: progress_every, series_every, fields_every, checkpoint_every, particles_every
     ! &run
     character(len=256) :: title
     real(dp) :: max_wall_hours
@@ -192,10 +211,17 @@ contains
     real(dp) :: external_force(3, max_inline_particles), external_torque(3, max_inline_particles)
     character(len=max_line) :: position_file
     character(len=16) :: motion
+    real(dp) :: solid_fraction, packing_min_gap
+    integer :: seed, packing_sweeps
+    ! &rheology
+    real(dp) :: discard_strain, average_strain, core(2), pair_shell, contact_shell
+    integer :: blocks, profile_bins, angle_bins
+    namelist /rheology/ discard_strain, average_strain, blocks, core, profile_bins, angle_bins, pair_shell, contact_shell
     ! &contact
     real(dp) :: roughness, eps_bar, friction, normal_stiffness, neighbour_skin
     namelist /particles/ number, position, position_file, radius, motion, velocity, omega, &
-         external_force, external_torque, radius_offset, slip_kappa
+         external_force, external_torque, radius_offset, slip_kappa, solid_fraction, seed, packing_sweeps, &
+         packing_min_gap
     namelist /contact/ roughness, eps_bar, friction, normal_stiffness, neighbour_skin
     ! &lubrication
     character(len=16) :: model
@@ -205,7 +231,7 @@ contains
     namelist /domain/ box, cells_per_radius, y_boundary, shear_rate
     namelist /fluid/ reynolds, body_force, velocity_tolerance, pressure_tolerance, viscous_theta, initial_flow
     namelist /time/ dt, steps, steady_tolerance
-    namelist /output/ directory, progress_every, series_every, fields_every, checkpoint_every
+    namelist /output/ directory, progress_every, series_every, fields_every, checkpoint_every, particles_every
     namelist /run/ title, max_wall_hours
     namelist /verification/ manufactured_solution
     integer :: stat
@@ -218,7 +244,7 @@ contains
     dt = cfg%dt; steps = cfg%steps; steady_tolerance = cfg%steady_tolerance
     directory = cfg%output_directory; progress_every = cfg%progress_every
     series_every = cfg%series_every; fields_every = cfg%fields_every
-    checkpoint_every = cfg%checkpoint_every
+    checkpoint_every = cfg%checkpoint_every; particles_every = cfg%particles_every
     title = cfg%title; max_wall_hours = cfg%max_wall_hours
     manufactured_solution = cfg%manufactured_solution
     number = cfg%particle_number; position = cfg%particle_position; position_file = cfg%position_file
@@ -226,6 +252,11 @@ contains
     omega = cfg%particle_omega; external_force = cfg%external_force
     external_torque = cfg%external_torque; radius_offset = cfg%radius_offset
     slip_kappa = cfg%slip_kappa
+    solid_fraction = cfg%solid_fraction; seed = cfg%seed; packing_sweeps = cfg%packing_sweeps
+    packing_min_gap = cfg%packing_min_gap
+    discard_strain = cfg%discard_strain; average_strain = cfg%average_strain; blocks = cfg%blocks
+    core = cfg%core; profile_bins = cfg%profile_bins; angle_bins = cfg%angle_bins
+    pair_shell = cfg%pair_shell; contact_shell = cfg%contact_shell
     roughness = cfg%roughness; eps_bar = cfg%eps_bar; friction = cfg%friction
     normal_stiffness = cfg%normal_stiffness; neighbour_skin = cfg%neighbour_skin
     model = cfg%lubrication_model; table = cfg%lubrication_table; outer_cutoff = cfg%outer_cutoff
@@ -243,6 +274,7 @@ contains
       case ('particles');    read(src, nml=particles, iostat=stat, iomsg=msg)
       case ('contact');      read(src, nml=contact, iostat=stat, iomsg=msg)
       case ('lubrication');  read(src, nml=lubrication, iostat=stat, iomsg=msg)
+      case ('rheology');     read(src, nml=rheology, iostat=stat, iomsg=msg)
       end select
       if (present(ios)) ios = stat
       if (stat /= 0) return
@@ -254,7 +286,7 @@ contains
       cfg%dt = dt; cfg%steps = steps; cfg%steady_tolerance = steady_tolerance
       cfg%output_directory = directory; cfg%progress_every = progress_every
       cfg%series_every = series_every; cfg%fields_every = fields_every
-      cfg%checkpoint_every = checkpoint_every
+      cfg%checkpoint_every = checkpoint_every; cfg%particles_every = particles_every
       cfg%title = title; cfg%max_wall_hours = max_wall_hours
       cfg%manufactured_solution = manufactured_solution
       cfg%particle_number = number; cfg%particle_position = position
@@ -262,11 +294,17 @@ contains
       cfg%particle_velocity = velocity; cfg%particle_omega = omega
       cfg%external_force = external_force; cfg%external_torque = external_torque
       cfg%radius_offset = radius_offset; cfg%slip_kappa = slip_kappa
+      cfg%solid_fraction = solid_fraction; cfg%seed = seed; cfg%packing_sweeps = packing_sweeps
+      cfg%packing_min_gap = packing_min_gap
+      cfg%discard_strain = discard_strain; cfg%average_strain = average_strain; cfg%blocks = blocks
+      cfg%core = core; cfg%profile_bins = profile_bins; cfg%angle_bins = angle_bins
+      cfg%pair_shell = pair_shell; cfg%contact_shell = contact_shell
       cfg%roughness = roughness; cfg%eps_bar = eps_bar; cfg%friction = friction
       cfg%normal_stiffness = normal_stiffness; cfg%neighbour_skin = neighbour_skin
       cfg%lubrication_model = to_lower(model); cfg%lubrication_table = table
       cfg%outer_cutoff = outer_cutoff; cfg%inner_cutoff = inner_cutoff; cfg%lubrication_skin = skin
       if (group == 'contact') cfg%contact_group = .true.
+      if (group == 'rheology') cfg%rheology_group = .true.
     end if
     if (present(echo_unit)) then
       select case (group)
@@ -278,6 +316,12 @@ contains
       case ('verification'); write(echo_unit, nml=verification)
       case ('particles');    call echo_particles(echo_unit, cfg)
       case ('lubrication');  write(echo_unit, nml=lubrication)
+      case ('rheology')
+        if (cfg%rheology_group) then
+          write(echo_unit, nml=rheology)
+        else
+          write(echo_unit, '(a)') '! &rheology absent: no statistics'
+        end if
       case ('contact')
         ! only when given: an absent &contact means no contacts, not these defaults
         if (cfg%contact_group) then
@@ -294,13 +338,17 @@ contains
     integer, intent(in) :: unit
     type(config_t), intent(in) :: cfg
     integer :: number
-    real(dp) :: radius, radius_offset, slip_kappa
+    real(dp) :: radius, radius_offset, slip_kappa, solid_fraction, packing_min_gap
+    integer :: seed, packing_sweeps
     character(len=max_line) :: position_file
     character(len=16) :: motion
-    namelist /particles/ number, position_file, radius, motion, radius_offset, slip_kappa
+    namelist /particles/ number, position_file, radius, motion, radius_offset, slip_kappa, solid_fraction, &
+         seed, packing_sweeps, packing_min_gap
     integer :: p
     number = cfg%particle_number; position_file = cfg%position_file; radius = cfg%radius
     motion = cfg%motion; radius_offset = cfg%radius_offset; slip_kappa = cfg%slip_kappa
+    solid_fraction = cfg%solid_fraction; seed = cfg%seed; packing_sweeps = cfg%packing_sweeps
+    packing_min_gap = cfg%packing_min_gap
     write(unit, nml=particles)
     do p = 1, cfg%particle_number
       write(unit, '(a,i0,a,3(es23.15e3,:,","))') ' position(:,', p, ')=', cfg%particle_position(:, p)
@@ -419,7 +467,7 @@ contains
            trim(cfg%initial_flow)//'''')
 
     call check_real(cfg, 'time', 'dt', cfg%dt, 0.0_dp, 10.0_dp, .true.)
-    call check_int(cfg, 'time', 'steps', cfg%steps, 0, 1000000000)
+    if (cfg%steps /= -1) call check_int(cfg, 'time', 'steps', cfg%steps, 0, 1000000000)
     call check_real(cfg, 'time', 'steady_tolerance', cfg%steady_tolerance, 0.0_dp, 1.0_dp)
 
     if (len_trim(cfg%output_directory) == 0) &
@@ -428,12 +476,15 @@ contains
     call check_int(cfg, 'output', 'series_every', cfg%series_every, 1, huge(1))
     call check_int(cfg, 'output', 'fields_every', cfg%fields_every, 0, huge(1))
     call check_int(cfg, 'output', 'checkpoint_every', cfg%checkpoint_every, 0, huge(1))
+    call check_int(cfg, 'output', 'particles_every', cfg%particles_every, 0, huge(1))
 
     call check_real(cfg, 'run', 'max_wall_hours', cfg%max_wall_hours, 0.0_dp, 1.0e5_dp)
 
     call validate_particles(cfg)
     call validate_contact(cfg)
     call validate_lubrication(cfg)
+    call validate_rheology(cfg)
+    if (cfg%steps == -1) cfg%steps = 1000
 
     if (cfg%manufactured_solution .and. any(cfg%body_force /= 0.0_dp)) &
       call input_error(cfg%deck_file, 'verification', 'manufactured_solution', &
@@ -447,9 +498,9 @@ contains
     logical :: exists
     call check_int(cfg, 'particles', 'number', cfg%particle_number, 0, max_inline_particles)
     call check_real(cfg, 'particles', 'radius', cfg%radius, 0.0_dp, 100.0_dp, .true.)
-    if (all(cfg%motion /= [character(len=16) :: 'free', 'prescribed', 'resistance', 'frozen'])) &
+    if (all(cfg%motion /= [character(len=16) :: 'free', 'prescribed', 'resistance', 'frozen', 'fixed'])) &
       call input_error(cfg%deck_file, 'particles', 'motion', &
-           'must be ''free'', ''prescribed'', ''resistance'' or ''frozen'', not '''// &
+           'must be ''free'', ''prescribed'', ''resistance'', ''frozen'' or ''fixed'', not '''// &
            trim(cfg%motion)//'''')
     call check_real(cfg, 'particles', 'radius_offset', cfg%radius_offset, -2.0_dp, 2.0_dp)
     call check_real(cfg, 'particles', 'slip_kappa', cfg%slip_kappa, 0.0_dp, 100.0_dp)
@@ -464,10 +515,61 @@ contains
         call input_error(cfg%deck_file, 'particles', 'motion', &
            'prescribed velocities are given inline: use number and position, not position_file')
     end if
+    call check_real(cfg, 'particles', 'solid_fraction', cfg%solid_fraction, 0.0_dp, phi_max)
+    call check_int(cfg, 'particles', 'seed', cfg%seed, 0, huge(1))
+    call check_int(cfg, 'particles', 'packing_sweeps', cfg%packing_sweeps, 0, 1000000)
+    call check_real(cfg, 'particles', 'packing_min_gap', cfg%packing_min_gap, 0.0_dp, 1.0_dp)
+    if (cfg%solid_fraction > 0.0_dp) then
+      if (cfg%particle_number > 0 .or. len_trim(cfg%position_file) > 0) &
+        call input_error(cfg%deck_file, 'particles', 'solid_fraction', &
+             'give the particles one way: solid_fraction (a packing made now), number/position, or position_file')
+      if (cfg%motion == 'prescribed' .or. cfg%motion == 'resistance') &
+        call input_error(cfg%deck_file, 'particles', 'motion', &
+           'prescribed velocities are given inline: use number and position, not solid_fraction')
+    end if
     if (cfg%radius + cfg%radius_offset * cfg%h < 1.5_dp * cfg%h) &
       call input_error(cfg%deck_file, 'particles', 'radius', &
            'the sphere must span at least 1.5 grid cells in radius (raise &domain cells_per_radius)')
   end subroutine validate_particles
+
+  ! Ranges of &rheology, and the step counts of the averaging window (doc/RHEOLOGY.md).
+  subroutine validate_rheology(cfg)
+    type(config_t), intent(inout) :: cfg
+    character(len=200) :: text
+    real(dp) :: strain_per_step
+    integer :: needed
+    if (.not. cfg%rheology_group) return
+    if (.not. cfg%walls .or. cfg%shear_rate == 0.0_dp) &
+      call input_error(cfg%deck_file, 'rheology', '', &
+           'statistics are taken in the core of the sheared Couette cell: needs y_boundary = ''walls'' and shear_rate /= 0')
+    if (cfg%particle_number == 0 .and. len_trim(cfg%position_file) == 0 .and. cfg%solid_fraction == 0.0_dp) &
+      call input_error(cfg%deck_file, 'rheology', '', 'needs particles (&particles solid_fraction, number or position_file)')
+    call check_real(cfg, 'rheology', 'discard_strain', cfg%discard_strain, 0.0_dp, 1.0e6_dp)
+    call check_real(cfg, 'rheology', 'average_strain', cfg%average_strain, 0.0_dp, 1.0e6_dp, .true.)
+    call check_int(cfg, 'rheology', 'blocks', cfg%blocks, 1, 1000)
+    call check_real(cfg, 'rheology', 'core(1)', cfg%core(1), 0.0_dp, 1.0_dp)
+    call check_real(cfg, 'rheology', 'core(2)', cfg%core(2), 0.0_dp, 1.0_dp)
+    if (cfg%core(2) <= cfg%core(1)) call input_error(cfg%deck_file, 'rheology', 'core', 'must be y_lo/Ly < y_hi/Ly')
+    call check_int(cfg, 'rheology', 'profile_bins', cfg%profile_bins, 0, 100000)
+    if (cfg%profile_bins == 0) cfg%profile_bins = max(1, nint(4 * cfg%box(2) / cfg%radius))
+    call check_int(cfg, 'rheology', 'angle_bins', cfg%angle_bins, 4, 3600)
+    call check_real(cfg, 'rheology', 'pair_shell', cfg%pair_shell, 2.0_dp, 3.0_dp, .true.)
+    call check_real(cfg, 'rheology', 'contact_shell', cfg%contact_shell, 0.0_dp, 0.5_dp)
+    if (cfg%contact_shell == 0.0_dp) then
+      cfg%contact_shell = 0.005_dp
+      if (cfg%contact_group .and. cfg%roughness > 0.0_dp) cfg%contact_shell = cfg%roughness
+    end if
+    strain_per_step = abs(cfg%shear_rate) * cfg%dt
+    cfg%discard_step = nint(cfg%discard_strain / strain_per_step)
+    cfg%block_steps = nint(cfg%average_strain / (cfg%blocks * strain_per_step))
+    if (cfg%block_steps < cfg%series_every) then
+      write(text, '(a,i0,a,i0,a)') 'a block of average_strain/blocks is ', cfg%block_steps, &
+           ' steps, fewer than &output series_every = ', cfg%series_every, ': every block needs records'
+      call input_error(cfg%deck_file, 'rheology', 'average_strain', trim(text))
+    end if
+    needed = cfg%discard_step + cfg%blocks * cfg%block_steps
+    if (cfg%steps == -1) cfg%steps = needed
+  end subroutine validate_rheology
 
   ! Ranges of &lubrication; whether a table exists for this resolution is checked where it is read
   ! (mod_lubrication_io), still before any work.

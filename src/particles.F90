@@ -7,11 +7,15 @@ module mod_particles
   implicit none
   private
   public :: particles_t, particles_init, advance_positions, configuration_fault
-  public :: MOTION_FREE, MOTION_PRESCRIBED, MOTION_FROZEN, MOTION_RESISTANCE, motion_code
+  public :: MOTION_FREE, MOTION_PRESCRIBED, MOTION_FROZEN, MOTION_RESISTANCE, MOTION_FIXED, motion_code
 
   ! resistance: velocities imposed as for prescribed, but the configuration is held where it is
   ! (a quasi-static resistance calculation: the force at this configuration and these velocities)
-  integer, parameter :: MOTION_FREE = 1, MOTION_PRESCRIBED = 2, MOTION_FROZEN = 3, MOTION_RESISTANCE = 4
+  ! free: force- and torque-free, moving; frozen: force- and torque-free velocities, configuration held
+  ! (the high-frequency viscosity eta_inf); prescribed/resistance: velocities imposed, moving/held;
+  ! fixed: at rest (obstacles)
+  integer, parameter :: MOTION_FREE = 1, MOTION_PRESCRIBED = 2, MOTION_FROZEN = 3, MOTION_RESISTANCE = 4, &
+                        MOTION_FIXED = 5
 
   type :: particles_t
     integer :: n = 0
@@ -38,6 +42,7 @@ contains
     case ('prescribed'); motion_code = MOTION_PRESCRIBED
     case ('frozen');     motion_code = MOTION_FROZEN
     case ('resistance'); motion_code = MOTION_RESISTANCE
+    case ('fixed');      motion_code = MOTION_FIXED
     case default;        motion_code = MOTION_FREE
     end select
   end function motion_code
@@ -74,7 +79,7 @@ contains
     real(dp), intent(in) :: dt, box(3)
     logical, intent(in) :: periodic(3)
     integer :: d
-    if (p%motion == MOTION_FROZEN .or. p%motion == MOTION_RESISTANCE) return
+    if (any(p%motion == [MOTION_FROZEN, MOTION_RESISTANCE, MOTION_FIXED])) return
     if (p%have_prev) then
       p%position = p%position + dt * (1.5_dp * p%velocity - 0.5_dp * p%velocity_prev)
     else

@@ -10,22 +10,47 @@ module mod_particles_io
   use mod_params, only: config_t
   use mod_particles, only: particles_t, particles_init, motion_code, configuration_fault
   use mod_h5util, only: write_attribute, read_attribute, has_object, write_dataset, read_dataset, dataset_dims
-  use mod_errors, only: is_root, input_error, file_error, abort_run
+  use mod_errors, only: is_root, input_error, file_error, abort_run, fatal_error, log_line
+  use mod_packing, only: random_packing, packing_count, packing_report_t
   implicit none
   private
-  public :: particles_load, particles_write, particles_read_state
+  public :: particles_load, particles_write, particles_read_state, particles_snapshot
 
 contains
 
-  ! The particles of the deck: inline (&particles number, position, ...) or from position_file.
-  ! Collective. Checks the configuration (inside the box, off the walls, no overlap).
+  ! The particles of the deck: inline (&particles number, position, ...), from position_file, or a
+  ! random hard-sphere packing of solid_fraction made now (mod_packing, as bin/fdsusp-pack; every
+  ! rank builds the same one). Collective. Checks the configuration (inside the box, off the
+  ! walls, no overlap).
   subroutine particles_load(cfg, parts)
     type(config_t), intent(in) :: cfg
     type(particles_t), intent(out) :: parts
     real(dp), allocatable :: position(:, :)
     character(len=400) :: message
-    integer :: n, culprit, ierr
+    integer :: n, culprit, ierr, info
     character(len=32) :: item
+    type(packing_report_t) :: report
+
+    if (cfg%solid_fraction > 0.0_dp) then
+      n = packing_count(cfg%solid_fraction, cfg%box, cfg%radius)
+      call random_packing(n, cfg%box, [.true., .not. cfg%walls, .true.], cfg%radius, cfg%packing_min_gap, &
+                          cfg%seed, cfg%packing_sweeps, position, info, message, report)
+      select case (info)
+      case (0)
+      case (1)
+        call input_error(cfg%deck_file, 'particles', 'solid_fraction', trim(message))
+      case (2)
+        call input_error(cfg%deck_file, 'domain', 'box', trim(message))
+      case default
+        call fatal_error('fdsusp: '//trim(message), 3)
+      end select
+      write(message, '(a,i0,a,f8.5,a,i0,a,es10.3,a)') 'packing: ', n, ' spheres, phi = ', report%phi, &
+           ' (seed ', cfg%seed, '), smallest gap ', min(report%min_pair_gap, report%min_wall_gap), ' a'
+      call log_line(message)
+      call particles_init(parts, n, cfg%radius, motion_code(cfg%motion))
+      parts%position = position
+      return
+    end if
 
     if (len_trim(cfg%position_file) == 0) then
       n = cfg%particle_number
@@ -116,6 +141,77 @@ contains
     end if
     call h5gclose_f(group, err)
   end subroutine particles_write
+
+  ! A particle snapshot for viewing (rank 0): OUTDIR/particles_NNNNNNNN.h5 (/particles: position,
+  ! velocity, omega, and radius per sphere for glyph scaling) and OUTDIR/particles.xmf, the XDMF
+  ! time series of the snapshots written so far by this run (ParaView: open it, apply Glyph
+  ! Sphere scaled by radius).
+  subroutine particles_snapshot(outdir, parts, box, step, time)
+    character(len=*), intent(in) :: outdir
+    type(particles_t), intent(in) :: parts
+    real(dp), intent(in) :: box(3)
+    integer, intent(in) :: step
+    real(dp), intent(in) :: time
+    integer, save :: nsnap = 0
+    integer, allocatable, save :: steps(:)
+    real(dp), allocatable, save :: times(:)
+    integer(HID_T) :: file, group
+    integer :: err, unit, k
+    character(len=32) :: h5
+    character(len=64) :: dims
+    if (.not. is_root()) return
+    if (.not. allocated(steps)) allocate(steps(0), times(0))
+    if (nsnap > 0) then
+      if (steps(nsnap) == step) return          ! already written (last record of the run)
+    end if
+    write(h5, '(a,i8.8,a)') 'particles_', step, '.h5'
+    call h5fcreate_f(trim(outdir)//'/'//trim(h5), H5F_ACC_TRUNC_F, file, err)
+    if (err /= 0) call abort_run('cannot create '//trim(outdir)//'/'//trim(h5))
+    call particles_write(file, parts, box, .false.)
+    call h5gopen_f(file, 'particles', group, err)
+    call write_matrix(group, 'velocity', parts%velocity)
+    call write_matrix(group, 'omega', parts%omega)
+    call write_dataset(group, 'radius', spread(spread(parts%radius, 1, 1), 2, parts%n), err)
+    call h5gclose_f(group, err)
+    call h5fclose_f(file, err)
+    nsnap = nsnap + 1
+    steps = [steps, step]
+    times = [times, time]
+    write(dims, '(i0,a)') parts%n, ' 3'
+    open(newunit=unit, file=trim(outdir)//'/particles.xmf', status='replace', action='write')
+    write(unit, '(a)') '<?xml version="1.0" ?>'
+    write(unit, '(a)') '<Xdmf Version="2.0">'
+    write(unit, '(a)') ' <Domain>'
+    write(unit, '(a)') '  <Grid Name="particles" GridType="Collection" CollectionType="Temporal">'
+    do k = 1, nsnap
+      write(h5, '(a,i8.8,a)') 'particles_', steps(k), '.h5'
+      write(unit, '(a,i0,a)') '   <Grid Name="step ', steps(k), '" GridType="Uniform">'
+      write(unit, '(a,es23.15,a)') '    <Time Value="', times(k), '"/>'
+      write(unit, '(a,i0,a)') '    <Topology TopologyType="Polyvertex" NumberOfElements="', parts%n, '"/>'
+      write(unit, '(a)') '    <Geometry GeometryType="XYZ">'
+      write(unit, '(5a)') '     <DataItem Dimensions="', trim(dims), '" NumberType="Float" Precision="8" Format="HDF">', &
+           trim(h5), ':/particles/position</DataItem>'
+      write(unit, '(a)') '    </Geometry>'
+      call attribute('velocity', 'Vector', dims)
+      call attribute('omega', 'Vector', dims)
+      write(dims, '(i0,a)') parts%n, ' 1'
+      call attribute('radius', 'Scalar', dims)
+      write(dims, '(i0,a)') parts%n, ' 3'
+      write(unit, '(a)') '   </Grid>'
+    end do
+    write(unit, '(a)') '  </Grid>'
+    write(unit, '(a)') ' </Domain>'
+    write(unit, '(a)') '</Xdmf>'
+    close(unit)
+  contains
+    subroutine attribute(name, kind, shape)
+      character(len=*), intent(in) :: name, kind, shape
+      write(unit, '(5a)') '    <Attribute Name="', name, '" AttributeType="', kind, '" Center="Node">'
+      write(unit, '(5a)') '     <DataItem Dimensions="', trim(shape), '" NumberType="Float" Precision="8" Format="HDF">', &
+           trim(h5), ':/particles/'//name//'</DataItem>'
+      write(unit, '(a)') '    </Attribute>'
+    end subroutine attribute
+  end subroutine particles_snapshot
 
   subroutine write_matrix(group, name, values)
     integer(HID_T), intent(in) :: group

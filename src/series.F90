@@ -9,11 +9,11 @@
 module mod_series
   use hdf5
   use mod_kinds, only: dp
-  use mod_h5util, only: has_object
+  use mod_h5util, only: has_object, write_attribute
   use mod_errors, only: is_root, warn_line, abort_run
   implicit none
   private
-  public :: series_t, series_open, series_record, series_flush
+  public :: series_t, series_open, series_record, series_flush, series_attributes
 
   type :: series_t
     character(len=1024) :: path = ''
@@ -75,6 +75,25 @@ contains
     end do
     call h5fclose_f(file, err)
   end subroutine series_open
+
+  ! Attributes of the file's root (rank 0): values(k) under names(k), replacing earlier ones.
+  subroutine series_attributes(s, names, values)
+    type(series_t), intent(in) :: s
+    character(len=*), intent(in) :: names(:)
+    real(dp), intent(in) :: values(:)
+    integer(HID_T) :: file
+    integer :: err, e, k
+    if (.not. is_root()) return
+    call h5fopen_f(trim(s%path), H5F_ACC_RDWR_F, file, err)
+    if (err /= 0) call abort_run('cannot open '//trim(s%path)//' to write its attributes')
+    e = 0
+    do k = 1, size(names)
+      call write_attribute(file, trim(names(k)), values(k:k), err)
+      e = max(e, abs(err))
+    end do
+    call h5fclose_f(file, err)
+    if (e /= 0) call abort_run('cannot write the attributes of '//trim(s%path))
+  end subroutine series_attributes
 
   ! Rank of a column's dataset: its per-record dimensions (those > 0) plus records.
   pure integer function column_rank(shape)

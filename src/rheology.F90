@@ -1,0 +1,415 @@
+! Suspension rheology in the core of the Couette cell (doc/RHEOLOGY.md; paper §4, eqs. (4.1)-(4.18)).
+! Pure kernels on plain arrays, no PETSc: every rank holds the same particles and computes the
+! same numbers.
+!
+! Per record (rheo_sample): the particle stress of the core region D^C = [0,Lx] x [y_lo,y_hi] x
+! [0,Lz] (paper eq. (4.10): y_lo = Ly/4, y_hi = 3Ly/4), split into hydrodynamic and contact parts,
+!     Sigma^h = (1/V_core) sum_i w_i S^h_i,   Sigma^c = (1/V_core) sum_i w_i S^c_i   (eqs. (4.3)-(4.4))
+! where w_i is the fraction of sphere i's volume inside the core (a smooth indicator: a sphere
+! half in the core counts half), so that the core volume fraction
+!     phi_core = (1/V_core) sum_i w_i (4/3) pi a^3
+! is the same ensemble as the stresses and (eta_r - 1)/phi_core does not jump when a sphere crosses
+! y_lo or y_hi. The core shear rate is the slope of the particle-phase velocity u_x against y in
+! the core, a w-weighted least-squares fit whose five sums are kept (so block averages fit the
+! pooled data, not average per-record slopes). Profiles across y: phi(y) and the particle momentum
+! phi u_x (y) in bins (exact sphere-slab volumes); pair counts in the shear plane for the pair
+! distribution g(theta) at r < r_outer and at contact (r < 2a + h_c).
+!
+! Statistics (paper §4, "five statistically independent time-segments"): the records after
+! discard_step are split into `blocks` blocks of block_steps steps; a block's mean is taken over
+! its records, every summary quantity is evaluated on each complete block's means (the error: the
+! standard deviation over blocks, ddof = 1, divided by sqrt(blocks)) and on the mean of the block
+! means (the value). scripts/rheology.py repeats exactly this from series.h5.
+module mod_rheology
+  use mod_kinds, only: dp, pi
+  use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
+  use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates, min_image
+  implicit none
+  private
+  public :: rheology_t, rheo_create, rheo_sample, rheo_accumulate, rheo_quantities, rheo_block_of, &
+            rheo_state, rheo_restore, rheo_summarise, rheo_write_summary, NQ, NSUMMARY, summary_names, slab_volume
+
+  ! per-record values that are block-averaged: stress_hydro(5), stress_contact(5), phi_core, fit(5)
+  integer, parameter :: NQ = 16
+  integer, parameter :: NSUMMARY = 32
+  ! the summary quantities, in the order of rheo_quantities (doc/RHEOLOGY.md defines each)
+  character(len=20), parameter :: summary_names(NSUMMARY) = [character(len=20) :: &
+       'eta_r', 'eta_h', 'eta_c', 'N1/tau', 'N2/tau', 'Pi/tau', &
+       'Sigma_xx/tau', 'Sigma_yy/tau', 'Sigma_zz/tau', 'Sigma_xx_c/tau', 'Sigma_yy_c/tau', 'Sigma_zz_c/tau', &
+       'N1_c/tau', 'N2_c/tau', 'Pi_c/tau', &
+       'lambda_2', 'lambda_3', 'lambda_2_c', 'lambda_3_c', 'eta_n', 'eta_n_c', &
+       'I_v', 'mu', 'mu_h', 'mu_c', 'phi_core', 'gamma_dot_core', 'tau', &
+       'Sigma_xy/tau', 'Sigma_xy_c/tau', 'Pi_h/tau', 'N1_h/tau']
+
+  type :: rheology_t
+    real(dp) :: box(3) = 0, radius = 1, shear_rate = 1
+    real(dp) :: core(2) = 0                 ! y_lo, y_hi of the core region [a]
+    real(dp) :: r_outer = 2.1_dp            ! pair shell of g(theta): r < r_outer [a]
+    real(dp) :: r_contact = 2.005_dp        ! contact shell: r < 2a + h_c [a]
+    integer :: nbins = 0, nangles = 0       ! profile bins across y, angle bins of g over [0, 2 pi)
+    integer :: blocks = 5, discard_step = 0, block_steps = 1
+    type(nlist_t) :: nl
+    ! the last sample
+    real(dp) :: values(NQ) = 0              ! stress_hydro(5), stress_contact(5), phi_core, fit(5)
+    real(dp) :: shear_rate_core = 0         ! this record's fitted slope (for the series only)
+    real(dp) :: min_pair_gap = 0            ! smallest surface gap of any pair [a]
+    real(dp) :: references = 0              ! spheres with their centre in the core
+    real(dp), allocatable :: profile(:, :)  ! (nbins, 2): phi, phi u_x
+    real(dp), allocatable :: angles(:, :)   ! (nangles, 2): pair counts r < r_outer, r < r_contact
+    ! accumulators per block (sums over records)
+    real(dp), allocatable :: block_sums(:, :)        ! (NQ, blocks)
+    real(dp), allocatable :: block_profile(:, :, :)  ! (nbins, 2, blocks)
+    real(dp), allocatable :: block_angles(:, :, :)   ! (nangles, 2, blocks)
+    real(dp), allocatable :: block_references(:)     ! (blocks)
+    real(dp), allocatable :: block_records(:)        ! (blocks)
+  end type rheology_t
+
+contains
+
+  !> Set up. contact_shell: h_c of the contact shell [a]; steps are counted from the start of the
+  !> simulation. info: 0 ok; 1 a periodic length below twice the pair search range.
+  subroutine rheo_create(r, n, box, radius, shear_rate, core_fraction, nbins, nangles, r_outer, contact_shell, &
+                         blocks, discard_step, block_steps, info)
+    type(rheology_t), intent(out) :: r
+    integer, intent(in) :: n                ! number of spheres
+    real(dp), intent(in) :: box(3), radius, shear_rate, core_fraction(2), r_outer, contact_shell
+    integer, intent(in) :: nbins, nangles, blocks, discard_step, block_steps
+    integer, intent(out) :: info
+    real(dp), parameter :: skin = 0.3_dp
+    r%box = box
+    r%radius = radius
+    r%shear_rate = shear_rate
+    r%core = core_fraction * box(2)
+    r%nbins = nbins
+    r%nangles = nangles
+    r%r_outer = r_outer * radius
+    r%r_contact = (2.0_dp + contact_shell) * radius
+    r%blocks = blocks
+    r%discard_step = discard_step
+    r%block_steps = block_steps
+    allocate(r%profile(nbins, 2), r%angles(nangles, 2))
+    allocate(r%block_sums(NQ, blocks), r%block_profile(nbins, 2, blocks), r%block_angles(nangles, 2, blocks), &
+             r%block_references(blocks), r%block_records(blocks))
+    r%profile = 0; r%angles = 0
+    r%block_sums = 0; r%block_profile = 0; r%block_angles = 0; r%block_references = 0; r%block_records = 0
+    call nlist_init(r%nl, n, box, [.true., .false., .true.], max(r%r_outer, r%r_contact) + skin, &
+                    radius + skin, skin, info)
+  end subroutine rheo_create
+
+  !> The block of a record at step (0-based), or -1 outside the averaging window.
+  pure integer function rheo_block_of(r, step) result(b)
+    type(rheology_t), intent(in) :: r
+    integer, intent(in) :: step
+    b = -1
+    if (step <= r%discard_step) return
+    b = (step - r%discard_step - 1) / r%block_steps
+    if (b >= r%blocks) b = -1
+  end function rheo_block_of
+
+  !> Volume of the sphere of radius a centred at height yc between the planes y1 < y2.
+  pure real(dp) function slab_volume(yc, a, y1, y2) result(v)
+    real(dp), intent(in) :: yc, a, y1, y2
+    real(dp) :: t1, t2
+    t1 = max(y1 - yc, -a)
+    t2 = min(y2 - yc, a)
+    v = 0.0_dp
+    if (t2 > t1) v = pi * (a * a * (t2 - t1) - (t2**3 - t1**3) / 3.0_dp)
+  end function slab_volume
+
+  !> One record: core stresses, volume fraction, velocity-fit sums, profiles, pair counts.
+  !> position, velocity (3, N); stresslet_hydro, stresslet_contact (3, 3, N) [eta gamma_dot a^3].
+  subroutine rheo_sample(r, position, velocity, stresslet_hydro, stresslet_contact)
+    type(rheology_t), intent(inout) :: r
+    real(dp), intent(in) :: position(:, :), velocity(:, :), stresslet_hydro(:, :, :), stresslet_contact(:, :, :)
+    real(dp) :: a, vp, v_core, w, y, u, dbin, d(3), dist, theta, sin_half, gap, den
+    integer :: n, i, b, b1, b2, k, p, np
+    integer, allocatable :: pairs(:, :), walls(:, :)
+    integer :: nw
+    logical :: ref_i, ref_j
+
+    n = size(position, 2)
+    a = r%radius
+    vp = 4.0_dp / 3.0_dp * pi * a**3
+    v_core = r%box(1) * r%box(3) * (r%core(2) - r%core(1))
+    r%values = 0
+    r%profile = 0
+    r%angles = 0
+    r%references = 0
+    dbin = r%box(2) / r%nbins
+    do i = 1, n
+      y = position(2, i)
+      u = velocity(1, i)
+      w = slab_volume(y, a, r%core(1), r%core(2)) / vp
+      if (w > 0) then
+        r%values(1:5) = r%values(1:5) + w * components(stresslet_hydro(:, :, i))
+        r%values(6:10) = r%values(6:10) + w * components(stresslet_contact(:, :, i))
+        r%values(11) = r%values(11) + w
+        r%values(12:16) = r%values(12:16) + w * [1.0_dp, y, u, y * y, y * u]
+      end if
+      if (y >= r%core(1) .and. y < r%core(2)) r%references = r%references + 1
+      b1 = max(1, int((y - a) / dbin) + 1)
+      b2 = min(r%nbins, int((y + a) / dbin) + 1)
+      do b = b1, b2
+        w = slab_volume(y, a, (b - 1) * dbin, b * dbin)
+        r%profile(b, 1) = r%profile(b, 1) + w
+        r%profile(b, 2) = r%profile(b, 2) + w * u
+      end do
+    end do
+    r%values(1:11) = r%values(1:11) / v_core
+    r%values(11) = r%values(11) * vp
+    r%profile = r%profile / (r%box(1) * r%box(3) * dbin)
+    den = r%values(12) * r%values(15) - r%values(13)**2
+    r%shear_rate_core = 0.0_dp
+    if (den > 0) r%shear_rate_core = (r%values(12) * r%values(16) - r%values(13) * r%values(14)) / den
+
+    ! pairs in the shear plane: polar angle from the vorticity axis within pi/2 -+ half an angle bin
+    sin_half = sin(pi / r%nangles)
+    r%min_pair_gap = max(r%r_outer, r%r_contact) - 2 * a
+    call nlist_candidates(r%nl, position, pairs, np, walls, nw)
+    do p = 1, np
+      d = min_image(position(:, pairs(2, p)) - position(:, pairs(1, p)), r%box, [.true., .false., .true.])
+      dist = norm2(d)
+      gap = dist - 2 * a
+      r%min_pair_gap = min(r%min_pair_gap, gap)
+      if (dist >= r%r_outer .and. dist >= r%r_contact) cycle
+      if (abs(d(3)) >= dist * sin_half) cycle
+      ref_i = position(2, pairs(1, p)) >= r%core(1) .and. position(2, pairs(1, p)) < r%core(2)
+      ref_j = position(2, pairs(2, p)) >= r%core(1) .and. position(2, pairs(2, p)) < r%core(2)
+      ! seen from i the partner is at d; seen from j at -d (theta + pi)
+      theta = modulo(atan2(d(2), d(1)), 2 * pi)
+      if (ref_i) call count_pair(theta)
+      if (ref_j) call count_pair(modulo(theta + pi, 2 * pi))
+    end do
+  contains
+    subroutine count_pair(angle)
+      real(dp), intent(in) :: angle
+      k = min(r%nangles, int(angle / (2 * pi) * r%nangles) + 1)
+      if (dist < r%r_outer) r%angles(k, 1) = r%angles(k, 1) + 1
+      if (dist < r%r_contact) r%angles(k, 2) = r%angles(k, 2) + 1
+    end subroutine count_pair
+  end subroutine rheo_sample
+
+  !> xx, yy, zz, xy and the trace of a 3 x 3 tensor.
+  pure function components(s) result(c)
+    real(dp), intent(in) :: s(3, 3)
+    real(dp) :: c(5)
+    c = [s(1, 1), s(2, 2), s(3, 3), s(1, 2), s(1, 1) + s(2, 2) + s(3, 3)]
+  end function components
+
+  !> Add the last sample to its block (the record at step; nothing outside the window).
+  subroutine rheo_accumulate(r, step)
+    type(rheology_t), intent(inout) :: r
+    integer, intent(in) :: step
+    integer :: b
+    b = rheo_block_of(r, step)
+    if (b < 0) return
+    b = b + 1
+    r%block_sums(:, b) = r%block_sums(:, b) + r%values
+    r%block_profile(:, :, b) = r%block_profile(:, :, b) + r%profile
+    r%block_angles(:, :, b) = r%block_angles(:, :, b) + r%angles
+    r%block_references(b) = r%block_references(b) + r%references
+    r%block_records(b) = r%block_records(b) + 1
+  end subroutine rheo_accumulate
+
+  !> The summary quantities of one set of (block-)mean values m(NQ), in the order of
+  !> summary_names; NaN where undefined (no contact pressure, no contact stress).
+  pure function rheo_quantities(m, shear_rate) result(q)
+    real(dp), intent(in) :: m(NQ), shear_rate
+    real(dp) :: q(NSUMMARY)
+    real(dp) :: sh(5), sc(5), sp(5), gd, den, tau, eta_r, eta_h, eta_c, p, nan
+    nan = ieee_value(1.0_dp, ieee_quiet_nan)
+    sh = m(1:5)
+    sc = m(6:10)
+    sp = sh + sc
+    den = m(12) * m(15) - m(13)**2
+    gd = nan
+    if (den > 0) gd = (m(12) * m(16) - m(13) * m(14)) / den
+    eta_r = 1.0_dp + sp(4) / gd
+    eta_h = 1.0_dp + sh(4) / gd        ! the solvent is lumped into the hydrodynamic part (paper §4.1)
+    eta_c = sc(4) / gd
+    tau = eta_r * gd
+    p = -sc(2)                          ! the confining pressure of the mu(I_v) rheology: -Sigma_yy^c
+    q = nan
+    q(1:3) = [eta_r, eta_h, eta_c]
+    q(4) = (sp(1) - sp(2)) / tau
+    q(5) = (sp(2) - sp(3)) / tau
+    q(6) = -sp(5) / 3.0_dp / tau
+    q(7:9) = sp(1:3) / tau
+    q(10:12) = sc(1:3) / tau
+    q(13) = (sc(1) - sc(2)) / tau
+    q(14) = (sc(2) - sc(3)) / tau
+    q(15) = -sc(5) / 3.0_dp / tau
+    if (sp(1) /= 0) q(16:17) = sp(2:3) / sp(1)
+    if (sc(1) /= 0) q(18:19) = sc(2:3) / sc(1)
+    q(20) = -sp(1) / gd
+    q(21) = -sc(1) / gd
+    if (p > 0) q(22:25) = [gd / p, tau / p, eta_h * gd / p, eta_c * gd / p]
+    q(26) = m(11)
+    q(27) = gd / shear_rate
+    q(28) = tau / shear_rate
+    q(29) = sp(4) / tau
+    q(30) = sc(4) / tau
+    q(31) = -sh(5) / 3.0_dp / tau
+    q(32) = (sh(1) - sh(2)) / tau
+  end function rheo_quantities
+
+  !> The accumulators as one flat array (checkpoints) and back.
+  pure function rheo_state(r) result(s)
+    type(rheology_t), intent(in) :: r
+    real(dp), allocatable :: s(:)
+    s = [reshape(r%block_sums, [size(r%block_sums)]), reshape(r%block_profile, [size(r%block_profile)]), &
+         reshape(r%block_angles, [size(r%block_angles)]), r%block_references, r%block_records]
+  end function rheo_state
+
+  !> info: 0 ok, 1 the array does not fit this set-up.
+  subroutine rheo_restore(r, s, info)
+    type(rheology_t), intent(inout) :: r
+    real(dp), intent(in) :: s(:)
+    integer, intent(out) :: info
+    integer :: k, m
+    info = 1
+    if (size(s) /= size(rheo_state(r))) return
+    info = 0
+    k = 0
+    m = size(r%block_sums); r%block_sums = reshape(s(k + 1:k + m), shape(r%block_sums)); k = k + m
+    m = size(r%block_profile); r%block_profile = reshape(s(k + 1:k + m), shape(r%block_profile)); k = k + m
+    m = size(r%block_angles); r%block_angles = reshape(s(k + 1:k + m), shape(r%block_angles)); k = k + m
+    m = r%blocks; r%block_references = s(k + 1:k + m); k = k + m
+    r%block_records = s(k + 1:k + m)
+  end subroutine rheo_restore
+
+  !> The summary over the complete blocks (those whose last step <= last_step): value and
+  !> standard error of every quantity (NaN where undefined or with fewer than 2 blocks), the
+  !> profiles phi(y) and u_x(y) = <phi u_x>/<phi>, and the pair distributions g(theta) at
+  !> r < r_outer and r < r_contact, normalised by the references, the core number density and
+  !> the bin volume (shell x dtheta x 2 sin(dtheta/2) in the polar angle).
+  subroutine rheo_summarise(r, last_step, complete, value, err, profile, angles)
+    type(rheology_t), intent(in) :: r
+    integer, intent(in) :: last_step
+    integer, intent(out) :: complete
+    real(dp), intent(out) :: value(NSUMMARY), err(NSUMMARY)
+    real(dp), allocatable, intent(out) :: profile(:, :), angles(:, :)
+    integer :: b, k
+    real(dp), allocatable :: per_block(:, :), mean_values(:)
+    real(dp) :: shell(2), references, records, n_core, dtheta, nan
+    nan = ieee_value(1.0_dp, ieee_quiet_nan)
+    complete = 0
+    do b = 1, r%blocks
+      if (r%discard_step + b * r%block_steps <= last_step .and. r%block_records(b) > 0) complete = b
+    end do
+    allocate(per_block(NSUMMARY, max(1, complete)), mean_values(NQ))
+    mean_values = 0
+    do b = 1, complete
+      per_block(:, b) = rheo_quantities(r%block_sums(:, b) / r%block_records(b), r%shear_rate)
+      mean_values = mean_values + r%block_sums(:, b) / r%block_records(b)
+    end do
+    value = nan
+    err = nan
+    if (complete > 0) then
+      mean_values = mean_values / complete
+      value = rheo_quantities(mean_values, r%shear_rate)
+    end if
+    if (complete > 1) then
+      do k = 1, NSUMMARY
+        err(k) = sqrt(sum((per_block(k, 1:complete) - sum(per_block(k, 1:complete)) / complete)**2) &
+                      / (complete - 1)) / sqrt(real(complete, dp))
+      end do
+    end if
+    allocate(profile(r%nbins, 2), angles(r%nangles, 2))
+    profile = 0; angles = 0; references = 0; records = 0
+    do b = 1, complete
+      profile = profile + r%block_profile(:, :, b)
+      angles = angles + r%block_angles(:, :, b)
+      references = references + r%block_references(b)
+      records = records + r%block_records(b)
+    end do
+    if (records > 0) then
+      profile(:, 2) = merge(profile(:, 2) / profile(:, 1), nan, profile(:, 1) > 0)
+      profile(:, 1) = profile(:, 1) / records
+      dtheta = 2 * pi / r%nangles
+      n_core = value(26) / (4.0_dp / 3.0_dp * pi * r%radius**3)
+      shell = [(r%r_outer**3 - (2 * r%radius)**3), (r%r_contact**3 - (2 * r%radius)**3)] / 3.0_dp &
+              * dtheta * 2 * sin(0.5_dp * dtheta)
+      do k = 1, 2
+        angles(:, k) = angles(:, k) / (references * n_core * shell(k))
+      end do
+    else
+      profile = nan
+      angles = nan
+    end if
+  end subroutine rheo_summarise
+
+  !> Write the summary (rheo_summarise) as JSON (rank 0 only). info: 0 ok, else the iostat.
+  subroutine rheo_write_summary(r, path, last_step, info)
+    type(rheology_t), intent(in) :: r
+    character(len=*), intent(in) :: path
+    integer, intent(in) :: last_step
+    integer, intent(out) :: info
+    integer :: complete, u, k
+    real(dp) :: value(NSUMMARY), err(NSUMMARY)
+    real(dp), allocatable :: profile(:, :), angles(:, :), y(:), theta(:)
+    call rheo_summarise(r, last_step, complete, value, err, profile, angles)
+    allocate(y(r%nbins), theta(r%nangles))
+    do k = 1, r%nbins
+      y(k) = (k - 0.5_dp) * r%box(2) / r%nbins
+    end do
+    do k = 1, r%nangles
+      theta(k) = (k - 0.5_dp) * 2 * pi / r%nangles
+    end do
+    open(newunit=u, file=path, status='replace', action='write', iostat=info)
+    if (info /= 0) return
+    write(u, '(a)') '{'
+    write(u, '(a)') '  "program": "fdsusp",'
+    write(u, '(a,a,a)') '  "complete": ', trim(merge('true ', 'false', complete == r%blocks)), ','
+    write(u, '(a,i0,a,i0,a)') '  "blocks": ', r%blocks, ', "blocks_complete": ', complete, ','
+    write(u, '(a,i0,a,i0,a,i0,a)') '  "discard_step": ', r%discard_step, ', "block_steps": ', r%block_steps, &
+         ', "last_step": ', last_step, ','
+    write(u, '(a,a,a)') '  "records_per_block": ', trim(json_array(r%block_records(1:max(1, complete)))), ','
+    write(u, '(a,2(a,a),a)') '  "core": ', trim(json_array(r%core)), ', "shear_rate": ', trim(json_number(r%shear_rate)), ','
+    write(u, '(a)') '  "quantities": {'
+    do k = 1, NSUMMARY
+      write(u, '(5a)') '    "', trim(summary_names(k)), '": {"value": ', trim(json_number(value(k))), &
+           ', "error": '//trim(json_number(err(k)))//'}'//trim(merge(', ', '  ', k < NSUMMARY))
+    end do
+    write(u, '(a)') '  },'
+    write(u, '(a)') '  "profiles": {'
+    write(u, '(a,a,a)') '    "y": ', json_array(y), ','
+    write(u, '(a,a,a)') '    "solid_fraction": ', json_array(profile(:, 1)), ','
+    write(u, '(a,a)') '    "velocity": ', json_array(profile(:, 2))
+    write(u, '(a)') '  },'
+    write(u, '(a)') '  "pair_distribution": {'
+    write(u, '(a,a,a,a,a)') '    "r_outer": ', trim(json_number(r%r_outer)), ', "r_contact": ', &
+         trim(json_number(r%r_contact)), ','
+    write(u, '(a,a,a)') '    "theta": ', json_array(theta), ','
+    write(u, '(a,a,a)') '    "g": ', json_array(angles(:, 1)), ','
+    write(u, '(a,a)') '    "g_contact": ', json_array(angles(:, 2))
+    write(u, '(a)') '  }'
+    write(u, '(a)') '}'
+    close(u)
+  end subroutine rheo_write_summary
+
+  !> A number in JSON: 17 significant digits, null when not finite.
+  function json_number(x) result(s)
+    real(dp), intent(in) :: x
+    character(len=32) :: s
+    if (.not. ieee_is_finite(x)) then
+      s = 'null'
+    else
+      write(s, '(es25.16e3)') x
+      s = adjustl(s)
+    end if
+  end function json_number
+
+  function json_array(x) result(s)
+    real(dp), intent(in) :: x(:)
+    character(len=:), allocatable :: s
+    integer :: k
+    s = '['
+    do k = 1, size(x)
+      s = s//trim(json_number(x(k)))
+      if (k < size(x)) s = s//', '
+    end do
+    s = s//']'
+  end function json_array
+
+end module mod_rheology
