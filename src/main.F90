@@ -175,8 +175,9 @@ program fdsusp
     ! what scripts/rheology.py needs to repeat the statistics from series.h5 alone
     call series_attributes(series, [character(len=32) :: 'box_x', 'box_y', 'box_z', 'radius', 'shear_rate', &
          'dt', 'core_lo', 'core_hi', 'pair_radius', 'contact_radius', 'blocks', 'discard_step', 'block_steps', &
-         'series_every'], [cfg%box, parts%radius, cfg%shear_rate, cfg%dt, rh%core, rh%r_outer, rh%r_contact, &
-         real([cfg%blocks, cfg%discard_step, cfg%block_steps, cfg%series_every], dp)])
+         'series_every', 'friction', 'roughness'], [cfg%box, parts%radius, cfg%shear_rate, cfg%dt, rh%core, &
+         rh%r_outer, rh%r_contact, real([cfg%blocks, cfg%discard_step, cfg%block_steps, cfg%series_every], dp), &
+         merge(cfg%friction, 0.0_dp, has_contacts), merge(cfg%roughness, 0.0_dp, has_contacts)])
   end if
   call install_signal_handlers()
   PetscCallA(stage_pop(ierr))

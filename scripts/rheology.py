@@ -1,0 +1,267 @@
+#!/usr/bin/env python3
+"""Rheology of fdsusp runs from their series.h5 (doc/RHEOLOGY.md).
+
+    scripts/rheology.py OUTDIR [OUTDIR ...] [--plots DIR] [--compare]
+
+For each output directory, recomputes the summary of the core region from series.h5 alone, by
+the rules of src/rheology.F90 (records on the series_every grid after discard_step, `blocks`
+blocks of block_steps steps, quantities evaluated on the block means; value from the mean of the
+block means, error = standard deviation over the complete blocks (ddof 1) / sqrt(blocks)), and
+prints it. --compare: also compare with the run's own summary.json and exit 1 if any number
+differs by more than 1e-10 (relative). --plots DIR: PNG figures: per run the core stress time
+series, phi(y) and u_x(y), g(theta) and g_c(theta) (paper figs. 6 and 15); over all runs given,
+eta_r, N1/tau and N2/tau against phi_core, one series per friction coefficient (paper figs. 9,
+11).
+"""
+import argparse
+import json
+import math
+import os
+import sys
+
+import h5py
+import numpy as np
+
+# order and definitions as mod_rheology::rheo_quantities
+NAMES = ['eta_r', 'eta_h', 'eta_c', 'N1/tau', 'N2/tau', 'Pi/tau',
+         'Sigma_xx/tau', 'Sigma_yy/tau', 'Sigma_zz/tau', 'Sigma_xx_c/tau', 'Sigma_yy_c/tau', 'Sigma_zz_c/tau',
+         'N1_c/tau', 'N2_c/tau', 'Pi_c/tau',
+         'lambda_2', 'lambda_3', 'lambda_2_c', 'lambda_3_c', 'eta_n', 'eta_n_c',
+         'I_v', 'mu', 'mu_h', 'mu_c', 'phi_core', 'gamma_dot_core', 'tau',
+         'Sigma_xy/tau', 'Sigma_xy_c/tau', 'Pi_h/tau', 'N1_h/tau']
+NAN = float('nan')
+
+
+def div(a, b):
+    return a / b if b != 0 and math.isfinite(b) else NAN
+
+
+def quantities(m, shear_rate):
+    """m: the 16 block-mean values (stress_hydro 5, stress_contact 5, phi_core, velocity fit 5)."""
+    sh, sc = m[0:5], m[5:10]
+    sp = sh + sc
+    den = m[11] * m[14] - m[12] ** 2
+    gd = (m[11] * m[15] - m[12] * m[13]) / den if den > 0 else NAN
+    eta_r = 1.0 + div(sp[3], gd)
+    eta_h = 1.0 + div(sh[3], gd)
+    eta_c = div(sc[3], gd)
+    tau = eta_r * gd
+    p = -sc[1]
+    q = [NAN] * len(NAMES)
+    q[0:3] = [eta_r, eta_h, eta_c]
+    q[3] = div(sp[0] - sp[1], tau)
+    q[4] = div(sp[1] - sp[2], tau)
+    q[5] = div(-sp[4] / 3.0, tau)
+    q[6:9] = [div(x, tau) for x in sp[0:3]]
+    q[9:12] = [div(x, tau) for x in sc[0:3]]
+    q[12] = div(sc[0] - sc[1], tau)
+    q[13] = div(sc[1] - sc[2], tau)
+    q[14] = div(-sc[4] / 3.0, tau)
+    if sp[0] != 0:
+        q[15:17] = [sp[1] / sp[0], sp[2] / sp[0]]
+    if sc[0] != 0:
+        q[17:19] = [sc[1] / sc[0], sc[2] / sc[0]]
+    q[19] = div(-sp[0], gd)
+    q[20] = div(-sc[0], gd)
+    if p > 0:
+        q[21:25] = [gd / p, tau / p, eta_h * gd / p, eta_c * gd / p]
+    q[25] = m[10]
+    q[26] = gd / shear_rate
+    q[27] = tau / shear_rate
+    q[28] = div(sp[3], tau)
+    q[29] = div(sc[3], tau)
+    q[30] = div(-sh[4] / 3.0, tau)
+    q[31] = div(sh[0] - sh[1], tau)
+    return np.array(q)
+
+
+def load(outdir):
+    """The series of a run, with its settings (attributes written by fdsusp)."""
+    with h5py.File(os.path.join(outdir, 'series.h5'), 'r') as f:
+        if 'core/stress_hydro' not in f:
+            raise SystemExit(f'{outdir}/series.h5 holds no core statistics: the run had no &rheology')
+        a = {k: float(np.ravel(v)[0]) for k, v in f.attrs.items()}
+        s = {k: f[k][()] for k in ['step', 'time', 'core/stress_hydro', 'core/stress_contact', 'core/solid_fraction',
+                                   'core/velocity_fit', 'core/shear_rate', 'pairs/references', 'pairs/shell',
+                                   'pairs/contact', 'profiles/solid_fraction', 'profiles/momentum']}
+    return a, s
+
+
+def summarise(a, s):
+    """The summary as src/rheology.F90 computes it (see the module header there)."""
+    step = np.rint(s['step']).astype(np.int64)
+    blocks, discard, block_steps = int(a['blocks']), int(a['discard_step']), int(a['block_steps'])
+    every = int(a['series_every'])
+    last_step = int(step.max())
+    block = np.where((step > discard) & (step % every == 0), (step - discard - 1) // block_steps, -1)
+    block[block >= blocks] = -1
+    values = np.hstack([s['core/stress_hydro'], s['core/stress_contact'], s['core/solid_fraction'][:, None],
+                        s['core/velocity_fit']])
+    records = np.array([np.count_nonzero(block == b) for b in range(blocks)])
+    complete = 0
+    for b in range(1, blocks + 1):
+        if discard + b * block_steps <= last_step and records[b - 1] > 0:
+            complete = b
+    means = [values[block == b].sum(axis=0) / records[b] for b in range(complete)]
+    value = quantities(np.mean(means, axis=0), a['shear_rate']) if complete > 0 else np.full(len(NAMES), NAN)
+    error = np.full(len(NAMES), NAN)
+    if complete > 1:
+        per_block = np.array([quantities(m, a['shear_rate']) for m in means])
+        error = per_block.std(axis=0, ddof=1) / math.sqrt(complete)
+    inside = (block >= 0) & (block < complete)
+    nrec = np.count_nonzero(inside)
+    nbins = s['profiles/solid_fraction'].shape[1]
+    nang = s['pairs/shell'].shape[1]
+    y = (np.arange(nbins) + 0.5) * a['box_y'] / nbins
+    theta = (np.arange(nang) + 0.5) * 2 * math.pi / nang
+    if nrec > 0:
+        phi_sum = s['profiles/solid_fraction'][inside].sum(axis=0)
+        mom_sum = s['profiles/momentum'][inside].sum(axis=0)
+        with np.errstate(invalid='ignore', divide='ignore'):
+            velocity = np.where(phi_sum > 0, mom_sum / phi_sum, NAN)
+        phi = phi_sum / nrec
+        dtheta = 2 * math.pi / nang
+        n_core = value[25] / (4.0 / 3.0 * math.pi * a['radius'] ** 3)
+        refs = s['pairs/references'][inside].sum()
+        shells = [(r ** 3 - (2 * a['radius']) ** 3) / 3.0 * dtheta * 2 * math.sin(0.5 * dtheta)
+                  for r in (a['pair_radius'], a['contact_radius'])]
+        g = s['pairs/shell'][inside].sum(axis=0) / (refs * n_core * shells[0])
+        gc = s['pairs/contact'][inside].sum(axis=0) / (refs * n_core * shells[1])
+    else:
+        phi = velocity = np.full(nbins, NAN)
+        g = gc = np.full(nang, NAN)
+    return {'blocks': blocks, 'blocks_complete': complete, 'last_step': last_step,
+            'quantities': {n: {'value': v, 'error': e} for n, v, e in zip(NAMES, value, error)},
+            'profiles': {'y': y, 'solid_fraction': phi, 'velocity': velocity},
+            'pair_distribution': {'theta': theta, 'g': g, 'g_contact': gc}}
+
+
+def differs(x, y, tol=1e-10):
+    """Relative difference above tol; None (JSON null) equals NaN."""
+    x = NAN if x is None else float(x)
+    y = NAN if y is None else float(y)
+    if math.isnan(x) or math.isnan(y):
+        return not (math.isnan(x) and math.isnan(y))
+    return abs(x - y) > tol * max(abs(x), abs(y), 1e-300)
+
+
+def compare(ours, path):
+    """Differences between our summary and the run's summary.json: a list of lines."""
+    with open(path) as f:
+        theirs = json.load(f)
+    bad = []
+    for key in ('blocks', 'blocks_complete', 'last_step'):
+        if theirs[key] != ours[key]:
+            bad.append(f'{key}: {theirs[key]} vs {ours[key]}')
+    for n in NAMES:
+        for part in ('value', 'error'):
+            if differs(theirs['quantities'][n][part], ours['quantities'][n][part]):
+                bad.append(f"{n} {part}: {theirs['quantities'][n][part]} vs {ours['quantities'][n][part]}")
+    for group, keys in (('profiles', ('solid_fraction', 'velocity')), ('pair_distribution', ('g', 'g_contact'))):
+        for k in keys:
+            for i, (x, y) in enumerate(zip(theirs[group][k], ours[group][k])):
+                if differs(x, y):
+                    bad.append(f'{group}/{k}[{i}]: {x} vs {y}')
+                    break
+    return bad
+
+
+def print_summary(outdir, summ):
+    print(f"{outdir}: {summ['blocks_complete']} of {summ['blocks']} blocks complete (last step {summ['last_step']})")
+    for n in NAMES:
+        q = summ['quantities'][n]
+        print(f"  {n:16s} {q['value']:13.5e} +- {q['error']:10.3e}")
+
+
+def plots(runs, directory):
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    os.makedirs(directory, exist_ok=True)
+    for outdir, a, s, summ in runs:
+        name = os.path.basename(os.path.normpath(outdir))
+        strain = s['time'] * abs(a['shear_rate'])
+        fig, ax = plt.subplots(1, 3, figsize=(15, 4))
+        gd = a['shear_rate']
+        ax[0].plot(strain, s['core/stress_hydro'][:, 3] / gd, label=r'$\Sigma^h_{xy}$')
+        ax[0].plot(strain, s['core/stress_contact'][:, 3] / gd, label=r'$\Sigma^c_{xy}$')
+        for k, lab in ((0, 'xx'), (1, 'yy'), (2, 'zz')):
+            ax[0].plot(strain, (s['core/stress_hydro'][:, k] + s['core/stress_contact'][:, k]) / gd,
+                       label=rf'$\Sigma^p_{{{lab}}}$', lw=0.8)
+        ax[0].axvline(a['discard_step'] * a['dt'] * abs(gd), color='k', ls=':')
+        ax[0].set_xlabel(r'strain $\dot\gamma t$')
+        ax[0].set_ylabel(r'core stress / $\eta\dot\gamma$')
+        ax[0].legend(fontsize=7)
+        p = summ['profiles']
+        ax[1].plot(p['y'], p['solid_fraction'], label=r'$\langle\phi(y)\rangle$')
+        ax[1].axvspan(a['core_lo'], a['core_hi'], color='0.9')
+        ax[1].set_xlabel('y / a')
+        ax[1].set_ylabel(r'$\phi$')
+        ax1 = ax[1].twinx()
+        ax1.plot(p['y'], p['velocity'], 'r', lw=0.8)
+        ax1.set_ylabel(r'particle $u_x$ / $a\dot\gamma$', color='r')
+        pd = summ['pair_distribution']
+        # mirror symmetry (paper fig. 15): fold theta and theta + pi, plot against pi - theta
+        n = len(pd['theta'])
+        half = n // 2
+        th = pd['theta'][:half]
+        for key, lab in (('g', r'$g(r<r_{out},\theta)$'), ('g_contact', r'$g_c(\theta)$')):
+            v = np.asarray(pd[key])
+            folded = 0.5 * (v[:half] + v[half:2 * half])
+            scale = np.nanmax(folded) if key == 'g_contact' and np.nanmax(folded) > 0 else 1.0
+            ax[2].plot(math.pi - th, folded / scale, 'o-', ms=3,
+                       label=lab + (' (scaled to max 1)' if scale != 1.0 else ''))
+        ax[2].set_xlabel(r'$\pi - \theta$')
+        ax[2].legend(fontsize=7)
+        fig.suptitle(f"{name}: phi_core = {summ['quantities']['phi_core']['value']:.3f}, "
+                     f"eta_r = {summ['quantities']['eta_r']['value']:.3f}")
+        fig.tight_layout()
+        fig.savefig(os.path.join(directory, f'{name}_run.png'), dpi=110)
+        plt.close(fig)
+    if len(runs) > 1:
+        fig, ax = plt.subplots(1, 3, figsize=(15, 4))
+        frictions = sorted({a.get('friction', 0.0) for _, a, _, _ in runs})
+        for mu in frictions:
+            sel = [summ for _, a, _, summ in runs if a.get('friction', 0.0) == mu]
+            sel.sort(key=lambda z: z['quantities']['phi_core']['value'])
+            phi = [z['quantities']['phi_core']['value'] for z in sel]
+            for k, n in enumerate(('eta_r', 'N1/tau', 'N2/tau')):
+                ax[k].errorbar(phi, [z['quantities'][n]['value'] for z in sel],
+                               yerr=[z['quantities'][n]['error'] for z in sel], marker='o', capsize=3,
+                               label=rf'$\mu_d$ = {mu:g}')
+        for k, n in enumerate(('eta_r', 'N1/tau', 'N2/tau')):
+            ax[k].set_xlabel(r'$\phi_{core}$')
+            ax[k].set_ylabel(n)
+            ax[k].legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(os.path.join(directory, 'rheology_vs_phi.png'), dpi=110)
+        plt.close(fig)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument('outdirs', nargs='+')
+    ap.add_argument('--plots', metavar='DIR')
+    ap.add_argument('--compare', action='store_true')
+    args = ap.parse_args()
+    runs = []
+    status = 0
+    for outdir in args.outdirs:
+        a, s = load(outdir)
+        summ = summarise(a, s)
+        print_summary(outdir, summ)
+        if args.compare:
+            bad = compare(summ, os.path.join(outdir, 'summary.json'))
+            if bad:
+                status = 1
+                print(f'  summary.json differs ({len(bad)}):', *bad[:10], sep='\n    ')
+            else:
+                print('  summary.json agrees to 1e-10')
+        runs.append((outdir, a, s, summ))
+    if args.plots:
+        plots(runs, args.plots)
+    return status
+
+
+if __name__ == '__main__':
+    sys.exit(main())
