@@ -108,8 +108,11 @@ $(BUILD)/deps.mk: $(SRC_F90) $(PROGRAM_SRC) $(REF_F90) $(UNIT_F90) scripts/f90de
 
 NP ?= 2
 MPIRUN := mpiexec --oversubscribe
+# the demo suspension (input/demo.nml, ~7 min on 2 cores), then its summary recomputed from the
+# series and its figures (doc/RHEOLOGY.md)
 run: all
 	$(MPIRUN) -n $(NP) $(BIN)/fdsusp input/demo.nml
+	$(PYTHON) scripts/rheology.py out/demo --compare --plots out/demo/plots
 
 # TESTS=pattern runs only the tests whose path contains pattern.
 check: all
