@@ -1,0 +1,95 @@
+"""Invariants of the suspension statistics (doc/RHEOLOGY.md) on a sheared phi = 0.3 suspension
+with every model on (rough frictional contacts, full lubrication), 2 ranks:
+ 1. summary.json and scripts/rheology.py (the same statistics redone from series.h5 alone) agree
+    to 1e-10 relative, for an uninterrupted run and for a restarted one;
+ 2. a restart in the middle of the averaging window (step 35 of 60, inside block 3 of 5) gives
+    the same summary as the uninterrupted run: the checkpoint carries the accumulators and the
+    restart is exact, so 1e-12 relative (bitwise in practice);
+ 3. two independent paths of the code agree: the profile phi(y), integrated over the gap, is the
+    volume of all spheres over the box (exact slab volumes per bin; to 1e-12), and averaged over
+    the bins of the core (the bins align with y = Ly/4, 3Ly/4) it is phi_core (slab volumes per
+    core; to 1e-12) at every record;
+ 4. the particle snapshots exist with their XDMF series.
+Set-up: 8a x 20a x 8a Couette cell, a/Delta = 4, 92 spheres packed at start (seed 2), dt = 2e-3,
+10 steps discarded and 5 blocks of 10 steps. Rounding between the Fortran sums and numpy's
+pairwise sums is ~1e-15 relative, hence the 1e-10 of (1)."""
+import json
+import os
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
+import fdsusp_testlib as T
+
+DECK = """&domain box = 8, 20, 8, cells_per_radius = 4, shear_rate = 1 /
+&fluid initial_flow = 'shear' /
+&time dt = 2e-3, steps = {steps} /
+&output directory = 'out', progress_every = 5, particles_every = 20 /
+&particles solid_fraction = 0.3, seed = 2 /
+&contact roughness = 5e-3, friction = 0.5 /
+&rheology discard_strain = 0.02, average_strain = 0.1, blocks = 5 /
+"""
+RHEOLOGY = os.path.join(T.ROOT, 'scripts', 'rheology.py')
+
+
+def summary(d):
+    with open(os.path.join(d, 'out', 'summary.json')) as f:
+        return json.load(f)
+
+
+def flat(s):
+    """Every number of a summary, in a fixed order."""
+    vals = []
+    for n in sorted(s['quantities']):
+        vals += [s['quantities'][n]['value'], s['quantities'][n]['error']]
+    for group, keys in (('profiles', ('solid_fraction', 'velocity')), ('pair_distribution', ('g', 'g_contact'))):
+        for k in keys:
+            vals += s[group][k]
+    return np.array([np.nan if v is None else v for v in vals], dtype=float)
+
+
+a = T.scratch('rheology_restart_a')
+b = T.scratch('rheology_restart_b')
+T.run(T.write_deck(a, 'deck.nml', DECK.format(steps=60)), a, np_ranks=2)
+T.run(T.write_deck(b, 'deck.nml', DECK.format(steps=35)), b, np_ranks=2)
+sb_partial = summary(b)
+T.check(sb_partial['blocks_complete'] == 2 and not sb_partial['complete'],
+        'the run stopped at step 35 reports 2 complete blocks of 5 (%d)' % sb_partial['blocks_complete'])
+T.run(T.write_deck(b, 'deck.nml', DECK.format(steps=60)), b, np_ranks=2, args=['-restart', 'out/checkpoint.h5'])
+
+for d, name in ((a, 'uninterrupted'), (b, 'restarted')):
+    p = subprocess.run([sys.executable, RHEOLOGY, os.path.join(d, 'out'), '--compare'], capture_output=True, text=True)
+    T.check(p.returncode == 0 and 'agrees to 1e-10' in p.stdout,
+            '%s run: scripts/rheology.py reproduces summary.json to 1e-10' % name)
+    if p.returncode != 0:
+        print(p.stdout[-2000:], p.stderr[-2000:])
+
+sa, sb = summary(a), summary(b)
+T.check(sa['complete'] and sa['blocks_complete'] == 5, 'uninterrupted run: 5 complete blocks')
+fa, fb = flat(sa), flat(sb)
+same_nan = np.array_equal(np.isnan(fa), np.isnan(fb))
+rel = np.nanmax(np.abs(fa - fb) / np.maximum(np.abs(fa), 1e-300))
+T.check(same_nan and rel <= 1e-12, 'restart at step 35 gives the same summary (max rel. diff %.1e <= 1e-12; '
+        'eta_r = %.4f +- %.4f)' % (rel, sa['quantities']['eta_r']['value'], sa['quantities']['eta_r']['error']))
+T.check(sa['quantities']['eta_c']['value'] > 0 and sa['quantities']['I_v']['value'] is not None,
+        'contacts take part (eta_c = %.3g, I_v = %s)' % (sa['quantities']['eta_c']['value'], sa['quantities']['I_v']['value']))
+
+with h5py.File(os.path.join(a, 'out', 'series.h5'), 'r') as f:
+    prof = f['profiles/solid_fraction'][()]
+    core = f['core/solid_fraction'][()]
+    n = f['particles/position'].shape[1]
+    box = [float(f.attrs[k][0]) for k in ('box_x', 'box_y', 'box_z')]
+phi_bulk = n * 4.0 / 3.0 * np.pi / np.prod(box)
+err_total = np.abs(prof.mean(axis=1) / phi_bulk - 1).max()
+T.check(err_total <= 1e-12, 'phi(y) integrates to the spheres\' volume at every record (max rel. err %.1e)' % err_total)
+nb = prof.shape[1]
+err_core = np.abs(prof[:, nb // 4: 3 * nb // 4].mean(axis=1) / core - 1).max()
+T.check(err_core <= 1e-12, 'phi(y) over the core bins is phi_core at every record (max rel. err %.1e)' % err_core)
+for step in (20, 40, 60):
+    T.check(os.path.exists(os.path.join(a, 'out', 'particles_%08d.h5' % step)), 'particle snapshot at step %d' % step)
+with open(os.path.join(a, 'out', 'particles.xmf')) as f:
+    T.check(f.read().count('Polyvertex') == 3, 'particles.xmf lists the three snapshots')
+T.finish()
