@@ -44,7 +44,7 @@ cases = [
     ('restart with another particle count', GOOD + '&particles number = 1, position(:,1) = 1.6, 1.6, 1.6 /\n',
      ['-restart', 'good_run/checkpoint.h5'], ['good_run/checkpoint.h5', '/particles', '0 particles', 'the deck 1']),
     ('not a checkpoint', GOOD, ['-restart', 'bad.nml'], ['bad.nml', 'cannot be opened as HDF5']),
-    ('unknown particle motion', GOOD + "&particles number = 1, position(:,1) = 1.6, 1.6, 1.6, motion = 'fixed' /\n", [],
+    ('unknown particle motion', GOOD + "&particles number = 1, position(:,1) = 1.6, 1.6, 1.6, motion = 'stuck' /\n", [],
      ['bad.nml', '&particles', 'motion']),
     ('overlapping particles', GOOD.replace('3.2, 3.2, 3.2', '6.4, 6.4, 6.4') +
      '&particles number = 2, position(:,1) = 2, 3, 3, position(:,2) = 3.5, 3, 3 /\n', [],
@@ -73,6 +73,16 @@ cases = [
      ['resolved_a5.h5', 'radius_offset']),
     ('lubricating pairs beyond the periodic box', GOOD + '&particles number = 2, position(:,1) = 0.8, 1.05, 0.8, ' +
      'position(:,2) = 2.4, 2.15, 2.4 /\n', [], ['bad.nml', '&lubrication', 'periodic length']),
+    ('statistics without walls', GOOD.replace('cells_per_radius = 5', "cells_per_radius = 5, y_boundary = 'periodic', "
+     "shear_rate = 0") + '&particles solid_fraction = 0.1 /\n&rheology /\n', [], ['bad.nml', '&rheology', 'walls']),
+    ('statistics without particles', GOOD + '&rheology /\n', [], ['bad.nml', '&rheology', 'needs particles']),
+    ('packing and inline particles', GOOD + '&particles solid_fraction = 0.1, number = 1, position(:,1) = 1.6, 1.6, 1.6 /\n',
+     [], ['bad.nml', '&particles', 'solid_fraction', 'one way']),
+    ('packing beyond the supported fraction', GOOD + '&particles solid_fraction = 0.6 /\n', [],
+     ['bad.nml', '&particles', 'solid_fraction', 'out of range']),
+    ('averaging blocks without records', GOOD + '&particles solid_fraction = 0.1 /\n'
+     '&rheology average_strain = 0.01, blocks = 5 /\n', [],
+     ['bad.nml', '&rheology', 'average_strain', 'series_every']),
 ]
 for name, text, args, words in cases:
     deck = os.path.join(d, 'bad.nml')
