@@ -28,7 +28,7 @@ NAMES = ['eta_r', 'eta_h', 'eta_c', 'N1/tau', 'N2/tau', 'Pi/tau',
          'N1_c/tau', 'N2_c/tau', 'Pi_c/tau',
          'lambda_2', 'lambda_3', 'lambda_2_c', 'lambda_3_c', 'eta_n', 'eta_n_c',
          'I_v', 'mu', 'mu_h', 'mu_c', 'phi_core', 'gamma_dot_core', 'tau',
-         'Sigma_xy/tau', 'Sigma_xy_c/tau', 'Pi_h/tau', 'N1_h/tau']
+         'Sigma_xy/tau', 'Sigma_xy_c/tau', 'Pi_h/tau', 'N1_h/tau', 'gamma_dot_flow']
 NAN = float('nan')
 
 
@@ -36,12 +36,18 @@ def div(a, b):
     return a / b if b != 0 and math.isfinite(b) else NAN
 
 
+def slope(t):
+    """Slope of a least-squares line from its sums (n, sum x, sum y, sum x^2, sum x y)."""
+    den = t[0] * t[3] - t[1] ** 2
+    return (t[0] * t[4] - t[1] * t[2]) / den if den > 0 else NAN
+
+
 def quantities(m, shear_rate):
-    """m: the 16 block-mean values (stress_hydro 5, stress_contact 5, phi_core, velocity fit 5)."""
+    """m: the 21 block-mean values (stress_hydro 5, stress_contact 5, phi_core, particle velocity
+    fit 5, suspension flow fit 5)."""
     sh, sc = m[0:5], m[5:10]
     sp = sh + sc
-    den = m[11] * m[14] - m[12] ** 2
-    gd = (m[11] * m[15] - m[12] * m[13]) / den if den > 0 else NAN
+    gd = slope(m[11:16])
     eta_r = 1.0 + div(sp[3], gd)
     eta_h = 1.0 + div(sh[3], gd)
     eta_c = div(sc[3], gd)
@@ -72,6 +78,7 @@ def quantities(m, shear_rate):
     q[29] = div(sc[3], tau)
     q[30] = div(-sh[4] / 3.0, tau)
     q[31] = div(sh[0] - sh[1], tau)
+    q[32] = slope(m[16:21]) / shear_rate
     return np.array(q)
 
 
@@ -82,7 +89,7 @@ def load(outdir):
             raise SystemExit(f'{outdir}/series.h5 holds no core statistics: the run had no &rheology')
         a = {k: float(np.ravel(v)[0]) for k, v in f.attrs.items()}
         s = {k: f[k][()] for k in ['step', 'time', 'core/stress_hydro', 'core/stress_contact', 'core/solid_fraction',
-                                   'core/velocity_fit', 'core/shear_rate', 'pairs/references', 'pairs/shell',
+                                   'core/velocity_fit', 'core/flow_fit', 'core/shear_rate', 'pairs/references', 'pairs/shell',
                                    'pairs/contact', 'profiles/solid_fraction', 'profiles/momentum']}
     return a, s
 
@@ -96,7 +103,7 @@ def summarise(a, s):
     block = np.where((step > discard) & (step % every == 0), (step - discard - 1) // block_steps, -1)
     block[block >= blocks] = -1
     values = np.hstack([s['core/stress_hydro'], s['core/stress_contact'], s['core/solid_fraction'][:, None],
-                        s['core/velocity_fit']])
+                        s['core/velocity_fit'], s['core/flow_fit']])
     records = np.array([np.count_nonzero(block == b) for b in range(blocks)])
     complete = 0
     for b in range(1, blocks + 1):

@@ -21,7 +21,7 @@ module mod_fluid
   use mod_manufactured, only: mms_forcing, mms_velocity, mms_pressure
   implicit none
   private
-  public :: fluid_t, fluid_create, fluid_step, fluid_destroy, fluid_errors_vs_manufactured
+  public :: fluid_t, fluid_create, fluid_step, fluid_destroy, fluid_errors_vs_manufactured, fluid_mean_profile
 
   type :: fluid_t
     Vec :: vel(3)           ! u^n, v^n, w^n
@@ -350,6 +350,29 @@ contains
 
   ! Errors against the manufactured solution (plus the Couette shear, which needs no forcing):
   ! max over all velocity unknowns, and max and rms of the pressure with both means removed.
+  ! The x-z plane mean of u at every cell row j (y = (j + 1/2) h): the mean velocity profile of
+  ! the suspension (fluid, and the particles' rigid motion that the fictitious domain imposes on
+  ! the faces they cover). Collective.
+  subroutine fluid_mean_profile(grid, fl, profile, ierr)
+    type(grid_t), intent(in) :: grid
+    type(fluid_t), intent(in) :: fl
+    real(dp), intent(out) :: profile(0:)
+    PetscErrorCode, intent(out) :: ierr
+    PetscScalar, pointer :: u(:,:,:)
+    real(dp), allocatable :: sums(:)
+    PetscErrorCode :: mpierr
+    integer :: j
+    allocate(sums(0:grid%n(2) - 1))
+    sums = 0.0_dp
+    PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_U), fl%vel(FIELD_U), u, ierr))
+    do j = grid%lo(2), grid%hi(2)
+      sums(j) = sum(u(grid%lo(1):grid%hi(1), j, grid%lo(3):grid%hi(3)))
+    end do
+    PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_U), fl%vel(FIELD_U), u, ierr))
+    call MPI_Allreduce(sums, profile, grid%n(2), MPIU_REAL, MPI_SUM, PETSC_COMM_WORLD, mpierr)
+    profile = profile / real(grid%n(1) * grid%n(3), dp)
+  end subroutine fluid_mean_profile
+
   subroutine fluid_errors_vs_manufactured(grid, fl, shear_rate, err_vel, err_p_max, err_p_rms, ierr)
     type(grid_t), intent(in) :: grid
     type(fluid_t), intent(inout) :: fl

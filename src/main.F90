@@ -11,7 +11,8 @@ program fdsusp
   use mod_params, only: config_t, read_deck, echo_deck, max_line
   use mod_errors, only: log_line, warn_line, input_error, fatal_error, is_root
   use mod_grid, only: grid_t, grid_create, grid_destroy
-  use mod_fluid, only: fluid_t, fluid_create, fluid_step, fluid_destroy, fluid_errors_vs_manufactured
+  use mod_fluid, only: fluid_t, fluid_create, fluid_step, fluid_destroy, fluid_errors_vs_manufactured, &
+                       fluid_mean_profile
   use mod_series, only: series_t, series_open, series_record, series_flush, series_attributes
   use mod_output, only: write_fields, progress_line
   use mod_checkpoint, only: checkpoint_write, checkpoint_check, checkpoint_read
@@ -20,7 +21,7 @@ program fdsusp
                         STAGE_PARTICLES, STAGE_CONTACTS, STAGE_LUBRICATION
   use mod_particles, only: particles_t, advance_positions
   use mod_particles_io, only: particles_load, particles_snapshot
-  use mod_rheology, only: rheology_t, rheo_create, rheo_sample, rheo_accumulate, rheo_state, rheo_restore, &
+  use mod_rheology, only: rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, rheo_state, rheo_restore, &
                           rheo_write_summary, rheo_summarise, summary_names, NSUMMARY
   use mod_fictitious_domain, only: fd_t, fd_create, fd_geometry, fd_particle_step, fd_destroy
   use mod_particle_contacts, only: particle_contacts_t, pcontacts_create, pcontacts_step
@@ -45,6 +46,7 @@ program fdsusp
   type(rheology_t), allocatable :: rh               ! allocated when the deck has &rheology
   real(dp), allocatable :: statistics(:)            ! rh's accumulators, for checkpoints
   real(dp), allocatable :: no_contact_stresslet(:, :, :)
+  real(dp), allocatable :: mean_flow(:)             ! x-z plane means of u, per cell row
   logical :: has_particles, has_contacts, has_lubrication
   integer :: info
   integer, allocatable :: shapes(:, :)
@@ -96,6 +98,7 @@ program fdsusp
     if (info /= 0) call input_error(cfg%deck_file, 'domain', 'box', &
          'with &rheology every periodic length must be >= 2 (pair_shell + 0.3) a')
     if (.not. has_contacts) allocate(no_contact_stresslet(3, 3, parts%n), source=0.0_dp)
+    allocate(mean_flow(0:cfg%cells(2) - 1))
     statistics = rheo_state(rh)
     write(text, '(a,i0,a,i0,a,i0,a,i0)') 'statistics: discard ', cfg%discard_step, ' steps, then ', cfg%blocks, &
          ' blocks of ', cfg%block_steps, ' steps, ending at step ', cfg%discard_step + cfg%blocks * cfg%block_steps
@@ -160,9 +163,9 @@ program fdsusp
   end if
   if (allocated(rh)) then
     columns = [character(len=32) :: columns, 'core/stress_hydro', 'core/stress_contact', 'core/solid_fraction', &
-               'core/velocity_fit', 'core/shear_rate', 'min_pair_gap', 'pairs/references', 'pairs/shell', &
+               'core/velocity_fit', 'core/flow_fit', 'core/shear_rate', 'min_pair_gap', 'pairs/references', 'pairs/shell', &
                'pairs/contact', 'profiles/solid_fraction', 'profiles/momentum']
-    shapes = reshape([shapes, [5, 0, 0], [5, 0, 0], [0, 0, 0], [5, 0, 0], [0, 0, 0], [0, 0, 0], [0, 0, 0], &
+    shapes = reshape([shapes, [5, 0, 0], [5, 0, 0], [0, 0, 0], [5, 0, 0], [5, 0, 0], [0, 0, 0], [0, 0, 0], [0, 0, 0], &
                       [cfg%angle_bins, 0, 0], [cfg%angle_bins, 0, 0], [cfg%profile_bins, 0, 0], &
                       [cfg%profile_bins, 0, 0]], [3, size(columns)])
     if (has_contacts) then
@@ -237,6 +240,8 @@ program fdsusp
         else
           call rheo_sample(rh, parts%position, parts%velocity, parts%stresslet_hydro, no_contact_stresslet)
         end if
+        PetscCallA(fluid_mean_profile(grid, fl, mean_flow, ierr))
+        call rheo_sample_flow(rh, mean_flow, grid%h)
       end if
       call advance_positions(parts, cfg%dt, cfg%box, [.true., .not. cfg%walls, .true.])
       PetscCallA(stage_pop(ierr))
@@ -399,7 +404,7 @@ contains
              real(pc%stats%sliding, dp), pc%max_overlap, reshape(pc%force, [3 * parts%n]), &
              reshape(pc%torque, [3 * parts%n]), reshape(pc%stresslet, [9 * parts%n])]
       if (allocated(rh)) then
-        row = [row, rh%values(1:11), rh%values(12:16), rh%shear_rate_core, rh%min_pair_gap, rh%references, &
+        row = [row, rh%values(1:11), rh%values(12:16), rh%values(17:21), rh%shear_rate_core, rh%min_pair_gap, rh%references, &
                rh%angles(:, 1), rh%angles(:, 2), rh%profile(:, 1), rh%profile(:, 2)]
         if (has_contacts) row = [row, pc%max_overlap / max(pc%params%h_r, tiny(1.0_dp))]
         ! only the records on the series_every grid enter the statistics (a restart then adds

@@ -26,12 +26,13 @@ module mod_rheology
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates, min_image
   implicit none
   private
-  public :: rheology_t, rheo_create, rheo_sample, rheo_accumulate, rheo_quantities, rheo_block_of, &
+  public :: rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, rheo_quantities, rheo_block_of, &
             rheo_state, rheo_restore, rheo_summarise, rheo_write_summary, NQ, NSUMMARY, summary_names, slab_volume
 
-  ! per-record values that are block-averaged: stress_hydro(5), stress_contact(5), phi_core, fit(5)
-  integer, parameter :: NQ = 16
-  integer, parameter :: NSUMMARY = 32
+  ! per-record values that are block-averaged: stress_hydro(5), stress_contact(5), phi_core,
+  ! particle fit(5), suspension fit(5)
+  integer, parameter :: NQ = 21
+  integer, parameter :: NSUMMARY = 33
   ! the summary quantities, in the order of rheo_quantities (doc/RHEOLOGY.md defines each)
   character(len=20), parameter :: summary_names(NSUMMARY) = [character(len=20) :: &
        'eta_r', 'eta_h', 'eta_c', 'N1/tau', 'N2/tau', 'Pi/tau', &
@@ -39,7 +40,7 @@ module mod_rheology
        'N1_c/tau', 'N2_c/tau', 'Pi_c/tau', &
        'lambda_2', 'lambda_3', 'lambda_2_c', 'lambda_3_c', 'eta_n', 'eta_n_c', &
        'I_v', 'mu', 'mu_h', 'mu_c', 'phi_core', 'gamma_dot_core', 'tau', &
-       'Sigma_xy/tau', 'Sigma_xy_c/tau', 'Pi_h/tau', 'N1_h/tau']
+       'Sigma_xy/tau', 'Sigma_xy_c/tau', 'Pi_h/tau', 'N1_h/tau', 'gamma_dot_flow']
 
   type :: rheology_t
     real(dp) :: box(3) = 0, radius = 1, shear_rate = 1
@@ -50,8 +51,8 @@ module mod_rheology
     integer :: blocks = 5, discard_step = 0, block_steps = 1
     type(nlist_t) :: nl
     ! the last sample
-    real(dp) :: values(NQ) = 0              ! stress_hydro(5), stress_contact(5), phi_core, fit(5)
-    real(dp) :: shear_rate_core = 0         ! this record's fitted slope (for the series only)
+    real(dp) :: values(NQ) = 0              ! stress_hydro(5), stress_contact(5), phi_core, fit(5), flow fit(5)
+    real(dp) :: shear_rate_core = 0         ! this record's particle-phase slope (for the series only)
     real(dp) :: min_pair_gap = 0            ! smallest surface gap of any pair [a]
     real(dp) :: references = 0              ! spheres with their centre in the core
     real(dp), allocatable :: profile(:, :)  ! (nbins, 2): phi, phi u_x
@@ -121,7 +122,7 @@ contains
   subroutine rheo_sample(r, position, velocity, stresslet_hydro, stresslet_contact)
     type(rheology_t), intent(inout) :: r
     real(dp), intent(in) :: position(:, :), velocity(:, :), stresslet_hydro(:, :, :), stresslet_contact(:, :, :)
-    real(dp) :: a, vp, v_core, w, y, u, dbin, d(3), dist, theta, sin_half, gap, den
+    real(dp) :: a, vp, v_core, w, y, u, dbin, d(3), dist, theta, sin_half, gap
     integer :: n, i, b, b1, b2, k, p, np
     integer, allocatable :: pairs(:, :), walls(:, :)
     integer :: nw
@@ -131,7 +132,7 @@ contains
     a = r%radius
     vp = 4.0_dp / 3.0_dp * pi * a**3
     v_core = r%box(1) * r%box(3) * (r%core(2) - r%core(1))
-    r%values = 0
+    r%values(1:16) = 0
     r%profile = 0
     r%angles = 0
     r%references = 0
@@ -158,9 +159,7 @@ contains
     r%values(1:11) = r%values(1:11) / v_core
     r%values(11) = r%values(11) * vp
     r%profile = r%profile / (r%box(1) * r%box(3) * dbin)
-    den = r%values(12) * r%values(15) - r%values(13)**2
-    r%shear_rate_core = 0.0_dp
-    if (den > 0) r%shear_rate_core = (r%values(12) * r%values(16) - r%values(13) * r%values(14)) / den
+    r%shear_rate_core = line_slope(r%values(12:16))
 
     ! pairs in the shear plane: polar angle from the vorticity axis within pi/2 -+ half an angle bin
     sin_half = sin(pi / r%nangles)
@@ -189,6 +188,21 @@ contains
     end subroutine count_pair
   end subroutine rheo_sample
 
+  !> The suspension's mean velocity profile u(y_j) (x-z plane means at the cell rows y_j =
+  !> (j + 1/2) h, j = 0..): the five sums of its least-squares line over the rows in the core.
+  pure subroutine rheo_sample_flow(r, profile, h)
+    type(rheology_t), intent(inout) :: r
+    real(dp), intent(in) :: profile(0:), h
+    integer :: j
+    real(dp) :: y
+    r%values(17:21) = 0
+    do j = 0, size(profile) - 1
+      y = (j + 0.5_dp) * h
+      if (y < r%core(1) .or. y > r%core(2)) cycle
+      r%values(17:21) = r%values(17:21) + [1.0_dp, y, profile(j), y * y, y * profile(j)]
+    end do
+  end subroutine rheo_sample_flow
+
   !> xx, yy, zz, xy and the trace of a 3 x 3 tensor.
   pure function components(s) result(c)
     real(dp), intent(in) :: s(3, 3)
@@ -213,17 +227,17 @@ contains
 
   !> The summary quantities of one set of (block-)mean values m(NQ), in the order of
   !> summary_names; NaN where undefined (no contact pressure, no contact stress).
+  !> gamma_dot_core is the particle-phase slope over the core (the paper's, m(12:16));
+  !> gamma_dot_flow, the slope of the suspension's mean velocity (m(17:21)), is reported beside it.
   pure function rheo_quantities(m, shear_rate) result(q)
     real(dp), intent(in) :: m(NQ), shear_rate
     real(dp) :: q(NSUMMARY)
-    real(dp) :: sh(5), sc(5), sp(5), gd, den, tau, eta_r, eta_h, eta_c, p, nan
+    real(dp) :: sh(5), sc(5), sp(5), gd, tau, eta_r, eta_h, eta_c, p, nan
     nan = ieee_value(1.0_dp, ieee_quiet_nan)
     sh = m(1:5)
     sc = m(6:10)
     sp = sh + sc
-    den = m(12) * m(15) - m(13)**2
-    gd = nan
-    if (den > 0) gd = (m(12) * m(16) - m(13) * m(14)) / den
+    gd = line_slope(m(12:16))
     eta_r = 1.0_dp + sp(4) / gd
     eta_h = 1.0_dp + sh(4) / gd        ! the solvent is lumped into the hydrodynamic part (paper §4.1)
     eta_c = sc(4) / gd
@@ -251,7 +265,18 @@ contains
     q(30) = sc(4) / tau
     q(31) = -sh(5) / 3.0_dp / tau
     q(32) = (sh(1) - sh(2)) / tau
+    q(33) = line_slope(m(17:21)) / shear_rate
   end function rheo_quantities
+
+  !> Slope of the least-squares line from its sums (n, sum x, sum y, sum x^2, sum x y); NaN if
+  !> undefined.
+  pure real(dp) function line_slope(t) result(slope)
+    real(dp), intent(in) :: t(5)
+    real(dp) :: den
+    slope = ieee_value(1.0_dp, ieee_quiet_nan)
+    den = t(1) * t(4) - t(2)**2
+    if (den > 0) slope = (t(1) * t(5) - t(2) * t(3)) / den
+  end function line_slope
 
   !> The accumulators as one flat array (checkpoints) and back.
   pure function rheo_state(r) result(s)

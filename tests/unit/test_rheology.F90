@@ -18,7 +18,7 @@
 program test_rheology
   use mod_kinds, only: dp, pi
   use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
-  use mod_rheology, only: rheology_t, rheo_create, rheo_sample, rheo_accumulate, rheo_quantities, &
+  use mod_rheology, only: rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, rheo_quantities, &
                           rheo_block_of, rheo_state, rheo_restore, slab_volume, NQ, NSUMMARY, summary_names
   implicit none
   integer :: nfail = 0, info, k, n
@@ -71,8 +71,9 @@ program test_rheology
   m(1:5) = [0.3_dp, -0.2_dp, -0.1_dp, 1.5_dp, 0.0_dp]       ! hydrodynamic xx yy zz xy tr
   m(6:10) = [-0.8_dp, -1.2_dp, -0.6_dp, 0.9_dp, -2.6_dp]    ! contact
   m(11) = 0.4_dp
-  m(12:16) = [2.0_dp, 12.0_dp, 1.8_dp, 80.0_dp, 20.0_dp]    ! fit sums: slope (2*20-12*1.8)/(2*80-144) = 1.15
+  m(12:16) = [2.0_dp, 12.0_dp, 1.8_dp, 80.0_dp, 20.0_dp]    ! particle fit sums: slope (2*20-12*1.8)/(2*80-144) = 1.15
   gd = (2 * 20.0_dp - 12 * 1.8_dp) / (2 * 80.0_dp - 144.0_dp)
+  m(17:21) = [3.0_dp, 3.0_dp, 0.0_dp, 5.0_dp, 1.4_dp]       ! flow fit: slope (3*1.4-0)/(15-9) = 0.7
   q = rheo_quantities(m, 2.0_dp)
   call check(abs(q(idx('eta_r')) - (1 + 2.4_dp / gd)) < 1e-14_dp, 'eta_r = 1 + Sigma^p_xy/gamma_dot_core')
   call check(abs(q(idx('eta_h')) - (1 + 1.5_dp / gd)) < 1e-14_dp, 'eta_h includes the solvent')
@@ -84,10 +85,22 @@ program test_rheology
   call check(abs(q(idx('mu')) - (gd + 2.4_dp) / 1.2_dp) < 1e-14_dp, 'mu = tau/(-Sigma^c_yy)')
   call check(abs(q(idx('mu_h')) + q(idx('mu_c')) - q(idx('mu'))) < 1e-13_dp, 'mu = mu_h + mu_c')
   call check(abs(q(idx('lambda_2_c')) - 1.5_dp) < 1e-14_dp, 'lambda_2^c = Sigma^c_yy/Sigma^c_xx')
-  call check(abs(q(idx('gamma_dot_core')) - gd / 2) < 1e-14_dp, 'gamma_dot_core over the imposed rate')
+  call check(abs(q(idx('gamma_dot_core')) - gd / 2) < 1e-14_dp, 'gamma_dot_core (particle phase) over the imposed rate')
+  call check(abs(q(idx('gamma_dot_flow')) - 0.35_dp) < 1e-14_dp, 'gamma_dot_flow (suspension mean velocity)')
   m(6:10) = 0
   q = rheo_quantities(m, 1.0_dp)
   call check(ieee_is_nan(q(idx('I_v'))) .and. ieee_is_nan(q(idx('mu'))), 'no contact pressure: I_v, mu undefined')
+
+  ! the suspension's mean flow u = 0.3 (y - 2) + 1 on rows y_j = (j + 1/2) h: slope 0.3 over the core rows
+  allocate(state(0:47))
+  do k = 0, 47
+    state(k) = 0.3_dp * ((k + 0.5_dp) * 0.25_dp - 2) + 1
+  end do
+  call rheo_sample_flow(r, state, 0.25_dp)
+  call check(abs(r%values(17) - 24) < 0.5_dp, 'the 24 rows of the core enter the flow fit')
+  q = rheo_quantities(r%values, 1.0_dp)
+  call check(abs(q(idx('gamma_dot_flow')) - 0.3_dp) < 1e-12_dp, 'flow fit of a linear profile returns its slope')
+  deallocate(state)
 
   ! 5. pair angles (8 bins of pi/4; theta = 0 falls in bin 1, pi/2 in bin 3, pi in 5, 3 pi/2 in 7)
   x(:, 1) = [1.0_dp, 5.0_dp, 3.0_dp]

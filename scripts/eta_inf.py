@@ -1,0 +1,82 @@
+#!/usr/bin/env python3
+"""High-frequency viscosity eta_inf of frozen random hard-sphere configurations against the
+paper's Krieger fit (Gallier et al. 2014 §4.3: [eta] = 2.4, phi_m' = 0.68), issue 6.
+
+    scripts/eta_inf.py [--phi 0.1 0.2 0.3 0.4] [--seeds 1] [--box 8 20 8] [--cells 4] [--steps 300]
+                       [--jobs 2] [--work out/eta_inf]
+
+For each phi and seed: bin/fdsusp with &particles solid_fraction = phi, motion = 'frozen' (no
+contacts, full lubrication), Re = 0.01, dt = 5e-3, backward Euler; the last 50 steps are
+averaged. Prints a markdown table of phi_core, eta_inf (core statistics, summary.json), the fit
+at phi_core and the difference (doc/VALIDATION.md §5). Runs `jobs` cases at a time on one rank
+each.
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
+DECK = """&domain box = {box}, cells_per_radius = {cells}, shear_rate = 1 /
+&fluid reynolds = 0.01, initial_flow = 'shear', viscous_theta = 1 /
+&time dt = 5e-3 /
+&output directory = 'out', progress_every = 50 /
+&particles solid_fraction = {phi}, seed = {seed}, motion = 'frozen' /
+&rheology discard_strain = {discard}, average_strain = 0.25, blocks = 5 /
+"""
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument('--phi', type=float, nargs='+', default=[0.1, 0.2, 0.3, 0.4])
+    ap.add_argument('--seeds', type=int, nargs='+', default=[1])
+    ap.add_argument('--box', type=float, nargs=3, default=[8, 20, 8])
+    ap.add_argument('--cells', type=int, default=4)
+    ap.add_argument('--steps', type=int, default=300)
+    ap.add_argument('--jobs', type=int, default=2)
+    ap.add_argument('--work', default=os.path.join(ROOT, 'out', 'eta_inf'))
+    args = ap.parse_args()
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT='1', OMPI_ALLOW_RUN_AS_ROOT_CONFIRM='1')
+    cases = [(phi, seed) for phi in args.phi for seed in args.seeds]
+    running, done = [], []
+    discard = (args.steps - 50) * 5e-3
+    while cases or running:
+        while cases and len(running) < args.jobs:
+            phi, seed = cases.pop(0)
+            d = os.path.join(args.work, 'phi%g_seed%d' % (phi, seed))
+            os.makedirs(d, exist_ok=True)
+            with open(os.path.join(d, 'deck.nml'), 'w') as f:
+                f.write(DECK.format(box=', '.join('%g' % b for b in args.box), cells=args.cells, phi=phi,
+                                    seed=seed, discard=discard))
+            log = open(os.path.join(d, 'log'), 'w')
+            running.append((phi, seed, d, subprocess.Popen([os.path.join(ROOT, 'bin', 'fdsusp'), 'deck.nml'],
+                                                           cwd=d, env=env, stdout=log, stderr=subprocess.STDOUT)))
+        phi, seed, d, p = running.pop(0)
+        if p.wait() != 0:
+            sys.exit('fdsusp failed in ' + d)
+        with open(os.path.join(d, 'out', 'summary.json')) as f:
+            q = json.load(f)['quantities']
+        done.append((phi, seed, q))
+    print('| phi (packed) | seed | phi_core | gamma_dot_core (particles) | eta_inf | Krieger fit | difference '
+          '| (eta - 1)/phi_core | 2.5 + 5.0 phi_core | difference |')
+    print('|---|---|---|---|---|---|---|---|---|---|')
+    intrinsic = []
+    for phi, seed, q in sorted(done):
+        pc, eta = q['phi_core']['value'], q['eta_r']['value']
+        fit = (1 - pc / 0.68) ** (-2.4 * 0.68)
+        dilute = 2.5 + 5.0 * pc
+        intrinsic.append(((eta - 1) / pc, dilute))
+        print('| %.2f | %d | %.4f | %.4f (%.4f) | %.4f +- %.1e | %.4f | %+.1f %% | %.4f | %.4f | %+.1f %% |' % (
+            phi, seed, pc, q['gamma_dot_core']['value'], q['gamma_dot_particles']['value'], eta,
+            q['eta_r']['error'], fit, 100 * (eta / fit - 1), (eta - 1) / pc, dilute, 100 * ((eta - 1) / pc / dilute - 1)))
+    if len(intrinsic) > 1:
+        r = [a / b for a, b in intrinsic]
+        mean = sum(r) / len(r)
+        sd = (sum((x - mean) ** 2 for x in r) / (len(r) - 1)) ** 0.5
+        print('\nmean of (eta - 1)/phi over 2.5 + 5.0 phi: %.4f, standard deviation %.4f, standard error %.4f (%d runs)'
+              % (mean, sd, sd / len(r) ** 0.5, len(r)))
+
+
+if __name__ == '__main__':
+    main()
