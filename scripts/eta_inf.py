@@ -36,12 +36,18 @@ def main():
     ap.add_argument('--steps', type=int, default=300)
     ap.add_argument('--jobs', type=int, default=2)
     ap.add_argument('--work', default=os.path.join(ROOT, 'out', 'eta_inf'))
+    ap.add_argument('--table-only', action='store_true', help='tabulate finished runs in --work, run nothing')
     args = ap.parse_args()
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT='1', OMPI_ALLOW_RUN_AS_ROOT_CONFIRM='1')
     cases = [(phi, seed) for phi in args.phi for seed in args.seeds]
     running, done = [], []
     discard = (args.steps - 50) * 5e-3
     while cases or running:
+        while cases and args.table_only:
+            phi, seed = cases.pop(0)
+            d = os.path.join(args.work, 'phi%g_seed%d' % (phi, seed))
+            with open(os.path.join(d, 'out', 'summary.json')) as f:
+                done.append((phi, seed, json.load(f)['quantities']))
         while cases and len(running) < args.jobs:
             phi, seed = cases.pop(0)
             d = os.path.join(args.work, 'phi%g_seed%d' % (phi, seed))
@@ -52,13 +58,15 @@ def main():
             log = open(os.path.join(d, 'log'), 'w')
             running.append((phi, seed, d, subprocess.Popen([os.path.join(ROOT, 'bin', 'fdsusp'), 'deck.nml'],
                                                            cwd=d, env=env, stdout=log, stderr=subprocess.STDOUT)))
+        if not running:
+            break
         phi, seed, d, p = running.pop(0)
         if p.wait() != 0:
             sys.exit('fdsusp failed in ' + d)
         with open(os.path.join(d, 'out', 'summary.json')) as f:
             q = json.load(f)['quantities']
         done.append((phi, seed, q))
-    print('| phi (packed) | seed | phi_core | gamma_dot_core (particles) | eta_inf | Krieger fit | difference '
+    print('| phi (packed) | seed | phi_core | gamma_dot_core (flow) | eta_inf | Krieger fit | difference '
           '| (eta - 1)/phi_core | 2.5 + 5.0 phi_core | difference |')
     print('|---|---|---|---|---|---|---|---|---|---|')
     intrinsic = []
@@ -68,9 +76,9 @@ def main():
         dilute = 2.5 + 5.0 * pc
         intrinsic.append(((eta - 1) / pc, dilute))
         print('| %.2f | %d | %.4f | %.4f (%.4f) | %.4f +- %.1e | %.4f | %+.1f %% | %.4f | %.4f | %+.1f %% |' % (
-            phi, seed, pc, q['gamma_dot_core']['value'], q['gamma_dot_particles']['value'], eta,
+            phi, seed, pc, q['gamma_dot_core']['value'], q.get('gamma_dot_flow', {'value': float('nan')})['value'], eta,
             q['eta_r']['error'], fit, 100 * (eta / fit - 1), (eta - 1) / pc, dilute, 100 * ((eta - 1) / pc / dilute - 1)))
-    if len(intrinsic) > 1:
+    if len(intrinsic) > 1 and max(args.phi) <= 0.1:   # the dilute-limit summary
         r = [a / b for a, b in intrinsic]
         mean = sum(r) / len(r)
         sd = (sum((x - mean) ** 2 for x in r) / (len(r) - 1)) ** 0.5

@@ -55,7 +55,7 @@ program fdsusp
   character(len=32), allocatable :: columns(:)
   integer :: step, first_step, stop_reason, cold_its
   integer :: iterations_sum(4)
-  real(dp) :: time, wall_start, wall_now, wall_per_step, wall_loop, cold_seconds
+  real(dp) :: time, wall_start, wall_now, wall_per_step, wall_loop, cold_seconds, core_edge_speed
   PetscBool :: bench_cold, fault_set
   PetscInt :: fault_nan_step
   real(dp) :: err_vel, err_p_max, err_p_rms
@@ -103,6 +103,14 @@ program fdsusp
     write(text, '(a,i0,a,i0,a,i0,a,i0)') 'statistics: discard ', cfg%discard_step, ' steps, then ', cfg%blocks, &
          ' blocks of ', cfg%block_steps, ' steps, ending at step ', cfg%discard_step + cfg%blocks * cfg%block_steps
     call log_line(text)
+    ! spheres crossing more than ~0.02 cells per step lose stresslet (doc/VALIDATION.md §5.3)
+    core_edge_speed = abs(cfg%shear_rate) * max(rh%core(2) - 0.5_dp * cfg%box(2), 0.5_dp * cfg%box(2) - rh%core(1))
+    if (core_edge_speed * cfg%dt > 0.02_dp * cfg%h) then
+      write(text, '(a,f6.3,a,es9.2,a)') 'spheres at the edge of the core cross ', core_edge_speed * cfg%dt / cfg%h, &
+           ' cells per step, and their stresslets lag (doc/VALIDATION.md 5.3): dt <= ', &
+           0.02_dp * cfg%h / core_edge_speed, ' keeps them within 1 %'
+      call warn_line(text)
+    end if
     if (cfg%steps < cfg%discard_step + cfg%blocks * cfg%block_steps) then
       write(text, '(a,i0,a)') '&time steps = ', cfg%steps, ' ends before the averaging window: the summary '// &
            'will hold the blocks complete by then (restart with more steps to finish)'
