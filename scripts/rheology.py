@@ -186,7 +186,9 @@ def plots(runs, directory):
     import matplotlib.pyplot as plt
     os.makedirs(directory, exist_ok=True)
     for outdir, a, s, summ in runs:
-        name = os.path.basename(os.path.normpath(outdir))
+        # the run's directory name (its parent's when fdsusp wrote into a directory called 'out')
+        parts = os.path.normpath(os.path.abspath(outdir)).split(os.sep)
+        name = parts[-2] if parts[-1] == 'out' and len(parts) > 1 else parts[-1]
         strain = s['time'] * abs(a['shear_rate'])
         fig, ax = plt.subplots(1, 3, figsize=(15, 4))
         gd = a['shear_rate']
@@ -236,6 +238,9 @@ def plots(runs, directory):
                 ax[k].errorbar(phi, [z['quantities'][n]['value'] for z in sel],
                                yerr=[z['quantities'][n]['error'] for z in sel], marker='o', capsize=3,
                                label=rf'$\mu_d$ = {mu:g}')
+        phis = np.linspace(0.0, max(z['quantities']['phi_core']['value'] for _, _, _, z in runs), 50)
+        ax[0].plot(phis, (1 - phis / 0.68) ** (-2.4 * 0.68), 'k--', lw=0.8,
+                   label=r'$\eta_\infty$ fit of the paper (Krieger, 2.4, 0.68)')
         for k, n in enumerate(('eta_r', 'N1/tau', 'N2/tau')):
             ax[k].set_xlabel(r'$\phi_{core}$')
             ax[k].set_ylabel(n)
