@@ -8,7 +8,11 @@ step 10 (checkpoint_every = 10), from which a restart runs on cleanly to step 14
 fault; series.h5 holds the steps up to the failure.
 Second guard: a sphere driven into the lower wall by an external force (no contacts, no
 lubrication) stops the run (status 5) once its centre is half a radius from the wall, with a
-message naming the particle and the wall, and failed_state.h5."""
+message naming the particle and the wall, and failed_state.h5.
+Third guard: a linear solver that does not converge stops the run (status 3) with one message
+naming the solver, its KSP reason and iterations, and the last good checkpoint survives: the
+run of the first guard is restarted from its step-14 checkpoint with the pressure solver capped
+at one iteration (-p_ksp_max_it 1, a stand-in for a diverging or stagnating solve)."""
 import os
 import sys
 import numpy as np
@@ -38,6 +42,14 @@ T.check(s['step'].max() <= 12, 'series.h5 ends at the failure (last step %d)' % 
 deck = T.write_deck(d, 'g.nml', DECK.format(steps=14))
 status, out, err = T.run(deck, d, np_ranks=2, args=['-restart', ck], expect_ok=False)
 T.check(status == 0 and 'finished at step 14' in out, 'restart from the kept checkpoint runs to step 14 (status %d)' % status)
+os.replace(ck, os.path.join(d, 'good.h5'))
+deck = T.write_deck(d, 'g.nml', DECK.format(steps=30))
+status, out, err = T.run(deck, d, np_ranks=2, args=['-restart', 'good.h5', '-p_ksp_max_it', '1'], expect_ok=False)
+messages = [l for l in err.splitlines() if l.startswith('fdsusp:')]
+T.check(status == 3 and len(messages) == 1 and 'p solver diverged' in messages[0] and 'KSPConvergedReason -3' in messages[0],
+        'a pressure solve that does not converge stops the run: status %d, %s' % (status, messages[:1]))
+T.check(not os.path.exists(ck) and int(T.h5_attr(os.path.join(d, 'good.h5'), 'step')) == 14,
+        'no checkpoint was written over the good one (good.h5 still at step 14)')
 
 d = T.scratch('runtime_guard_wall')
 deck = T.write_deck(d, 'w.nml', """&domain box = 3.2, 6.4, 3.2, cells_per_radius = 5, y_boundary = 'walls', shear_rate = 0 /
