@@ -45,7 +45,6 @@ program fdsusp
   type(particle_lubrication_t), allocatable :: pl   ! allocated when lubrication is on
   type(rheology_t), allocatable :: rh               ! allocated when the deck has &rheology
   real(dp), allocatable :: statistics(:)            ! rh's accumulators, for checkpoints
-  real(dp), allocatable :: no_contact_stresslet(:, :, :)
   real(dp), allocatable :: mean_flow(:)             ! x-z plane means of u, per cell row
   logical :: has_particles, has_contacts, has_lubrication
   integer :: info
@@ -97,7 +96,6 @@ program fdsusp
          cfg%angle_bins, cfg%pair_shell, cfg%contact_shell, cfg%blocks, cfg%discard_step, cfg%block_steps, info)
     if (info /= 0) call input_error(cfg%deck_file, 'domain', 'box', &
          'with &rheology every periodic length must be >= 2 (pair_shell + 0.3) a')
-    if (.not. has_contacts) allocate(no_contact_stresslet(3, 3, parts%n), source=0.0_dp)
     allocate(mean_flow(0:cfg%cells(2) - 1))
     statistics = rheo_state(rh)
     write(text, '(a,i0,a,i0,a,i0,a,i0)') 'statistics: discard ', cfg%discard_step, ' steps, then ', cfg%blocks, &
@@ -242,12 +240,9 @@ program fdsusp
       ! contact forces and lubrication links, each absent when not allocated (no such model)
       PetscCallA(fd_particle_step(grid, fd, fl%vel, fl%pressure, parts, ierr, pc%force, pc%torque, pl))
       ! the core statistics of this configuration, before it moves on
+      ! (pc%stresslet is absent, as unallocated, when there are no contacts)
       if (allocated(rh)) then
-        if (has_contacts) then
-          call rheo_sample(rh, parts%position, parts%velocity, parts%stresslet_hydro, pc%stresslet)
-        else
-          call rheo_sample(rh, parts%position, parts%velocity, parts%stresslet_hydro, no_contact_stresslet)
-        end if
+        call rheo_sample(rh, parts%position, parts%velocity, parts%stresslet_hydro, pc%stresslet)
         PetscCallA(fluid_mean_profile(grid, fl, mean_flow, ierr))
         call rheo_sample_flow(rh, mean_flow, grid%h)
       end if
@@ -412,7 +407,7 @@ contains
              real(pc%stats%sliding, dp), pc%max_overlap, reshape(pc%force, [3 * parts%n]), &
              reshape(pc%torque, [3 * parts%n]), reshape(pc%stresslet, [9 * parts%n])]
       if (allocated(rh)) then
-        row = [row, rh%values(1:11), rh%values(12:16), rh%values(17:21), rh%shear_rate_core, rh%min_pair_gap, rh%references, &
+        row = [row, rh%values, rh%shear_rate_core, rh%min_pair_gap, rh%references, &
                rh%angles(:, 1), rh%angles(:, 2), rh%profile(:, 1), rh%profile(:, 2)]
         if (has_contacts) row = [row, pc%max_overlap / max(pc%params%h_r, tiny(1.0_dp))]
         ! only the records on the series_every grid enter the statistics (a restart then adds
@@ -447,9 +442,9 @@ contains
          'N2/tau', 'Pi/tau', 'lambda_2', 'lambda_3', 'eta_n', 'I_v', 'mu', 'phi_core', 'gamma_dot_core', 'tau']
     if (.not. is_root()) return
     path = trim(cfg%output_directory)//'/summary.json'
-    call rheo_write_summary(rh, path, step, err)
-    if (err /= 0) call warn_line('cannot write '//trim(path))
     call rheo_summarise(rh, step, complete, value, error, profile, angles)
+    call rheo_write_summary(rh, path, step, complete, value, error, profile, angles, err)
+    if (err /= 0) call warn_line('cannot write '//trim(path))
     write(text, '(a,i0,a,i0,a)') 'rheology of the core region (', complete, ' of ', cfg%blocks, &
          ' blocks complete; value +- standard error; doc/RHEOLOGY.md):'
     call log_line(text)

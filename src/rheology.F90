@@ -118,10 +118,12 @@ contains
   end function slab_volume
 
   !> One record: core stresses, volume fraction, velocity-fit sums, profiles, pair counts.
-  !> position, velocity (3, N); stresslet_hydro, stresslet_contact (3, 3, N) [eta gamma_dot a^3].
+  !> position, velocity (3, N); stresslet_hydro, stresslet_contact (3, 3, N) [eta gamma_dot a^3];
+  !> stresslet_contact absent: no contacts (zero contact stress).
   subroutine rheo_sample(r, position, velocity, stresslet_hydro, stresslet_contact)
     type(rheology_t), intent(inout) :: r
-    real(dp), intent(in) :: position(:, :), velocity(:, :), stresslet_hydro(:, :, :), stresslet_contact(:, :, :)
+    real(dp), intent(in) :: position(:, :), velocity(:, :), stresslet_hydro(:, :, :)
+    real(dp), intent(in), optional :: stresslet_contact(:, :, :)
     real(dp) :: a, vp, v_core, w, y, u, dbin, d(3), dist, theta, sin_half, gap
     integer :: n, i, b, b1, b2, k, p, np
     integer, allocatable :: pairs(:, :), walls(:, :)
@@ -143,7 +145,7 @@ contains
       w = slab_volume(y, a, r%core(1), r%core(2)) / vp
       if (w > 0) then
         r%values(1:5) = r%values(1:5) + w * components(stresslet_hydro(:, :, i))
-        r%values(6:10) = r%values(6:10) + w * components(stresslet_contact(:, :, i))
+        if (present(stresslet_contact)) r%values(6:10) = r%values(6:10) + w * components(stresslet_contact(:, :, i))
         r%values(11) = r%values(11) + w
         r%values(12:16) = r%values(12:16) + w * [1.0_dp, y, u, y * y, y * u]
       end if
@@ -364,16 +366,15 @@ contains
     end if
   end subroutine rheo_summarise
 
-  !> Write the summary (rheo_summarise) as JSON (rank 0 only). info: 0 ok, else the iostat.
-  subroutine rheo_write_summary(r, path, last_step, info)
+  !> Write the summary of rheo_summarise as JSON (rank 0 only). info: 0 ok, else the iostat.
+  subroutine rheo_write_summary(r, path, last_step, complete, value, err, profile, angles, info)
     type(rheology_t), intent(in) :: r
     character(len=*), intent(in) :: path
-    integer, intent(in) :: last_step
+    integer, intent(in) :: last_step, complete
+    real(dp), intent(in) :: value(NSUMMARY), err(NSUMMARY), profile(:, :), angles(:, :)
     integer, intent(out) :: info
-    integer :: complete, u, k
-    real(dp) :: value(NSUMMARY), err(NSUMMARY)
-    real(dp), allocatable :: profile(:, :), angles(:, :), y(:), theta(:)
-    call rheo_summarise(r, last_step, complete, value, err, profile, angles)
+    integer :: u, k
+    real(dp), allocatable :: y(:), theta(:)
     allocate(y(r%nbins), theta(r%nangles))
     do k = 1, r%nbins
       y(k) = (k - 0.5_dp) * r%box(2) / r%nbins
