@@ -42,7 +42,7 @@ module mod_fictitious_domain
   use mod_errors, only: fatal_error
   implicit none
   private
-  public :: fd_t, fd_create, fd_geometry, fd_particle_step, fd_destroy
+  public :: fd_t, fd_create, fd_geometry, fd_follow, fd_particle_step, fd_destroy
 
   type :: fd_t
     real(dp) :: beta = 0.0_dp           ! rho/dt = Re/dt
@@ -218,6 +218,76 @@ contains
     fd%f_alpha(fd%nf) = a
     fd%f_relax(fd%nf) = relax
   end subroutine push_face
+
+  ! The geometry at the new positions, and Lambda carried with the spheres that moved (issue 7,
+  ! doc/VALIDATION.md §5.3). Lambda is incremental: each step only corrects it, so left on the
+  ! faces of X^n it lags a sphere that has moved on to X^{n+1}; the leading faces start from zero
+  ! and relax over several steps, and a sphere crossing 0.08 cells per step loses 14 % of its
+  ! stresslet. Carried, each face the sphere now owns takes the old Lambda at the same place
+  ! relative to the centre, x_f - dX, interpolated trilinearly on its own staggered grid; faces no
+  ! sphere owns get zero. Only the translation is carried: the traction on a sphere that turns in
+  ! a steady flow is steady in the lab frame, not in the body's. displacement (3, n): X^{n+1} - X^n,
+  ! unwrapped; each component must stay below one cell (the ghost width). Collective.
+  subroutine fd_follow(grid, fd, parts, displacement, ierr)
+    type(grid_t), intent(in) :: grid
+    type(fd_t), intent(inout) :: fd
+    type(particles_t), intent(in) :: parts
+    real(dp), intent(in) :: displacement(:, :)
+    PetscErrorCode, intent(out) :: ierr
+    Vec :: old(3)
+    type(field_pointer) :: lam_old(3), lam(3)
+    real(dp) :: t(3), w(3), value, weight
+    integer :: f, c, q, o(3), a, b, e, idx(3)
+    character(len=200) :: text
+
+    call fd_geometry(grid, fd, parts)
+    if (maxval(abs(displacement)) >= grid%h) then
+      write(text, '(a,f8.3,a)') 'fdsusp: fatal: a sphere moved ', maxval(abs(displacement)) / grid%h, &
+           ' cells in one step (its force density can follow at most one): reduce &time dt'
+      call fatal_error(text, 3)
+    end if
+    do c = 1, 3
+      PetscCall(DMGetLocalVector(grid%da(c), old(c), ierr))
+      PetscCall(DMGlobalToLocalBegin(grid%da(c), fd%lambda(c), INSERT_VALUES, old(c), ierr))
+      PetscCall(DMGlobalToLocalEnd(grid%da(c), fd%lambda(c), INSERT_VALUES, old(c), ierr))
+      PetscCall(VecSet(fd%lambda(c), 0.0_dp, ierr))
+      PetscCall(DMDAVecGetArrayReadF90(grid%da(c), old(c), lam_old(c)%ptr, ierr))
+      PetscCall(DMDAVecGetArrayF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
+    end do
+    do f = 1, fd%nf
+      c = fd%f_comp(f)
+      if (c == FIELD_P) cycle
+      q = fd%f_part(f)
+      ! x_f - dX in cells from the face itself: offsets o and o + 1 in {-1, 0, 1}, weights w of o + 1
+      t = -displacement(:, q) / grid%h
+      o = floor(t)
+      w = t - o
+      if (all(displacement(:, q) == 0.0_dp)) then
+        lam(c)%ptr(fd%f_ijk(1, f), fd%f_ijk(2, f), fd%f_ijk(3, f)) = &
+             lam_old(c)%ptr(fd%f_ijk(1, f), fd%f_ijk(2, f), fd%f_ijk(3, f))
+        cycle
+      end if
+      value = 0.0_dp
+      do e = 0, 1
+        do b = 0, 1
+          do a = 0, 1
+            idx = fd%f_ijk(:, f) + o + [a, b, e]
+            ! beyond a wall there is no fluid and no Lambda (the periodic ghost would wrap)
+            if (grid%walls .and. (idx(2) < 0 .or. idx(2) >= grid%n(2))) cycle
+            weight = merge(w(1), 1.0_dp - w(1), a == 1) * merge(w(2), 1.0_dp - w(2), b == 1) &
+                   * merge(w(3), 1.0_dp - w(3), e == 1)
+            value = value + weight * lam_old(c)%ptr(idx(1), idx(2), idx(3))
+          end do
+        end do
+      end do
+      lam(c)%ptr(fd%f_ijk(1, f), fd%f_ijk(2, f), fd%f_ijk(3, f)) = value
+    end do
+    do c = 1, 3
+      PetscCall(DMDAVecRestoreArrayF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
+      PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), old(c), lam_old(c)%ptr, ierr))
+      PetscCall(DMRestoreLocalVector(grid%da(c), old(c), ierr))
+    end do
+  end subroutine fd_follow
 
   ! g such that (U + Omega x r)_c = g . (U, Omega): g = (e_c, r x e_c).
   pure function rigid_row(c, r) result(g)

@@ -19,11 +19,11 @@ program fdsusp
   use mod_system, only: install_signal_handlers, stop_signal, make_directory, probe_directory
   use mod_timers, only: timers_register, stage_push, stage_pop, STAGE_SETUP, STAGE_FLUID, STAGE_OUTPUT, &
                         STAGE_PARTICLES, STAGE_CONTACTS, STAGE_LUBRICATION
-  use mod_particles, only: particles_t, advance_positions
+  use mod_particles, only: particles_t, advance_positions, displacements
   use mod_particles_io, only: particles_load, particles_snapshot
   use mod_rheology, only: rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, rheo_state, rheo_restore, &
                           rheo_write_summary, rheo_summarise, summary_names, NSUMMARY
-  use mod_fictitious_domain, only: fd_t, fd_create, fd_geometry, fd_particle_step, fd_destroy
+  use mod_fictitious_domain, only: fd_t, fd_create, fd_geometry, fd_follow, fd_particle_step, fd_destroy
   use mod_particle_contacts, only: particle_contacts_t, pcontacts_create, pcontacts_step
   use mod_lubrication, only: lubrication_t, LUB_NONE, LUB_SIMPLE
   use mod_lubrication_io, only: lubrication_load
@@ -46,6 +46,8 @@ program fdsusp
   type(rheology_t), allocatable :: rh               ! allocated when the deck has &rheology
   real(dp), allocatable :: statistics(:)            ! rh's accumulators, for checkpoints
   real(dp), allocatable :: mean_flow(:)             ! x-z plane means of u, per cell row
+  real(dp), allocatable :: position_before(:, :)    ! X^n, then X^{n+1} - X^n, as a step moves the spheres
+  logical :: carry_lambda                           ! -fd_carry_lambda (default true)
   logical :: has_particles, has_contacts, has_lubrication
   integer :: info
   integer, allocatable :: shapes(:, :)
@@ -215,11 +217,18 @@ program fdsusp
   first_step = step
   stop_reason = RUNNING
   if (step >= cfg%steps) stop_reason = DONE
+  if (has_particles) then
+    ! the geometry at X^n; each step then moves it, and Lambda with it, to X^{n+1} (fd_follow)
+    PetscCallA(stage_push(STAGE_PARTICLES, ierr))
+    call fd_geometry(grid, fd, parts)
+    PetscCallA(stage_pop(ierr))
+    ! -fd_carry_lambda 0: leave Lambda on the faces of X^n (the scheme before 2026-11-23; for the
+    ! comparison of doc/VALIDATION.md §5.3 only)
+    carry_lambda = .true.
+    PetscCallA(PetscOptionsGetBool(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-fd_carry_lambda', carry_lambda, fault_set, ierr))
+  end if
   do while (stop_reason == RUNNING)
     if (has_particles) then
-      PetscCallA(stage_push(STAGE_PARTICLES, ierr))
-      call fd_geometry(grid, fd, parts)
-      PetscCallA(stage_pop(ierr))
       if (has_contacts) then
         ! contacts at X^n with the latest velocities (those of the previous step)
         PetscCallA(stage_push(STAGE_CONTACTS, ierr))
@@ -246,7 +255,14 @@ program fdsusp
         PetscCallA(fluid_mean_profile(grid, fl, mean_flow, ierr))
         call rheo_sample_flow(rh, mean_flow, grid%h)
       end if
+      position_before = parts%position
       call advance_positions(parts, cfg%dt, cfg%box, [.true., .not. cfg%walls, .true.])
+      if (carry_lambda) then
+        position_before = displacements(parts%position, position_before, cfg%box, [.true., .not. cfg%walls, .true.])
+        PetscCallA(fd_follow(grid, fd, parts, position_before, ierr))
+      else
+        call fd_geometry(grid, fd, parts)
+      end if
       PetscCallA(stage_pop(ierr))
     else
       PetscCallA(stage_push(STAGE_FLUID, ierr))

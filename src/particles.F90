@@ -6,7 +6,7 @@ module mod_particles
   use mod_neighbours, only: min_image
   implicit none
   private
-  public :: particles_t, particles_init, advance_positions, configuration_fault
+  public :: particles_t, particles_init, advance_positions, displacements, configuration_fault
   public :: MOTION_FREE, MOTION_PRESCRIBED, MOTION_FROZEN, MOTION_RESISTANCE, MOTION_FIXED, motion_code
 
   ! resistance: velocities imposed as for prescribed, but the configuration is held where it is
@@ -91,6 +91,17 @@ contains
       if (periodic(d)) p%position(d, :) = modulo(p%position(d, :), box(d))
     end do
   end subroutine advance_positions
+
+  ! X^{n+1} - X^n for each sphere, across periodic boundaries (positions are wrapped into the box).
+  pure function displacements(position, before, box, periodic) result(d)
+    real(dp), intent(in) :: position(:, :), before(:, :), box(3)
+    logical, intent(in) :: periodic(3)
+    real(dp) :: d(3, size(position, 2))
+    integer :: q
+    do q = 1, size(position, 2)
+      d(:, q) = min_image(position(:, q) - before(:, q), box, periodic)
+    end do
+  end function displacements
 
   ! '' if the configuration is acceptable, else what is wrong (and the particle at fault):
   ! a centre outside the box, a sphere crossing a wall, or two spheres overlapping by more than
