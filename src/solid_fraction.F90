@@ -20,7 +20,7 @@ contains
   ! Fraction of the cube of side h centred at offset r from the sphere centre inside radius R.
   pure real(dp) function cube_fraction(r, radius, h) result(alpha)
     real(dp), intent(in) :: r(3), radius, h
-    real(dp) :: d, half_diag, s, q(3), dist
+    real(dp) :: d, half_diag, s, dist2, inner2, outer2, x2(n_sub), y2(n_sub), z2(n_sub)
     integer :: a, b, c
     d = norm2(r)
     half_diag = 0.5_dp * sqrt(3.0_dp) * h
@@ -33,15 +33,26 @@ contains
       return
     end if
     s = h / n_sub
+    ! Each sub-sample counts min(1, max(0, (radius - dist)/s + 1/2)): 1 inside radius - s/2, 0
+    ! beyond radius + s/2, so only the samples in that band need the square root (this routine
+    ! is most of the geometry's cost: doc/BENCHMARKS.md §7).
+    inner2 = max(0.0_dp, radius - 0.5_dp * s)**2
+    outer2 = (radius + 0.5_dp * s)**2
+    do a = 1, n_sub
+      x2(a) = (r(1) + (a - 0.5_dp * (n_sub + 1)) * s)**2
+      y2(a) = (r(2) + (a - 0.5_dp * (n_sub + 1)) * s)**2
+      z2(a) = (r(3) + (a - 0.5_dp * (n_sub + 1)) * s)**2
+    end do
     alpha = 0.0_dp
     do c = 1, n_sub
-      q(3) = r(3) + (c - 0.5_dp * (n_sub + 1)) * s
       do b = 1, n_sub
-        q(2) = r(2) + (b - 0.5_dp * (n_sub + 1)) * s
         do a = 1, n_sub
-          q(1) = r(1) + (a - 0.5_dp * (n_sub + 1)) * s
-          dist = norm2(q)
-          alpha = alpha + min(1.0_dp, max(0.0_dp, (radius - dist) / s + 0.5_dp))
+          dist2 = x2(a) + y2(b) + z2(c)
+          if (dist2 <= inner2) then
+            alpha = alpha + 1.0_dp
+          else if (dist2 < outer2) then
+            alpha = alpha + min(1.0_dp, max(0.0_dp, (radius - sqrt(dist2)) / s + 0.5_dp))
+          end if
         end do
       end do
     end do
