@@ -28,7 +28,7 @@ module mod_contact
   public :: contact_params_t, contact_setup, contact_stats_t
   public :: contact_history_t, history_size, history_pack, history_unpack, history_clear
   public :: history_lookup, contact_pair, contact_forces, contact_stresslet
-  public :: wall_lower, wall_upper
+  public :: wall_lower, wall_upper, chatter_number
 
   integer, parameter :: wall_lower = -1, wall_upper = -2   ! history partner ids of the walls
 
@@ -63,6 +63,22 @@ module mod_contact
   end type contact_history_t
 
 contains
+
+  !> dt gamma_dot h_r / delta_0, with delta_0 = (6 pi eta gamma_dot a^2 / k_n)^(2/3) the overlap
+  !> under the force scale (= dt gamma_dot / eps_bar when k_n comes from eps_bar): the explicit
+  !> Hertz force against the lubricated one-step response of a pair at a gap ~h_r, i.e.
+  !> dt k_eff / R with k_eff = (3/2) k_n delta_0^(1/2), R ~ 6 pi eta a^2 / h_r, up to a constant.
+  !> Measured in a lubricated phi = 0.3 suspension: a period-two chatter of the contact stress at
+  !> 0.04, none at 0.02 (doc/CONTACT.md "Time-step considerations"). 0 without roughness or shear.
+  pure real(dp) function chatter_number(p, dt) result(q)
+    type(contact_params_t), intent(in) :: p
+    real(dp), intent(in) :: dt
+    real(dp) :: delta_0
+    q = 0
+    if (p%h_r <= 0 .or. p%gamma_dot == 0 .or. p%k_n <= 0) return
+    delta_0 = (6 * pi * p%eta * abs(p%gamma_dot) * p%a**2 / p%k_n)**(2.0_dp / 3)
+    q = dt * abs(p%gamma_dot) * p%h_r / delta_0
+  end function chatter_number
 
   !> Parameters from the deck quantities. eps_r = h_r/a. k_n_prescribed > 0 overrides the eps_bar
   !> rule. info: 0 ok; 1 a <= 0, eta <= 0 or a negative eps_r, mu_d; 2 k_n cannot be derived

@@ -25,6 +25,7 @@ program fdsusp
                           rheo_write_summary, rheo_summarise, summary_names, NSUMMARY
   use mod_fictitious_domain, only: fd_t, fd_create, fd_geometry, fd_follow, fd_particle_step, fd_destroy
   use mod_particle_contacts, only: particle_contacts_t, pcontacts_create, pcontacts_step
+  use mod_contact, only: chatter_number
   use mod_lubrication, only: lubrication_t, LUB_NONE, LUB_SIMPLE
   use mod_lubrication_io, only: lubrication_load
   use mod_particle_lubrication, only: particle_lubrication_t, plub_create, plub_links
@@ -90,6 +91,15 @@ program fdsusp
     allocate(pl)
     call plub_create(pl, lub, parts%n, cfg%box, cfg%walls, cfg%shear_rate, cfg%lubrication_skin, info, text)
     if (info /= 0) call input_error(cfg%deck_file, 'lubrication', 'skin', trim(text))
+  end if
+  ! the explicit rough contacts against the lubricated response (doc/CONTACT.md)
+  if (has_contacts .and. has_lubrication) then
+    if (chatter_number(pc%params, cfg%dt) > 0.02_dp) then
+      write(text, '(a,f6.3,a,es9.2,a)') 'dt gamma_dot h_r/delta_0 = ', chatter_number(pc%params, cfg%dt), &
+           ' > 0.02: the explicit contact forces may chatter with period two (measured at 0.04; '// &
+           'doc/CONTACT.md): dt <= ', 0.02_dp * cfg%dt / chatter_number(pc%params, cfg%dt), ' or a larger eps_bar'
+      call warn_line(text)
+    end if
   end if
   ! statistics of the core region (doc/RHEOLOGY.md)
   if (cfg%rheology_group) then

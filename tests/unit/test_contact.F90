@@ -24,9 +24,12 @@
 !  10. Walls by the same law: the normal force on a sphere at wall gap g equals the pair force
 !      at pair gap g (bitwise), pointing away from the wall.
 !  11. Set-up refusals: eps_r = 0 without a prescribed k_n; negative mu_d; a prescribed k_n wins.
+!  12. The chatter number dt gamma_dot h_r/delta_0 reduces to dt gamma_dot/eps_bar when k_n comes
+!      from eps_bar (1e-13: one power and a few products), scales as k_n^(2/3) for a prescribed
+!      k_n (8 k_n gives 4 times the number, 1e-13), and is 0 for smooth spheres.
 program test_contact
   use mod_kinds, only: dp, pi
-  use mod_contact, only: contact_params_t, contact_setup, contact_history_t, history_size, &
+  use mod_contact, only: contact_params_t, contact_setup, chatter_number, contact_history_t, history_size, &
                          contact_pair, contact_forces, contact_stats_t, history_lookup
   implicit none
   type(contact_params_t) :: p, p0, pb
@@ -211,6 +214,16 @@ program test_contact
   call check('negative mu_d refused', info /= 0)
   call contact_setup(p0, 1.0_dp, 5.0e-3_dp, 0.5_dp, 0.05_dp, 2.0e5_dp, 1.0_dp, 1.0_dp, info, msg)
   call check('a prescribed k_n overrides eps_bar', info == 0 .and. p0%k_n == 2e5_dp)
+
+  ! 12. chatter number
+  err = abs(chatter_number(p, 2.0e-3_dp) / (2.0e-3_dp / 0.05_dp) - 1)
+  print '(a,es12.5,a,es9.2)', '12. chatter number at dt = 2e-3: ', chatter_number(p, 2.0e-3_dp), ' rel. error ', err
+  call check('chatter number = dt gamma_dot / eps_bar', err < 1e-13_dp)
+  call contact_setup(p0, 1.0_dp, 5.0e-3_dp, 0.5_dp, 0.05_dp, 8 * p%k_n, 1.0_dp, 1.0_dp, info, msg)
+  err = abs(chatter_number(p0, 2.0e-3_dp) / (4 * chatter_number(p, 2.0e-3_dp)) - 1)
+  call check('chatter number scales as k_n^(2/3)', err < 1e-13_dp)
+  call contact_setup(p0, 1.0_dp, 0.0_dp, 0.5_dp, 0.05_dp, 1.0e6_dp, 1.0_dp, 1.0_dp, info, msg)
+  call check('no chatter number for smooth spheres', chatter_number(p0, 2.0e-3_dp) == 0)
 
   if (nfail > 0) then
     print '(i0,a)', nfail, ' check(s) FAILED'
