@@ -4,6 +4,7 @@
 #   make check      build and run the whole test suite; last line "N passed, N failed"
 #   make run        run input/demo.nml on 2 ranks
 #   make bench      timings recorded in doc/BENCHMARKS.md
+#   make extremes   the extreme scenes of input/extremes in full (doc/VALIDATION.md §6)
 # PETSC_DIR defaults to Debian's petsc-dev; set it to use a cluster's PETSc (3.18, real, double).
 
 SHELL := /bin/bash
@@ -72,7 +73,7 @@ UNIT_BIN := $(patsubst tests/unit/%.F90,$(BUILD)/tests/%,$(UNIT_F90))
 
 PROGRAMS := $(BIN)/fdsusp $(BIN)/fdsusp-pack $(BIN)/fdsusp-resistance $(if $(REF_F90),$(BIN)/pairtraj)
 
-.PHONY: all debug check run bench calibrate clean tests-build
+.PHONY: all debug check run bench extremes calibrate clean tests-build
 all: $(PROGRAMS) $(UNIT_BIN)
 
 debug:
@@ -120,6 +121,10 @@ check: all
 
 bench: all
 	@bash scripts/bench.sh
+
+# The extreme scenes of issue 8 in full (input/extremes, 5 strains each; doc/VALIDATION.md §6)
+extremes: all
+	$(PYTHON) scripts/extremes.py --json out/extremes/extremes.json
 
 # Lubrication tables (doc/LUBRICATION.md): the resolved resistance measured at each a/Delta and
 # written to input/lubrication/resolved_a<N>.h5. CELLS_PER_RADIUS="5" redoes one resolution.

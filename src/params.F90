@@ -68,7 +68,7 @@ module mod_params
     real(dp) :: solid_fraction = 0.0_dp                 ! > 0: pack this volume fraction at start [-]
     integer :: seed = 1                                 ! random seed of that packing [-]
     integer :: packing_sweeps = 200                     ! its hard-sphere Monte Carlo sweeps [-]
-    real(dp) :: packing_min_gap = 0.0_dp                ! its smallest surface gap [a]
+    real(dp) :: packing_min_gap = -1.0_dp               ! its smallest surface gap [a] (-1: h_r with contacts, else 0)
     ! &contact (doc/CONTACT.md; active when the group is present and the run has particles)
     logical :: contact_group = .false.                  ! the deck has a &contact group (derived)
     real(dp) :: roughness = 0.0_dp                      ! eps_r = h_r/a [-]
@@ -485,6 +485,16 @@ contains
     call validate_lubrication(cfg)
     call validate_rheology(cfg)
     if (cfg%steps == -1) cfg%steps = 1000
+    ! the in-run packing of a rough contact run starts contact-free, like the paper's hard-sphere
+    ! configurations (the start-gap rule of mod_particles::configuration_fault asks for h_r/2)
+    if (cfg%packing_min_gap == -1.0_dp) then
+      cfg%packing_min_gap = 0.0_dp
+      if (cfg%contact_group) cfg%packing_min_gap = cfg%roughness * cfg%radius
+    else if (cfg%contact_group .and. cfg%solid_fraction > 0.0_dp &
+             .and. cfg%packing_min_gap < 0.5_dp * cfg%roughness * cfg%radius) then
+      call input_error(cfg%deck_file, 'particles', 'packing_min_gap', &
+           'rough contacts need gaps >= h_r/2 at the start (&contact roughness x radius / 2)')
+    end if
 
     if (cfg%manufactured_solution .and. any(cfg%body_force /= 0.0_dp)) &
       call input_error(cfg%deck_file, 'verification', 'manufactured_solution', &
@@ -518,7 +528,8 @@ contains
     call check_real(cfg, 'particles', 'solid_fraction', cfg%solid_fraction, 0.0_dp, phi_max)
     call check_int(cfg, 'particles', 'seed', cfg%seed, 0, huge(1))
     call check_int(cfg, 'particles', 'packing_sweeps', cfg%packing_sweeps, 0, 1000000)
-    call check_real(cfg, 'particles', 'packing_min_gap', cfg%packing_min_gap, 0.0_dp, 1.0_dp)
+    if (cfg%packing_min_gap /= -1.0_dp) &
+      call check_real(cfg, 'particles', 'packing_min_gap', cfg%packing_min_gap, 0.0_dp, 1.0_dp)
     if (cfg%solid_fraction > 0.0_dp) then
       if (cfg%particle_number > 0 .or. len_trim(cfg%position_file) > 0) &
         call input_error(cfg%deck_file, 'particles', 'solid_fraction', &

@@ -105,18 +105,27 @@ contains
 
   ! '' if the configuration is acceptable, else what is wrong (and the particle at fault):
   ! a centre outside the box, a sphere crossing a wall, or two spheres overlapping by more than
-  ! 5 % of the radius (far beyond any roughness overlap; an O(N^2) check, done once at start-up).
-  function configuration_fault(position, radius, box, walls, culprit) result(message)
+  ! 5 % of the radius (an O(N^2) check, done once at start-up). With rough contacts, roughness
+  ! = h_r > 0: every surface gap, pair or wall, must be at least h_r/2, since an overlap
+  ! |delta'| = h_r - gap beyond h_r/2 is outside what the contact model is stable for (the
+  ! extreme scenes of doc/VALIDATION.md §6) and would start the run with a force of
+  ! k_n (h_r/2)^(3/2), some 30 times the force scale.
+  function configuration_fault(position, radius, box, walls, culprit, roughness) result(message)
     real(dp), intent(in) :: position(:, :), radius, box(3)
     logical, intent(in) :: walls
     integer, intent(out) :: culprit
+    real(dp), intent(in), optional :: roughness
     character(len=200) :: message
     logical :: periodic(3)
     integer :: i, j, d
-    real(dp) :: dist
+    real(dp) :: dist, min_gap
     message = ''
     culprit = 0
     periodic = [.true., .not. walls, .true.]
+    min_gap = -0.05_dp * radius
+    if (present(roughness)) then
+      if (roughness > 0.0_dp) min_gap = 0.5_dp * roughness
+    end if
     do i = 1, size(position, 2)
       do d = 1, 3
         if (position(d, i) < 0.0_dp .or. position(d, i) > box(d) .or. position(d, i) /= position(d, i)) then
@@ -130,13 +139,25 @@ contains
         culprit = i
         return
       end if
+      if (walls .and. min_gap > 0.0_dp .and. min(position(2, i), box(2) - position(2, i)) - radius < min_gap) then
+        write(message, '(a,i0,a,es10.3,a,es10.3,a)') 'particle ', i, ' starts at a wall gap of ', &
+             min(position(2, i), box(2) - position(2, i)) - radius, ' a: rough contacts need >= h_r/2 = ', &
+             min_gap, ' a at the start'
+        culprit = i
+        return
+      end if
     end do
     do i = 1, size(position, 2)
       do j = i + 1, size(position, 2)
         dist = norm2(min_image(position(:, j) - position(:, i), box, periodic))
-        if (dist < 1.95_dp * radius) then
-          write(message, '(a,i0,a,i0,a,f10.5,a)') 'particles ', i, ' and ', j, ' overlap (centre distance ', &
-               dist / radius, ' radii)'
+        if (dist - 2 * radius < min_gap) then
+          if (min_gap > 0.0_dp) then
+            write(message, '(a,i0,a,i0,a,es10.3,a,es10.3,a)') 'particles ', i, ' and ', j, ' start at a gap of ', &
+                 dist - 2 * radius, ' a: rough contacts need >= h_r/2 = ', min_gap, ' a at the start'
+          else
+            write(message, '(a,i0,a,i0,a,f10.5,a)') 'particles ', i, ' and ', j, ' overlap (centre distance ', &
+                 dist / radius, ' radii)'
+          end if
           culprit = i
           return
         end if

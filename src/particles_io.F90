@@ -60,7 +60,7 @@ contains
       parts%prescribed_omega = cfg%particle_omega(:, 1:n)
       parts%external_force = cfg%external_force(:, 1:n)
       parts%external_torque = cfg%external_torque(:, 1:n)
-      message = configuration_fault(parts%position, parts%radius, cfg%box, cfg%walls, culprit)
+      message = configuration_fault(parts%position, parts%radius, cfg%box, cfg%walls, culprit, start_gap_roughness(cfg))
       if (len_trim(message) > 0) then
         write(item, '(a,i0,a)') 'position(:,', culprit, ')'
         call input_error(cfg%deck_file, 'particles', trim(item), trim(message))
@@ -79,9 +79,16 @@ contains
     call MPI_Bcast(position, 3 * n, MPI_DOUBLE_PRECISION, 0, MPI_COMM_WORLD, ierr)
     call particles_init(parts, n, cfg%radius, motion_code(cfg%motion))
     parts%position = position
-    message = configuration_fault(parts%position, parts%radius, cfg%box, cfg%walls, culprit)
+    message = configuration_fault(parts%position, parts%radius, cfg%box, cfg%walls, culprit, start_gap_roughness(cfg))
     if (len_trim(message) > 0) call file_error(trim(cfg%position_file), 'particles/position', trim(message))
   end subroutine particles_load
+
+  ! h_r when the run has rough contacts (their start-gap rule), else 0.
+  pure real(dp) function start_gap_roughness(cfg) result(h_r)
+    type(config_t), intent(in) :: cfg
+    h_r = 0.0_dp
+    if (cfg%contact_group) h_r = cfg%roughness * cfg%radius
+  end function start_gap_roughness
 
   subroutine read_positions(path, position, message)
     character(len=*), intent(in) :: path

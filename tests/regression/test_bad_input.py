@@ -51,6 +51,20 @@ cases = [
      ['bad.nml', '&particles', 'position(:,1)', 'overlap']),
     ('particle through a wall', GOOD + '&particles number = 1, position(:,1) = 1.6, 0.5, 1.6 /\n', [],
      ['bad.nml', '&particles', 'position(:,1)', 'crosses a wall']),
+    ('rough pair starting inside h_r/2', GOOD.replace('3.2, 3.2, 3.2', '6.4, 6.4, 6.4') +
+     '&particles number = 2, position(:,1) = 2, 3.2, 3.2, position(:,2) = 4.004, 3.2, 3.2 /\n'
+     '&contact roughness = 0.01 /\n', [],
+     ['bad.nml', '&particles', 'position(:,1)', 'start at a gap of', 'h_r/2']),
+    ('rough sphere touching a wall', GOOD.replace('3.2, 3.2, 3.2', '6.4, 6.4, 6.4') +
+     '&particles number = 1, position(:,1) = 3.2, 1.0, 3.2 /\n&contact roughness = 0.01 /\n', [],
+     ['bad.nml', '&particles', 'position(:,1)', 'wall gap', 'h_r/2']),
+    ('rough contacts that would chatter', GOOD.replace('3.2, 3.2, 3.2, cells_per_radius = 5 /',
+                                                       '6.4, 6.4, 6.4, cells_per_radius = 5, shear_rate = 1 /') +
+     '&particles number = 1, position(:,1) = 3.2, 3.2, 3.2 /\n&contact roughness = 0.01 /\n', [],
+     ['bad.nml', '&time', 'dt', 'chatter', 'largest stable dt here is  1.25E-03']),
+    ('rough packing closer than h_r/2', GOOD.replace('3.2, 3.2, 3.2', '6.4, 6.4, 6.4') +
+     '&particles solid_fraction = 0.1, packing_min_gap = 1e-3 /\n&contact roughness = 0.01 /\n', [],
+     ['bad.nml', '&particles', 'packing_min_gap', 'h_r/2']),
     ('missing position file', GOOD + "&particles position_file = 'nowhere.h5' /\n", [],
      ['bad.nml', '&particles', 'position_file', 'does not exist']),
     ('position file without particles', GOOD + "&particles position_file = 'good_run/checkpoint.h5' /\n", [],

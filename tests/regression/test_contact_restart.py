@@ -25,7 +25,7 @@ DECK = """&domain box = 6.4, 6.4, 6.4, cells_per_radius = 5, y_boundary = 'walls
 &output directory = 'out', progress_every = 5 /
 &particles number = 3,
   position(:,1) = 3.2, 2.2, 3.2, external_force(:,1) = 0, 18.84955592153876, 0,
-  position(:,2) = 3.2, 4.205, 3.2, external_force(:,2) = 0, -18.84955592153876, 0,
+  position(:,2) = 3.2, 4.206, 3.2, external_force(:,2) = 0, -18.84955592153876, 0,
   position(:,3) = 0.3, 1.006, 3.0, external_force(:,3) = 0, -18.84955592153876, 0 /
 &contact roughness = 0.01, normal_stiffness = 1e5, friction = 0.5 /
 """

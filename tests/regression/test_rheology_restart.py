@@ -11,7 +11,9 @@ with every model on (rough frictional contacts, full lubrication), 2 ranks:
     core; to 1e-12) at every record;
  4. the particle snapshots exist with their XDMF series.
 Set-up: 8a x 20a x 8a Couette cell, a/Delta = 4, 92 spheres packed at start (seed 2), dt = 2e-3,
-10 steps discarded and 5 blocks of 10 steps. Rounding between the Fortran sums and numpy's
+10 steps discarded and 5 blocks of 10 steps; eps_bar = 0.1 keeps the contacts below their chatter
+limit at this step (doc/CONTACT.md), and packing_min_gap = h_r/2 (instead of the contact-free
+default h_r) lets contacts take part from the start. Rounding between the Fortran sums and numpy's
 pairwise sums is ~1e-15 relative, hence the 1e-10 of (1)."""
 import json
 import os
@@ -28,8 +30,8 @@ DECK = """&domain box = 8, 20, 8, cells_per_radius = 4, shear_rate = 1 /
 &fluid initial_flow = 'shear' /
 &time dt = 2e-3, steps = {steps} /
 &output directory = 'out', progress_every = 5, particles_every = 20 /
-&particles solid_fraction = 0.3, seed = 2 /
-&contact roughness = 5e-3, friction = 0.5 /
+&particles solid_fraction = 0.3, seed = 2, packing_min_gap = 2.5e-3 /
+&contact roughness = 5e-3, eps_bar = 0.1, friction = 0.5 /
 &rheology discard_strain = 0.02, average_strain = 0.1, blocks = 5 /
 """
 RHEOLOGY = os.path.join(T.ROOT, 'scripts', 'rheology.py')

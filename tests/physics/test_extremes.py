@@ -1,0 +1,41 @@
+"""Invariant: at every extreme scene of issue 8 (input/extremes) fdsusp either runs stably, the
+largest rough-contact overlap below h_r/2 and every stress finite, or refuses before any work
+with one message that names the limit. Short version for make check: each running scene for
+100 steps (0.1 strain at dt = 1e-3, 0.05 at 5e-4; the full 5 strains are `make extremes`,
+results in doc/VALIDATION.md §6), through scripts/extremes.py, which applies the criteria:
+'stable' needs exit status 0, every step run, overlap < h_r/2 (the bound of the issue) and finite
+stresslets and velocities; 'refused' needs status 2 with an input error and no time step taken.
+The refusals are checked for the words that state their limit."""
+import json
+import os
+import subprocess
+import sys
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
+import fdsusp_testlib as T
+
+EXPECTED = {
+    'phi050': ('stable', []), 'phi055': ('stable', []), 'mu1': ('stable', []),
+    'epsr1e-4': ('stable', []), 'gamma1e-1': ('stable', []),
+    'gamma1e-3': ('refused', ['&time', 'dt', 'chatter', 'largest stable dt here is  2.50E-04']),
+    'dt5x': ('refused', ['&time', 'dt', 'chatter', 'largest stable dt here is  1.25E-03']),
+    'wall_touch': ('refused', ['&particles', 'position(:,1)', 'wall gap', 'h_r/2']),
+    'pair_overlap': ('refused', ['&particles', 'position(:,1)', 'start at a gap of', 'h_r/2']),
+}
+d = T.scratch('extremes')
+report = os.path.join(d, 'extremes.json')
+proc = subprocess.run([sys.executable, os.path.join(T.ROOT, 'scripts', 'extremes.py'), '--steps', '100',
+                       '--jobs', '2', '--work', d, '--json', report], capture_output=True, text=True)
+print(proc.stdout)
+print(proc.stderr)
+records = {r['scene']: r for r in json.load(open(report))}
+T.check(sorted(records) == sorted(EXPECTED), 'every scene of input/extremes was run: %s' % sorted(records))
+for name, (verdict, words) in EXPECTED.items():
+    r = records.get(name)
+    if r is None:
+        continue
+    T.check(r['verdict'] == verdict, '%s: %s (expected %s) %s' % (name, r['verdict'], verdict, r['message']))
+    if verdict == 'stable':
+        T.check(r['overlap_over_hr'] < 0.5, '%s: largest overlap %.4f h_r < 0.5' % (name, r['overlap_over_hr']))
+    for w in words:
+        T.check(w in r['message'], '%s: the message states %r' % (name, w))
+T.finish()
