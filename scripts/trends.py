@@ -64,11 +64,14 @@ def start(d, args, phi, mu, env):
 
 
 def summary(d):
+    """The quantities of a finished case (every block complete), else None: a run stopped early
+    also writes summary.json, with 'complete' false."""
     path = os.path.join(d, 'out', 'summary.json')
     if not os.path.exists(path):
         return None
     with open(path) as f:
-        return json.load(f)['quantities']
+        s = json.load(f)
+    return s['quantities'] if s.get('complete') else None
 
 
 def main():
