@@ -47,6 +47,7 @@ module mod_contact
     integer :: pair_contacts = 0, wall_contacts = 0
     integer :: sliding = 0              ! contacts at the Coulomb limit
     real(dp) :: max_overlap = 0         ! max |delta'| / h_r (/ a when h_r = 0)
+    integer :: max_overlap_pair(2) = 0  ! its particles (partner wall_lower/wall_upper for a wall)
     real(dp) :: max_normal_force = 0
   end type contact_stats_t
 
@@ -244,7 +245,7 @@ contains
       s = contact_stresslet(f, 0.5_dp * r)
       stresslet(:, :, i) = stresslet(:, :, i) + s
       stresslet(:, :, j) = stresslet(:, :, j) + s
-      call tally(.false.)
+      call tally(.false., j)
     end do
 
     do m = 1, nwalls
@@ -266,7 +267,7 @@ contains
       force(:, i) = force(:, i) + f
       torque(:, i) = torque(:, i) + tq
       stresslet(:, :, i) = stresslet(:, :, i) + contact_stresslet(f, 0.5_dp * (p%a + d) * n)
-      call tally(.true.)
+      call tally(.true., -w)
     end do
 
     if (tangential) call history_build(h, np, nnew, new_owner, new_partner, new_ups, info)
@@ -281,15 +282,19 @@ contains
       new_ups(:, nnew) = ups
     end subroutine append
 
-    subroutine tally(wall)
+    subroutine tally(wall, partner)
       logical, intent(in) :: wall
+      integer, intent(in) :: partner
       if (wall) then
         stats%wall_contacts = stats%wall_contacts + 1
       else
         stats%pair_contacts = stats%pair_contacts + 1
       end if
       if (sliding) stats%sliding = stats%sliding + 1
-      stats%max_overlap = max(stats%max_overlap, -dlt / scale)
+      if (-dlt / scale > stats%max_overlap) then
+        stats%max_overlap = -dlt / scale
+        stats%max_overlap_pair = [i, partner]
+      end if
       stats%max_normal_force = max(stats%max_normal_force, fn)
     end subroutine tally
 

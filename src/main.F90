@@ -25,7 +25,7 @@ program fdsusp
                           rheo_write_summary, rheo_summarise, summary_names, NSUMMARY
   use mod_fictitious_domain, only: fd_t, fd_create, fd_geometry, fd_follow, fd_particle_step, fd_destroy
   use mod_particle_contacts, only: particle_contacts_t, pcontacts_create, pcontacts_step
-  use mod_contact, only: chatter_number
+  use mod_contact, only: chatter_number, wall_lower, wall_upper
   use mod_lubrication, only: lubrication_t, LUB_NONE, LUB_SIMPLE
   use mod_lubrication_io, only: lubrication_load
   use mod_particle_lubrication, only: particle_lubrication_t, plub_create, plub_links
@@ -253,8 +253,8 @@ program fdsusp
           ! once: the roughness deforms beyond the bound the extreme scenes hold (doc/VALIDATION.md §6)
           if (largest_overlap <= 0.5_dp * pc%params%h_r .and. pc%max_overlap > 0.5_dp * pc%params%h_r) then
             write(text, '(a,i0,a,f6.3,a)') 'at step ', step, ' a contact overlap reaches ', &
-                 pc%max_overlap / pc%params%h_r, ' h_r (> h_r/2): stiffer contacts (a smaller &contact eps_bar, '// &
-                 'with dt <= 0.025 eps_bar) keep the roughness from flattening'
+                 pc%max_overlap / pc%params%h_r, ' h_r (> h_r/2): stiffer contacts (a smaller &contact eps_bar '// &
+                 'or a larger normal_stiffness, with dt gamma_dot h_r/delta_0 <= 0.025) keep the roughness from flattening'
             call warn_line(text)
           end if
           largest_overlap = pc%max_overlap
@@ -535,14 +535,25 @@ contains
   ! Collective (every rank holds the same contacts): stop with a diagnostic.
   subroutine contact_failure(code)
     integer, intent(in) :: code
+    character(len=400) :: what
+    character(len=40) :: partner
+    integer :: pair(2)
     if (code == 2) then
-      write(text, '(a,i0,a,es10.3,a,es10.3,a)') 'fdsusp: fatal: at step ', step + 1, ' a contact overlap |delta''| = ', &
-           pc%max_overlap, ' a exceeds ', pc%overlap_limit, &
+      pair = pc%stats%max_overlap_pair
+      select case (pair(2))
+      case (wall_lower)
+        partner = 'the lower wall'
+      case (wall_upper)
+        partner = 'the upper wall'
+      case default
+        write(partner, '(a,i0)') 'particle ', pair(2)
+      end select
+      write(what, '(a,es10.3,a,i0,a,a,es10.3,a)') 'a contact overlap |delta''| = ', pc%max_overlap, &
+           ' a between particle ', pair(1), ' and '//trim(partner), ' exceeds ', pc%overlap_limit, &
            ' a (far beyond the roughness): lower &time dt or raise &contact normal_stiffness'
-    else
-      text = 'fdsusp: fatal: the contact history does not belong to this particle set'
+      call stop_with_state(step + 1, what)
     end if
-    call fatal_error(text, 4)
+    call fatal_error('fdsusp: fatal: the contact history does not belong to this particle set', 4)
   end subroutine contact_failure
 
   ! Runtime guard (design.md "Errors"): a non-finite velocity, pressure or particle quantity, or a
@@ -587,16 +598,24 @@ contains
       end do
     end if
     if (len_trim(what) == 0) return
+    call stop_with_state(step, what)
+  end subroutine check_health
+
+  ! Stop a run that went wrong: the series so far, the state in failed_state.h5 beside the last
+  ! good checkpoint (never over it), one message naming the step and what went wrong, status 5.
+  subroutine stop_with_state(at_step, what)
+    integer, intent(in) :: at_step
+    character(len=*), intent(in) :: what
     call series_flush(series)
     if (has_particles) then
       PetscCallA(checkpoint_write(trim(cfg%output_directory)//'/failed_state.h5', cfg, fl, step, time, ierr, fd%lambda, parts))
     else
       PetscCallA(checkpoint_write(trim(cfg%output_directory)//'/failed_state.h5', cfg, fl, step, time, ierr))
     end if
-    write(text, '(a,i0,a)') 'fdsusp: fatal: at step ', step, ': '//trim(what)// &
+    write(text, '(a,i0,a)') 'fdsusp: fatal: at step ', at_step, ': '//trim(what)// &
          '; state written to '//trim(cfg%output_directory)//'/failed_state.h5, the last good checkpoint is kept'
     call fatal_error(text, 5)
-  end subroutine check_health
+  end subroutine stop_with_state
 
   ! Collective: every rank takes the same decision.
   integer function why_stop()

@@ -12,7 +12,8 @@ message naming the particle and the wall, and failed_state.h5.
 Third guard: a linear solver that does not converge stops the run (status 3) with one message
 naming the solver, its KSP reason and iterations, and the last good checkpoint survives: the
 run of the first guard is restarted from its step-14 checkpoint with the pressure solver capped
-at one iteration (-p_ksp_max_it 1, a stand-in for a diverging or stagnating solve)."""
+at one iteration (-p_ksp_max_it 1, a stand-in for a diverging or stagnating solve).
+Fourth guard: a contact overlap beyond h_r (see the last case)."""
 import os
 import sys
 import numpy as np
@@ -63,4 +64,26 @@ messages = [l for l in err.splitlines() if l.startswith('fdsusp:')]
 T.check(status == 5 and len(messages) == 1 and 'particle 1' in messages[0] and 'wall' in messages[0],
         'a sphere pushed through the wall stops the run: status %d, %s' % (status, messages[:1]))
 T.check(os.path.exists(os.path.join(d, 'out', 'failed_state.h5')), 'failed_state.h5 written')
+
+# Fourth guard: two rough spheres (h_r = 0.01 a, soft k_n = 1e3 prescribed, no lubrication) driven
+# together by +-20 (the force that overlaps them by h_r is k_n h_r^(3/2) = 1): the overlap passes
+# h_r after some tens of steps and the run stops (status 5) with one message naming both particles and
+# the overlap, failed_state.h5 beside the checkpoint of a step before, which stays the good one.
+d = T.scratch('runtime_guard_overlap')
+deck = T.write_deck(d, 'o.nml', """&domain box = 6.4, 6.4, 6.4, cells_per_radius = 5, y_boundary = 'walls', shear_rate = 0 /
+&time dt = 1e-3, steps = 200 /
+&output directory = 'out', progress_every = 10, checkpoint_every = 5 /
+&lubrication model = 'none' /
+&particles number = 2, position(:,1) = 2.2, 3.2, 3.2, position(:,2) = 4.21, 3.2, 3.2,
+  external_force(:,1) = 20, 0, 0, external_force(:,2) = -20, 0, 0 /
+&contact roughness = 0.01, normal_stiffness = 1e3 /
+""")
+status, out, err = T.run(deck, d, np_ranks=2, expect_ok=False)
+messages = [l for l in err.splitlines() if l.startswith('fdsusp: fatal')]
+T.check(status == 5 and len(messages) == 1 and 'particle 1 and particle 2' in messages[0] and 'exceeds' in messages[0],
+        'an overlap beyond h_r stops the run: status %d, %s' % (status, messages[:1]))
+T.check(os.path.exists(os.path.join(d, 'out', 'failed_state.h5')), 'failed_state.h5 written')
+ck = os.path.join(d, 'out', 'checkpoint.h5')
+T.check(os.path.exists(ck) and int(T.h5_attr(ck, 'step')) % 5 == 0 and np.isfinite(T.read_h5(ck, ['u'])['u']).all(),
+        'the last good checkpoint is kept (step %s)' % (T.h5_attr(ck, 'step') if os.path.exists(ck) else None))
 T.finish()
