@@ -91,11 +91,27 @@ def main():
     ap.add_argument('--jobs', type=int, default=2)
     ap.add_argument('--work', default=os.path.join(ROOT, 'out', 'extremes'))
     ap.add_argument('--json')
+    ap.add_argument('--table-only', action='store_true',
+                    help='judge the scenes already run in --work (status read from their logs), run nothing')
     args = ap.parse_args()
     names = args.scenes or sorted(os.path.basename(p)[:-4] for p in glob.glob(os.path.join(SCENES, '*.nml')))
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT='1', OMPI_ALLOW_RUN_AS_ROOT_CONFIRM='1')
-    binary = os.path.join(os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin')), 'fdsusp')
+    # a copy, so that a rebuild during the study cannot change or break it
+    os.makedirs(args.work, exist_ok=True)
+    binary = os.path.join(args.work, 'fdsusp')
+    shutil.copy2(os.path.join(os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin')), 'fdsusp'), binary)
     waiting, running, records = list(names), [], []
+    if args.table_only:
+        waiting = []
+        for name in names:
+            d = os.path.join(args.work, name)
+            with open(os.path.join(d, 'deck.nml')) as f:
+                time_group = re.search(r'^&time.*$', f.read(), re.MULTILINE).group(0)
+            log = open(os.path.join(d, 'log')).read()
+            status = 2 if 'fdsusp: input error' in log else (0 if re.search(r'^wall time', log, re.M) and
+                                                             'fdsusp: fatal' not in log else 1)
+            records.append(verdict(name, d, status, int(re.search(r'steps\s*=\s*(\d+)', time_group).group(1)),
+                                   float(re.search(r'dt\s*=\s*([0-9.eE+-]+)', time_group).group(1))))
     while waiting or running:
         while waiting and len(running) < args.jobs:
             name = waiting.pop(0)
