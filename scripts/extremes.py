@@ -97,6 +97,7 @@ def main():
     names = args.scenes or sorted(os.path.basename(p)[:-4] for p in glob.glob(os.path.join(SCENES, '*.nml')))
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT='1', OMPI_ALLOW_RUN_AS_ROOT_CONFIRM='1')
     # a copy, so that a rebuild during the study cannot change or break it
+    args.work = os.path.abspath(args.work)
     os.makedirs(args.work, exist_ok=True)
     binary = os.path.join(args.work, 'fdsusp')
     shutil.copy2(os.path.join(os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin')), 'fdsusp'), binary)
