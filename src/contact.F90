@@ -28,7 +28,7 @@ module mod_contact
   public :: contact_params_t, contact_setup, contact_stats_t
   public :: contact_history_t, history_size, history_pack, history_unpack, history_clear
   public :: history_lookup, contact_pair, contact_forces, contact_stresslet
-  public :: wall_lower, wall_upper, chatter_number
+  public :: wall_lower, wall_upper, chatter_number, flattening_estimate
 
   integer, parameter :: wall_lower = -1, wall_upper = -2   ! history partner ids of the walls
 
@@ -71,6 +71,31 @@ contains
   !> dt k_eff / R with k_eff = (3/2) k_n delta_0^(1/2), R ~ 6 pi eta a^2 / h_r, up to a constant.
   !> Measured in a lubricated phi = 0.3 suspension: a period-two chatter of the contact stress at
   !> 0.04, none at 0.02 (doc/CONTACT.md "Time-step considerations"). 0 without roughness or shear.
+  !> Expected largest overlap over h_r in a sheared suspension at volume fraction phi:
+  !> (delta_0/h_r) g(phi), delta_0 the overlap under the force scale (= eps_bar h_r with k_n from
+  !> eps_bar) and g = (F_max/F_0)^(2/3) the flattening factor of the densest force chains, measured
+  !> in the Couette cell with mu_d = 0.5 over 1.4-6.5 strains (doc/VALIDATION.md §6): 3.2 at
+  !> phi = 0.3, 6.9 at 0.4, 16.7 at 0.5, 26 at 0.55; linear in between, g = 1 + 2.2 phi/0.3 below
+  !> 0.3 (one isolated pair carries about the force scale), the last slope beyond 0.55. An
+  !> empirical estimate, for the start-up checks only. 0 without roughness or shear.
+  pure real(dp) function flattening_estimate(p, phi) result(e)
+    type(contact_params_t), intent(in) :: p
+    real(dp), intent(in) :: phi
+    real(dp), parameter :: phis(4) = [0.3_dp, 0.4_dp, 0.5_dp, 0.55_dp], g(4) = [3.2_dp, 6.9_dp, 16.7_dp, 26.0_dp]
+    real(dp) :: delta_0, factor
+    integer :: k
+    e = 0
+    if (p%h_r <= 0 .or. p%gamma_dot == 0 .or. p%k_n <= 0) return
+    delta_0 = (6 * pi * p%eta * abs(p%gamma_dot) * p%a**2 / p%k_n)**(2.0_dp / 3)
+    if (phi <= phis(1)) then
+      factor = 1 + (g(1) - 1) * max(phi, 0.0_dp) / phis(1)
+    else
+      k = min(3, count(phis(2:3) <= phi) + 1)
+      factor = g(k) + (g(k + 1) - g(k)) * (phi - phis(k)) / (phis(k + 1) - phis(k))
+    end if
+    e = delta_0 / p%h_r * factor
+  end function flattening_estimate
+
   pure real(dp) function chatter_number(p, dt) result(q)
     type(contact_params_t), intent(in) :: p
     real(dp), intent(in) :: dt

@@ -25,7 +25,7 @@ program fdsusp
                           rheo_write_summary, rheo_summarise, summary_names, NSUMMARY
   use mod_fictitious_domain, only: fd_t, fd_create, fd_geometry, fd_follow, fd_particle_step, fd_destroy
   use mod_particle_contacts, only: particle_contacts_t, pcontacts_create, pcontacts_step
-  use mod_contact, only: chatter_number, wall_lower, wall_upper
+  use mod_contact, only: chatter_number, flattening_estimate, wall_lower, wall_upper
   use mod_lubrication, only: lubrication_t, LUB_NONE, LUB_SIMPLE
   use mod_lubrication_io, only: lubrication_load
   use mod_particle_lubrication, only: particle_lubrication_t, plub_create, plub_links
@@ -47,6 +47,7 @@ program fdsusp
   type(rheology_t), allocatable :: rh               ! allocated when the deck has &rheology
   real(dp), allocatable :: statistics(:)            ! rh's accumulators, for checkpoints
   real(dp), allocatable :: mean_flow(:)             ! x-z plane means of u, per cell row
+  real(dp) :: solid_fraction, expected_overlap        ! the start-up flattening check
   real(dp) :: largest_overlap = 0.0_dp              ! of this run (since the start or restart) [a]
   integer :: largest_overlap_step = 0
   real(dp), allocatable :: position_before(:, :)    ! X^n, then X^{n+1} - X^n, as a step moves the spheres
@@ -104,6 +105,22 @@ program fdsusp
            ' (period-two oscillation measured above it; doc/CONTACT.md): the largest stable dt here is ', &
            CHATTER_LIMIT * cfg%dt / chatter_number(pc%params, cfg%dt), ' (or raise &contact eps_bar)'
       call input_error(cfg%deck_file, 'time', 'dt', trim(text))
+    end if
+    ! the roughness of a dense suspension flattens under its force chains (doc/VALIDATION.md §6)
+    if (cfg%walls) then
+      solid_fraction = parts%n * (4.0_dp / 3.0_dp) * acos(-1.0_dp) * parts%radius**3 / product(cfg%box)
+      expected_overlap = flattening_estimate(pc%params, solid_fraction)
+      if (expected_overlap > 1.0_dp) then
+        write(text, '(a,f6.2,a,f5.3,a,es9.2,a)') 'the roughness would flatten completely: expected largest overlap ', &
+             expected_overlap, ' h_r at phi = ', solid_fraction, ' (doc/VALIDATION.md §6); stiffer contacts, eps_bar <= ', &
+             0.5_dp * cfg%eps_bar / expected_overlap, ' (or a larger normal_stiffness), keep it below h_r/2'
+        call input_error(cfg%deck_file, 'contact', trim(merge('normal_stiffness', 'eps_bar         ', &
+                         cfg%normal_stiffness > 0.0_dp)), trim(text))
+      else if (expected_overlap > 0.5_dp) then
+        write(text, '(a,f6.2,a,f5.3,a)') 'expected largest contact overlap ', expected_overlap, ' h_r at phi = ', &
+             solid_fraction, ' (> h_r/2, doc/VALIDATION.md §6): a smaller &contact eps_bar keeps the roughness'
+        call warn_line(text)
+      end if
     end if
   end if
   ! statistics of the core region (doc/RHEOLOGY.md)

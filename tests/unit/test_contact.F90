@@ -27,9 +27,12 @@
 !  12. The chatter number dt gamma_dot h_r/delta_0 reduces to dt gamma_dot/eps_bar when k_n comes
 !      from eps_bar (1e-13: one power and a few products), scales as k_n^(2/3) for a prescribed
 !      k_n (8 k_n gives 4 times the number, 1e-13), and is 0 for smooth spheres.
+!  13. The flattening estimate eps_bar g(phi) takes the measured g at its table points (6.9 at
+!      phi = 0.4, 26 at 0.55; 1e-13), is continuous at the joins (0.3, 0.5: 1e-12) and is eps_bar
+!      at phi = 0 (one pair under the force scale).
 program test_contact
   use mod_kinds, only: dp, pi
-  use mod_contact, only: contact_params_t, contact_setup, chatter_number, contact_history_t, history_size, &
+  use mod_contact, only: contact_params_t, contact_setup, chatter_number, flattening_estimate, contact_history_t, history_size, &
                          contact_pair, contact_forces, contact_stats_t, history_lookup
   implicit none
   type(contact_params_t) :: p, p0, pb
@@ -224,6 +227,15 @@ program test_contact
   call check('chatter number scales as k_n^(2/3)', err < 1e-13_dp)
   call contact_setup(p0, 1.0_dp, 0.0_dp, 0.5_dp, 0.05_dp, 1.0e6_dp, 1.0_dp, 1.0_dp, info, msg)
   call check('no chatter number for smooth spheres', chatter_number(p0, 2.0e-3_dp) == 0)
+
+  ! 13. flattening estimate (p: eps_bar = 0.05)
+  call check('flattening at phi = 0.4 is 6.9 eps_bar', abs(flattening_estimate(p, 0.4_dp) / (6.9_dp * 0.05_dp) - 1) < 1e-13_dp)
+  call check('flattening at phi = 0.55 is 26 eps_bar', abs(flattening_estimate(p, 0.55_dp) / (26.0_dp * 0.05_dp) - 1) < 1e-13_dp)
+  call check('flattening continuous at phi = 0.3', abs(flattening_estimate(p, 0.3_dp - 1e-12_dp) &
+             / flattening_estimate(p, 0.3_dp + 1e-12_dp) - 1) < 1e-10_dp)
+  call check('flattening continuous at phi = 0.5', abs(flattening_estimate(p, 0.5_dp - 1e-12_dp) &
+             / flattening_estimate(p, 0.5_dp + 1e-12_dp) - 1) < 1e-10_dp)
+  call check('flattening at phi = 0 is eps_bar', abs(flattening_estimate(p, 0.0_dp) / 0.05_dp - 1) < 1e-13_dp)
 
   if (nfail > 0) then
     print '(i0,a)', nfail, ' check(s) FAILED'
