@@ -6,7 +6,7 @@
 program fdsusp
 #include <petsc/finclude/petscvec.h>
   use petscvec
-  use mod_kinds, only: dp
+  use mod_kinds, only: dp, pi
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
   use mod_params, only: config_t, read_deck, echo_deck, max_line
   use mod_errors, only: log_line, warn_line, input_error, fatal_error, is_root
@@ -47,7 +47,6 @@ program fdsusp
   type(rheology_t), allocatable :: rh               ! allocated when the deck has &rheology
   real(dp), allocatable :: statistics(:)            ! rh's accumulators, for checkpoints
   real(dp), allocatable :: mean_flow(:)             ! x-z plane means of u, per cell row
-  real(dp) :: solid_fraction, expected_overlap        ! the start-up flattening check
   real(dp) :: largest_overlap = 0.0_dp              ! of this run (since the start or restart) [a]
   integer :: largest_overlap_step = 0
   real(dp), allocatable :: position_before(:, :)    ! X^n, then X^{n+1} - X^n, as a step moves the spheres
@@ -96,33 +95,8 @@ program fdsusp
     call plub_create(pl, lub, parts%n, cfg%box, cfg%walls, cfg%shear_rate, cfg%lubrication_skin, info, text)
     if (info /= 0) call input_error(cfg%deck_file, 'lubrication', 'skin', trim(text))
   end if
-  ! the explicit rough contacts against the lubricated response: refused where they chatter
-  ! (doc/CONTACT.md "Time-step considerations": clean at 0.02, period-two chatter from 0.03 on)
-  if (has_contacts .and. has_lubrication) then
-    if (chatter_number(pc%params, cfg%dt) > CHATTER_LIMIT) then
-      write(text, '(a,f6.3,a,f5.3,a,es9.2,a)') 'the rough contacts would chatter: dt gamma_dot h_r/delta_0 = ', &
-           chatter_number(pc%params, cfg%dt), ' exceeds ', CHATTER_LIMIT, &
-           ' (period-two oscillation measured above it; doc/CONTACT.md): the largest stable dt here is ', &
-           CHATTER_LIMIT * cfg%dt / chatter_number(pc%params, cfg%dt), ' (or raise &contact eps_bar)'
-      call input_error(cfg%deck_file, 'time', 'dt', trim(text))
-    end if
-    ! the roughness of a dense suspension flattens under its force chains (doc/VALIDATION.md §6)
-    if (cfg%walls) then
-      solid_fraction = parts%n * (4.0_dp / 3.0_dp) * acos(-1.0_dp) * parts%radius**3 / product(cfg%box)
-      expected_overlap = flattening_estimate(pc%params, solid_fraction)
-      if (expected_overlap > 1.0_dp) then
-        write(text, '(a,f6.2,a,f5.3,a,es9.2,a)') 'the roughness would flatten completely: expected largest overlap ', &
-             expected_overlap, ' h_r at phi = ', solid_fraction, ' (doc/VALIDATION.md §6); stiffer contacts, eps_bar <= ', &
-             0.5_dp * cfg%eps_bar / expected_overlap, ' (or a larger normal_stiffness), keep it below h_r/2'
-        call input_error(cfg%deck_file, 'contact', trim(merge('normal_stiffness', 'eps_bar         ', &
-                         cfg%normal_stiffness > 0.0_dp)), trim(text))
-      else if (expected_overlap > 0.5_dp) then
-        write(text, '(a,f6.2,a,f5.3,a)') 'expected largest contact overlap ', expected_overlap, ' h_r at phi = ', &
-             solid_fraction, ' (> h_r/2, doc/VALIDATION.md §6): a smaller &contact eps_bar keeps the roughness'
-        call warn_line(text)
-      end if
-    end if
-  end if
+  ! rough contacts: the limits of doc/CONTACT.md and doc/VALIDATION.md §6, before any work
+  if (has_contacts .and. has_lubrication) call check_contact_limits()
   ! statistics of the core region (doc/RHEOLOGY.md)
   if (cfg%rheology_group) then
     allocate(rh)
@@ -266,17 +240,7 @@ program fdsusp
         PetscCallA(stage_push(STAGE_CONTACTS, ierr))
         call pcontacts_step(pc, parts%position, parts%velocity, parts%omega, info)
         if (info /= 0) call contact_failure(info)
-        if (pc%max_overlap > largest_overlap) then
-          ! once: the roughness deforms beyond the bound the extreme scenes hold (doc/VALIDATION.md §6)
-          if (largest_overlap <= 0.5_dp * pc%params%h_r .and. pc%max_overlap > 0.5_dp * pc%params%h_r) then
-            write(text, '(a,i0,a,f6.3,a)') 'at step ', step, ' a contact overlap reaches ', &
-                 pc%max_overlap / pc%params%h_r, ' h_r (> h_r/2): stiffer contacts (a smaller &contact eps_bar '// &
-                 'or a larger normal_stiffness, with dt gamma_dot h_r/delta_0 <= 0.025) keep the roughness from flattening'
-            call warn_line(text)
-          end if
-          largest_overlap = pc%max_overlap
-          largest_overlap_step = step
-        end if
+        if (pc%max_overlap > largest_overlap) call note_overlap()
         PetscCallA(stage_pop(ierr))
       end if
       if (has_lubrication) then
@@ -548,6 +512,49 @@ contains
            ' a, ', size(lub%pair_gap), ' tabulated gaps)'
     end select
   end function lubrication_models
+
+  ! The explicit rough contacts against the lubricated response: refused where they chatter
+  ! (doc/CONTACT.md "Time-step considerations": clean at 0.02, period-two chatter from 0.03 on),
+  ! and where the roughness of a dense suspension would flatten completely (doc/VALIDATION.md §6).
+  subroutine check_contact_limits()
+    real(dp) :: solid_fraction, expected_overlap
+    if (chatter_number(pc%params, cfg%dt) > CHATTER_LIMIT) then
+      write(text, '(a,f6.3,a,f5.3,a,es9.2,a)') 'the rough contacts would chatter: dt gamma_dot h_r/delta_0 = ', &
+           chatter_number(pc%params, cfg%dt), ' exceeds ', CHATTER_LIMIT, &
+           ' (period-two oscillation measured above it; doc/CONTACT.md): the largest stable dt here is ', &
+           CHATTER_LIMIT * cfg%dt / chatter_number(pc%params, cfg%dt), ' (or raise &contact eps_bar)'
+      call input_error(cfg%deck_file, 'time', 'dt', trim(text))
+    end if
+    ! the roughness of a dense suspension flattens under its force chains (doc/VALIDATION.md §6)
+    if (cfg%walls) then
+      solid_fraction = parts%n * (4.0_dp / 3.0_dp) * pi * parts%radius**3 / product(cfg%box)
+      expected_overlap = flattening_estimate(pc%params, solid_fraction)
+      if (expected_overlap > 1.0_dp) then
+        write(text, '(a,f6.2,a,f5.3,a,es9.2,a)') 'the roughness would flatten completely: expected largest overlap ', &
+             expected_overlap, ' h_r at phi = ', solid_fraction, ' (doc/VALIDATION.md §6); stiffer contacts, eps_bar <= ', &
+             0.5_dp * cfg%eps_bar / expected_overlap, ' (or a larger normal_stiffness), keep it below h_r/2'
+        call input_error(cfg%deck_file, 'contact', trim(merge('normal_stiffness', 'eps_bar         ', &
+                         cfg%normal_stiffness > 0.0_dp)), trim(text))
+      else if (expected_overlap > 0.5_dp) then
+        write(text, '(a,f6.2,a,f5.3,a)') 'expected largest contact overlap ', expected_overlap, ' h_r at phi = ', &
+             solid_fraction, ' (> h_r/2, doc/VALIDATION.md §6): a smaller &contact eps_bar keeps the roughness'
+        call warn_line(text)
+      end if
+    end if
+  end subroutine check_contact_limits
+
+  ! A new largest overlap of the run; warned once when it passes h_r/2, the bound the extreme
+  ! scenes hold (doc/VALIDATION.md §6).
+  subroutine note_overlap()
+    if (largest_overlap <= 0.5_dp * pc%params%h_r .and. pc%max_overlap > 0.5_dp * pc%params%h_r) then
+      write(text, '(a,i0,a,f6.3,a)') 'at step ', step, ' a contact overlap reaches ', &
+           pc%max_overlap / pc%params%h_r, ' h_r (> h_r/2): stiffer contacts (a smaller &contact eps_bar '// &
+           'or a larger normal_stiffness, with dt gamma_dot h_r/delta_0 <= 0.025) keep the roughness from flattening'
+      call warn_line(text)
+    end if
+    largest_overlap = pc%max_overlap
+    largest_overlap_step = step
+  end subroutine note_overlap
 
   ! Collective (every rank holds the same contacts): stop with a diagnostic.
   subroutine contact_failure(code)
