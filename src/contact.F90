@@ -82,29 +82,33 @@ contains
     type(contact_params_t), intent(in) :: p
     real(dp), intent(in) :: phi
     real(dp), parameter :: phis(4) = [0.3_dp, 0.4_dp, 0.5_dp, 0.55_dp], g(4) = [3.2_dp, 6.9_dp, 16.7_dp, 26.0_dp]
-    real(dp) :: delta_0, factor
+    real(dp) :: factor
     integer :: k
     e = 0
     if (p%h_r <= 0 .or. p%gamma_dot == 0 .or. p%k_n <= 0) return
-    delta_0 = (6 * pi * p%eta * abs(p%gamma_dot) * p%a**2 / p%k_n)**(2.0_dp / 3)
     if (phi <= phis(1)) then
       factor = 1 + (g(1) - 1) * max(phi, 0.0_dp) / phis(1)
     else
       k = min(3, count(phis(2:3) <= phi) + 1)
       factor = g(k) + (g(k + 1) - g(k)) * (phi - phis(k)) / (phis(k + 1) - phis(k))
     end if
-    e = delta_0 / p%h_r * factor
+    e = reference_overlap(p) / p%h_r * factor
   end function flattening_estimate
 
   pure real(dp) function chatter_number(p, dt) result(q)
     type(contact_params_t), intent(in) :: p
     real(dp), intent(in) :: dt
-    real(dp) :: delta_0
     q = 0
     if (p%h_r <= 0 .or. p%gamma_dot == 0 .or. p%k_n <= 0) return
-    delta_0 = (6 * pi * p%eta * abs(p%gamma_dot) * p%a**2 / p%k_n)**(2.0_dp / 3)
-    q = dt * abs(p%gamma_dot) * p%h_r / delta_0
+    q = dt * abs(p%gamma_dot) * p%h_r / reference_overlap(p)
   end function chatter_number
+
+  !> delta_0 = (6 pi eta gamma_dot a^2 / k_n)^(2/3): the Hertz overlap under the force scale
+  !> (eps_bar h_r when k_n comes from eps_bar); needs k_n > 0 and gamma_dot /= 0.
+  pure real(dp) function reference_overlap(p) result(delta_0)
+    type(contact_params_t), intent(in) :: p
+    delta_0 = (6 * pi * p%eta * abs(p%gamma_dot) * p%a**2 / p%k_n)**(2.0_dp / 3)
+  end function reference_overlap
 
   !> Parameters from the deck quantities. eps_r = h_r/a. k_n_prescribed > 0 overrides the eps_bar
   !> rule. info: 0 ok; 1 a <= 0, eta <= 0 or a negative eps_r, mu_d; 2 k_n cannot be derived

@@ -517,12 +517,13 @@ contains
   ! (doc/CONTACT.md "Time-step considerations": clean at 0.02, period-two chatter from 0.03 on),
   ! and where the roughness of a dense suspension would flatten completely (doc/VALIDATION.md §6).
   subroutine check_contact_limits()
-    real(dp) :: solid_fraction, expected_overlap
-    if (chatter_number(pc%params, cfg%dt) > CHATTER_LIMIT) then
+    real(dp) :: chatter, solid_fraction, expected_overlap
+    chatter = chatter_number(pc%params, cfg%dt)
+    if (chatter > CHATTER_LIMIT) then
       write(text, '(a,f6.3,a,f5.3,a,es9.2,a)') 'the rough contacts would chatter: dt gamma_dot h_r/delta_0 = ', &
-           chatter_number(pc%params, cfg%dt), ' exceeds ', CHATTER_LIMIT, &
+           chatter, ' exceeds ', CHATTER_LIMIT, &
            ' (period-two oscillation measured above it; doc/CONTACT.md): the largest stable dt here is ', &
-           CHATTER_LIMIT * cfg%dt / chatter_number(pc%params, cfg%dt), ' (or raise &contact eps_bar)'
+           CHATTER_LIMIT * cfg%dt / chatter, ' (or raise &contact eps_bar)'
       call input_error(cfg%deck_file, 'time', 'dt', trim(text))
     end if
     ! the roughness of a dense suspension flattens under its force chains (doc/VALIDATION.md §6)
