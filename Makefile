@@ -5,6 +5,7 @@
 #   make run        run input/demo.nml on 2 ranks
 #   make bench      timings recorded in doc/BENCHMARKS.md
 #   make extremes   the extreme scenes of input/extremes in full (doc/VALIDATION.md §6)
+#   make tradeoff   speed against accuracy, one knob at a time (doc/BENCHMARKS.md §8)
 # PETSC_DIR defaults to Debian's petsc-dev; set it to use a cluster's PETSc (3.18, real, double).
 
 SHELL := /bin/bash
@@ -73,7 +74,7 @@ UNIT_BIN := $(patsubst tests/unit/%.F90,$(BUILD)/tests/%,$(UNIT_F90))
 
 PROGRAMS := $(BIN)/fdsusp $(BIN)/fdsusp-pack $(BIN)/fdsusp-resistance $(if $(REF_F90),$(BIN)/pairtraj)
 
-.PHONY: all debug check run bench extremes calibrate clean tests-build
+.PHONY: all debug check run bench extremes tradeoff calibrate clean tests-build
 all: $(PROGRAMS) $(UNIT_BIN)
 
 debug:
@@ -125,6 +126,11 @@ bench: all
 # The extreme scenes of issue 8 in full (input/extremes, 5 strains each; doc/VALIDATION.md §6)
 extremes: all
 	$(PYTHON) scripts/extremes.py --json out/extremes/extremes.json
+
+# Speed against accuracy (issue 7): error of each setting against the finest, CPU s per strain,
+# table and doc/figures/tradeoff.png (doc/BENCHMARKS.md §8; about 70 CPU minutes)
+tradeoff: all
+	$(PYTHON) scripts/tradeoff.py
 
 # Lubrication tables (doc/LUBRICATION.md): the resolved resistance measured at each a/Delta and
 # written to input/lubrication/resolved_a<N>.h5. CELLS_PER_RADIUS="5" redoes one resolution.

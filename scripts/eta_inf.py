@@ -17,6 +17,9 @@ import os
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from jobpool import ENV, run_all  # noqa: E402
+
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
 DECK = """&domain box = {box}, cells_per_radius = {cells}, shear_rate = 1 /
 &fluid reynolds = 0.01, initial_flow = 'shear', viscous_theta = 1 /
@@ -38,34 +41,30 @@ def main():
     ap.add_argument('--work', default=os.path.join(ROOT, 'out', 'eta_inf'))
     ap.add_argument('--table-only', action='store_true', help='tabulate finished runs in --work, run nothing')
     args = ap.parse_args()
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT='1', OMPI_ALLOW_RUN_AS_ROOT_CONFIRM='1')
     cases = [(phi, seed) for phi in args.phi for seed in args.seeds]
-    running, done = [], []
     discard = (args.steps - 50) * 5e-3
-    while cases or running:
-        while cases and args.table_only:
-            phi, seed = cases.pop(0)
-            d = os.path.join(args.work, 'phi%g_seed%d' % (phi, seed))
-            with open(os.path.join(d, 'out', 'summary.json')) as f:
-                done.append((phi, seed, json.load(f)['quantities']))
-        while cases and len(running) < args.jobs:
-            phi, seed = cases.pop(0)
-            d = os.path.join(args.work, 'phi%g_seed%d' % (phi, seed))
-            os.makedirs(d, exist_ok=True)
-            with open(os.path.join(d, 'deck.nml'), 'w') as f:
-                f.write(DECK.format(box=', '.join('%g' % b for b in args.box), cells=args.cells, phi=phi,
-                                    seed=seed, discard=discard))
-            log = open(os.path.join(d, 'log'), 'w')
-            running.append((phi, seed, d, subprocess.Popen([os.path.join(ROOT, 'bin', 'fdsusp'), 'deck.nml'],
-                                                           cwd=d, env=env, stdout=log, stderr=subprocess.STDOUT)))
-        if not running:
-            break
-        phi, seed, d, p = running.pop(0)
-        if p.wait() != 0:
-            sys.exit('fdsusp failed in ' + d)
-        with open(os.path.join(d, 'out', 'summary.json')) as f:
-            q = json.load(f)['quantities']
-        done.append((phi, seed, q))
+
+    def case_dir(case):
+        return os.path.join(args.work, 'phi%g_seed%d' % case)
+
+    def start(case):
+        d = case_dir(case)
+        os.makedirs(d, exist_ok=True)
+        with open(os.path.join(d, 'deck.nml'), 'w') as f:
+            f.write(DECK.format(box=', '.join('%g' % b for b in args.box), cells=args.cells, phi=case[0],
+                                seed=case[1], discard=discard))
+        log = open(os.path.join(d, 'log'), 'w')
+        return subprocess.Popen([os.path.join(ROOT, 'bin', 'fdsusp'), 'deck.nml'], cwd=d, env=ENV, stdout=log,
+                                stderr=subprocess.STDOUT)
+
+    if not args.table_only:
+        for case, (status, _) in run_all(cases, start, args.jobs).items():
+            if status != 0:
+                sys.exit('fdsusp failed in ' + case_dir(case))
+    done = []
+    for case in cases:
+        with open(os.path.join(case_dir(case), 'out', 'summary.json')) as f:
+            done.append(case + (json.load(f)['quantities'],))
     print('| phi (packed) | seed | phi_core | gamma_dot_core (flow) | eta_inf | Krieger fit | difference '
           '| (eta - 1)/phi_core | 2.5 + 5.0 phi_core | difference |')
     print('|---|---|---|---|---|---|---|---|---|---|')

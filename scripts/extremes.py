@@ -22,6 +22,9 @@ import sys
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from jobpool import ENV, run_all  # noqa: E402
+
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
 SCENES = os.path.join(ROOT, 'input', 'extremes')
 
@@ -95,13 +98,12 @@ def main():
                     help='judge the scenes already run in --work (status read from their logs), run nothing')
     args = ap.parse_args()
     names = args.scenes or sorted(os.path.basename(p)[:-4] for p in glob.glob(os.path.join(SCENES, '*.nml')))
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT='1', OMPI_ALLOW_RUN_AS_ROOT_CONFIRM='1')
     # a copy, so that a rebuild during the study cannot change or break it
     args.work = os.path.abspath(args.work)
     os.makedirs(args.work, exist_ok=True)
     binary = os.path.join(args.work, 'fdsusp')
     shutil.copy2(os.path.join(os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin')), 'fdsusp'), binary)
-    waiting, running, records = list(names), [], []
+    waiting, records = list(names), []
     if args.table_only:
         waiting = []
         for name in names:
@@ -113,16 +115,18 @@ def main():
                                                              'fdsusp: fatal' not in log else 1)
             records.append(verdict(name, d, status, int(re.search(r'steps\s*=\s*(\d+)', time_group).group(1)),
                                    float(re.search(r'dt\s*=\s*([0-9.eE+-]+)', time_group).group(1))))
-    while waiting or running:
-        while waiting and len(running) < args.jobs:
-            name = waiting.pop(0)
-            d, requested, dt = prepare(name, args.work, args.steps)
-            log = open(os.path.join(d, 'log'), 'w')
-            proc = subprocess.Popen([binary, 'deck.nml'], cwd=d, env=env, stdout=log, stderr=subprocess.STDOUT)
-            running.append((name, d, requested, dt, proc))
-        name, d, requested, dt, proc = running.pop(0)
-        proc.wait()
-        records.append(verdict(name, d, proc.returncode, requested, dt))
+    prepared = {}
+
+    def start(name):
+        prepared[name] = prepare(name, args.work, args.steps)
+        d = prepared[name][0]
+        log = open(os.path.join(d, 'log'), 'w')
+        return subprocess.Popen([binary, 'deck.nml'], cwd=d, env=ENV, stdout=log, stderr=subprocess.STDOUT)
+
+    statuses = run_all(waiting, start, args.jobs)
+    for name in waiting:
+        d, requested, dt = prepared[name]
+        records.append(verdict(name, d, statuses[name][0], requested, dt))
     print('| scene | dt | steps (strain) | verdict | largest overlap / h_r | finite | message or warnings |')
     print('|---|---|---|---|---|---|---|')
     for r in records:

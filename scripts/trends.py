@@ -26,6 +26,9 @@ import shutil
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from jobpool import ENV, run_all  # noqa: E402
+
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
 DECK = """&domain box = {box}, cells_per_radius = {cells}, y_boundary = 'walls', shear_rate = 1 /
 &fluid reynolds = 0.01, initial_flow = 'shear' /
@@ -45,7 +48,7 @@ def case_dir(work, phi, mu):
     return os.path.join(work, 'phi%g_mu%g' % (phi, mu))
 
 
-def start(d, args, phi, mu, env):
+def start(d, args, phi, mu):
     os.makedirs(d, exist_ok=True)
     binary = os.path.join(d, 'fdsusp')
     if not os.path.exists(binary):
@@ -60,7 +63,7 @@ def start(d, args, phi, mu, env):
     log = open(os.path.join(d, 'log'), 'a')
     log.write('\n# %s\n' % ' '.join(command))
     log.flush()
-    return subprocess.Popen(command, cwd=d, env=env, stdout=log, stderr=subprocess.STDOUT)
+    return subprocess.Popen(command, cwd=d, env=ENV, stdout=log, stderr=subprocess.STDOUT)
 
 
 def summary(d):
@@ -89,20 +92,15 @@ def main():
     ap.add_argument('--work', default=os.path.join(ROOT, 'out', 'trends'))
     ap.add_argument('--table-only', action='store_true', help='tabulate the finished cases, run nothing')
     args = ap.parse_args()
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT='1', OMPI_ALLOW_RUN_AS_ROOT_CONFIRM='1')
     cases = [(phi, mu) for phi in args.phi for mu in args.friction]
     if not args.table_only:
         waiting = [c for c in cases if summary(case_dir(args.work, *c)) is None]
-        running = []
-        while waiting or running:
-            while waiting and len(running) < args.jobs:
-                phi, mu = waiting.pop(0)
-                running.append((phi, mu, start(case_dir(args.work, phi, mu), args, phi, mu, env)))
-            phi, mu, proc = running[0]
-            proc.wait()
-            running.pop(0)
-            if proc.returncode != 0:
-                print('case phi %g mu %g stopped with status %d (see its log)' % (phi, mu, proc.returncode))
+
+        def report(case, status, cpu):
+            if status != 0:
+                print('case phi %g mu %g stopped with status %d (see its log)' % (case + (status,)))
+
+        run_all(waiting, lambda c: start(case_dir(args.work, *c), args, *c), args.jobs, report)
     results = {c: summary(case_dir(args.work, *c)) for c in cases}
     print('| phi | mu_d | ' + ' | '.join(SHOWN) + ' |')
     print('|---|---|' + '---|' * len(SHOWN))

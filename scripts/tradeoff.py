@@ -1,0 +1,228 @@
+#!/usr/bin/env python3
+"""Speed against accuracy (issue 7): one knob at a time around the default settings, for a small
+sheared suspension, with the error of each setting against the finest one and its cost per strain.
+
+    scripts/tradeoff.py [--knobs grid dt tolerance lubrication] [--strain 1.0] [--jobs 2]
+                        [--work out/tradeoff] [--table-only] [--plot FILE]
+
+The scene (the same packing at every setting: seed 1, positions in units of a): phi = 0.3 in a
+7a x 10a x 7a Couette cell with walls, rough frictional contacts (eps_r = 5e-3, eps_bar = 0.1,
+mu_d = 0.5), shear rate 1, started from the linear profile; the core stress (2.5a < y < 7.5a) is
+averaged over strains 0.2 to --strain. All runs follow the same deterministic trajectory up to
+their discretisation, so the difference of their mean eta_r is the error of the setting, not
+sampling noise (over one strain the trajectories do not decorrelate; the block standard error of
+each run is printed beside it for scale).
+
+Settings (base: a/Delta = 4, dt = 1e-3, tolerances 1e-8 / 1e-10, lubrication 'full'):
+  grid         a/Delta = 4, 5 and every further a/Delta with a shipped table (full model);
+               the 'simple' model at a/Delta = 4, 5, 6, 8 (no table needed)
+  dt           2e-3, 1e-3, 5e-4, 2.5e-4
+  tolerance    velocity = pressure relative tolerance 1e-3, 1e-4, 1e-6, 1e-8 (base: 1e-8 / 1e-10)
+  lubrication  none, simple, full at a/Delta = 4
+The reference is the finest of everything available: the largest a/Delta with a table, dt =
+2.5e-4, the base tolerances, 'full'. Cost = CPU seconds per unit strain of the single-rank run
+(its own rusage, start-up included), so runs side by side do not bias it.
+
+Writes a markdown table (doc/BENCHMARKS.md §8), out/tradeoff/tradeoff.json and the error-cost
+plot with its Pareto front (doc/figures/tradeoff.png by default).
+"""
+import argparse
+import glob
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from jobpool import ENV, run_all  # noqa: E402
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
+BASE = {'cells': 4, 'dt': 1e-3, 'vtol': 1e-8, 'ptol': 1e-10, 'lub': 'full'}
+DECK = """&domain box = 7, 10, 7, cells_per_radius = {cells}, y_boundary = 'walls', shear_rate = 1 /
+&fluid reynolds = 0.01, initial_flow = 'shear', velocity_tolerance = {vtol:g}, pressure_tolerance = {ptol:g} /
+&time dt = {dt:g} /
+&output directory = 'out', progress_every = 250, series_every = 1 /
+&particles solid_fraction = 0.3, seed = 1 /
+&contact roughness = 5e-3, eps_bar = 0.1, friction = 0.5 /
+&lubrication model = '{lub}' /
+&rheology discard_strain = 0.2, average_strain = {average:g}, blocks = 4 /
+&run title = 'tradeoff: {name}' /
+"""
+
+
+def tabled_grids():
+    """a/Delta of the shipped full-model tables."""
+    found = []
+    for path in glob.glob(os.path.join(ROOT, 'input', 'lubrication', 'resolved_a*.h5')):
+        m = re.search(r'resolved_a(\d+)\.h5$', path)
+        if m:
+            found.append(int(m.group(1)))
+    return sorted(found)
+
+
+def settings(knobs):
+    """(name, knob, label, parameters) for every run; the reference first."""
+    grids = tabled_grids()
+    runs = [('reference', 'reference', 'a/D %d, dt 2.5e-4, full' % grids[-1],
+             dict(BASE, cells=grids[-1], dt=2.5e-4))]
+    if 'grid' in knobs:
+        runs += [('grid_full_a%d' % n, 'grid', 'a/D %d full' % n, dict(BASE, cells=n)) for n in grids]
+        runs += [('grid_simple_a%d' % n, 'grid', 'a/D %d simple' % n, dict(BASE, cells=n, lub='simple'))
+                 for n in (4, 5, 6, 8)]
+    if 'dt' in knobs:
+        runs += [('dt_%g' % dt, 'dt', 'dt %g' % dt, dict(BASE, dt=dt)) for dt in (2e-3, 1e-3, 5e-4, 2.5e-4)]
+    if 'tolerance' in knobs:
+        runs += [('tol_%g' % t, 'tolerance', 'tol %g' % t, dict(BASE, vtol=t, ptol=t))
+                 for t in (1e-3, 1e-4, 1e-6, 1e-8)]
+    if 'lubrication' in knobs:
+        runs += [('lub_%s' % m, 'lubrication', 'lubrication %s' % m, dict(BASE, lub=m))
+                 for m in ('none', 'simple', 'full')]
+        # without the correction the contacts need a shorter step (doc/INPUT.md &lubrication)
+        runs += [('lub_none_dt2.5e-4', 'lubrication', 'none, dt 2.5e-4', dict(BASE, lub='none', dt=2.5e-4))]
+    # identical parameter sets run once (the base appears under several knobs)
+    unique, seen = [], {}
+    for name, knob, label, p in runs:
+        key = tuple(sorted(p.items()))
+        if key in seen:
+            unique.append((seen[key], knob, label, p))
+        else:
+            seen[key] = name
+            unique.append((name, knob, label, p))
+    return unique
+
+
+def start(work, name, p, strain):
+    d = os.path.join(work, name)
+    if os.path.exists(d):
+        shutil.rmtree(d)
+    os.makedirs(d)
+    with open(os.path.join(d, 'deck.nml'), 'w') as f:
+        f.write(DECK.format(average=strain - 0.2, name=name, **p))
+    log = open(os.path.join(d, 'log'), 'w')
+    return subprocess.Popen([os.path.join(work, 'fdsusp'), 'deck.nml'], cwd=d, env=ENV,
+                            stdout=log, stderr=subprocess.STDOUT)
+
+
+def result(work, name):
+    """(quantities, None) of a finished run, else (None, why): the run's first error line."""
+    path = os.path.join(work, name, 'out', 'summary.json')
+    if os.path.exists(path):
+        with open(path) as f:
+            s = json.load(f)
+        if s.get('complete'):
+            return s['quantities'], None
+    why = 'not run'
+    log = os.path.join(work, name, 'log')
+    if os.path.exists(log):
+        errors = [line for line in open(log) if line.startswith('fdsusp: fatal') or
+                  line.startswith('fdsusp: input error')]
+        # the message up to its advice, without the '|' of |delta'| (the table is markdown)
+        why = errors[0][len('fdsusp: '):].split(';')[0].replace('|', '').strip() if errors else 'unfinished'
+    return None, why
+
+
+def pareto(points):
+    """Indices of the points no other point beats in both cost and error."""
+    front = []
+    for i, (c, e) in enumerate(points):
+        if not any((c2 <= c and e2 <= e) and (c2 < c or e2 < e) for c2, e2 in points):
+            front.append(i)
+    return sorted(front, key=lambda i: points[i][0])
+
+
+def plot(rows, path):
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(7, 5))
+    markers = {'grid': 'o', 'dt': 's', 'tolerance': '^', 'lubrication': 'D'}
+    for knob, marker in markers.items():
+        pts = [r for r in rows if r['knob'] == knob and r['error'] is not None]
+        if pts:
+            ax.scatter([r['cpu_per_strain'] for r in pts], [max(r['error'], 1e-5) for r in pts],
+                       marker=marker, label=knob, s=40)
+            for r in pts:
+                ax.annotate(r['label'], (r['cpu_per_strain'], max(r['error'], 1e-5)), fontsize=6,
+                            xytext=(3, 3), textcoords='offset points')
+    pts = [r for r in rows if r['knob'] != 'reference' and r['error'] is not None]
+    front = pareto([(r['cpu_per_strain'], max(r['error'], 1e-5)) for r in pts])
+    ax.plot([pts[i]['cpu_per_strain'] for i in front], [max(pts[i]['error'], 1e-5) for i in front],
+            'k--', lw=1, label='Pareto front')
+    ax.set_xscale('log')
+    ax.set_yscale('log')
+    ax.set_xlabel('cost: CPU seconds per unit strain (1 rank)')
+    ax.set_ylabel('|eta_r - eta_r(reference)| / eta_r(reference)')
+    ax.set_title('fdsusp speed against accuracy (phi = 0.3, 7a x 10a x 7a)')
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    fig.savefig(path, dpi=120)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument('--knobs', nargs='+', default=['grid', 'dt', 'tolerance', 'lubrication'],
+                    choices=['grid', 'dt', 'tolerance', 'lubrication'])
+    ap.add_argument('--strain', type=float, default=1.0, help='strain run (the first 0.2 discarded)')
+    ap.add_argument('--jobs', type=int, default=2)
+    ap.add_argument('--work', default=os.path.join(ROOT, 'out', 'tradeoff'))
+    ap.add_argument('--table-only', action='store_true', help='tabulate runs already made')
+    ap.add_argument('--plot', default=os.path.join(ROOT, 'doc', 'figures', 'tradeoff.png'))
+    args = ap.parse_args()
+    if args.strain <= 0.2:
+        ap.error('--strain must exceed the 0.2 strain discarded')
+    runs = settings(args.knobs)
+    cpu_path = os.path.join(args.work, 'cpu.json')
+    cpu = {}
+    if os.path.exists(cpu_path):
+        with open(cpu_path) as f:
+            cpu = json.load(f)
+    if not args.table_only:
+        os.makedirs(args.work, exist_ok=True)
+        shutil.copy2(os.path.join(ROOT, 'bin', 'fdsusp'), os.path.join(args.work, 'fdsusp'))
+        params = {}
+        for name, _, _, p in runs:
+            params.setdefault(name, p)
+
+        def report(name, status, seconds):
+            cpu[name] = seconds
+            with open(cpu_path, 'w') as f:
+                json.dump(cpu, f, indent=1)
+            print('%-20s status %d, %.0f CPU s' % (name, status, seconds), flush=True)
+
+        run_all(list(params), lambda n: start(args.work, n, params[n], args.strain), args.jobs, report)
+
+    ref = result(args.work, 'reference')[0]
+    rows = []
+    for name, knob, label, p in runs:
+        q, why = result(args.work, name)
+        row = {'name': name, 'knob': knob, 'label': label, 'parameters': p, 'eta_r': None,
+               'eta_r_error': None, 'error': None, 'failure': why,
+               'cpu_per_strain': cpu.get(name, float('nan')) / args.strain}
+        if q is not None:
+            row['eta_r'], row['eta_r_error'] = q['eta_r']['value'], q['eta_r']['error']
+            if ref is not None:
+                row['error'] = abs(row['eta_r'] / ref['eta_r']['value'] - 1.0)
+        rows.append(row)
+    with open(os.path.join(args.work, 'tradeoff.json'), 'w') as f:
+        json.dump(rows, f, indent=1)
+    print('| knob | setting | eta_r (block s.e.) | error vs reference | CPU s per strain |')
+    print('|---|---|---|---|---|')
+    for r in rows:
+        if r['eta_r'] is None:
+            print('| %s | %s | failed: %s | | %.0f |' % (r['knob'], r['label'], r['failure'],
+                                                     r['cpu_per_strain']))
+            continue
+        print('| %s | %s | %.4f (%.3f) | %s | %.0f |'
+              % (r['knob'], r['label'], r['eta_r'], r['eta_r_error'],
+                 '-' if r['error'] is None else '%.2e' % r['error'], r['cpu_per_strain']))
+    if any(r['error'] is not None and r['knob'] != 'reference' for r in rows):
+        plot(rows, args.plot)
+        print('plot: %s' % os.path.relpath(args.plot, ROOT))
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
