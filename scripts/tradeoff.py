@@ -13,15 +13,18 @@ their discretisation, so the difference of their mean eta_r is the error of the 
 sampling noise (over one strain the trajectories do not decorrelate; the block standard error of
 each run is printed beside it for scale).
 
-Settings (base: a/Delta = 4, dt = 1e-3, tolerances 1e-8 / 1e-10, lubrication 'full'):
-  grid         a/Delta = 4, 5 and every further a/Delta with a shipped table (full model);
-               the 'simple' model at a/Delta = 4, 5, 6, 8 (no table needed)
-  dt           2e-3, 1e-3, 5e-4, 2.5e-4
-  tolerance    velocity = pressure relative tolerance 1e-3, 1e-4, 1e-6, 1e-8 (base: 1e-8 / 1e-10)
-  lubrication  none, simple, full at a/Delta = 4
-The reference is the finest of everything available: the largest a/Delta with a table, dt =
-2.5e-4, the base tolerances, 'full'. Cost = CPU seconds per unit strain of the single-rank run
-(its own rusage, start-up included), so runs side by side do not bias it.
+Settings, one knob at a time around the base (a/Delta = 4, dt = 1e-3, tolerances 1e-8 / 1e-10,
+lubrication 'full'); the last of each knob is its finest:
+  grid (full)    a/Delta = 4, 5 and every further a/Delta with a shipped table
+  grid (simple)  the 'simple' model, which needs no table, at a/Delta = 4, 5, 6
+  dt             2e-3, 1e-3, 5e-4, 2.5e-4
+  tolerance      velocity = pressure relative tolerance 1e-3, 1e-4, 1e-6, then the defaults
+  lubrication    none (at dt = 1e-3 and 2.5e-4), simple, full
+Two errors per setting: against its knob's finest setting (the error that knob causes), and
+against the reference, the finest affordable configuration (the largest a/Delta with a table,
+dt = 5e-4, default tolerances, 'full'), which is the total error that the plot and its Pareto
+front use. Cost = CPU seconds per unit strain of the single-rank run (its own rusage, start-up
+included), so runs side by side do not bias it.
 
 Writes a markdown table (doc/BENCHMARKS.md §8), out/tradeoff/tradeoff.json and the error-cost
 plot with its Pareto front (doc/figures/tradeoff.png by default).
@@ -63,34 +66,29 @@ def tabled_grids():
 
 
 def settings(knobs):
-    """(name, knob, label, parameters) for every run; the reference first."""
+    """Every run as a dict: name (its directory; identical parameter sets share one run), knob,
+    label, parameters and finest (the label of the knob's finest setting). The reference first."""
     grids = tabled_grids()
-    runs = [('reference', 'reference', 'a/D %d, dt 2.5e-4, full' % grids[-1],
-             dict(BASE, cells=grids[-1], dt=2.5e-4))]
+    series = {'reference': [('a/D %d, dt 5e-4, full' % grids[-1], dict(BASE, cells=grids[-1], dt=5e-4))]}
     if 'grid' in knobs:
-        runs += [('grid_full_a%d' % n, 'grid', 'a/D %d full' % n, dict(BASE, cells=n)) for n in grids]
-        runs += [('grid_simple_a%d' % n, 'grid', 'a/D %d simple' % n, dict(BASE, cells=n, lub='simple'))
-                 for n in (4, 5, 6, 8)]
+        series['grid (full)'] = [('a/D %d full' % n, dict(BASE, cells=n)) for n in grids]
+        series['grid (simple)'] = [('a/D %d simple' % n, dict(BASE, cells=n, lub='simple')) for n in (4, 5, 6)]
     if 'dt' in knobs:
-        runs += [('dt_%g' % dt, 'dt', 'dt %g' % dt, dict(BASE, dt=dt)) for dt in (2e-3, 1e-3, 5e-4, 2.5e-4)]
+        series['dt'] = [('dt %g' % dt, dict(BASE, dt=dt)) for dt in (2e-3, 1e-3, 5e-4, 2.5e-4)]
     if 'tolerance' in knobs:
-        runs += [('tol_%g' % t, 'tolerance', 'tol %g' % t, dict(BASE, vtol=t, ptol=t))
-                 for t in (1e-3, 1e-4, 1e-6, 1e-8)]
+        series['tolerance'] = [('tol %g' % t, dict(BASE, vtol=t, ptol=t)) for t in (1e-3, 1e-4, 1e-6)] + \
+                              [('tol 1e-8/1e-10 (default)', dict(BASE))]
     if 'lubrication' in knobs:
-        runs += [('lub_%s' % m, 'lubrication', 'lubrication %s' % m, dict(BASE, lub=m))
-                 for m in ('none', 'simple', 'full')]
-        # without the correction the contacts need a shorter step (doc/INPUT.md &lubrication)
-        runs += [('lub_none_dt2.5e-4', 'lubrication', 'none, dt 2.5e-4', dict(BASE, lub='none', dt=2.5e-4))]
-    # identical parameter sets run once (the base appears under several knobs)
-    unique, seen = [], {}
-    for name, knob, label, p in runs:
-        key = tuple(sorted(p.items()))
-        if key in seen:
-            unique.append((seen[key], knob, label, p))
-        else:
-            seen[key] = name
-            unique.append((name, knob, label, p))
-    return unique
+        # without the correction the contacts need a shorter step (doc/INPUT.md &lubrication);
+        # the full model is the finest
+        series['lubrication'] = [('none', dict(BASE, lub='none')), ('none, dt 2.5e-4', dict(BASE, lub='none', dt=2.5e-4)),
+                                 ('simple', dict(BASE, lub='simple')), ('full', dict(BASE))]
+    out = []
+    for knob, members in series.items():
+        for label, p in members:
+            out.append({'name': 'a%(cells)d_dt%(dt)g_tol%(vtol)g-%(ptol)g_%(lub)s' % p, 'knob': knob, 'label': label, 'parameters': p,
+                        'finest': members[-1][0]})
+    return out
 
 
 def start(work, name, p, strain):
@@ -137,7 +135,7 @@ def plot(rows, path):
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(7, 5))
-    markers = {'grid': 'o', 'dt': 's', 'tolerance': '^', 'lubrication': 'D'}
+    markers = {'grid (full)': 'o', 'grid (simple)': 'v', 'dt': 's', 'tolerance': '^', 'lubrication': 'D'}
     for knob, marker in markers.items():
         pts = [r for r in rows if r['knob'] == knob and r['error'] is not None]
         if pts:
@@ -146,7 +144,8 @@ def plot(rows, path):
             for r in pts:
                 ax.annotate(r['label'], (r['cpu_per_strain'], max(r['error'], 1e-5)), fontsize=6,
                             xytext=(3, 3), textcoords='offset points')
-    pts = [r for r in rows if r['knob'] != 'reference' and r['error'] is not None]
+    # each configuration once (the base appears under several knobs)
+    pts = list({r['name']: r for r in rows if r['knob'] != 'reference' and r['error'] is not None}.values())
     front = pareto([(r['cpu_per_strain'], max(r['error'], 1e-5)) for r in pts])
     ax.plot([pts[i]['cpu_per_strain'] for i in front], [max(pts[i]['error'], 1e-5) for i in front],
             'k--', lw=1, label='Pareto front')
@@ -179,45 +178,49 @@ def main():
     if os.path.exists(cpu_path):
         with open(cpu_path) as f:
             cpu = json.load(f)
+    params = {}
+    for r in runs:
+        params.setdefault(r['name'], r['parameters'])
     if not args.table_only:
         os.makedirs(args.work, exist_ok=True)
         shutil.copy2(os.path.join(ROOT, 'bin', 'fdsusp'), os.path.join(args.work, 'fdsusp'))
-        params = {}
-        for name, _, _, p in runs:
-            params.setdefault(name, p)
 
         def report(name, status, seconds):
             cpu[name] = seconds
             with open(cpu_path, 'w') as f:
                 json.dump(cpu, f, indent=1)
-            print('%-20s status %d, %.0f CPU s' % (name, status, seconds), flush=True)
+            print('%-10s status %d, %.0f CPU s' % (name, status, seconds), flush=True)
 
         run_all(list(params), lambda n: start(args.work, n, params[n], args.strain), args.jobs, report)
 
-    ref = result(args.work, 'reference')[0]
-    rows = []
-    for name, knob, label, p in runs:
+    eta = {}
+    for name in params:
         q, why = result(args.work, name)
-        row = {'name': name, 'knob': knob, 'label': label, 'parameters': p, 'eta_r': None,
-               'eta_r_error': None, 'error': None, 'failure': why,
-               'cpu_per_strain': cpu.get(name, float('nan')) / args.strain}
-        if q is not None:
-            row['eta_r'], row['eta_r_error'] = q['eta_r']['value'], q['eta_r']['error']
-            if ref is not None:
-                row['error'] = abs(row['eta_r'] / ref['eta_r']['value'] - 1.0)
+        eta[name] = (q['eta_r']['value'], q['eta_r']['error']) if q else why
+    rows = []
+    for r in runs:
+        finest = next(x['name'] for x in runs if x['knob'] == r['knob'] and x['label'] == r['finest'])
+        row = dict(r, eta_r=None, eta_r_error=None, error_knob=None, error=None, failure=None,
+                   cpu_per_strain=cpu.get(r['name'], float('nan')) / args.strain)
+        if isinstance(eta[r['name']], str):
+            row['failure'] = eta[r['name']]
+        else:
+            row['eta_r'], row['eta_r_error'] = eta[r['name']]
+            for key, other in (('error_knob', finest), ('error', runs[0]['name'])):
+                if not isinstance(eta[other], str):
+                    row[key] = abs(row['eta_r'] / eta[other][0] - 1.0)
         rows.append(row)
     with open(os.path.join(args.work, 'tradeoff.json'), 'w') as f:
         json.dump(rows, f, indent=1)
-    print('| knob | setting | eta_r (block s.e.) | error vs reference | CPU s per strain |')
-    print('|---|---|---|---|---|')
+    print('| knob | setting | eta_r (block s.e.) | error vs the knob\'s finest | error vs reference | CPU s per strain |')
+    print('|---|---|---|---|---|---|')
+    e = lambda x: '-' if x is None else '%.1e' % x  # noqa: E731
     for r in rows:
         if r['eta_r'] is None:
-            print('| %s | %s | failed: %s | | %.0f |' % (r['knob'], r['label'], r['failure'],
-                                                     r['cpu_per_strain']))
+            print('| %s | %s | failed: %s | | | %.0f |' % (r['knob'], r['label'], r['failure'], r['cpu_per_strain']))
             continue
-        print('| %s | %s | %.4f (%.3f) | %s | %.0f |'
-              % (r['knob'], r['label'], r['eta_r'], r['eta_r_error'],
-                 '-' if r['error'] is None else '%.2e' % r['error'], r['cpu_per_strain']))
+        print('| %s | %s | %.4f (%.3f) | %s | %s | %.0f |' % (r['knob'], r['label'], r['eta_r'], r['eta_r_error'],
+                                                           e(r['error_knob']), e(r['error']), r['cpu_per_strain']))
     if any(r['error'] is not None and r['knob'] != 'reference' for r in rows):
         plot(rows, args.plot)
         print('plot: %s' % os.path.relpath(args.plot, ROOT))
