@@ -59,6 +59,7 @@ module mod_fictitious_domain
     integer, allocatable :: f_comp(:), f_ijk(:, :), f_part(:)
     real(dp), allocatable :: f_r(:, :), f_alpha(:), f_relax(:)   ! r, alpha, 1/(1+gamma)
     real(dp), allocatable :: rigid_matrix(:, :, :)               ! M_p (6, 6, n), summed over ranks
+    real(dp), allocatable :: lambda_new(:)   ! Lambda^{n+1} per listed face (kept: no allocation per step)
     type(particle_system_t) :: system
     type(particle_solver_t) :: solver     ! the 6N system once pairs couple it
     integer :: solver_iterations = 0
@@ -126,15 +127,16 @@ contains
     if (.not. allocated(fd%rigid_matrix)) allocate(fd%rigid_matrix(6, 6, parts%n))
     fd%rigid_matrix = 0.0_dp
     block
-      integer :: f
+      integer :: f, b
       real(dp) :: g(6), w, dv
       dv = grid%h**3
       do f = 1, fd%nf
         if (fd%f_comp(f) == FIELD_P) cycle
         g = rigid_row(fd%f_comp(f), fd%f_r(:, f))
-        w = fd%f_alpha(f) * fd%f_relax(f)
-        fd%rigid_matrix(:, :, fd%f_part(f)) = fd%rigid_matrix(:, :, fd%f_part(f)) &
-             + w * dv * spread(g, 2, 6) * spread(g, 1, 6)
+        w = fd%f_alpha(f) * fd%f_relax(f) * dv
+        do b = 1, 6
+          fd%rigid_matrix(:, b, fd%f_part(f)) = fd%rigid_matrix(:, b, fd%f_part(f)) + (w * g(b)) * g
+        end do
       end do
     end block
     call MPI_Allreduce(MPI_IN_PLACE, fd%rigid_matrix, 36 * parts%n, MPI_DOUBLE_PRECISION, MPI_SUM, &
@@ -149,49 +151,66 @@ contains
     type(fd_t), intent(inout) :: fd
     integer, intent(in) :: q, c, pass
     real(dp), intent(in) :: centre(3), radius
-    integer :: lo(3), hi(3), i, j, k, ijk(3), d
-    real(dp) :: r(3), a, h, gamma
-    logical :: inside
+    ! indices per axis: at most 2R/h + 2 (the box below), with one to spare for round-off
+    integer :: wrapped(ceiling(2.0_dp * radius / grid%h) + 3, 3)
+    logical :: mine(ceiling(2.0_dp * radius / grid%h) + 3, 3)
+    integer :: lo(3), hi(3), i, j, k, d, m
+    real(dp) :: r(3), a, h, gamma, reach2
     h = grid%h
+    ! The control volume of unknown i spans (i + stagger +- 1/2) h, so only |(i + stagger) h - x_d|
+    ! < R + h/2 can meet the sphere: the box below is that range, no wider (issue 7: the loops are
+    ! most of the geometry's cost). Each index is wrapped and tested for ownership once per axis.
     do d = 1, 3
-      lo(d) = floor((centre(d) - radius) / h - stagger(d, c)) - 1
-      hi(d) = ceiling((centre(d) + radius) / h - stagger(d, c)) + 1
+      lo(d) = floor((centre(d) - radius) / h - stagger(d, c) - 0.5_dp)
+      hi(d) = min(ceiling((centre(d) + radius) / h - stagger(d, c) + 0.5_dp), lo(d) + size(mine, 1) - 1)
+      do m = 1, hi(d) - lo(d) + 1
+        i = lo(d) + m - 1
+        if (d == 2 .and. grid%walls) then
+          wrapped(m, d) = i
+          ! outside the walls there is no fluid; on the wall itself v = 0 stays (no constraint)
+          mine(m, d) = i >= 0 .and. i < grid%n(2) .and. .not. (c == FIELD_V .and. i == 0)
+        else
+          wrapped(m, d) = modulo(i, grid%n(d))
+          mine(m, d) = .true.
+        end if
+        mine(m, d) = mine(m, d) .and. wrapped(m, d) >= grid%lo(d) .and. wrapped(m, d) <= grid%hi(d)
+      end do
     end do
+    ! beyond this distance from the centre a control volume lies wholly outside (its half-diagonal)
+    reach2 = (radius + 0.5_dp * sqrt(3.0_dp) * h)**2
     do k = lo(3), hi(3)
+      if (.not. mine(k - lo(3) + 1, 3)) cycle
       do j = lo(2), hi(2)
+        if (.not. mine(j - lo(2) + 1, 2)) cycle
         do i = lo(1), hi(1)
-          ijk = [i, j, k]
-          inside = .true.
-          do d = 1, 3
-            if (d == 2 .and. grid%walls) then
-              if (j < 0 .or. j >= grid%n(2)) inside = .false.
-            else
-              ijk(d) = modulo(ijk(d), grid%n(d))
-            end if
-            if (ijk(d) < grid%lo(d) .or. ijk(d) > grid%hi(d)) inside = .false.
-          end do
-          if (.not. inside) cycle
-          if (grid%walls .and. c == FIELD_V .and. j == 0) cycle   ! the wall: v = 0 stays
+          if (.not. mine(i - lo(1) + 1, 1)) cycle
           r = ([i, j, k] + stagger(:, c)) * h - centre
-          if (pass == 1) then
-            a = cube_fraction(r, radius, h)
-            if (a > fd%alpha(ijk(1), ijk(2), ijk(3), c)) then
-              fd%alpha_second(ijk(1), ijk(2), ijk(3), c) = fd%alpha(ijk(1), ijk(2), ijk(3), c)
-              fd%alpha(ijk(1), ijk(2), ijk(3), c) = a
-              fd%owner(ijk(1), ijk(2), ijk(3), c) = q
-            else if (a > fd%alpha_second(ijk(1), ijk(2), ijk(3), c)) then
-              fd%alpha_second(ijk(1), ijk(2), ijk(3), c) = a
-            end if
-          else if (fd%owner(ijk(1), ijk(2), ijk(3), c) == q) then
-            a = fd%alpha(ijk(1), ijk(2), ijk(3), c) - fd%alpha_second(ijk(1), ijk(2), ijk(3), c)
-            if (a <= 0.0_dp) cycle
-            gamma = 0.0_dp
-            if (c /= FIELD_P) gamma = relaxation_gamma(a, fd%kappa, fd%beta, h, fd%eta)
-            call push_face(fd, c, ijk, q, r, a, 1.0_dp / (1.0_dp + gamma))
-          end if
+          if (sum(r**2) >= reach2) cycle
+          call claim(wrapped(i - lo(1) + 1, 1), wrapped(j - lo(2) + 1, 2), wrapped(k - lo(3) + 1, 3))
         end do
       end do
     end do
+  contains
+    ! pass 1: the largest alpha owns the unknown; pass 2: list the unknowns particle q owns
+    subroutine claim(iw, jw, kw)
+      integer, intent(in) :: iw, jw, kw
+      if (pass == 1) then
+        a = cube_fraction(r, radius, h)
+        if (a > fd%alpha(iw, jw, kw, c)) then
+          fd%alpha_second(iw, jw, kw, c) = fd%alpha(iw, jw, kw, c)
+          fd%alpha(iw, jw, kw, c) = a
+          fd%owner(iw, jw, kw, c) = q
+        else if (a > fd%alpha_second(iw, jw, kw, c)) then
+          fd%alpha_second(iw, jw, kw, c) = a
+        end if
+      else if (fd%owner(iw, jw, kw, c) == q) then
+        a = fd%alpha(iw, jw, kw, c) - fd%alpha_second(iw, jw, kw, c)
+        if (a <= 0.0_dp) return
+        gamma = 0.0_dp
+        if (c /= FIELD_P) gamma = relaxation_gamma(a, fd%kappa, fd%beta, h, fd%eta)
+        call push_face(fd, c, [iw, jw, kw], q, r, a, 1.0_dp / (1.0_dp + gamma))
+      end if
+    end subroutine claim
   end subroutine visit
 
   subroutine push_face(fd, c, ijk, q, r, a, relax)
@@ -316,18 +335,22 @@ contains
     PetscErrorCode, intent(out) :: ierr
     real(dp), intent(in), optional :: extra_force(:, :), extra_torque(:, :)
     type(particle_lubrication_t), intent(inout), optional :: lubrication
-    real(dp), allocatable :: moments(:, :), rhs(:, :), x(:, :), lambda_new(:), sums(:, :)
+    real(dp), allocatable :: moments(:, :), rhs(:, :), x(:, :), sums(:, :)
     type(field_pointer) :: u(3), lam(3)
     PetscScalar, pointer :: p(:,:,:)
-    real(dp) :: g(6), dv, b, rigid, s(3, 3), r(3), e(3), integral
-    integer :: f, c, q, i, j, k, n
+    real(dp) :: g(6), dv, b, rigid, r(3), integral
+    integer :: f, c, q, i, j, k, n, d
     logical :: ok
     character(len=200) :: text
     KSPConvergedReason :: reason
 
     n = parts%n
     dv = grid%h**3
-    allocate(moments(12, n), rhs(6, n), x(6, n), lambda_new(fd%nf), sums(16, n))
+    allocate(moments(12, n), rhs(6, n), x(6, n), sums(16, n))
+    if (allocated(fd%lambda_new)) then
+      if (size(fd%lambda_new) < fd%nf) deallocate(fd%lambda_new)
+    end if
+    if (.not. allocated(fd%lambda_new)) allocate(fd%lambda_new(size(fd%f_comp)))
 
     ! moments b(u~) and m(Lambda^n) (rows 1-6 and 7-12)
     moments = 0.0_dp
@@ -392,7 +415,7 @@ contains
       q = fd%f_part(f)
       g = rigid_row(c, fd%f_r(:, f))
       rigid = dot_product(g(1:3), parts%velocity(:, q)) + dot_product(g(4:6), parts%omega(:, q))
-      lambda_new(f) = (lam(c)%ptr(i, j, k) + fd%beta * fd%f_alpha(f) * (rigid - u(c)%ptr(i, j, k))) &
+      fd%lambda_new(f) = (lam(c)%ptr(i, j, k) + fd%beta * fd%f_alpha(f) * (rigid - u(c)%ptr(i, j, k))) &
            * fd%f_relax(f)
     end do
     do c = 1, 3
@@ -418,16 +441,18 @@ contains
         sums(16, q) = sums(16, q) + fd%f_alpha(f) * p(i, j, k) * dv     ! interior pressure
         cycle
       end if
-      b = lambda_new(f)
+      b = fd%lambda_new(f)
       lam(c)%ptr(i, j, k) = b
       u(c)%ptr(i, j, k) = u(c)%ptr(i, j, k) + b / fd%beta
       ! force -Lambda e_c dV and torque -r x (Lambda e_c) dV are -Lambda dV times g = (e_c, r x e_c)
       r = fd%f_r(:, f)
       g = rigid_row(c, r)
       sums(1:6, q) = sums(1:6, q) - b * dv * g
-      e = g(1:3)
-      s = -0.5_dp * b * dv * (spread(r, 2, 3) * spread(e, 1, 3) + spread(e, 2, 3) * spread(r, 1, 3))
-      sums(7:15, q) = sums(7:15, q) + reshape(s, [9])
+      ! -1/2 Lambda dV (r e_c + e_c r): column c and row c of the 3x3 block (stored by columns)
+      do d = 1, 3
+        sums(6 + d + 3 * (c - 1), q) = sums(6 + d + 3 * (c - 1), q) - 0.5_dp * b * dv * r(d)
+        sums(6 + c + 3 * (d - 1), q) = sums(6 + c + 3 * (d - 1), q) - 0.5_dp * b * dv * r(d)
+      end do
     end do
     PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_P), pressure, p, ierr))
     do c = 1, 3

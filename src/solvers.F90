@@ -142,6 +142,7 @@ contains
     PetscReal :: rnorm, bnorm
     Mat :: A, P
     Vec :: r
+    DM :: dm
     character(len=200) :: text
 
     PetscCall(VecScale(b, s%cell_volume, ierr))
@@ -149,12 +150,15 @@ contains
       PetscCall(MatNullSpaceRemove(s%nullspace, b, ierr))
     end if
     PetscCall(KSPGetOperators(s%ksp, A, P, ierr))
-    PetscCall(VecDuplicate(b, r, ierr))
+    ! the residual in a vector the DM keeps between calls: a fresh 8 MB vector every solve cost
+    ! ~8 % of a paper-scene step in page faults (doc/BENCHMARKS.md §8)
+    PetscCall(KSPGetDM(s%ksp, dm, ierr))
+    PetscCall(DMGetGlobalVector(dm, r, ierr))
     PetscCall(MatMult(A, x, r, ierr))
     PetscCall(VecAYPX(r, -1.0_dp, b, ierr))
     PetscCall(VecNorm(r, NORM_2, rnorm, ierr))
     PetscCall(VecNorm(b, NORM_2, bnorm, ierr))
-    PetscCall(VecDestroy(r, ierr))
+    PetscCall(DMRestoreGlobalVector(dm, r, ierr))
     if (rnorm > bnorm) then
       PetscCall(VecSet(x, 0.0_dp, ierr))
     end if
