@@ -5,7 +5,7 @@
 #   make run        run input/demo.nml on 2 ranks
 #   make bench      timings recorded in doc/BENCHMARKS.md
 #   make extremes   the extreme scenes of input/extremes in full (doc/VALIDATION.md §6)
-#   make tradeoff   speed against accuracy, one knob at a time (doc/BENCHMARKS.md §8)
+#   make tradeoff   speed against accuracy, one knob at a time (doc/BENCHMARKS.md §9)
 # PETSC_DIR defaults to Debian's petsc-dev; set it to use a cluster's PETSc (3.18, real, double).
 
 SHELL := /bin/bash
@@ -128,7 +128,7 @@ extremes: all
 	$(PYTHON) scripts/extremes.py --json out/extremes/extremes.json
 
 # Speed against accuracy (issue 7): error of each setting against the finest, CPU s per strain,
-# table and doc/figures/tradeoff.png (doc/BENCHMARKS.md §8; about 70 CPU minutes)
+# table and doc/figures/tradeoff.png (doc/BENCHMARKS.md §9; about 70 CPU minutes)
 tradeoff: all
 	$(PYTHON) scripts/tradeoff.py
 

@@ -26,7 +26,7 @@ dt = 5e-4, default tolerances, 'full'), which is the total error that the plot a
 front use. Cost = CPU seconds per unit strain of the single-rank run (its own rusage, start-up
 included), so runs side by side do not bias it.
 
-Writes a markdown table (doc/BENCHMARKS.md §8), out/tradeoff/tradeoff.json and the error-cost
+Writes a markdown table (doc/BENCHMARKS.md §9), out/tradeoff/tradeoff.json and the error-cost
 plot with its Pareto front (doc/figures/tradeoff.png by default).
 """
 import argparse

@@ -150,8 +150,8 @@ contains
       PetscCall(MatNullSpaceRemove(s%nullspace, b, ierr))
     end if
     PetscCall(KSPGetOperators(s%ksp, A, P, ierr))
-    ! the residual in a vector the DM keeps between calls: a fresh 8 MB vector every solve cost
-    ! ~8 % of a paper-scene step in page faults (doc/BENCHMARKS.md §8)
+    ! the residual in a vector the DM keeps between calls, so the time loop allocates nothing
+    ! (doc/BENCHMARKS.md §8)
     PetscCall(KSPGetDM(s%ksp, dm, ierr))
     PetscCall(DMGetGlobalVector(dm, r, ierr))
     PetscCall(MatMult(A, x, r, ierr))
