@@ -112,11 +112,125 @@ contains
     PetscCall(KSPSetComputeOperators(s%ksp, compute_operator, field_ids(field), ierr))
     PetscCall(KSPSetInitialGuessNonzero(s%ksp, PETSC_TRUE, ierr))
     PetscCall(KSPSetFromOptions(s%ksp, ierr))
+    if (field == FIELD_P) then
+      PetscCall(set_cell_centred_interpolation(s%ksp, grid%da(FIELD_P), ierr))
+    end if
     if (s%singular) then
       PetscCall(MatNullSpaceCreate(PETSC_COMM_WORLD, PETSC_TRUE, 0, PETSC_NULL_VEC, s%nullspace, ierr))
     end if
     PetscCall(KSPSetUp(s%ksp, ierr))
   end subroutine solver_create
+
+  ! The pressure lives at cell centres, but the DMDA's own multigrid transfer is vertex-centred
+  ! trilinear (Q1): it places each coarse unknown on a fine one, half a fine cell from where the
+  ! coarse cell centre is, and on a periodic DMDA it interpolates across the walls in y. Here the
+  ! prolongation is trilinear between cell centres (weights 3/4, 1/4 per direction) and, at a wall,
+  ! constant towards it (zero normal gradient, as the Poisson operator); restriction is its
+  ! transpose, which sums the volume-scaled residuals. Cold Poisson solve on 64^3 with walls: 20
+  ! iterations with the DMDA transfer, 11 fully periodic (doc/BENCHMARKS.md §8). Only when the
+  ! pressure preconditioner is PCMG; -p_mg_cell_centred 0 restores the DMDA transfer.
+  subroutine set_cell_centred_interpolation(ksp, da, ierr)
+    KSP, intent(in) :: ksp
+    DM, intent(in) :: da
+    PetscErrorCode, intent(out) :: ierr
+    PC :: pc
+    PCType :: pc_type
+    PetscBool :: wanted, found
+    PetscInt :: levels, l
+    DM :: fine, coarse
+    Mat :: prolongation
+    KSP :: smoother
+
+    wanted = PETSC_TRUE
+    PetscCall(PetscOptionsGetBool(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-p_mg_cell_centred', wanted, found, ierr))
+    PetscCall(KSPGetPC(ksp, pc, ierr))
+    PetscCall(PCGetType(pc, pc_type, ierr))
+    if (.not. wanted .or. pc_type /= PCMG) return
+    PetscCall(PCMGGetLevels(pc, levels, ierr))
+    ! With every interpolation given, PCMG builds no coarse DMDAs: each level's smoother gets its
+    ! own here, which carries compute_operator (DMCoarsen copies it), so the coarse operators are
+    ! rediscretised as before.
+    fine = da
+    do l = levels - 1, 1, -1
+      PetscCall(DMCoarsen(fine, PETSC_COMM_WORLD, coarse, ierr))
+      PetscCall(cell_centred_prolongation(fine, coarse, prolongation, ierr))
+      PetscCall(PCMGSetInterpolation(pc, l, prolongation, ierr))
+      PetscCall(MatDestroy(prolongation, ierr))
+      PetscCall(PCMGGetSmoother(pc, l - 1, smoother, ierr))
+      PetscCall(KSPSetDM(smoother, coarse, ierr))
+      if (l < levels - 1) then
+        PetscCall(DMDestroy(fine, ierr))
+      end if
+      fine = coarse
+    end do
+    if (levels > 1) then
+      PetscCall(DMDestroy(fine, ierr))
+    end if
+  end subroutine set_cell_centred_interpolation
+
+  ! P (fine x coarse) for cell-centred unknowns on DMDAs coarsened by 2 in every direction.
+  subroutine cell_centred_prolongation(fine, coarse, P, ierr)
+    DM, intent(in) :: fine, coarse
+    Mat, intent(out) :: P
+    PetscErrorCode, intent(out) :: ierr
+    PetscInt :: mf(3), mc(3), procs(3), dof, sw, bt(3), st, dim
+    PetscInt :: xs, ys, zs, xm, ym, zm, cxs, cys, czs, cxm, cym, czm
+    PetscInt :: i, j, k, a, b, c, n, row(1), cols(8)
+    PetscScalar :: w(8)
+    integer :: idx(2, 3), f(3), d
+    real(dp) :: wt(2, 3)
+    AO :: fine_ao, coarse_ao
+
+    PetscCall(DMDAGetInfo(fine, dim, mf(1), mf(2), mf(3), procs(1), procs(2), procs(3), dof, sw, bt(1), bt(2), bt(3), st, ierr))
+    PetscCall(DMDAGetInfo(coarse, dim, mc(1), mc(2), mc(3), procs(1), procs(2), procs(3), dof, sw, bt(1), bt(2), bt(3), st, ierr))
+    PetscCall(DMDAGetCorners(fine, xs, ys, zs, xm, ym, zm, ierr))
+    PetscCall(DMDAGetCorners(coarse, cxs, cys, czs, cxm, cym, czm, ierr))
+    if (any(mf /= 2 * mc)) then
+      ! e.g. -p_pc_mg_levels beyond what the grid allows (mod_grid picks the most that halve it)
+      call fatal_error('fdsusp: error: cell-centred multigrid needs every level to halve the pressure grid; use '// &
+                       'fewer -p_pc_mg_levels or -p_mg_cell_centred 0', 1)
+    end if
+    PetscCall(DMDAGetAO(fine, fine_ao, ierr))
+    PetscCall(DMDAGetAO(coarse, coarse_ao, ierr))
+    PetscCall(MatCreateAIJ(PETSC_COMM_WORLD, xm * ym * zm, cxm * cym * czm, PETSC_DETERMINE, PETSC_DETERMINE, 8, PETSC_NULL_INTEGER, 8, PETSC_NULL_INTEGER, P, ierr))
+    do k = zs, zs + zm - 1
+      do j = ys, ys + ym - 1
+        do i = xs, xs + xm - 1
+          f = [i, j, k]
+          do d = 1, 3
+            ! fine cell f lies in coarse cell f/2, on its low side if f is even
+            idx(1, d) = f(d) / 2
+            idx(2, d) = idx(1, d) + merge(-1, 1, mod(f(d), 2) == 0)
+            wt(:, d) = [0.75_dp, 0.25_dp]
+            if (idx(2, d) < 0 .or. idx(2, d) >= mc(d)) then
+              if (d == 2 .and. has_walls) then
+                idx(2, d) = idx(1, d)          ! zero gradient towards the wall
+              else
+                idx(2, d) = modulo(idx(2, d), mc(d))
+              end if
+            end if
+          end do
+          n = 0
+          do c = 1, 2
+            do b = 1, 2
+              do a = 1, 2
+                n = n + 1
+                cols(n) = idx(a, 1) + mc(1) * (idx(b, 2) + mc(2) * idx(c, 3))
+                w(n) = wt(a, 1) * wt(b, 2) * wt(c, 3)
+              end do
+            end do
+          end do
+          row(1) = i + mf(1) * (j + mf(2) * k)
+          PetscCall(AOApplicationToPetsc(fine_ao, 1, row, ierr))
+          PetscCall(AOApplicationToPetsc(coarse_ao, 8, cols, ierr))
+          ! ADD: at a wall two of the eight columns coincide
+          PetscCall(MatSetValues(P, 1, row, 8, cols, w, ADD_VALUES, ierr))
+        end do
+      end do
+    end do
+    PetscCall(MatAssemblyBegin(P, MAT_FINAL_ASSEMBLY, ierr))
+    PetscCall(MatAssemblyEnd(P, MAT_FINAL_ASSEMBLY, ierr))
+  end subroutine cell_centred_prolongation
 
   ! The Helmholtz operator m I - d lap with Jacobi has condition number at most 1 + r,
   ! r = 12 d / (m h^2) (Gershgorin: the 7-point Laplacian's eigenvalues lie in [0, 12/h^2]), so CG
