@@ -127,9 +127,12 @@ bench: all
 extremes: all
 	$(PYTHON) scripts/extremes.py --json out/extremes/extremes.json
 
-# Speed against accuracy (issue 7): error of each setting against the finest, CPU s per strain,
-# table and doc/figures/tradeoff.png (doc/BENCHMARKS.md §9; about 70 CPU minutes)
+# Speed against accuracy (issue 7), one knob at a time: the suspension scene (error of each
+# setting against the finest, CPU s per strain; doc/figures/tradeoff.png, about 70 CPU minutes)
+# and the pair test (resistance against exact theory, CPU s per run; doc/figures/tradeoff_pair.png,
+# about 20 CPU minutes). Tables in doc/BENCHMARKS.md §9.
 tradeoff: all
+	$(PYTHON) scripts/tradeoff_pair.py
 	$(PYTHON) scripts/tradeoff.py
 
 # Lubrication tables (doc/LUBRICATION.md): the resolved resistance measured at each a/Delta and

@@ -57,13 +57,13 @@ PI = math.pi
 ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT='1', OMPI_ALLOW_RUN_AS_ROOT_CONFIRM='1')
 
 
-def deck(path, out, box, walls, shear, spheres, h, model='none'):
+def deck(path, out, box, walls, shear, spheres, h, model='none', vtol=1e-6, ptol=1e-8):
     """spheres: list of (position, velocity, omega); model: the lubrication model (calibration
-    measures the resolved part alone, so 'none')."""
+    measures the resolved part alone, so 'none'); vtol, ptol: the solver tolerances."""
     lines = [f"&domain box = {box[0]}, {box[1]}, {box[2]}, cells_per_radius = {round(1 / h)},",
              f"  y_boundary = '{'walls' if walls else 'periodic'}', shear_rate = {shear} /",
              f"&fluid reynolds = {REYNOLDS}, viscous_theta = 1.0, initial_flow = 'shear',",
-             f"  velocity_tolerance = 1e-6, pressure_tolerance = 1e-8 /",
+             f"  velocity_tolerance = {vtol:g}, pressure_tolerance = {ptol:g} /",
              f"&time dt = {REYNOLDS / BETA!r}, steps = {STEPS} /",
              f"&output directory = '{out}', progress_every = {STEPS}, series_every = {EVERY} /",
              f"&lubrication model = '{model}' /",
