@@ -9,12 +9,14 @@
 #   bash scripts/bench_paper.sh                  both rank counts
 #   RANKS="2" STEPS=10 bash scripts/bench_paper.sh
 #   BIN=/path/to/other/bin bash scripts/bench_paper.sh   (before/after comparisons)
+#   FLUID="velocity_tolerance = 1e-6" bash scripts/bench_paper.sh   (extra &fluid settings)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 BIN=${BIN:-bin}
 RANKS=${RANKS:-"1 2"}
 STEPS=${STEPS:-50}
+FLUID=${FLUID:+, $FLUID}
 TAG=${TAG:-paper}
 mkdir -p build/bench
 stage() { awk -v s="$1" '$2 == s":" {print $3; exit}' "$2"; }
@@ -24,7 +26,8 @@ printf '|---|---|---|---|---|---|---|---|---|---|---|\n'
 for np in $RANKS; do
   deck=build/bench/${TAG}_np$np.nml
   sed -e "s|directory = '[^']*'|directory = 'build/bench/${TAG}_np$np'|" \
-      -e "s|steps = [0-9]*|steps = $STEPS|" input/bench_paper.nml > "$deck"
+      -e "s|steps = [0-9]*|steps = $STEPS|" -e "s|initial_flow = 'shear'|initial_flow = 'shear'$FLUID|" \
+      input/bench_paper.nml > "$deck"
   log=build/bench/${TAG}_np$np.log
   mpiexec --oversubscribe -n "$np" "$BIN/fdsusp" "$deck" -log_view -memory_view -bench_cold_poisson > "$log" 2>&1
   steps=$(awk '/^steps run:/ {print $3}' "$log")
