@@ -67,7 +67,7 @@ def settings():
         'grid (full)': [('a/D %d full' % n, dict(BASE, cells=n)) for n in tabled_grids()],
         'grid (simple)': [('a/D %d simple' % n, dict(BASE, cells=n, lub='simple')) for n in (4, 5, 6, 8)],
         'grid (none)': [('a/D %d none' % n, dict(BASE, cells=n, lub='none')) for n in (4, 5, 6, 8)],
-        'tolerance': [('tol %g' % t, dict(BASE, tol=t)) for t in (1e-3, 1e-4)] + [('tol 1e-6 (default)', dict(BASE, tol=1e-6))] +
+        'tolerance': [('tol %g%s' % (t, ' (default)' * (t == 1e-6)), dict(BASE, tol=t)) for t in (1e-3, 1e-4, 1e-6)] +
                      [('tol 1e-8/1e-10', dict(BASE))],
         'lubrication': [('none', dict(BASE, lub='none')), ('simple', dict(BASE, lub='simple')),
                         ('full', dict(BASE))],
