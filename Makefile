@@ -6,6 +6,7 @@
 #   make bench      timings recorded in doc/BENCHMARKS.md
 #   make extremes   the extreme scenes of input/extremes in full (doc/VALIDATION.md §6)
 #   make tradeoff   speed against accuracy, one knob at a time (doc/BENCHMARKS.md §9)
+#   make pair-dns   the paper's pair test in the DNS against pairtraj (doc/VALIDATION.md §4.4)
 # PETSC_DIR defaults to Debian's petsc-dev; set it to use a cluster's PETSc (3.18, real, double).
 
 SHELL := /bin/bash
@@ -74,7 +75,7 @@ UNIT_BIN := $(patsubst tests/unit/%.F90,$(BUILD)/tests/%,$(UNIT_F90))
 
 PROGRAMS := $(BIN)/fdsusp $(BIN)/fdsusp-pack $(BIN)/fdsusp-resistance $(if $(REF_F90),$(BIN)/pairtraj)
 
-.PHONY: all debug check run bench extremes tradeoff calibrate clean tests-build
+.PHONY: pair-dns all debug check run bench extremes tradeoff calibrate clean tests-build
 all: $(PROGRAMS) $(UNIT_BIN)
 
 debug:
@@ -134,6 +135,14 @@ extremes: all
 tradeoff: all
 	$(PYTHON) scripts/tradeoff_pair.py
 	$(PYTHON) scripts/tradeoff.py
+
+# The paper's pair test in the DNS (Gallier et al. 2014 §3; 20a cube, a/Delta = 5, dt = 1e-3, start
+# -6a, four cases): about a day per case on one core, resumable (PAIR_DNS_ARGS="--hours 10" stops
+# each run with a checkpoint after 10 h; the same command continues). Figures
+# doc/figures/pair_dns_paper_*.png, table on stdout (doc/VALIDATION.md §4.4).
+PAIR_DNS_ARGS ?=
+pair-dns: all
+	$(PYTHON) scripts/pair_dns.py $(PAIR_DNS_ARGS)
 
 # Lubrication tables (doc/LUBRICATION.md): the resolved resistance measured at each a/Delta and
 # written to input/lubrication/resolved_a<N>.h5. CELLS_PER_RADIUS="5" redoes one resolution.

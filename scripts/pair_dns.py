@@ -1,0 +1,290 @@
+#!/usr/bin/python3
+"""The paper's pair test in the DNS, against bin/pairtraj (Gallier et al. 2014 JFM §3, figures 3-5;
+issue 5): two free rough spheres in a Couette cell, sphere 2 starting at r = x2 - x1 = (start, 0.5a, 0)
+from sphere 1, the pair centred in the box, until sphere 2 has passed to x = -start.
+
+    scripts/pair_dns.py [--cases eps0 eps1e-3 eps1e-2 eps1e-2_mu03] [--box 20] [--cells 5]
+                        [--dt 1e-3] [--start -6] [--reynolds 0.01] [--ranks 1] [--jobs 2]
+                        [--hours 0] [--work out/pair_dns] [--figures doc/figures] [--plot-only]
+
+The defaults are the paper's set-up (20a cube with walls in y, a/Delta = 5, dt = 1e-3, start -6a):
+a bench of roughly a day per case on one core. tests/physics/test_pair_dns.py runs a shortened
+version through the functions below. Each case is a directory under --work with its decks, log,
+the DNS output and pairtraj's CSV; a case with out/checkpoint.h5 continues from it (--hours sets
+&run max_wall_hours, so a long study goes on in a later session). The DNS runs for 1.25 times the
+pairtraj transit time (the confined, slightly inertial DNS pair may be slower) and is read up to
+the crossing of x = -start.
+
+Compared (doc/VALIDATION.md §4.4): the relative position y where the pair crosses x = -start (the
+"final offset"), the largest |y_DNS - y_pairtraj| at equal x, and N1*, N2* against theta with
+N* = 2 (S_xx - S_yy) / S_inf, 2 (S_yy - S_zz) / S_inf, S the stresslet of one sphere (hydrodynamic,
+with the lubrication correction, plus contact), S_inf = (20/3) pi eta a^3 gamma_dot, as pairtraj.
+Needs Debian's python3 with numpy, h5py and matplotlib (the shebang is /usr/bin/python3).
+"""
+import argparse
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from jobpool import ENV, run_all  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+BIN = os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin'))
+S_INF = 20.0 / 3.0 * math.pi
+# case: (pairtraj deck under input/ used as the template, eps_r, mu_d)
+CASES = {'eps0': ('pair_eps0', 0.0, 0.0),
+         'eps1e-3': ('pair_eps1e-3', 1e-3, 0.0),
+         'eps1e-2': ('pair_eps1e-2', 1e-2, 0.0),
+         'eps1e-2_mu03': ('pair_eps1e-2_mu03', 1e-2, 0.3)}
+LABELS = {'eps0': r'$\epsilon_r = 0$', 'eps1e-3': r'$\epsilon_r = 10^{-3}$',
+          'eps1e-2': r'$\epsilon_r = 10^{-2}$', 'eps1e-2_mu03': r'$\epsilon_r = 10^{-2}$, $\mu_d = 0.3$'}
+COLOURS = {'eps0': 'k', 'eps1e-3': 'tab:blue', 'eps1e-2': 'tab:red', 'eps1e-2_mu03': 'tab:orange'}
+Y0 = 0.5          # initial offset across the shear, a (the paper's)
+
+# Smooth spheres (eps_r = 0) get no &contact group: lubrication alone keeps them apart, as in
+# pairtraj, whose smooth pair never touches (its closest gap from y = 0.5a is 8.7e-5 a).
+DNS_DECK = """! pair test in the DNS, written by scripts/pair_dns.py (case {case})
+&domain box = {box}, {box}, {box}, cells_per_radius = {cells}, y_boundary = 'walls', shear_rate = 1 /
+&fluid reynolds = {reynolds}, initial_flow = 'shear' /
+&time dt = {dt}, steps = {steps} /
+&output directory = 'out', progress_every = {progress}, series_every = {every}, checkpoint_every = {checkpoint} /
+&run title = 'pair test {case}', max_wall_hours = {hours} /
+&particles number = 2,
+  position(:,1) = {x1:.12g}, {y1:.12g}, {c:.12g},
+  position(:,2) = {x2:.12g}, {y2:.12g}, {c:.12g} /
+&lubrication model = 'full' /
+{contact}"""
+
+
+def override(text, **values):
+    """A namelist deck's text with the given variables' values replaced (each must occur once)."""
+    for var, value in values.items():
+        text, n = re.subn(r'(?im)^(\s*%s\s*=\s*)[^\n!]*' % re.escape(var), r'\g<1>%s' % value, text)
+        if n != 1:
+            raise SystemExit('pair_dns.py: variable %s not found once in the pairtraj deck' % var)
+    return text
+
+
+def pairtraj(case, d, start, eps_bar):
+    """Run bin/pairtraj for the case from r = (start, Y0, 0) to x = -start; return its CSV rows."""
+    template, _, _ = CASES[case]
+    with open(os.path.join(ROOT, 'input', template + '.nml')) as f:
+        text = f.read()
+    deck = os.path.join(d, 'pairtraj.nml')
+    with open(deck, 'w') as f:
+        f.write(override(text, start='%r, %r, 0.0' % (start, Y0), x_end=repr(-start),
+                         eps_bar=repr(eps_bar), csv_file="'pairtraj.csv'", dt_out='0.01'))
+    subprocess.run([os.path.join(BIN, 'pairtraj'), 'pairtraj.nml'], cwd=d, check=True,
+                   stdout=subprocess.DEVNULL)
+    return np.genfromtxt(os.path.join(d, 'pairtraj.csv'), delimiter=',', names=True)
+
+
+def prepare(case, d, box, cells, dt, start, eps_bar=0.05, reynolds=0.01, hours=0.0, steps_factor=1.25):
+    """Write the case's decks, run pairtraj; return the DNS command (continuing from a checkpoint
+    when there is one). The DNS runs for steps_factor times pairtraj's transit time."""
+    os.makedirs(d, exist_ok=True)
+    ref = pairtraj(case, d, start, eps_bar)
+    _, eps_r, mu_d = CASES[case]
+    steps = int(math.ceil(steps_factor * ref['t'][-1] / dt))
+    c = box / 2.0
+    contact = '' if eps_r == 0 else '&contact roughness = %r, eps_bar = %r, friction = %r /\n' % (eps_r, eps_bar, mu_d)
+    every = max(1, int(round(0.01 / dt)))                     # a record every 0.01 strain
+    with open(os.path.join(d, 'deck.nml'), 'w') as f:
+        f.write(DNS_DECK.format(case=case, box=box, cells=cells, reynolds=reynolds, dt=dt, steps=steps,
+                                progress=max(1, steps // 20), every=every, checkpoint=max(1, steps // 10),
+                                hours=hours, x1=c - start / 2, y1=c - Y0 / 2, x2=c + start / 2,
+                                y2=c + Y0 / 2, c=c, contact=contact))
+    binary = os.path.join(d, 'fdsusp')          # a copy: a rebuild cannot change a study half-way
+    if not os.path.exists(binary):
+        shutil.copy2(os.path.join(BIN, 'fdsusp'), binary)
+    command = [binary, 'deck.nml']
+    if os.path.exists(os.path.join(d, 'out', 'checkpoint.h5')):
+        command += ['-restart', 'out/checkpoint.h5']
+    return command
+
+
+def start_dns(d, command, ranks):
+    if ranks > 1:
+        command = ['mpiexec', '--oversubscribe', '-n', str(ranks)] + command
+    log = open(os.path.join(d, 'log'), 'a')
+    log.write('\n# %s\n' % ' '.join(command))
+    log.flush()
+    return subprocess.Popen(command, cwd=d, env=ENV, stdout=log, stderr=subprocess.STDOUT)
+
+
+def load_dns(d, box):
+    """The DNS pair: time, relative position r = x2 - x1 (minimum image in x and z), theta, and N1*,
+    N2* of one sphere (the mean of the two, equal by symmetry), with their contact parts."""
+    import h5py
+    with h5py.File(os.path.join(d, 'out', 'series.h5'), 'r') as f:
+        t = f['time'][:]
+        x = f['particles/position'][:]
+        s = f['particles/stresslet_hydro'][:]
+        sc = f['particles/stresslet_contact'][:] if 'particles/stresslet_contact' in f else np.zeros_like(s)
+    r = x[:, 1] - x[:, 0]
+    for k in (0, 2):
+        r[:, k] -= box * np.round(r[:, k] / box)
+
+    def normal_stresses(stresslet):
+        m = stresslet.mean(axis=1)
+        return 2 * (m[:, 0, 0] - m[:, 1, 1]) / S_INF, 2 * (m[:, 1, 1] - m[:, 2, 2]) / S_INF
+    n1, n2 = normal_stresses(s + sc)
+    n1c, n2c = normal_stresses(sc)
+    return dict(t=t, x=r[:, 0], y=r[:, 1], z=r[:, 2], theta=np.arctan2(r[:, 1], r[:, 0]),
+                gap=np.linalg.norm(r, axis=1) - 2, N1star=n1, N2star=n2, N1star_contact=n1c,
+                N2star_contact=n2c)
+
+
+def upto(d, x_end):
+    """The records of d before x first reaches x_end, and the y where it does (linear
+    interpolation between the records around the crossing; None when it never does)."""
+    above = np.nonzero(d['x'] >= x_end)[0]
+    if len(above) == 0 or above[0] == 0:
+        return d, None
+    k = above[0]
+    w = (x_end - d['x'][k - 1]) / (d['x'][k] - d['x'][k - 1])
+    return {q: v[:k] for q, v in d.items()}, d['y'][k - 1] + w * (d['y'][k] - d['y'][k - 1])
+
+
+def compare(dns, ref, start, skip_time=0.0):
+    """Deviations of the DNS from pairtraj over the transit x in [start, -start]; the normal
+    stresses from time skip_time on (the stresslets of the DNS build up from zero at the start)."""
+    part, y_end = upto(dns, -start)
+    out = {'y_end_pairtraj': float(ref['y'][-1]), 'y_end_dns': y_end,
+           'gap_min_dns': float(part['gap'].min()), 'gap_min_pairtraj': float(ref['gap'].min()),
+           'time_dns': None if y_end is None else float(part['t'][-1]), 'time_pairtraj': float(ref['t'][-1])}
+    if y_end is None:
+        return out
+    out['y_end_error'] = (y_end - ref['y'][-1]) / ref['y'][-1]
+    out['y_max_deviation'] = float(np.abs(part['y'] - np.interp(part['x'], ref['x'], ref['y'])).max())
+    late = part['t'] >= skip_time
+    order = np.argsort(ref['theta'])          # theta decreases along the transit; np.interp needs it increasing
+    for q in ('N1star', 'N2star', 'N1star_contact', 'N2star_contact'):
+        at_dns = np.interp(part['theta'][late], ref['theta'][order], ref[q][order])
+        out[q + '_abs_deviation'] = float(np.abs(part[q][late] - at_dns).max())
+        out[q + '_extremes_dns'] = [float(part[q].min()), float(part[q].max())]
+        out[q + '_extremes_pairtraj'] = [float(ref[q].min()), float(ref[q].max())]
+    # the contact: the angles where it opens and closes (the contact parts jump there, so they are
+    # compared by window and peak rather than pointwise at equal theta)
+    touching = np.nonzero((part['N1star_contact'] != 0) | (part['N2star_contact'] != 0))[0]
+    touching_ref = np.nonzero(ref['contact'] > 0)[0]
+    if len(touching) and len(touching_ref):
+        out['contact_theta_dns'] = [float(part['theta'][touching[0]]), float(part['theta'][touching[-1]])]
+        out['contact_theta_pairtraj'] = [float(ref['theta'][touching_ref[0]]), float(ref['theta'][touching_ref[-1]])]
+    return out
+
+
+def plot(results, start, figures, tag):
+    """Paper figures 3-5 with the DNS (markers) over pairtraj (lines); results: {case: (dns, ref)}."""
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    os.makedirs(figures, exist_ok=True)
+    names = []
+    fig, ax = plt.subplots(figsize=(7, 4))
+    arc = np.linspace(0, np.pi, 200)
+    ax.fill_between(2 * np.cos(arc), 0, 2 * np.sin(arc), color='0.85', label='excluded, $r < 2a$')
+    for k, (case, (dns, ref)) in enumerate(results.items()):
+        part, _ = upto(dns, -start)
+        ax.plot(ref['x'], ref['y'], '-', color=COLOURS[case], label=LABELS[case])
+        ax.plot(part['x'][::5], part['y'][::5], 'o', ms=2.5, color=COLOURS[case],
+                label='DNS (markers; lines pairtraj)' if k == 0 else None)
+    ax.set_xlim(start, -start)
+    ax.set_ylim(0, 2.4)
+    ax.set_xlabel('$x/a$')
+    ax.set_ylabel('$y/a$')
+    ax.set_title('Relative trajectories, DNS against pairtraj (cf. JFM 2014 fig. 3)', fontsize=10)
+    ax.legend(fontsize=7, loc='upper left', ncol=2)
+    fig.tight_layout()
+    names.append(os.path.join(figures, 'pair_dns_%s_trajectories.png' % tag))
+    fig.savefig(names[-1], dpi=130)
+    plt.close(fig)
+    groups = [('normal_stress', [c for c in results if not c.endswith('mu03')], 'frictionless (cf. fig. 4)'),
+              ('friction', [c for c in results if c.startswith('eps1e-2')], r'$\epsilon_r = 10^{-2}$ (cf. fig. 5)')]
+    for name, cases, title in groups:
+        if not cases:
+            continue
+        fig, axes = plt.subplots(1, 2, figsize=(10, 4), sharex=True)
+        for k, case in enumerate(cases):
+            dns, ref = results[case]
+            part, _ = upto(dns, -start)
+            for ax, q in zip(axes, ('N1star', 'N2star')):
+                ax.plot(ref['theta'], ref[q], '-', color=COLOURS[case], label=LABELS[case])
+                ax.plot(part['theta'][::3], part[q][::3], 'o', ms=2.5, color=COLOURS[case],
+                        label='DNS (markers; lines pairtraj)' if k == 0 else None)
+        for ax, q in zip(axes, ('N_1^*', 'N_2^*')):
+            ax.axhline(0, color='0.6', lw=0.5)
+            ax.axvline(np.pi / 2, color='0.6', lw=0.5, ls=':')
+            ax.set_xlim(0, np.pi)
+            ax.set_xlabel(r'$\theta$ (rad, from $+x$)')
+            ax.set_ylabel('$%s$' % q)
+            ax.legend(fontsize=7)
+        fig.suptitle('Pair normal stress differences, DNS against pairtraj, ' + title, fontsize=10)
+        fig.tight_layout()
+        names.append(os.path.join(figures, 'pair_dns_%s_%s.png' % (tag, name)))
+        fig.savefig(names[-1], dpi=130)
+        plt.close(fig)
+    return names
+
+
+def table(comparisons):
+    rows = ['| case | y_end DNS | y_end pairtraj | error | max \\|dy\\| (a) | max \\|dN1*\\| | max \\|dN2*\\| | '
+            'min gap DNS / pairtraj | transit time DNS / pairtraj |', '|' + '---|' * 9]
+    for case, c in comparisons.items():
+        if c['y_end_dns'] is None:
+            rows.append('| %s | (not across yet) | %.4f | | | | | | |' % (case, c['y_end_pairtraj']))
+            continue
+        rows.append('| %s | %.4f | %.4f | %+.2f %% | %.4f | %.3f | %.3f | %.2e / %.2e | %.2f / %.2f |' % (
+            case, c['y_end_dns'], c['y_end_pairtraj'], 100 * c['y_end_error'], c['y_max_deviation'],
+            c['N1star_abs_deviation'], c['N2star_abs_deviation'], c['gap_min_dns'], c['gap_min_pairtraj'],
+            c['time_dns'], c['time_pairtraj']))
+    return '\n'.join(rows)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument('--cases', nargs='+', default=list(CASES), choices=list(CASES))
+    ap.add_argument('--box', type=float, default=20.0)
+    ap.add_argument('--cells', type=float, default=5.0)
+    ap.add_argument('--dt', type=float, default=1e-3)
+    ap.add_argument('--start', type=float, default=-6.0)
+    ap.add_argument('--eps-bar', type=float, default=0.05)
+    ap.add_argument('--reynolds', type=float, default=0.01)
+    ap.add_argument('--ranks', type=int, default=1)
+    ap.add_argument('--jobs', type=int, default=2)
+    ap.add_argument('--hours', type=float, default=0.0)
+    ap.add_argument('--work', default=os.path.join(ROOT, 'out', 'pair_dns'))
+    ap.add_argument('--figures', default=os.path.join(ROOT, 'doc', 'figures'))
+    ap.add_argument('--tag', default='paper', help='figure names: pair_dns_<tag>_*.png')
+    ap.add_argument('--plot-only', action='store_true')
+    args = ap.parse_args()
+    if args.start >= -2:
+        ap.error('--start must be below -2 (the spheres would overlap)')
+    dirs = {c: os.path.join(os.path.abspath(args.work), c) for c in args.cases}
+    if not args.plot_only:
+        commands = {c: prepare(c, dirs[c], args.box, args.cells, args.dt, args.start, args.eps_bar,
+                               args.reynolds, args.hours) for c in args.cases}
+        results = run_all(args.cases, lambda c: start_dns(dirs[c], commands[c], args.ranks), args.jobs)
+        for c, (status, cpu) in results.items():
+            print('%s: exit %d, %.0f CPU s' % (c, status, cpu))
+    data, comparisons = {}, {}
+    for c in args.cases:
+        if not os.path.exists(os.path.join(dirs[c], 'out', 'series.h5')):
+            continue
+        ref = np.genfromtxt(os.path.join(dirs[c], 'pairtraj.csv'), delimiter=',', names=True)
+        dns = load_dns(dirs[c], args.box)
+        data[c] = (dns, ref)
+        comparisons[c] = compare(dns, ref, args.start, skip_time=0.25)
+    print(table(comparisons))
+    if data:
+        print('wrote', ', '.join(plot(data, args.start, args.figures, args.tag)))
+
+
+if __name__ == '__main__':
+    sys.exit(main())
