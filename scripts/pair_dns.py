@@ -182,9 +182,8 @@ def compare(dns, ref, start, skip_time=0.0):
 
 def plot(results, start, figures, tag):
     """Paper figures 3-5 with the DNS (markers) over pairtraj (lines); results: {case: (dns, ref)}."""
-    import matplotlib
-    matplotlib.use('Agg')
     import matplotlib.pyplot as plt
+    from plot_pair import theta_axes          # sets the Agg backend
     os.makedirs(figures, exist_ok=True)
     names = []
     fig, ax = plt.subplots(figsize=(7, 4))
@@ -218,13 +217,7 @@ def plot(results, start, figures, tag):
                 ax.plot(ref['theta'], ref[q], '-', color=COLOURS[case], label=LABELS[case])
                 ax.plot(part['theta'][::3], part[q][::3], 'o', ms=2.5, color=COLOURS[case],
                         label='DNS (markers; lines pairtraj)' if k == 0 else None)
-        for ax, q in zip(axes, ('N_1^*', 'N_2^*')):
-            ax.axhline(0, color='0.6', lw=0.5)
-            ax.axvline(np.pi / 2, color='0.6', lw=0.5, ls=':')
-            ax.set_xlim(0, np.pi)
-            ax.set_xlabel(r'$\theta$ (rad, from $+x$)')
-            ax.set_ylabel('$%s$' % q)
-            ax.legend(fontsize=7)
+        theta_axes(axes, fontsize=7)
         fig.suptitle('Pair normal stress differences, DNS against pairtraj, ' + title, fontsize=10)
         fig.tight_layout()
         names.append(os.path.join(figures, 'pair_dns_%s_%s.png' % (tag, name)))

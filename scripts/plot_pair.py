@@ -31,6 +31,18 @@ CASES = [("pair_eps0", r"$\epsilon_r = 0$", "k", "-"),
          ("pair_eps1e-2_mu03", r"$\epsilon_r = 10^{-2}$, $\mu_d = 0.3$", "tab:orange", "--")]
 
 
+def theta_axes(axes, fontsize):
+    """Frame the N1*, N2* against theta panels (the line theta = pi/2 splits compression from
+    extension)."""
+    for ax, q in zip(axes, ("N_1^*", "N_2^*")):
+        ax.axhline(0, color="0.6", lw=0.5)
+        ax.axvline(np.pi / 2, color="0.6", lw=0.5, ls=":")
+        ax.set_xlim(0, np.pi)
+        ax.set_xlabel(r"$\theta$ (rad, from $+x$)")
+        ax.set_ylabel("$%s$" % q)
+        ax.legend(fontsize=fontsize)
+
+
 def load(case, csv_dir, run):
     path = os.path.join(csv_dir, case + ".csv")
     if run or not os.path.exists(path):
@@ -77,13 +89,7 @@ def main():
             d = data[case]
             axes[0].plot(d["theta"], d["N1star"], style, color=color, label=label)
             axes[1].plot(d["theta"], d["N2star"], style, color=color, label=label)
-        for ax, q in zip(axes, ("N_1^*", "N_2^*")):
-            ax.axhline(0, color="0.6", lw=0.5)
-            ax.axvline(np.pi / 2, color="0.6", lw=0.5, ls=":")
-            ax.set_xlim(0, np.pi)
-            ax.set_xlabel(r"$\theta$ (rad, from $+x$)")
-            ax.set_ylabel("$%s$" % q)
-            ax.legend(fontsize=8)
+        theta_axes(axes, fontsize=8)
         fig.suptitle("Pair normal stress differences, " + title, fontsize=10)
         fig.tight_layout()
         fig.savefig(os.path.join(args.out_dir, name), dpi=130)
