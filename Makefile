@@ -75,7 +75,7 @@ UNIT_BIN := $(patsubst tests/unit/%.F90,$(BUILD)/tests/%,$(UNIT_F90))
 
 PROGRAMS := $(BIN)/fdsusp $(BIN)/fdsusp-pack $(BIN)/fdsusp-resistance $(if $(REF_F90),$(BIN)/pairtraj)
 
-.PHONY: pair-dns all debug check run bench extremes tradeoff calibrate clean tests-build
+.PHONY: all debug check run bench extremes tradeoff pair-dns calibrate clean tests-build
 all: $(PROGRAMS) $(UNIT_BIN)
 
 debug:

@@ -46,6 +46,7 @@ LABELS = {'eps0': r'$\epsilon_r = 0$', 'eps1e-3': r'$\epsilon_r = 10^{-3}$',
           'eps1e-2': r'$\epsilon_r = 10^{-2}$', 'eps1e-2_mu03': r'$\epsilon_r = 10^{-2}$, $\mu_d = 0.3$'}
 COLOURS = {'eps0': 'k', 'eps1e-3': 'tab:blue', 'eps1e-2': 'tab:red', 'eps1e-2_mu03': 'tab:orange'}
 Y0 = 0.5          # initial offset across the shear, a (the paper's)
+STARTUP = 0.25    # strain over which the DNS stresslets build up from zero (lambda starts at 0)
 
 # Smooth spheres (eps_r = 0) get no &contact group: lubrication alone keeps them apart, as in
 # pairtraj, whose smooth pair never touches (its closest gap from y = 0.5a is 8.7e-5 a).
@@ -82,6 +83,10 @@ def pairtraj(case, d, start, eps_bar):
                          eps_bar=repr(eps_bar), csv_file="'pairtraj.csv'", dt_out='0.01'))
     subprocess.run([os.path.join(BIN, 'pairtraj'), 'pairtraj.nml'], cwd=d, check=True,
                    stdout=subprocess.DEVNULL)
+    return read_pairtraj(d)
+
+
+def read_pairtraj(d):
     return np.genfromtxt(os.path.join(d, 'pairtraj.csv'), delimiter=',', names=True)
 
 
@@ -139,6 +144,12 @@ def load_dns(d, box):
     return dict(t=t, x=r[:, 0], y=r[:, 1], z=r[:, 2], theta=np.arctan2(r[:, 1], r[:, 0]),
                 gap=np.linalg.norm(r, axis=1) - 2, N1star=n1, N2star=n2, N1star_contact=n1c,
                 N2star_contact=n2c)
+
+
+def load_case(d, box, start):
+    """A finished case: (DNS records, pairtraj rows, their comparison after the start-up)."""
+    dns, ref = load_dns(d, box), read_pairtraj(d)
+    return dns, ref, compare(dns, ref, start, skip_time=STARTUP)
 
 
 def upto(d, x_end):
@@ -270,10 +281,8 @@ def main():
     for c in args.cases:
         if not os.path.exists(os.path.join(dirs[c], 'out', 'series.h5')):
             continue
-        ref = np.genfromtxt(os.path.join(dirs[c], 'pairtraj.csv'), delimiter=',', names=True)
-        dns = load_dns(dirs[c], args.box)
+        dns, ref, comparisons[c] = load_case(dirs[c], args.box, args.start)
         data[c] = (dns, ref)
-        comparisons[c] = compare(dns, ref, args.start, skip_time=0.25)
     print(table(comparisons))
     if data:
         print('wrote', ', '.join(plot(data, args.start, args.figures, args.tag)))

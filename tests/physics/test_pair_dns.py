@@ -29,7 +29,6 @@ Tolerances, from the differences between the two models rather than from measure
   - the rough pair's closest gap equals pairtraj's within 2 % (both set by the Hertz overlap at
     the same force: gap = h_r - |delta'|).
 """
-import math
 import os
 import sys
 
@@ -43,7 +42,6 @@ import pair_dns as P  # noqa: E402
 from jobpool import run_all  # noqa: E402
 
 BOX, CELLS, DT, START, EPS_BAR = 10.0, 4, 2.5e-3, -2.5, 0.1
-STARTUP = 0.25            # strain during which the stresslets build up from zero
 work = T.scratch('pair_dns')
 cases = ['eps1e-2', 'eps0']
 dirs = {c: os.path.join(work, c) for c in cases}
@@ -54,14 +52,10 @@ for c in cases:
 if T.failures:
     T.finish()
 
-res = {}
-for c in cases:
-    ref = np.genfromtxt(os.path.join(dirs[c], 'pairtraj.csv'), delimiter=',', names=True)
-    dns = P.load_dns(dirs[c], BOX)
-    res[c] = (dns, ref, P.compare(dns, ref, START, skip_time=STARTUP))
-print(P.table({c: r[2] for c, r in res.items()}))
+res = {c: P.load_case(dirs[c], BOX, START)[2] for c in cases}     # compared after P.STARTUP
+print(P.table(res))
 
-dns, ref, cmp_rough = res['eps1e-2']
+cmp_rough = res['eps1e-2']
 T.check(cmp_rough['y_end_dns'] is not None, 'rough pair crossed x = %g' % -START)
 if cmp_rough['y_end_dns'] is not None:
     T.check(abs(cmp_rough['y_end_error']) <= 0.05, 'rough final offset %.4f vs pairtraj %.4f (%+.2f %%, within 5 %%)'
@@ -79,7 +73,7 @@ if cmp_rough['y_end_dns'] is not None:
         T.check(abs(peak - peak_ref) <= 0.1 * peak_ref, 'rough %s peak |%.3f| vs pairtraj |%.3f| (within 10 %%)'
                 % (q, peak, peak_ref))
 
-_, _, cmp_smooth = res['eps0']
+cmp_smooth = res['eps0']
 T.check(cmp_smooth['y_end_dns'] is not None, 'smooth pair crossed x = %g' % -START)
 if cmp_smooth['y_end_dns'] is not None:
     T.check(abs(cmp_smooth['y_end_pairtraj'] - P.Y0) <= 1e-6, 'pairtraj smooth pair symmetric: y_end %.8f'
@@ -88,7 +82,7 @@ if cmp_smooth['y_end_dns'] is not None:
             '(<= 0.01a)' % (cmp_smooth['y_end_dns'], P.Y0))
 
 for c in cases:
-    r = res[c][2]
+    r = res[c]
     if r['y_end_dns'] is None:
         continue
     T.check(r['y_max_deviation'] <= 0.05, '%s: trajectory within %.4fa of pairtraj (<= 0.05a)' % (c, r['y_max_deviation']))
