@@ -18,6 +18,8 @@ Wall (walls at rest, box 8 x 8 x 8): mode W1 translates and spins along the norm
 W2 along a tangent t (f_tt; f_tr from the torque about b = n x t; f_rr). The cell's other wall and
 the images are removed as in scripts/calibrate.py (superposed exact single-wall theory, with
 the sphere at the centre as reference).
+The resolution is a/Delta = 5 in make check; `test_lubrication_resistance.py N` checks the table of
+another resolution N (4, 6, 8: bench, doc/VALIDATION.md §4.2) with the same configurations.
 Tolerance 5 %: the issue's. Contributions: the calibration scatter over sub-cell positions and
 orientations (doc/LUBRICATION.md table), the Aitken extrapolation (< 0.5 %), the resolved
 one-body rotation (XC, YC of an isolated sphere are 1.02, which the pair correction by design
@@ -38,10 +40,11 @@ from resistance_exact import pair_scalars, wall_scalars, wall_excess, NAMES
 import h5py
 
 PI = math.pi
-h = 0.2
+CELLS = int(sys.argv[1]) if len(sys.argv) > 1 else 5
+h = 1.0 / CELLS
 GAPS = [0.001, 0.01, 0.1, 0.5]
 L = 8.0
-work = T.scratch('lubrication_resistance')
+work = T.scratch('lubrication_resistance' + ('' if CELLS == 5 else f'_a{CELLS}'))
 runner = C.Runner(work, 2)
 off = np.array([0.37, 0.61, 0.13]) * h
 d = np.array([0.3, -0.5, 0.81]); d /= np.linalg.norm(d)
@@ -75,6 +78,7 @@ def steady(name):
     return out[0], out[1], lub[0], lub[1]
 
 
+print('a/Delta = %d' % CELLS)
 print('%7s %-9s %9s %9s %9s %7s' % ('gap', 'function', 'exact', 'fdsusp', 'no corr.', 'error'))
 for g in GAPS:
     ex = dict(zip(NAMES, pair_scalars(g)))
