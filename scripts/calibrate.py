@@ -56,10 +56,19 @@ STEPS = 100
 EVERY = 20
 PI = math.pi
 ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT='1', OMPI_ALLOW_RUN_AS_ROOT_CONFIRM='1')
+# The Couette cell at shear rate 1 (u_x = y - Ly/2 about its mid-plane): strain rate and rotation
+SHEAR_E = np.array([[0.0, 0.5, 0.0], [0.5, 0.0, 0.0], [0.0, 0.0, 0.0]])
+SHEAR_OMEGA = np.array([0.0, 0.0, -0.5])
 
 
-def deck(path, out, box, walls, shear, spheres, h, model='none', vtol=1e-6, ptol=1e-8):
-    """spheres: list of (position, velocity, omega); model: the lubrication model (calibration
+def with_flow(x, height):
+    """A sphere at x moving and spinning with the undisturbed flow of a Couette cell this high."""
+    return (x, np.array([x[1] - height / 2, 0.0, 0.0]), SHEAR_OMEGA)
+
+
+def deck(path, out, box, walls, shear, spheres, h, model='none', vtol=1e-6, ptol=1e-8, motion='resistance'):
+    """spheres: list of (position, velocity, omega); motion: 'resistance' (the velocities imposed)
+    or 'frozen' (the velocities force-free, scripts/frozen_pair.py); model: the lubrication model (calibration
     measures the resolved part alone, so 'none'); vtol, ptol: the solver tolerances."""
     lines = [f"&domain box = {box[0]}, {box[1]}, {box[2]}, cells_per_radius = {round(1 / h)},",
              f"  y_boundary = '{'walls' if walls else 'periodic'}', shear_rate = {shear} /",
@@ -68,7 +77,7 @@ def deck(path, out, box, walls, shear, spheres, h, model='none', vtol=1e-6, ptol
              f"&time dt = {REYNOLDS / BETA!r}, steps = {STEPS} /",
              f"&output directory = '{out}', progress_every = {STEPS}, series_every = {EVERY} /",
              f"&lubrication model = '{model}' /",
-             f"&particles number = {len(spheres)}, motion = 'resistance'"]
+             f"&particles number = {len(spheres)}, motion = '{motion}'"]
     for i, (x, u, w) in enumerate(spheres, 1):
         lines.append(f"  position(:,{i}) = {x[0]!r}, {x[1]!r}, {x[2]!r}")
         lines.append(f"  velocity(:,{i}) = {u[0]!r}, {u[1]!r}, {u[2]!r}")
@@ -217,25 +226,23 @@ def main():
     rng = np.random.default_rng(20261123 + n)
     L = 8.0
     LW = 10.0
-    E = np.array([[0, 0.5, 0], [0.5, 0, 0], [0, 0, 0]])
-    om_inf = np.array([0, 0, -0.5])
+    E = SHEAR_E
     zero = np.zeros(3)
     runner = Runner(work, args.jobs)
     samples = []
     for s in range(args.samples):
         off = rng.uniform(0, h, size=3)
         d, e1, e2 = frame(rng)
-        t = np.array([math.cos(rng.uniform(0, 2 * PI)), 0.0, 0.0])
+        rng.uniform(0, 2 * PI)   # a discarded draw: it keeps the random stream, hence the tables' samples
         ang = rng.uniform(0, 2 * PI)
         t = np.array([math.cos(ang), 0.0, math.sin(ang)])
         dc = strain_direction(d, E, seed=20261125 + 100 * n + s)
         samples.append((off, d, e1, e2, t, dc))
         c = np.array([L / 2, L / 2, L / 2]) + off
         cc = np.array([L / 2, LW / 2, L / 2]) + off
-        uc = lambda x: np.array([x[1] - LW / 2, 0.0, 0.0])
         runner.add(f's{s}_one_A', box=(L, L, L), walls=False, shear=0.0, spheres=[(c, d, d)], h=h)
         runner.add(f's{s}_one_B', box=(L, L, L), walls=False, shear=0.0, spheres=[(c, e1, e1)], h=h)
-        runner.add(f's{s}_one_C', box=(L, LW, L), walls=True, shear=1.0, spheres=[(cc, uc(cc), om_inf)], h=h)
+        runner.add(f's{s}_one_C', box=(L, LW, L), walls=True, shear=1.0, spheres=[with_flow(cc, LW)], h=h)
         for g in GAPS:
             x1, x2 = c - (1 + g / 2) * d, c + (1 + g / 2) * d
             runner.add(f's{s}_g{g}_A', box=(L, L, L), walls=False, shear=0.0,
@@ -244,7 +251,7 @@ def main():
                        spheres=[(x1, e1, e1), (x2, -e1, zero)], h=h)
             y1, y2 = cc - (1 + g / 2) * dc, cc + (1 + g / 2) * dc
             runner.add(f's{s}_g{g}_C', box=(L, LW, L), walls=True, shear=1.0,
-                       spheres=[(y1, uc(y1), om_inf), (y2, uc(y2), om_inf)], h=h)
+                       spheres=[with_flow(y1, LW), with_flow(y2, LW)], h=h)
         n_wall = np.array([0.0, 1.0, 0.0])
         for g in WALL_GAPS + ['centre']:
             y = LW / 2 if g == 'centre' else 1.0 + g
