@@ -237,6 +237,65 @@ def plot(results, start, figures, tag):
     return names
 
 
+MOBILITY_GAPS = (0.02, 0.05, 0.1, 0.3)
+
+
+def mobility(d, box):
+    """The DNS pair's relative velocity against the exact one of a free pair at the same r, record
+    by record while no contact force acts: dr/dt = Om x r + E.r - [A dd + B (I - dd)].E.r (simple
+    shear of rate 1, Batchelor & Green functions from bin/fdsusp-resistance). The radial part is
+    (1 - A) r d.E.d, small near contact and sensitive to the resistance ratio XG/XA (1 - A is 2.7
+    times as sensitive at gap 0.1, 25 times at 0.01), so it shows where the trajectory goes wrong:
+    in the approach (d.E.d < 0) or the separation (d.E.d > 0). Returns, per phase and gap of
+    MOBILITY_GAPS, the relative errors (radial, tangential) at the record nearest that gap."""
+    import h5py
+    from resistance_exact import shear_functions
+    with h5py.File(os.path.join(d, 'out', 'series.h5'), 'r') as f:
+        x = f['particles/position'][:]
+        v = f['particles/velocity'][:]
+        contact = np.abs(f['particles/force_contact'][:]).sum(axis=(1, 2)) if 'particles/force_contact' in f \
+            else np.zeros(len(x))
+        dt = (f['time'][1] - f['time'][0]) / (f['step'][1] - f['step'][0])
+    dv = v[:, 1] - v[:, 0]
+    # a record holds X^{n+1} and the velocity of X^n: step back, or the pair's rotation (omega dt)
+    # turns v_t omega dt of tangential velocity into a spurious radial one (2.3e-3 at dt 2.5e-3)
+    r = x[:, 1] - x[:, 0] - dt * dv
+    for k in (0, 2):
+        r[:, k] -= box * np.round(r[:, k] / box)
+    dist = np.linalg.norm(r, axis=1)
+    keep = (contact == 0) & (dist < 4.0)
+    r, dist, dv = r[keep], dist[keep], dv[keep]
+    n = r / dist[:, None]
+    er = np.stack([r[:, 1] / 2, r[:, 0] / 2, np.zeros(len(r))], axis=1)       # E.r
+    fn = shear_functions(np.maximum(dist - 2, 1e-4))
+    radial_e = np.einsum('ij,ij->i', n, er)
+    tangential_e = er - radial_e[:, None] * n
+    t = tangential_e / np.linalg.norm(tangential_e, axis=1)[:, None]
+    rot = np.stack([r[:, 1] / 2, -r[:, 0] / 2, np.zeros(len(r))], axis=1)    # Om x r, Om = -e_z/2
+    exact = rot + (1 - fn[:, 0])[:, None] * radial_e[:, None] * n + (1 - fn[:, 1])[:, None] * tangential_e
+    rad = np.einsum('ij,ij->i', dv, n) / np.einsum('ij,ij->i', exact, n) - 1
+    tan = np.einsum('ij,ij->i', dv, t) / np.einsum('ij,ij->i', exact, t) - 1
+    out = {}
+    for phase, sel in (('approach', radial_e < 0), ('separation', radial_e > 0)):
+        for g in MOBILITY_GAPS:
+            k = np.nonzero(sel)[0]
+            if len(k):
+                k = k[np.argmin(np.abs(dist[k] - 2 - g))]
+                if abs(dist[k] - 2 - g) < 0.2 * g:
+                    out[phase, g] = (rad[k], tan[k])
+    return out
+
+
+def mobility_table(results):
+    head = ' | '.join('%s %g' % (p[:3], g) for p in ('approach', 'separation') for g in MOBILITY_GAPS)
+    rows = ['| case | %s |' % head, '|' + '---|' * (1 + 2 * len(MOBILITY_GAPS))]
+    for case, m in results.items():
+        cells = ['%+.1f / %+.1f' % tuple(100 * e for e in m[p, g]) if (p, g) in m else ''
+                 for p in ('approach', 'separation') for g in MOBILITY_GAPS]
+        rows.append('| %s | %s |' % (case, ' | '.join(cells)))
+    return 'relative velocity against the free-pair mobility (radial / tangential error, %%)\n' + '\n'.join(rows)
+
+
 def table(comparisons):
     rows = ['| case | y_end DNS | y_end pairtraj | error | max \\|dy\\| (a) | max \\|dN1*\\| | max \\|dN2*\\| | '
             'min gap DNS / pairtraj | transit time DNS / pairtraj |', '|' + '---|' * 9]
@@ -277,13 +336,15 @@ def main():
         results = run_all(args.cases, lambda c: start_dns(dirs[c], commands[c], args.ranks), args.jobs)
         for c, (status, cpu) in results.items():
             print('%s: exit %d, %.0f CPU s' % (c, status, cpu))
-    data, comparisons = {}, {}
+    data, comparisons, mobilities = {}, {}, {}
     for c in args.cases:
         if not os.path.exists(os.path.join(dirs[c], 'out', 'series.h5')):
             continue
         dns, ref, comparisons[c] = load_case(dirs[c], args.box, args.start)
+        mobilities[c] = mobility(dirs[c], args.box)
         data[c] = (dns, ref)
     print(table(comparisons))
+    print(mobility_table(mobilities))
     if data:
         print('wrote', ', '.join(plot(data, args.start, args.figures, args.tag)))
 

@@ -19,6 +19,13 @@ def pair_scalars(gap):
     return _table('pair', [gap])[0, 1:]
 
 
+def shear_functions(gaps):
+    """Rows [A, B, C, K, L, M] of a force- and torque-free equal pair in a linear flow at these gaps
+    (Batchelor & Green; mod_resistance::pair_shear_functions): the relative velocity is
+    dr/dt = Om x r + E.r - [A dd + B (I - dd)].E.r."""
+    return _table('shear', list(gaps))[:, 1:]
+
+
 def wall_scalars(gap):
     """[lambda_perp, f_tt, f_tr, f_rr, x_w] at this gap."""
     return _table('wall', [gap])[0, 1:]

@@ -4,23 +4,28 @@
 !   bin/fdsusp-resistance pair GAP [GAP ...]   one line per gap: gap XA11 YA11 ... ZM12 (22 scalars,
 !                                              Kim & Karrila normalisation, order of the header)
 !   bin/fdsusp-resistance wall GAP [GAP ...]   one line per gap: gap lambda_perp f_tt f_tr f_rr x_w
+!   bin/fdsusp-resistance shear GAP [GAP ...]  one line per gap: gap A B C K L M, the mobility and
+!                                              stresslet functions of a free pair in a linear flow
+!                                              (pair_shear_functions, the ones bin/pairtraj integrates)
 program fdsusp_resistance
   use mod_kinds, only: dp
   use mod_resistance, only: resistance_scalars, pair_scalar_names, n_pair_scalars, wall_normal_resistance, &
-       wall_tangential_resistance, wall_twist_resistance
+       wall_tangential_resistance, wall_twist_resistance, pair_shear_functions
   implicit none
   character(len=64) :: kind, arg
-  real(dp) :: gap, f_tt, f_tr, f_rr
+  real(dp) :: gap, f_tt, f_tr, f_rr, bg(6)
   integer :: k, stat
   call get_command_argument(1, kind)
-  if (command_argument_count() < 2 .or. (kind /= 'pair' .and. kind /= 'wall')) then
-    write(0, '(a)') 'usage: fdsusp-resistance pair|wall GAP [GAP ...]'
+  if (command_argument_count() < 2 .or. (kind /= 'pair' .and. kind /= 'wall' .and. kind /= 'shear')) then
+    write(0, '(a)') 'usage: fdsusp-resistance pair|wall|shear GAP [GAP ...]'
     stop 2
   end if
   if (kind == 'pair') then
     write(*, '(a,22(1x,a))') '# gap', (trim(pair_scalar_names(k)), k = 1, n_pair_scalars)
-  else
+  else if (kind == 'wall') then
     write(*, '(a)') '# gap lambda_perp f_tt f_tr f_rr x_w'
+  else
+    write(*, '(a)') '# gap A B C K L M'
   end if
   do k = 2, command_argument_count()
     call get_command_argument(k, arg)
@@ -31,6 +36,9 @@ program fdsusp_resistance
     end if
     if (kind == 'pair') then
       write(*, '(23es24.15e3)') gap, resistance_scalars(gap)
+    else if (kind == 'shear') then
+      call pair_shear_functions(gap, bg(1), bg(2), bg(3), bg(4), bg(5), bg(6))
+      write(*, '(7es24.15e3)') gap, bg
     else
       call wall_tangential_resistance(gap, f_tt, f_tr, f_rr)
       write(*, '(6es24.15e3)') gap, wall_normal_resistance(gap), f_tt, f_tr, f_rr, wall_twist_resistance(gap)
