@@ -293,7 +293,7 @@ def mobility_table(results):
         cells = ['%+.1f / %+.1f' % tuple(100 * e for e in m[p, g]) if (p, g) in m else ''
                  for p in ('approach', 'separation') for g in MOBILITY_GAPS]
         rows.append('| %s | %s |' % (case, ' | '.join(cells)))
-    return 'relative velocity against the free-pair mobility (radial / tangential error, %%)\n' + '\n'.join(rows)
+    return 'relative velocity against the free-pair mobility (radial / tangential error, %)\n' + '\n'.join(rows)
 
 
 def table(comparisons):
