@@ -41,7 +41,7 @@ for n in cells:
     for g in GAPS:
         with h5py.File(os.path.join(work, f'a{n}_g{g}', 'series.h5'), 'r') as f:
             V = C.aitken(f['particles/velocity'][:])
-        dv = V[1] - V[0]                       # Om x r is along t-perpendicular directions only
+        dv = V[1] - V[0]                       # dr/dt; Om x r has no radial part, its t part is removed
         s = 2 + g
         one_a = (dv @ d) / (s * ded)
         one_b = (dv @ t - s * np.cross(C.SHEAR_OMEGA, d) @ t) / (s * (Ed @ t))
