@@ -19,6 +19,9 @@ Compared (doc/VALIDATION.md §4.4): the relative position y where the pair cross
 "final offset"), the largest |y_DNS - y_pairtraj| at equal x, and N1*, N2* against theta with
 N* = 2 (S_xx - S_yy) / S_inf, 2 (S_yy - S_zz) / S_inf, S the stresslet of one sphere (hydrodynamic,
 with the lubrication correction, plus contact), S_inf = (20/3) pi eta a^3 gamma_dot, as pairtraj.
+Also printed: the DNS pair's relative velocity against the exact free-pair one along its trajectory
+(mobility(): radial / tangential errors at four gaps in the approach and the separation), which
+tells a steady resistance error from a lag (doc/VALIDATION.md §4.4).
 Needs Debian's python3 with numpy, h5py and matplotlib (the shebang is /usr/bin/python3).
 """
 import argparse
