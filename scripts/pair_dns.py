@@ -280,12 +280,13 @@ def mobility(d, box):
     tan = np.einsum('ij,ij->i', dv, t) / np.einsum('ij,ij->i', exact, t) - 1
     out = {}
     for phase, sel in (('approach', radial_e < 0), ('separation', radial_e > 0)):
+        records = np.nonzero(sel)[0]
+        if len(records) == 0:
+            continue
         for g in MOBILITY_GAPS:
-            k = np.nonzero(sel)[0]
-            if len(k):
-                k = k[np.argmin(np.abs(dist[k] - 2 - g))]
-                if abs(dist[k] - 2 - g) < 0.2 * g:
-                    out[phase, g] = (rad[k], tan[k])
+            k = records[np.argmin(np.abs(dist[records] - 2 - g))]
+            if abs(dist[k] - 2 - g) < 0.2 * g:
+                out[phase, g] = (rad[k], tan[k])
     return out
 
 
