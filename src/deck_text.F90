@@ -152,10 +152,15 @@ contains
     e = index(line(1:last - 1), '=', back=.true.)
     if (e <= 1) return
     s = line(1:e - 1)
+    ! an array section "velocity(:,1)" holds separators of its own: cut it off first
+    if (len_trim(s) > 0) then
+      if (s(len_trim(s):len_trim(s)) == ')') then
+        b = index(s, '(', back=.true.)
+        if (b > 1) s = s(1:b - 1)
+      end if
+    end if
     b = scan(trim(s), ' ,&', back=.true.)
     name = adjustl(s(b + 1:))
-    b = index(name, '(')
-    if (b > 1) name = name(1:b - 1)
   end function variable_before
 
   function explain(line, msg) result(text)

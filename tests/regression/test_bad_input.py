@@ -28,6 +28,9 @@ cases = [
     ('value out of range', GOOD.replace('dt = 0.005', 'dt = -1'), [], ['bad.nml', '&time', 'dt', 'out of range']),
     ('wrong type', GOOD.replace('steps = 4', "steps = 'many'"), [], ['bad.nml', '&time', 'steps', 'cannot read']),
     ('unknown group', GOOD + '&fluidd reynolds = 1 /\n', [], ['bad.nml', '&fluidd', 'unknown group']),
+    # the comma of the array section must not cut the name to '1)'
+    ('bad value in an array section', GOOD + "&particles number = 1, position(:,1) = 1.6, 1.6, 1.6, "
+     "motion = 'prescribed', velocity(:,1) = --0.1, 0, 0 /\n", [], ['bad.nml', '&particles', 'variable velocity', 'cannot read']),
     ('missing deck', None, [], ['bad.nml', 'does not exist']),
     ('periodic box with shear', GOOD.replace('cells_per_radius = 5', "cells_per_radius = 5, y_boundary = 'periodic'"),
      [], ['bad.nml', '&domain', 'shear_rate', 'periodic']),
