@@ -55,7 +55,7 @@ STARTUP = 0.25    # strain over which the DNS stresslets build up from zero (lam
 # pairtraj, whose smooth pair never touches (its closest gap from y = 0.5a is 8.7e-5 a).
 DNS_DECK = """! pair test in the DNS, written by scripts/pair_dns.py (case {case})
 &domain box = {box}, {box}, {box}, cells_per_radius = {cells}, y_boundary = 'walls', shear_rate = 1 /
-&fluid reynolds = {reynolds}, initial_flow = 'shear' /
+&fluid reynolds = {reynolds}, viscous_theta = {theta}, initial_flow = 'shear' /
 &time dt = {dt}, steps = {steps} /
 &output directory = 'out', progress_every = {progress}, series_every = {every}, checkpoint_every = {checkpoint} /
 &run title = 'pair test {case}', max_wall_hours = {hours} /
@@ -93,7 +93,7 @@ def read_pairtraj(d):
     return np.genfromtxt(os.path.join(d, 'pairtraj.csv'), delimiter=',', names=True)
 
 
-def prepare(case, d, box, cells, dt, start, eps_bar=0.05, reynolds=0.01, hours=0.0, steps_factor=1.25):
+def prepare(case, d, box, cells, dt, start, eps_bar=0.05, reynolds=0.01, theta=0.5, hours=0.0, steps_factor=1.25):
     """Write the case's decks, run pairtraj; return the DNS command (continuing from a checkpoint
     when there is one). The DNS runs for steps_factor times pairtraj's transit time."""
     os.makedirs(d, exist_ok=True)
@@ -104,7 +104,7 @@ def prepare(case, d, box, cells, dt, start, eps_bar=0.05, reynolds=0.01, hours=0
     contact = '' if eps_r == 0 else '&contact roughness = %r, eps_bar = %r, friction = %r /\n' % (eps_r, eps_bar, mu_d)
     every = max(1, int(round(0.01 / dt)))                     # a record every 0.01 strain
     with open(os.path.join(d, 'deck.nml'), 'w') as f:
-        f.write(DNS_DECK.format(case=case, box=box, cells=cells, reynolds=reynolds, dt=dt, steps=steps,
+        f.write(DNS_DECK.format(case=case, box=box, cells=cells, reynolds=reynolds, theta=theta, dt=dt, steps=steps,
                                 progress=max(1, steps // 20), every=every, checkpoint=max(1, steps // 10),
                                 hours=hours, x1=c - start / 2, y1=c - Y0 / 2, x2=c + start / 2,
                                 y2=c + Y0 / 2, c=c, contact=contact))
@@ -323,6 +323,7 @@ def main():
     ap.add_argument('--start', type=float, default=-6.0)
     ap.add_argument('--eps-bar', type=float, default=0.05)
     ap.add_argument('--reynolds', type=float, default=0.01)
+    ap.add_argument('--theta', type=float, default=0.5, help='viscous_theta of the DNS (0.5 Crank-Nicolson, 1 backward Euler)')
     ap.add_argument('--ranks', type=int, default=1)
     ap.add_argument('--jobs', type=int, default=2)
     ap.add_argument('--hours', type=float, default=0.0)
@@ -336,7 +337,7 @@ def main():
     dirs = {c: os.path.join(os.path.abspath(args.work), c) for c in args.cases}
     if not args.plot_only:
         commands = {c: prepare(c, dirs[c], args.box, args.cells, args.dt, args.start, args.eps_bar,
-                               args.reynolds, args.hours) for c in args.cases}
+                               args.reynolds, args.theta, args.hours) for c in args.cases}
         results = run_all(args.cases, lambda c: start_dns(dirs[c], commands[c], args.ranks), args.jobs)
         for c, (status, cpu) in results.items():
             print('%s: exit %d, %.0f CPU s' % (c, status, cpu))

@@ -198,6 +198,7 @@ program fdsusp
   end if
   call install_signal_handlers()
   PetscCallA(stage_pop(ierr))
+  if (has_particles .and. has_lubrication .and. trim(cfg%motion) == 'free') call check_pair_lag()
   if (has_particles) then
     write(text, '(a,i0,a)') 'models: fluid (unsteady Stokes, projection); ', parts%n, &
          ' rigid spheres (fictitious domain, motion '''//trim(cfg%motion)//'''); '//trim(contact_models())// &
@@ -512,6 +513,21 @@ contains
            ' a, ', size(lub%pair_gap), ' tabulated gaps)'
     end select
   end function lubrication_models
+
+  ! Close free pairs: Lambda on the faces between them relaxes over ~dt^2/(kappa (1 - alpha) Re h^2)
+  ! strains, so a pair that opens separates too fast: by ~0.7 % per 1e-3 of dt^2/(Re h^2) at gaps
+  ! 0.05-0.1 a (a/Delta = 4, 5, 6; doc/VALIDATION.md §4.4, the pair test's mobility table).
+  subroutine check_pair_lag()
+    real(dp), parameter :: LAG_LIMIT = 4.0e-3_dp     ! ~3 % in the separation, measured
+    real(dp) :: lag
+    lag = cfg%dt**2 / (cfg%reynolds * cfg%h**2)
+    if (lag > LAG_LIMIT) then
+      write(text, '(a,es9.2,a,es8.1,a,es9.2,a)') 'close pairs will separate too fast: dt^2/(Re Delta^2) = ', lag, &
+           ' exceeds ', LAG_LIMIT, ' (about 0.7 % per 1e-3 in the separation velocity, doc/VALIDATION.md 4.4): dt <= ', &
+           sqrt(LAG_LIMIT * cfg%reynolds) * cfg%h, ' keeps it within ~3 %'
+      call warn_line(text)
+    end if
+  end subroutine check_pair_lag
 
   ! The explicit rough contacts against the lubricated response: refused where they chatter
   ! (doc/CONTACT.md "Time-step considerations": clean at 0.02, period-two chatter from 0.03 on),
