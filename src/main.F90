@@ -19,7 +19,7 @@ program fdsusp
   use mod_system, only: install_signal_handlers, stop_signal, make_directory, probe_directory
   use mod_timers, only: timers_register, stage_push, stage_pop, STAGE_SETUP, STAGE_FLUID, STAGE_OUTPUT, &
                         STAGE_PARTICLES, STAGE_CONTACTS, STAGE_LUBRICATION
-  use mod_particles, only: particles_t, advance_positions, displacements
+  use mod_particles, only: particles_t, advance_positions, displacements, MOTION_FREE
   use mod_particles_io, only: particles_load, particles_snapshot
   use mod_rheology, only: rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, rheo_state, rheo_restore, &
                           rheo_write_summary, rheo_summarise, summary_names, NSUMMARY
@@ -198,7 +198,7 @@ program fdsusp
   end if
   call install_signal_handlers()
   PetscCallA(stage_pop(ierr))
-  if (has_particles .and. has_lubrication .and. trim(cfg%motion) == 'free') call check_pair_lag()
+  if (has_particles .and. has_lubrication .and. parts%motion == MOTION_FREE) call check_pair_lag()
   if (has_particles) then
     write(text, '(a,i0,a)') 'models: fluid (unsteady Stokes, projection); ', parts%n, &
          ' rigid spheres (fictitious domain, motion '''//trim(cfg%motion)//'''); '//trim(contact_models())// &
