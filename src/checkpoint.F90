@@ -2,12 +2,16 @@
 !   datasets  /u /v /w (face velocities u^n), /p (p^{n-1/2}), /phi (last pressure increment, the
 !             warm start of the next Poisson solve: without it a restart would iterate from
 !             another guess and differ at the solver tolerance)
+!             /u_star /v_star /w_star, /u_star_old ... (the provisional velocities u*^n, u*^{n-1}
+!             whose extrapolation starts the next viscous solves, mod_fluid; for the same reason)
+!             with the attribute star_history (how many of them are set, 0-2); a checkpoint
+!             without them (written before 2026-11-25) restarts from u^n, at the solver tolerance
 !             with particles also /lambda_u /lambda_v /lambda_w (the fictitious-domain force
 !             density Lambda^n, a source of the next fluid step) and the group /particles
 !             (mod_particles_io: positions with attribute box, velocities, Adams-Bashforth history)
 !             with contacts also the group /contacts (mod_contacts_io: the tangential springs)
 !             with statistics (&rheology) also /rheology/accumulators (mod_rheology::rheo_state)
-!   attributes format_version, step, time, cells, box, walls, reynolds, dt, shear_rate
+!   attributes format_version, step, time, cells, box, walls, reynolds, dt, shear_rate, star_history
 ! Written in parallel to NAME.tmp by PETSc's HDF5 viewer, completed by rank 0, flushed to disk
 ! and renamed over NAME: the previous checkpoint survives until the new one is whole.
 #include <petsc/finclude/petscdmda.h>
@@ -50,7 +54,7 @@ contains
     real(dp), intent(in), optional :: statistics(:)
     PetscViewer :: viewer
     integer(HID_T) :: file, group
-    integer :: err, e(10), c, walls
+    integer :: err, e(11), c, walls
     character(len=1100) :: tmp
     character(len=16) :: code
 
@@ -61,6 +65,10 @@ contains
     end do
     PetscCall(VecView(fl%pressure, viewer, ierr))
     PetscCall(VecView(fl%phi, viewer, ierr))
+    do c = FIELD_U, FIELD_W
+      PetscCall(VecView(fl%vel_star(c), viewer, ierr))
+      PetscCall(VecView(fl%vel_star_old(c), viewer, ierr))
+    end do
     if (present(lambda)) then
       do c = 1, 3
         PetscCall(VecView(lambda(c), viewer, ierr))
@@ -83,6 +91,7 @@ contains
       call write_attribute(file, 'dt', [cfg%dt], e(8))
       call write_attribute(file, 'shear_rate', [cfg%shear_rate], e(9))
       call write_string_attribute(file, 'program', 'fdsusp', e(10))
+      call write_attribute(file, 'star_history', [fl%star_history], e(11))
       if (present(parts)) call particles_write(file, parts, cfg%box, .true.)
       if (present(history) .and. present(parts)) call contacts_write(file, history, parts%n)
       if (present(statistics)) then
@@ -241,17 +250,33 @@ contains
     type(contact_history_t), intent(inout), optional :: history
     real(dp), intent(inout), optional :: statistics(:)
     PetscViewer :: viewer
-    integer :: c, rank, err
+    integer :: c, rank, err, stars(1)
     integer(HID_T) :: file
     integer(HSIZE_T) :: dims(2)
     character(len=200) :: message
     real(dp), allocatable :: buffer(:, :)
+    ! how many provisional velocities the file holds (none in a checkpoint older than them)
+    stars = 0
+    if (is_root()) then
+      call h5fopen_f(trim(path), H5F_ACC_RDONLY_F, file, err)
+      if (has_object(file, 'u_star_old')) call read_attribute(file, 'star_history', stars, err)
+      if (err /= 0) stars = 0
+      call h5fclose_f(file, err)
+    end if
+    call MPI_Bcast(stars, 1, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
+    fl%star_history = stars(1)
     PetscCall(PetscViewerHDF5Open(PETSC_COMM_WORLD, trim(path), FILE_MODE_READ, viewer, ierr))
     do c = FIELD_U, FIELD_W
       PetscCall(VecLoad(fl%vel(c), viewer, ierr))
     end do
     PetscCall(VecLoad(fl%pressure, viewer, ierr))
     PetscCall(VecLoad(fl%phi, viewer, ierr))
+    if (fl%star_history > 0) then
+      do c = FIELD_U, FIELD_W
+        PetscCall(VecLoad(fl%vel_star(c), viewer, ierr))
+        PetscCall(VecLoad(fl%vel_star_old(c), viewer, ierr))
+      end do
+    end if
     if (present(lambda)) then
       do c = 1, 3
         PetscCall(VecLoad(lambda(c), viewer, ierr))

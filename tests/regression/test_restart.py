@@ -1,6 +1,7 @@
 """Invariant: restart is exact. N steps in one run equal N/2 steps, a checkpoint, a restart and
-N/2 steps: the checkpoint holds the complete state (u, v, w, p and the last pressure increment,
-the warm start of the next Poisson solve), so the continued run repeats the same arithmetic and
+N/2 steps: the checkpoint holds the complete state (u, v, w, p, the last pressure increment,
+the warm start of the next Poisson solve, and the provisional velocities u*^n, u*^{n-1} whose
+extrapolation starts the viscous solves), so the continued run repeats the same arithmetic and
 agrees to round-off; asserted to 1e-12 absolute on O(1) fields. The same holds when the
 checkpoint was written because the run received SIGTERM (exit status 0), and SIGUSR1 through
 mpiexec on 2 ranks stops the run cleanly with a checkpoint too. series.h5 of the continued run
@@ -19,7 +20,7 @@ DECK = """&domain box = 3.2, 3.2, 3.2, cells_per_radius = 5, y_boundary = 'walls
 &output directory = 'out', progress_every = {progress} /
 &verification manufactured_solution = .true. /
 """
-NAMES = ['u', 'v', 'w', 'p', 'phi']
+NAMES = ['u', 'v', 'w', 'p', 'phi', 'u_star', 'v_star', 'w_star', 'u_star_old', 'v_star_old', 'w_star_old']
 
 
 def state(d):
