@@ -137,8 +137,10 @@ tradeoff: all
 	$(PYTHON) scripts/tradeoff.py
 
 # The paper's pair test in the DNS (Gallier et al. 2014 §3; 20a cube, a/Delta = 5, dt = 1e-3, start
-# -6a, four cases): about a day per case on one core, resumable (PAIR_DNS_ARGS="--hours 10" stops
-# each run with a checkpoint after 10 h; the same command continues). Figures
+# -6a, four cases): the approach the cases share runs once on both cores, then the four cases
+# branch from it before their first contact, two at a time (scripts/pair_dns.py --branch; about
+# 2 h per case on 2 cores unbranched, doc/VALIDATION.md §4.4). Resumable (PAIR_DNS_ARGS="--hours 1"
+# stops each run with a checkpoint after an hour; the same command continues). Figures
 # doc/figures/pair_dns_paper_*.png, table on stdout (doc/VALIDATION.md §4.4).
 PAIR_DNS_ARGS ?=
 pair-dns: all
