@@ -10,6 +10,7 @@
 #   RANKS="2" STEPS=10 bash scripts/bench_paper.sh
 #   BIN=/path/to/other/bin bash scripts/bench_paper.sh   (before/after comparisons)
 #   FLUID="velocity_tolerance = 1e-6" bash scripts/bench_paper.sh   (extra &fluid settings)
+#   OPTIONS="-fluid_extrapolate 0" bash scripts/bench_paper.sh   (extra command-line options)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
@@ -18,6 +19,7 @@ RANKS=${RANKS:-"1 2"}
 STEPS=${STEPS:-50}
 FLUID=${FLUID:+, $FLUID}
 TAG=${TAG:-paper}
+OPTIONS=${OPTIONS:-}
 mkdir -p build/bench
 stage() { awk -v s="$1" '$2 == s":" {print $3; exit}' "$2"; }
 declare -A per_step
@@ -29,7 +31,7 @@ for np in $RANKS; do
       -e "s|steps = [0-9]*|steps = $STEPS|" -e "s|initial_flow = 'shear'|initial_flow = 'shear'$FLUID|" \
       input/bench_paper.nml > "$deck"
   log=build/bench/${TAG}_np$np.log
-  mpiexec --oversubscribe -n "$np" "$BIN/fdsusp" "$deck" -log_view -memory_view -bench_cold_poisson > "$log" 2>&1
+  mpiexec --oversubscribe -n "$np" "$BIN/fdsusp" "$deck" -log_view -memory_view -bench_cold_poisson $OPTIONS > "$log" 2>&1
   steps=$(awk '/^steps run:/ {print $3}' "$log")
   step=$(awk '/^steps run:/ {print $8}' "$log")
   its=$(awk '/^steps run:/ {print $(NF-3)"/"$(NF-2)"/"$(NF-1)"/"$NF}' "$log")

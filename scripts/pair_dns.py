@@ -8,7 +8,7 @@ from sphere 1, the pair centred in the box, until sphere 2 has passed to x = -st
                         [--hours 0] [--[no-]branch] [--work out/pair_dns] [--figures doc/figures] [--plot-only]
 
 The defaults are the paper's set-up (20a cube with walls in y, a/Delta = 5, dt = 1e-3, start -6a):
-a bench of about 2.3 hours per case on two cores. tests/physics/test_pair_dns.py runs a shortened
+a bench of about 2 hours per case on two cores (0.45 s/step). tests/physics/test_pair_dns.py runs a shortened
 version through the functions below. Each case is a directory under --work with its decks, log,
 the DNS output and pairtraj's CSV; a case with out/checkpoint.h5 continues from it (--hours sets
 &run max_wall_hours, so a long study goes on in a later session). The DNS runs for 1.05 times the
