@@ -412,11 +412,11 @@ def main():
         ap.error('--start must be below -2 (the spheres would overlap)')
     dirs = {c: os.path.join(os.path.abspath(args.work), c) for c in args.cases}
     if not args.plot_only:
-        def prepare_case(c, steps=None):
-            return prepare(c, dirs[c], args.box, args.cells, args.dt, args.start, args.eps_bar, args.reynolds,
+        def prepare_case(c, d, steps=None):
+            return prepare(c, d, args.box, args.cells, args.dt, args.start, args.eps_bar, args.reynolds,
                            args.theta, args.hours, steps=steps)
 
-        commands = {c: prepare_case(c) for c in args.cases}
+        commands = {c: prepare_case(c, dirs[c]) for c in args.cases}
         if args.branch is None:
             args.branch = len(args.cases) > 1
         if args.branch:
@@ -424,8 +424,7 @@ def main():
             last = trunk_steps([read_pairtraj(dirs[c]) for c in args.cases], args.dt)
             done = series_steps(trunk)
             if len(done) == 0 or done[-1] < last:
-                command = prepare(TRUNK_CASE, trunk, args.box, args.cells, args.dt, args.start, args.eps_bar,
-                                  args.reynolds, args.theta, args.hours, steps=last)
+                command = prepare_case(TRUNK_CASE, trunk, steps=last)
                 # the trunk runs alone: it gets every core the study was given
                 status, cpu = run_all(['trunk'], lambda _: start_dns(trunk, command, args.ranks * args.jobs), 1)['trunk']
                 print('trunk (to step %d): exit %d, %.0f CPU s' % (last, status, cpu))
@@ -436,7 +435,7 @@ def main():
             for c in args.cases:
                 if not os.path.exists(os.path.join(dirs[c], 'out', 'checkpoint.h5')):
                     branch(trunk, dirs[c], c)
-                    commands[c] = prepare_case(c)          # now a restart from the trunk's checkpoint
+                    commands[c] = prepare_case(c, dirs[c])          # now a restart from the trunk's checkpoint
         pending = list(args.cases)
         while pending:
             results = run_all(pending, lambda c: start_dns(dirs[c], commands[c], args.ranks), args.jobs)
@@ -450,7 +449,7 @@ def main():
                     transit = float(read_pairtraj(dirs[c])['t'][-1])
                     more = deck_steps(dirs[c]) + int(math.ceil(EXTEND * transit / args.dt))
                     print('%s: not across x = %g by step %d; continued to step %d' % (c, -args.start, steps[-1], more))
-                    commands[c] = prepare_case(c, steps=more)
+                    commands[c] = prepare_case(c, dirs[c], steps=more)
                     pending.append(c)
     data, comparisons, mobilities = {}, {}, {}
     for c in args.cases:

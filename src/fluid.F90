@@ -27,7 +27,6 @@ module mod_fluid
   implicit none
   private
   public :: fluid_t, fluid_create, fluid_step, fluid_destroy, fluid_errors_vs_manufactured, fluid_mean_profile
-  public :: STAR_HISTORY_FULL
   integer, parameter :: STAR_HISTORY_FULL = 2   ! u*^n and u*^{n-1} known: extrapolate
 
   type :: fluid_t
@@ -75,6 +74,8 @@ contains
       PetscCall(VecDuplicate(fl%vel(c), fl%rhs(c), ierr))
       PetscCall(VecDuplicate(fl%vel(c), fl%forcing(c), ierr))
       PetscCall(VecSet(fl%vel(c), 0.0_dp, ierr))
+      PetscCall(VecSet(fl%vel_star(c), 0.0_dp, ierr))          ! written to checkpoints before it is set
+      PetscCall(VecSet(fl%vel_star_old(c), 0.0_dp, ierr))
       PetscCall(PetscObjectSetName(fl%vel(c), field_names(c), ierr))
       PetscCall(PetscObjectSetName(fl%vel_star(c), trim(field_names(c))//'_star', ierr))
       PetscCall(PetscObjectSetName(fl%vel_star_old(c), trim(field_names(c))//'_star_old', ierr))
