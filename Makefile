@@ -72,6 +72,9 @@ PURE_OBJ := $(call obj,$(PURE_F90))
 RESISTANCE_F90 := src/kinds.F90 src/resistance.F90 src/resistance_table.F90
 PAIRTRAJ_OBJ := $(call obj,$(REF_F90) $(RESISTANCE_F90))
 UNIT_BIN := $(patsubst tests/unit/%.F90,$(BUILD)/tests/%,$(UNIT_F90))
+# pass/fail bookkeeping every unit test links (mod_unit_checks)
+UNIT_CHECKS_F90 := tests/unit/unit_checks.F90
+UNIT_CHECKS_OBJ := $(call obj,$(UNIT_CHECKS_F90))
 
 PROGRAMS := $(BIN)/fdsusp $(BIN)/fdsusp-pack $(BIN)/fdsusp-resistance $(if $(REF_F90),$(BIN)/pairtraj)
 
@@ -101,12 +104,12 @@ $(BIN)/fdsusp-resistance: $(call obj,src/resistance_main.F90 $(RESISTANCE_F90)) 
 	$(FC_LINKER) $(OPTFLAGS) -o $@ $^
 $(BIN)/pairtraj: $(PAIRTRAJ_OBJ) | $(BIN)
 	$(FC_LINKER) $(OPTFLAGS) -o $@ $^
-$(BUILD)/tests/%: $(BUILD)/tests_unit_%.o $(PURE_OBJ) | $(BUILD)/tests
+$(BUILD)/tests/%: $(BUILD)/tests_unit_%.o $(UNIT_CHECKS_OBJ) $(PURE_OBJ) | $(BUILD)/tests
 	$(FC_LINKER) $(OPTFLAGS) -o $@ $^ -llapack -lblas
 
 # Module dependencies, regenerated whenever a source changes.
-$(BUILD)/deps.mk: $(SRC_F90) $(PROGRAM_SRC) $(REF_F90) $(UNIT_F90) scripts/f90deps | $(BUILD)
-	@scripts/f90deps $(BUILD) $(SRC_F90) $(PROGRAM_SRC) $(REF_F90) $(UNIT_F90) > $@
+$(BUILD)/deps.mk: $(SRC_F90) $(PROGRAM_SRC) $(REF_F90) $(UNIT_F90) $(UNIT_CHECKS_F90) scripts/f90deps | $(BUILD)
+	@scripts/f90deps $(BUILD) $(SRC_F90) $(PROGRAM_SRC) $(REF_F90) $(UNIT_F90) $(UNIT_CHECKS_F90) > $@
 -include $(BUILD)/deps.mk
 
 NP ?= 2

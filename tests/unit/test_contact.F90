@@ -34,11 +34,12 @@ program test_contact
   use mod_kinds, only: dp, pi
   use mod_contact, only: contact_params_t, contact_setup, chatter_number, flattening_estimate, contact_history_t, history_size, &
                          contact_pair, contact_forces, contact_stats_t, history_lookup
+  use mod_unit_checks, only: check, finish
   implicit none
   type(contact_params_t) :: p, p0, pb
   type(contact_history_t) :: h
   type(contact_stats_t) :: st
-  integer :: info, nfail, k, step
+  integer :: info, k, step
   integer :: pairs(2, 1), walls(2, 1)
   character(len=200) :: msg
   real(dp) :: n(3), ups(3), f(3), tq(3), fn, dlt, x(3, 2), u(3, 2), om(3, 2), box(3), vw(3, 2)
@@ -46,14 +47,13 @@ program test_contact
   real(dp) :: fsave(3), slip(3), frac(4) = [0.01_dp, 0.05_dp, 0.3_dp, 1.0_dp], fwall(3)
   logical :: per(3), sliding
 
-  nfail = 0
   call contact_setup(p, 1.0_dp, 5.0e-3_dp, 0.5_dp, 0.05_dp, 0.0_dp, 1.0_dp, 1.0_dp, info, msg)
-  call check('set-up accepted', info == 0)
+  call check(info == 0, 'set-up accepted')
 
   ! 1. stiffness
   err = abs(p%k_n * (p%eps_bar * p%h_r)**1.5_dp / (6 * pi) - 1)
   print '(a,es12.5,a,es9.2)', '1. k_n = ', p%k_n, ' eta gd a^1/2; balance rel. error ', err
-  call check('k_n from eps_bar', err < 1e-13_dp)
+  call check(err < 1e-13_dp, 'k_n from eps_bar')
 
   ! 2. Hertz value and direction
   n = [1.0_dp, 2.0_dp, -2.0_dp] / 3
@@ -66,7 +66,7 @@ program test_contact
     err = max(err, norm2(f + p%k_n * dlt**1.5_dp * n) / (p%k_n * dlt**1.5_dp))
   end do
   print '(a,es9.2)', '2. Hertz force, max rel. error over 4 overlaps ', err
-  call check('Hertz force value and direction', err < 1e-13_dp)
+  call check(err < 1e-13_dp, 'Hertz force value and direction')
 
   ! 3. onset exactly at |r| = 2a + h_r, through contact_forces with exact binary positions
   call contact_setup(pb, 1.0_dp, 2.0_dp**(-8), 0.5_dp, 0.05_dp, 0.0_dp, 1.0_dp, 1.0_dp, info, msg)
@@ -80,14 +80,14 @@ program test_contact
   x(:, 2) = x(:, 1) + [2 + pb%h_r, 0.0_dp, 0.0_dp]
   call cf(pb, x)
   print '(a,i0,a,es10.3)', '3. at gap h_r: contacts ', st%pair_contacts, ', |F| ', norm2(force(:, 1))
-  call check('contact with zero force at gap = h_r', st%pair_contacts == 1 .and. all(force == 0))
+  call check(st%pair_contacts == 1 .and. all(force == 0), 'contact with zero force at gap = h_r')
   x(1, 2) = nearest(x(1, 2), 1.0_dp)
   call cf(pb, x)
-  call check('no contact one ulp farther', st%pair_contacts == 0 .and. all(force == 0))
+  call check(st%pair_contacts == 0 .and. all(force == 0), 'no contact one ulp farther')
   x(1, 2) = nearest(nearest(x(1, 2), -1.0_dp), -1.0_dp)
   call cf(pb, x)
   print '(a,es10.3)', '   one ulp closer: F_x on sphere 1 ', force(1, 1)
-  call check('repulsive one ulp closer', st%pair_contacts == 1 .and. force(1, 1) < 0)
+  call check(st%pair_contacts == 1 .and. force(1, 1) < 0, 'repulsive one ulp closer')
 
   ! 4. Coulomb cap under a large slip
   dlt = 0.3_dp * p%h_r
@@ -102,9 +102,9 @@ program test_contact
   print '(a,es9.2,a,es9.2,a,es9.2)', '4. |F_t|/(mu_d|F_n|) - 1 = ', err, ', 1 + cos(F_t, slip) = ', &
     1 + dot_product(ft, slip) / (norm2(ft) * norm2(slip)), ', k_t|Ups|/|F_t| - 1 = ', &
     kt * norm2(ups) / norm2(ft) - 1
-  call check('Coulomb cap exact', err < 1e-13_dp .and. sliding)
-  call check('F_t opposes the slip', 1 + dot_product(ft, slip) / (norm2(ft) * norm2(slip)) < 1e-13_dp)
-  call check('spring reset to the cap', abs(kt * norm2(ups) / norm2(ft) - 1) < 1e-13_dp)
+  call check(err < 1e-13_dp .and. sliding, 'Coulomb cap exact')
+  call check(1 + dot_product(ft, slip) / (norm2(ft) * norm2(slip)) < 1e-13_dp, 'F_t opposes the slip')
+  call check(abs(kt * norm2(ups) / norm2(ft) - 1) < 1e-13_dp, 'spring reset to the cap')
 
   ! 5. rotation of the spring into a new tangent plane (the old spring has a normal part)
   ups = [1e-6_dp, 2e-6_dp, 0.5e-6_dp]
@@ -113,8 +113,8 @@ program test_contact
                     f, tq, fn, sliding)
   print '(a,es9.2,a,es9.2)', '5. after rotation |Ups.n|/|Ups| = ', abs(dot_product(ups, n)) / l0, &
     ', |Ups|/l0 - 1 = ', norm2(ups) / l0 - 1
-  call check('rotated spring is tangent', abs(dot_product(ups, n)) < 1e-15_dp * l0)
-  call check('rotated spring keeps its length', abs(norm2(ups) / l0 - 1) < 1e-14_dp)
+  call check(abs(dot_product(ups, n)) < 1e-15_dp * l0, 'rotated spring is tangent')
+  call check(abs(norm2(ups) / l0 - 1) < 1e-14_dp, 'rotated spring keeps its length')
 
   ! 6. reset on opening (history through contact_forces)
   x(:, 1) = [5.0_dp, 10.0_dp, 5.0_dp]
@@ -123,17 +123,17 @@ program test_contact
   call cf(p, x)
   call cf(p, x)
   fsave = force(:, 1)
-  call check('history holds the contact', history_size(h) == 1)
+  call check(history_size(h) == 1, 'history holds the contact')
   x(1, 2) = x(1, 2) + p%h_r
   call cf(p, x)
-  call check('history forgets an open contact', history_size(h) == 0 .and. &
-             all(history_lookup(h, 1, 2) == 0))
+  call check(history_size(h) == 0 .and. &
+             all(history_lookup(h, 1, 2) == 0), 'history forgets an open contact')
   x(1, 2) = x(1, 2) - p%h_r
   call cf(p, x)
   print '(a,es11.4,a,es11.4)', '6. F_t,z after 2 steps ', fsave(3), ', after reopening, 1 step ', &
     force(3, 1)
-  call check('reopened spring restarts at zero', &
-             abs(force(3, 1) - 0.5_dp * fsave(3)) < 1e-12_dp * abs(fsave(3)))
+  call check(abs(force(3, 1) - 0.5_dp * fsave(3)) < 1e-12_dp * abs(fsave(3)), &
+             'reopened spring restarts at zero')
 
   ! 7. action-reaction, torque rule, midpoint torque
   call clear_history()
@@ -152,14 +152,14 @@ program test_contact
   ft = f - dot_product(f, n) * n
   print '(a,es9.2,a,es9.2)', '7. |F_i + F_j| = ', norm2(force(:, 1) + force(:, 2)), &
     ', |F_t|/|F_n| = ', norm2(ft) / abs(dot_product(f, n))
-  call check('action = reaction (bitwise)', all(force(:, 1) == -force(:, 2)) .and. norm2(ft) > 0)
-  call check('T_i = T_j (bitwise)', all(torque(:, 1) == torque(:, 2)))
-  call check('torque = a n x F', norm2(torque(:, 1) - cross(n, f)) <= 1e-15_dp * norm2(f))
+  call check(all(force(:, 1) == -force(:, 2)) .and. norm2(ft) > 0, 'action = reaction (bitwise)')
+  call check(all(torque(:, 1) == torque(:, 2)), 'T_i = T_j (bitwise)')
+  call check(norm2(torque(:, 1) - cross(n, f)) <= 1e-15_dp * norm2(f), 'torque = a n x F')
   tot = torque(:, 1) + torque(:, 2) + cross(-0.5_dp * r, force(:, 1)) + cross(0.5_dp * r, force(:, 2))
   err = norm2(tot - (2 - d) * cross(n, ft)) / norm2(f)
   print '(a,es9.2,a,es9.2)', '   midpoint torque |T_tot|/|F| = ', norm2(tot) / norm2(f), &
     ', minus (2a - |r|) n x F_t: ', err
-  call check('midpoint torque = lever defect', err < 1e-13_dp)
+  call check(err < 1e-13_dp, 'midpoint torque = lever defect')
 
   ! 8. stresslet
   err = 0
@@ -170,10 +170,10 @@ program test_contact
                                                     spread(0.5_dp * r, 2, 3) * spread(f, 1, 3)))))
   print '(a,es9.2,a,es9.2)', '8. stresslet formula/symmetry error ', err / (norm2(f) * d), &
     ', trace rel. error ', (ss(1, 1, 1) + ss(2, 2, 1) + ss(3, 3, 1)) / (dot_product(f, r) / 2) - 1
-  call check('stresslet (2.24), symmetric', err < 1e-15_dp * norm2(f) * d)
-  call check('stresslet trace F.r/2', &
-             abs((ss(1, 1, 1) + ss(2, 2, 1) + ss(3, 3, 1)) / (dot_product(f, r) / 2) - 1) < 1e-13_dp)
-  call check('same stresslet on both spheres', all(ss(:, :, 1) == ss(:, :, 2)))
+  call check(err < 1e-15_dp * norm2(f) * d, 'stresslet (2.24), symmetric')
+  call check(abs((ss(1, 1, 1) + ss(2, 2, 1) + ss(3, 3, 1)) / (dot_product(f, r) / 2) - 1) < 1e-13_dp, &
+             'stresslet trace F.r/2')
+  call check(all(ss(:, :, 1) == ss(:, :, 2)), 'same stresslet on both spheres')
 
   ! 9. mu_d = 0: no tangential state at all
   call contact_setup(p0, 1.0_dp, 5.0e-3_dp, 0.0_dp, 0.05_dp, 0.0_dp, 1.0_dp, 1.0_dp, info, msg)
@@ -183,10 +183,10 @@ program test_contact
   end do
   print '(a,i0,a,l1,a,es9.2)', '9. mu_d = 0: stored ', history_size(h), ', allocated ', &
     allocated(h%partner), ', |F + |F_n| n| = ', norm2(force(:, 1) + norm2(force(:, 1)) * n)
-  call check('mu_d = 0 keeps no tangential state', history_size(h) == 0 .and. &
-             .not. allocated(h%partner) .and. .not. allocated(h%ups))
-  call check('mu_d = 0: F along -n, no torque', all(force(:, 1) == -st%max_normal_force * n) .and. &
-             all(torque == 0))
+  call check(history_size(h) == 0 .and. &
+             .not. allocated(h%partner) .and. .not. allocated(h%ups), 'mu_d = 0 keeps no tangential state')
+  call check(all(force(:, 1) == -st%max_normal_force * n) .and. &
+             all(torque == 0), 'mu_d = 0: F along -n, no torque')
 
   ! 10. walls by the same law (exact binary gap 2^-9 < h_r = 2^-8); stresslet lever (a + gap/2) n
   call clear_history()
@@ -203,45 +203,41 @@ program test_contact
   x(:, 2) = x(:, 1) - [0.0_dp, 2 + 2.0_dp**(-9), 0.0_dp]
   call cf(pb, x)
   print '(a,es12.5,a,es12.5)', '10. wall F_y = ', fwall(2), ', pair F_y at the same gap = ', force(2, 1)
-  call check('wall force = pair force at the same gap', fwall(2) == force(2, 1) .and. fwall(2) > 0 &
-             .and. fwall(1) == 0 .and. fwall(3) == 0)
-  call check('wall stresslet with lever (a + gap/2) n', err < 1e-15_dp)
+  call check(fwall(2) == force(2, 1) .and. fwall(2) > 0 &
+             .and. fwall(1) == 0 .and. fwall(3) == 0, 'wall force = pair force at the same gap')
+  call check(err < 1e-15_dp, 'wall stresslet with lever (a + gap/2) n')
 
   ! 11. refusals
   call contact_setup(p0, 1.0_dp, 0.0_dp, 0.5_dp, 0.05_dp, 0.0_dp, 1.0_dp, 1.0_dp, info, msg)
   print '(2a)', '11. eps_r = 0 without k_n: ', trim(msg)
-  call check('smooth spheres need a prescribed k_n', info /= 0)
+  call check(info /= 0, 'smooth spheres need a prescribed k_n')
   call contact_setup(p0, 1.0_dp, 0.0_dp, 0.5_dp, 0.05_dp, 1.0e6_dp, 1.0_dp, 1.0_dp, info, msg)
-  call check('a prescribed k_n is accepted', info == 0 .and. p0%k_n == 1e6_dp)
+  call check(info == 0 .and. p0%k_n == 1e6_dp, 'a prescribed k_n is accepted')
   call contact_setup(p0, 1.0_dp, 5.0e-3_dp, -0.1_dp, 0.05_dp, 0.0_dp, 1.0_dp, 1.0_dp, info, msg)
-  call check('negative mu_d refused', info /= 0)
+  call check(info /= 0, 'negative mu_d refused')
   call contact_setup(p0, 1.0_dp, 5.0e-3_dp, 0.5_dp, 0.05_dp, 2.0e5_dp, 1.0_dp, 1.0_dp, info, msg)
-  call check('a prescribed k_n overrides eps_bar', info == 0 .and. p0%k_n == 2e5_dp)
+  call check(info == 0 .and. p0%k_n == 2e5_dp, 'a prescribed k_n overrides eps_bar')
 
   ! 12. chatter number
   err = abs(chatter_number(p, 2.0e-3_dp) / (2.0e-3_dp / 0.05_dp) - 1)
   print '(a,es12.5,a,es9.2)', '12. chatter number at dt = 2e-3: ', chatter_number(p, 2.0e-3_dp), ' rel. error ', err
-  call check('chatter number = dt gamma_dot / eps_bar', err < 1e-13_dp)
+  call check(err < 1e-13_dp, 'chatter number = dt gamma_dot / eps_bar')
   call contact_setup(p0, 1.0_dp, 5.0e-3_dp, 0.5_dp, 0.05_dp, 8 * p%k_n, 1.0_dp, 1.0_dp, info, msg)
   err = abs(chatter_number(p0, 2.0e-3_dp) / (4 * chatter_number(p, 2.0e-3_dp)) - 1)
-  call check('chatter number scales as k_n^(2/3)', err < 1e-13_dp)
+  call check(err < 1e-13_dp, 'chatter number scales as k_n^(2/3)')
   call contact_setup(p0, 1.0_dp, 0.0_dp, 0.5_dp, 0.05_dp, 1.0e6_dp, 1.0_dp, 1.0_dp, info, msg)
-  call check('no chatter number for smooth spheres', chatter_number(p0, 2.0e-3_dp) == 0)
+  call check(chatter_number(p0, 2.0e-3_dp) == 0, 'no chatter number for smooth spheres')
 
   ! 13. flattening estimate (p: eps_bar = 0.05)
-  call check('flattening at phi = 0.4 is 6.9 eps_bar', abs(flattening_estimate(p, 0.4_dp) / (6.9_dp * 0.05_dp) - 1) < 1e-13_dp)
-  call check('flattening at phi = 0.55 is 26 eps_bar', abs(flattening_estimate(p, 0.55_dp) / (26.0_dp * 0.05_dp) - 1) < 1e-13_dp)
-  call check('flattening continuous at phi = 0.3', abs(flattening_estimate(p, 0.3_dp - 1e-12_dp) &
-             / flattening_estimate(p, 0.3_dp + 1e-12_dp) - 1) < 1e-10_dp)
-  call check('flattening continuous at phi = 0.5', abs(flattening_estimate(p, 0.5_dp - 1e-12_dp) &
-             / flattening_estimate(p, 0.5_dp + 1e-12_dp) - 1) < 1e-10_dp)
-  call check('flattening at phi = 0 is eps_bar', abs(flattening_estimate(p, 0.0_dp) / 0.05_dp - 1) < 1e-13_dp)
+  call check(abs(flattening_estimate(p, 0.4_dp) / (6.9_dp * 0.05_dp) - 1) < 1e-13_dp, 'flattening at phi = 0.4 is 6.9 eps_bar')
+  call check(abs(flattening_estimate(p, 0.55_dp) / (26.0_dp * 0.05_dp) - 1) < 1e-13_dp, 'flattening at phi = 0.55 is 26 eps_bar')
+  call check(abs(flattening_estimate(p, 0.3_dp - 1e-12_dp) &
+             / flattening_estimate(p, 0.3_dp + 1e-12_dp) - 1) < 1e-10_dp, 'flattening continuous at phi = 0.3')
+  call check(abs(flattening_estimate(p, 0.5_dp - 1e-12_dp) &
+             / flattening_estimate(p, 0.5_dp + 1e-12_dp) - 1) < 1e-10_dp, 'flattening continuous at phi = 0.5')
+  call check(abs(flattening_estimate(p, 0.0_dp) / 0.05_dp - 1) < 1e-13_dp, 'flattening at phi = 0 is eps_bar')
 
-  if (nfail > 0) then
-    print '(i0,a)', nfail, ' check(s) FAILED'
-    error stop 1
-  end if
-  print '(a)', 'test_contact: all checks passed'
+  call finish('test_contact')
 
 contains
 
@@ -250,24 +246,13 @@ contains
     real(dp), intent(in) :: xx(:,:)
     call contact_forces(pp, h, xx, u, om, box, per, vw, pairs, 1, walls, 0, 1e-3_dp, force, &
                         torque, ss, st, info)
-    if (info /= 0) call check('contact_forces info', .false.)
+    if (info /= 0) call check(.false., 'contact_forces info')
   end subroutine cf
 
   subroutine clear_history()
-    type(contact_history_t) :: empty
-    h = empty
+    h = contact_history_t()       ! the default: no contacts, nothing allocated
   end subroutine clear_history
 
-  subroutine check(what, ok)
-    character(len=*), intent(in) :: what
-    logical, intent(in) :: ok
-    if (ok) then
-      print '(2a)', '  ok    ', what
-    else
-      print '(2a)', '  FAIL  ', what
-      nfail = nfail + 1
-    end if
-  end subroutine check
 
   pure function cross(a, b) result(c)
     real(dp), intent(in) :: a(3), b(3)

@@ -24,7 +24,7 @@
 !      built for another particle count.
 !   4. With mu_d = 0 the same run never allocates the history.
 program test_contact_history
-  use mod_kinds, only: dp, i8
+  use mod_kinds, only: dp
   use mod_contact, only: contact_params_t, contact_setup, contact_history_t, history_size, &
                          history_pack, history_unpack, contact_forces, contact_stats_t
   use mod_neighbours, only: nlist_t, nlist_init, nlist_build, nlist_needs_rebuild

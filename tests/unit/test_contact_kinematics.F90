@@ -201,8 +201,7 @@ contains
   end subroutine one_pair_step
 
   subroutine clear_history()
-    type(contact_history_t) :: empty
-    h = empty
+    h = contact_history_t()       ! the default: no contacts, nothing allocated
   end subroutine clear_history
 
   subroutine fail(what)

@@ -19,18 +19,18 @@
 !     the simple normal function equals 1/e + ln(1/e)/5 minus its value at the cut-off;
 !  8. pair stresslet: symmetric, and its trace is a d.F_1 for a squeeze (method.md §2.7).
 program test_lubrication
-  use mod_kinds, only: dp, pi
+  use mod_kinds, only: dp
   use mod_resistance, only: n_pair_scalars, resistance_scalars, i_xa11, i_xa12, i_ya11, i_xc11, i_yc11, &
        i_xm11, i_ym11, i_zm11, i_xm12, i_ym12, i_zm12
   use mod_lubrication, only: lubrication_t, lub_setup, lub_pair_scalars, lub_wall_scalars, lub_pair_link, &
        lub_wall_link, lub_pair_stresslets, clip_to_psd, LUB_SIMPLE, LUB_FULL
+  use mod_unit_checks, only: check, finish
   implicit none
   type(lubrication_t) :: simple, full
-  integer :: failures, k, i
+  integer :: k
   real(dp) :: f(n_pair_scalars), f_exact(n_pair_scalars), xi, expect, r(12, 12), drive(12), ft(12), d(3), u_inf(3, 2), e0(3, 3)
   real(dp) :: w(5), rw(6, 6), dw(6), gaps(40), worst, a(6, 6), b(6, 6), s(3, 3, 2), squeeze
 
-  failures = 0
   call lub_setup(simple, LUB_SIMPLE, 1.0_dp, 1.0_dp, 5.0_dp, 0.0_dp, 1.0e-4_dp)
   d = [1.0_dp, 2.0_dp, 2.0_dp] / 3.0_dp
   u_inf = 0
@@ -115,11 +115,7 @@ program test_lubrication
              'pair stresslet: trace = a d.F_1 for a squeeze')
   call check(maxval(abs(s(:, :, 1) - transpose(s(:, :, 1)))) < 1.0e-12_dp * maxval(abs(s)), 'pair stresslet: symmetric')
 
-  if (failures > 0) then
-    print '(i0,a)', failures, ' check(s) failed'
-    error stop 1
-  end if
-  print '(a)', 'test_lubrication: all checks passed'
+  call finish('test_lubrication')
 
 contains
 
@@ -218,15 +214,5 @@ contains
     m = spread(v, 2, 6) * spread(v, 1, 6)
   end function outer6
 
-  subroutine check(ok, what)
-    logical, intent(in) :: ok
-    character(len=*), intent(in) :: what
-    if (ok) then
-      print '(a)', 'ok   '//what
-    else
-      print '(a)', 'FAIL '//what
-      failures = failures + 1
-    end if
-  end subroutine check
 
 end program test_lubrication

@@ -13,7 +13,7 @@
 ! bias is shown by a cubic fit over the same shells and a linear fit over [2a, 2.1a]: both are
 ! printed and must agree with the quadratic within 2 %.
 program test_packing_gr
-  use mod_kinds, only: dp, i8, pi
+  use mod_kinds, only: dp, pi
   use mod_packing, only: rng_t, rng_seed, random_packing, hs_monte_carlo, packing_report_t, &
                          packing_box_for, min_separation
   use mod_neighbours, only: nlist_t, nlist_init, nlist_build

@@ -11,14 +11,14 @@ program test_particle_system
   use mod_kinds, only: dp
   use mod_particle_system, only: particle_system_t, psys_reset, psys_add_diagonal, psys_add_pair, &
        psys_solve, psys_apply
+  use mod_unit_checks, only: check, finish
   implicit none
   integer, parameter :: n = 7
   type(particle_system_t) :: sys
   real(dp) :: b(6, n), x(6, n), y(6, n), dense(6 * n, 6 * n), xd(6 * n), d(6, 6), k(6, 6), x2(6, n), y2(6, n)
-  integer :: p, q, its, failures, i, j
+  integer :: p, q, its, i, j
   logical :: ok
 
-  failures = 0
   call psys_reset(sys, n)
   dense = 0.0_dp
   do p = 1, n
@@ -68,11 +68,7 @@ program test_particle_system
   call psys_solve(sys, b(:, 1:1), x(:, 1:1), 1.0e-12_dp, its, ok)
   call check(.not. ok, 'an indefinite block is reported')
 
-  if (failures > 0) then
-    write(*, '(i0,a)') failures, ' check(s) failed'
-    stop 1
-  end if
-  write(*, '(a)') 'all checks passed'
+  call finish('test_particle_system')
 
 contains
 
@@ -116,15 +112,5 @@ contains
     end do
   end function gauss
 
-  subroutine check(ok, what)
-    logical, intent(in) :: ok
-    character(len=*), intent(in) :: what
-    if (ok) then
-      write(*, '(2a)') 'ok    ', what
-    else
-      write(*, '(2a)') 'FAIL  ', what
-      failures = failures + 1
-    end if
-  end subroutine check
 
 end program test_particle_system

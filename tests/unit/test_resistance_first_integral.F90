@@ -20,15 +20,15 @@
 program test_resistance_first_integral
   use mod_kinds, only: dp
   use mod_resistance, only: pair_shear_functions
+  use mod_unit_checks, only: check_below, finish
   implicit none
   integer, parameter :: n = 40001
   real(dp), parameter :: u_lo = log(1.0e-7_dp), u_hi = log(1.0e4_dp)
   real(dp) :: u(n), rho(n), g(n), h(n), int_g(n), log_mu(n), int_mh(n), du
   real(dp) :: a, b, c, k, l, m, q0, xi_min, y6(2)
   real(dp), parameter :: eps_r(2) = [1.0e-3_dp, 1.0e-2_dp], y6_ref(2) = [0.70827_dp, 1.05522_dp]
-  integer :: i, failures
+  integer :: i
 
-  failures = 0
   du = (u_hi - u_lo) / (n - 1)
   do i = 1, n
     u(i) = u_lo + (i - 1) * du
@@ -53,7 +53,7 @@ program test_resistance_first_integral
   xi_min = bisect_gap(q0)
   print '(a,es12.5,a)', '   smooth pair through (-6, 0.5): closest gap from the first integral ', &
     xi_min, ' (pairtraj: 2.5239e-04)'
-  call check('1. closest approach vs pairtraj, rel. difference', abs(xi_min / 2.5239e-4_dp - 1.0_dp), &
+  call check_below('1. closest approach vs pairtraj, rel. difference', abs(xi_min / 2.5239e-4_dp - 1.0_dp), &
              2.0e-3_dp)
 
   ! 2. hard-contact offsets at x = 6
@@ -62,14 +62,13 @@ program test_resistance_first_integral
     print '(a,es8.1,a,f10.6,a,f8.5,a)', '   eps_r = ', eps_r(i), ': hard-contact y(x=6) = ', y6(i), &
       ' (reference ', y6_ref(i), ')'
   end do
-  call check('2. hard-contact offsets vs reference values, max abs difference', maxval(abs(y6 - y6_ref)), &
+  call check_below('2. hard-contact offsets vs reference values, max abs difference', maxval(abs(y6 - y6_ref)), &
              2.0e-5_dp)
 
   ! Information: in-plane separatrix between open and closed trajectories.
   print '(a,es10.3)', '   (info) open/closed separatrix in the shear plane: closest gap ', bisect_gap(0.0_dp)
 
-  if (failures > 0) error stop 1
-  print '(a)', 'all checks passed'
+  call finish('test_resistance_first_integral')
 
 contains
 
@@ -120,14 +119,4 @@ contains
     end do
   end function offset_at_x6
 
-  subroutine check(what, value, tol)
-    character(len=*), intent(in) :: what
-    real(dp), intent(in) :: value, tol
-    if (value <= tol) then
-      print '(a,a,a,es10.3,a,es9.2,a)', '   PASS ', what, ': ', value, ' (tol ', tol, ')'
-    else
-      print '(a,a,a,es10.3,a,es9.2,a)', '   FAIL ', what, ': ', value, ' (tol ', tol, ')'
-      failures = failures + 1
-    end if
-  end subroutine check
 end program test_resistance_first_integral

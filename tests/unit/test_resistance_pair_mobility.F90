@@ -21,15 +21,15 @@ program test_resistance_pair_mobility
   use mod_kinds, only: dp
   use mod_resistance, only: pair_shear_functions
   use mod_resistance_table, only: resistance_table_size, resistance_table_sep, resistance_table_a_bg
+  use mod_unit_checks, only: failures, check_below, finish
   implicit none
-  integer :: k, failures
+  integer :: k
   real(dp) :: a, b, c, kk, l, m, worst, xi, b600, b0, s, a_ff, b_ff, ea, eb
   real(dp), parameter :: far_s(4) = [6.0_dp, 8.0_dp, 12.0_dp, 20.0_dp]
   real(dp) :: b_1em3, b_1em5, b_l(3)
   real(dp), parameter :: h_l(3) = [1.0_dp / 100, 1.0_dp / 200, 1.0_dp / 300]
   real(dp) :: err_first
 
-  failures = 0
   worst = 0.0_dp
   ea = 0.0_dp
   do k = 1, resistance_table_size
@@ -40,8 +40,8 @@ program test_resistance_pair_mobility
       ea = max(ea, abs(a - resistance_table_a_bg(k)))
     end if
   end do
-  call check('1. A vs Batchelor-Green column, 26 rows s >= 2.025, max abs error', worst, 2.0e-6_dp)
-  call check('1. A vs Batchelor-Green column, 12 rows s < 2.025, max abs error', ea, 5.0e-4_dp)
+  call check_below('1. A vs Batchelor-Green column, 26 rows s >= 2.025, max abs error', worst, 2.0e-6_dp)
+  call check_below('1. A vs Batchelor-Green column, 12 rows s < 2.025, max abs error', ea, 5.0e-4_dp)
 
   worst = 0.0_dp
   do k = 6, 7
@@ -50,7 +50,7 @@ program test_resistance_pair_mobility
     print '(a,es8.1,a,f10.6)', '   xi = ', xi, ': (1 - A)/xi = ', (1.0_dp - a) / xi
     worst = max(worst, abs((1.0_dp - a) / xi / 4.077_dp - 1.0_dp))
   end do
-  call check('2. (1 - A)/xi -> 4.077, max rel. error', worst, 1.0e-3_dp)
+  call check_below('2. (1 - A)/xi -> 4.077, max rel. error', worst, 1.0e-3_dp)
 
   do k = 1, 3
     call pair_shear_functions(exp(-100.0_dp * k), a, b_l(k), c, kk, l, m)
@@ -64,7 +64,7 @@ program test_resistance_pair_mobility
   call pair_shear_functions(1.0e-5_dp, a, b_1em5, c, kk, l, m)
   print '(a,3f9.5,a,f9.5)', '   B(1e-3), B(1e-5), B(e^-300) = ', b_1em3, b_1em5, b600, &
     ';  extrapolated B(0) = ', b0
-  call check('3. B(0) vs Batchelor-Green 0.406, abs error', abs(b0 - 0.406_dp), 1.0e-3_dp)
+  call check_below('3. B(0) vs Batchelor-Green 0.406, abs error', abs(b0 - 0.406_dp), 1.0e-3_dp)
   if (.not. (0.25_dp < b_1em3 .and. b_1em3 < b_1em5 .and. b_1em5 < b600 .and. b600 < b0)) then
     print '(a)', '   FAIL B does not increase monotonically towards B(0)'
     failures = failures + 1
@@ -79,25 +79,12 @@ program test_resistance_pair_mobility
     eb = abs(b - b_ff)
     print '(a,f5.1,a,es12.5,a,es9.2,a,es12.5,a,es9.2,a)', '   s = ', s, ': A = ', a, &
       ' (rel. err ', ea / a_ff, '), B = ', b, ' (rel. err ', eb / b_ff, ')'
-    call check('4. far-field A and B, max rel. error', max(ea / a_ff, eb / b_ff), 1.0e-3_dp)
+    call check_below('4. far-field A and B, max rel. error', max(ea / a_ff, eb / b_ff), 1.0e-3_dp)
     if (k == 1) err_first = max(ea, eb)
   end do
-  call check('4. error(s=20)/error(s=6) below (6/20)^7', (max(ea, eb) / err_first) / (6.0_dp / 20.0_dp)**7, &
+  call check_below('4. error(s=20)/error(s=6) below (6/20)^7', (max(ea, eb) / err_first) / (6.0_dp / 20.0_dp)**7, &
              1.0_dp)
 
-  if (failures > 0) error stop 1
-  print '(a)', 'all checks passed'
+  call finish('test_resistance_pair_mobility')
 
-contains
-
-  subroutine check(what, value, tol)
-    character(len=*), intent(in) :: what
-    real(dp), intent(in) :: value, tol
-    if (value <= tol) then
-      print '(a,a,a,es10.3,a,es9.2,a)', '   PASS ', what, ': ', value, ' (tol ', tol, ')'
-    else
-      print '(a,a,a,es10.3,a,es9.2,a)', '   FAIL ', what, ': ', value, ' (tol ', tol, ')'
-      failures = failures + 1
-    end if
-  end subroutine check
 end program test_resistance_pair_mobility

@@ -18,6 +18,7 @@ program test_resistance_pair_stresslet
   use mod_kinds, only: dp, pi
   use mod_resistance, only: n_pair_scalars, resistance_scalars, pair_resistance_fu, &
                             pair_resistance_fe, pair_stresslets, pair_shear_functions
+  use mod_unit_checks, only: check_below, finish
   implicit none
   real(dp), parameter :: gaps(7) = [1.0e-4_dp, 1.0e-3_dp, 0.01_dp, 0.1_dp, 0.5_dp, 1.5_dp, 5.0_dp]
   real(dp), parameter :: e_shear(3, 3) = reshape([0.0_dp, 0.5_dp, 0.0_dp, 0.5_dp, 0.0_dp, 0.0_dp, &
@@ -25,9 +26,8 @@ program test_resistance_pair_stresslet
   real(dp), parameter :: s_inf = 20.0_dp / 3.0_dp * pi
   real(dp) :: f(n_pair_scalars), d(3), w(12), s(3, 3, 2), r(3), vrel(3), vbg(3), er(3)
   real(dp) :: a, b, c, kk, l, m, t, n1, n2, n1_bg, n2_bg, worst_n, worst_v, err_iso, rho
-  integer :: i, j, failures
+  integer :: i, j
 
-  failures = 0
   worst_n = 0.0_dp
   worst_v = 0.0_dp
   do i = 1, size(gaps)
@@ -53,8 +53,8 @@ program test_resistance_pair_stresslet
       worst_v = max(worst_v, norm2(vrel - vbg) / norm2(vbg))
     end do
   end do
-  call check('1. N1*, N2*: general blocks vs Batchelor-Green closed forms', worst_n, 1.0e-9_dp)
-  call check('2. relative velocity vs Batchelor-Green A, B form', worst_v, 1.0e-12_dp)
+  call check_below('1. N1*, N2*: general blocks vs Batchelor-Green closed forms', worst_n, 1.0e-9_dp)
+  call check_below('2. relative velocity vs Batchelor-Green A, B form', worst_v, 1.0e-12_dp)
 
   f = resistance_scalars(998.0_dp)
   d = [cos(0.3_dp), sin(0.3_dp), 0.0_dp]
@@ -63,14 +63,13 @@ program test_resistance_pair_stresslet
   ! Om_a = Om^inf - w(4:6), Om^inf - w(10:12): rotation with the fluid means w = 0 there.
   err_iso = max(maxval(abs(s(:, :, 1) - s_inf * e_shear)) / (s_inf / 2), &
                 maxval(abs(w(4:6))), maxval(abs(w(10:12))))
-  call check('3. isolated spheres: S = (20/3) pi E and Om = -1/2', err_iso, 1.0e-6_dp)
+  call check_below('3. isolated spheres: S = (20/3) pi E and Om = -1/2', err_iso, 1.0e-6_dp)
 
   call pair_shear_functions(1.0e-10_dp, a, b, c, kk, l, m)
   print '(a,f10.6)', '   K at xi = 1e-10: ', kk
-  call check('4. K(contact) = -0.04721', abs(kk + 0.04721_dp), 1.0e-5_dp)
+  call check_below('4. K(contact) = -0.04721', abs(kk + 0.04721_dp), 1.0e-5_dp)
 
-  if (failures > 0) error stop 1
-  print '(a)', 'all checks passed'
+  call finish('test_resistance_pair_stresslet')
 
 contains
 
@@ -111,14 +110,4 @@ contains
     end do
   end function solve
 
-  subroutine check(what, value, tol)
-    character(len=*), intent(in) :: what
-    real(dp), intent(in) :: value, tol
-    if (value <= tol) then
-      print '(a,a,a,es10.3,a,es9.2,a)', '   PASS ', what, ': ', value, ' (tol ', tol, ')'
-    else
-      print '(a,a,a,es10.3,a,es9.2,a)', '   FAIL ', what, ': ', value, ' (tol ', tol, ')'
-      failures = failures + 1
-    end if
-  end subroutine check
 end program test_resistance_pair_stresslet

@@ -42,8 +42,9 @@ program test_resistance_table
                             near_join_gap, far_join_gap, zm_join_gap
   use mod_resistance_table, only: resistance_table_size, resistance_table_sep, &
                                   resistance_table_values
+  use mod_unit_checks, only: failures, check_below, finish
   implicit none
-  integer :: k, j, failures
+  integer :: k, j
   real(dp) :: f(n_pair_scalars), g(n_pair_scalars), ref(n_pair_scalars), err, worst, xi, s
   real(dp) :: slope_lo(n_pair_scalars), slope_hi(n_pair_scalars), h, e_near(n_pair_scalars)
   real(dp) :: e_far(n_pair_scalars), isolated(n_pair_scalars), c(n_pair_scalars)
@@ -54,7 +55,6 @@ program test_resistance_table
     0.102501_dp, -0.029290_dp, -0.145424_dp, -0.207581_dp, -0.072311_dp]
   integer :: row_join
 
-  failures = 0
   h = 0.0_dp
 
   print '(a)', '1. every scalar at every Lamb-method row from its join on (tolerance 1e-6)'
@@ -68,7 +68,7 @@ program test_resistance_table
     if (xi < zm_join_gap * (1.0_dp - 1.0e-9_dp)) e_near([i_zm11, i_zm12]) = 0.0_dp
     worst = max(worst, maxval(e_near))
   end do
-  call check('Lamb rows, max scaled error', worst, 1.0e-6_dp)
+  call check_below('Lamb rows, max scaled error', worst, 1.0e-6_dp)
 
   print '(a)', '2. join agreement, series vs table before matching (scaled difference)'
   print '(a)', '   scalar  near join: s     table          series     scaled   | s = 4.5 scaled'
@@ -87,8 +87,8 @@ program test_resistance_table
     print '(3x,a4,f12.3,2es15.7,es10.2,a,es10.2)', pair_scalar_names(j), 2.0_dp + xi, &
       resistance_table_values(row_join, j), g(j), e_near(j), '   |', e_far(j)
   end do
-  call check('(a) near join, max scaled difference', maxval(e_near), 1.0e-3_dp)
-  call check('(b) far join s = 4.5, max scaled difference', maxval(e_far), 1.0e-6_dp)
+  call check_below('(a) near join, max scaled difference', maxval(e_near), 1.0e-3_dp)
+  call check_below('(b) far join s = 4.5, max scaled difference', maxval(e_far), 1.0e-6_dp)
   err = 0.0_dp
   do k = 1, resistance_table_size
     xi = resistance_table_sep(k) - 2.0_dp
@@ -99,7 +99,7 @@ program test_resistance_table
     err = max(err, abs(resistance_table_values(k, i_zm11) - g(i_zm11)), &
               abs(resistance_table_values(k, i_zm12) - g(i_zm12)))
   end do
-  call check('(c) Z^M table vs series below s = 2.1, max abs difference', err, 5.0e-4_dp)
+  call check_below('(c) Z^M table vs series below s = 2.1, max abs difference', err, 5.0e-4_dp)
 
   print '(a)', '3. rows below the near join (gap < 0.025): published asymptotic-form values'
   worst = 0.0_dp
@@ -121,9 +121,9 @@ program test_resistance_table
       h = max(h, maxval(near_error(f, ref)))
     end if
   end do
-  call check('(a) bare near-field forms vs near rows', worst, 1.0e-4_dp)
-  call check('(b) module vs near rows, gap <= 2e-3', err, 2.0e-3_dp)
-  call check('(c) module vs near rows, 5e-3 <= gap <= 0.02', h, 3.0e-2_dp)
+  call check_below('(a) bare near-field forms vs near rows', worst, 1.0e-4_dp)
+  call check_below('(b) module vs near rows, gap <= 2e-3', err, 2.0e-3_dp)
+  call check_below('(c) module vs near rows, 5e-3 <= gap <= 0.02', h, 3.0e-2_dp)
 
   print '(a)', '4. continuity at the joins'
   do k = 1, 3
@@ -134,10 +134,10 @@ program test_resistance_table
     f = resistance_scalars(xi * (1.0_dp - 1.0e-12_dp))
     g = resistance_scalars(xi * (1.0_dp + 1.0e-12_dp))
     print '(a,f6.3)', '   join at gap ', xi
-    call check('value jump', maxval(scaled_error(g, f)), 1.0e-8_dp)
+    call check_below('value jump', maxval(scaled_error(g, f)), 1.0e-8_dp)
     slope_lo = (resistance_scalars(xi) - resistance_scalars(xi - h)) / h
     slope_hi = (resistance_scalars(xi + h) - resistance_scalars(xi)) / h
-    call check('slope jump / max |slope|', &
+    call check_below('slope jump / max |slope|', &
                maxval(abs(slope_hi - slope_lo)) / maxval(abs(slope_lo)), 1.0e-4_dp)
   end do
 
@@ -146,7 +146,7 @@ program test_resistance_table
   do j = 1, n_pair_scalars
     print '(3x,a4,2f11.6,es10.2)', pair_scalar_names(j), c(j), published_c(j), c(j) - published_c(j)
   end do
-  call check('max |series - published|', maxval(abs(c - published_c)), 1.0e-3_dp)
+  call check_below('max |series - published|', maxval(abs(c - published_c)), 1.0e-3_dp)
 
   print '(a)', '6. isolated-sphere limits at s = 1e4'
   s = 1.0e4_dp
@@ -155,19 +155,15 @@ program test_resistance_table
   isolated(i_xa12) = -1.5_dp / s
   isolated(i_ya12) = -0.75_dp / s
   f = resistance_scalars(s - 2.0_dp)
-  call check('isolated-sphere limits, max abs error', maxval(abs(f - isolated)), 1.0e-6_dp)
+  call check_below('isolated-sphere limits, max abs error', maxval(abs(f - isolated)), 1.0e-6_dp)
   g = far_field_scalars(s)
-  call check('far_field_scalars = module beyond the table', maxval(abs(f - g)), 1.0e-12_dp)
+  call check_below('far_field_scalars = module beyond the table', maxval(abs(f - g)), 1.0e-12_dp)
 
   do j = 1, n_pair_scalars
     if (.not. (abs(f(j)) < huge(1.0_dp))) failures = failures + 1
   end do
 
-  if (failures > 0) then
-    print '(i0,a)', failures, ' check(s) FAILED'
-    error stop 1
-  end if
-  print '(a)', 'all checks passed'
+  call finish('test_resistance_table')
 
 contains
 
@@ -183,14 +179,4 @@ contains
     e = abs(v - vref) / max(abs(vref), 0.1_dp)
   end function near_error
 
-  subroutine check(what, value, tol)
-    character(len=*), intent(in) :: what
-    real(dp), intent(in) :: value, tol
-    if (value <= tol) then
-      print '(a,a,a,es10.3,a,es9.2,a)', '   PASS ', what, ': ', value, ' (tol ', tol, ')'
-    else
-      print '(a,a,a,es10.3,a,es9.2,a)', '   FAIL ', what, ': ', value, ' (tol ', tol, ')'
-      failures = failures + 1
-    end if
-  end subroutine check
 end program test_resistance_table

@@ -46,6 +46,7 @@ program test_resistance_wall_tangential
   use mod_kinds, only: dp
   use mod_resistance, only: wall_tangential_resistance, wall_tangential_exact, &
                             wall_tangential_inner, wall_tangential_far
+  use mod_unit_checks, only: check_below, finish
   implicit none
   real(dp), parameter :: gaps(6) = [1.0e-3_dp, 0.1_dp, 0.5_dp, 1.0_dp, 2.0_dp, 5.0_dp]
   ! 0a. O'Neill (1964) p. 73: alpha, F* (f_tt), G* ((3/4) f_tr)
@@ -63,9 +64,8 @@ program test_resistance_wall_tangential
   real(dp), parameter :: gcb_tr(8) = [1.0003_dp, 1.0059_dp, 1.0250_dp, 1.0998_dp, 1.3877_dp, &
                                       1.6996_dp, 2.5056_dp, 2.6793_dp]
   real(dp) :: v(3), w(3), f_rt, worst, eps, old(3), x, lo, hi, d(4), dmax(4), rmax
-  integer :: k, failures
+  integer :: k
 
-  failures = 0
   print '(a)', ' 0.  alpha   eps        f_tt  O''Neill   GCB  |  (3/4)f_tr  O''Neill |  f_rr    GCB'
   dmax = 0.0_dp
   rmax = 0.0_dp
@@ -90,36 +90,36 @@ program test_resistance_wall_tangential
   end do
   print '(a,es10.3,a)', '    max relative difference (G* with >= 3 digits): ', rmax, &
         ' (printed digits, not module error)'
-  call check('0a. O''Neill (1964) F* = f_tt, 8 gaps, max |diff| in units of 1e-4', dmax(1), 1.0_dp)
-  call check('0a. O''Neill (1964) G* = (3/4) f_tr, 8 gaps, max |diff| in units of 1e-5', dmax(2), &
+  call check_below('0a. O''Neill (1964) F* = f_tt, 8 gaps, max |diff| in units of 1e-4', dmax(1), 1.0_dp)
+  call check_below('0a. O''Neill (1964) G* = (3/4) f_tr, 8 gaps, max |diff| in units of 1e-5', dmax(2), &
              2.0_dp)
-  call check('0b. GCB (1967) F*_t = f_tt, 8 gaps, max |diff| in units of 1e-4', dmax(3), 1.0_dp)
-  call check('0b. GCB (1967) T*_r = f_rr, 8 gaps, max |diff| in units of 1e-4', dmax(4), 1.0_dp)
+  call check_below('0b. GCB (1967) F*_t = f_tt, 8 gaps, max |diff| in units of 1e-4', dmax(3), 1.0_dp)
+  call check_below('0b. GCB (1967) T*_r = f_rr, 8 gaps, max |diff| in units of 1e-4', dmax(4), 1.0_dp)
 
   call wall_tangential_resistance(1.0e-3_dp, v(1), v(2), v(3))
   print '(a,3f9.5)', ' 1. eps = 1e-3: f_tt, f_tr, (4/3) f_rr = ', v(1), v(2), 4.0_dp / 3.0_dp * v(3)
   print '(a)', '    O''Neill & Stewartson (1967):             4.640    0.665    4.184'
   worst = max(abs(v(1) / 4.640_dp - 1.0_dp), abs(v(2) / 0.665_dp - 1.0_dp), &
               abs(4.0_dp / 3.0_dp * v(3) / 4.184_dp - 1.0_dp))
-  call check('1. published values at 1e-3, max rel. error', worst, 1.0e-3_dp)
+  call check_below('1. published values at 1e-3, max rel. error', worst, 1.0e-3_dp)
 
   worst = 0.0_dp
   do k = 1, size(gaps)
     call wall_tangential_exact(gaps(k), v(1), v(2), v(3), f_rt)
     worst = max(worst, abs(f_rt / v(2) - 1.0_dp))
   end do
-  call check('2. reciprocity f_tr (translation) = f_rt (rotation), max rel. diff.', worst, 1.0e-8_dp)
+  call check_below('2. reciprocity f_tr (translation) = f_rt (rotation), max rel. diff.', worst, 1.0e-8_dp)
 
   call wall_tangential_exact(10.0_dp, v(1), v(2), v(3))
   w = wall_tangential_far(10.0_dp)
-  call check('3. far field eps = 10: f_tt vs Faxen', abs(w(1) / v(1) - 1.0_dp), 2.0e-6_dp)
-  call check('3. far field eps = 10: f_rr vs GCB', abs(w(3) / v(3) - 1.0_dp), 2.0e-6_dp)
-  call check('3. far field eps = 10: f_tr vs GCB', abs(w(2) / v(2) - 1.0_dp), 2.0e-2_dp)
+  call check_below('3. far field eps = 10: f_tt vs Faxen', abs(w(1) / v(1) - 1.0_dp), 2.0e-6_dp)
+  call check_below('3. far field eps = 10: f_rr vs GCB', abs(w(3) / v(3) - 1.0_dp), 2.0e-6_dp)
+  call check_below('3. far field eps = 10: f_tr vs GCB', abs(w(2) / v(2) - 1.0_dp), 2.0e-2_dp)
 
   call wall_tangential_exact(1.0e-4_dp, v(1), v(2), v(3))
   w = wall_tangential_inner(1.0e-4_dp)
   print '(a,3f9.5,a,3f9.5)', '    eps = 1e-4 exact ', v, ', inner forms ', w
-  call check('4. inner forms vs exact at eps = 1e-4, max rel. error', maxval(abs(w / v - 1.0_dp)), &
+  call check_below('4. inner forms vs exact at eps = 1e-4, max rel. error', maxval(abs(w / v - 1.0_dp)), &
              6.0e-3_dp)
 
   worst = 0.0_dp
@@ -129,7 +129,7 @@ program test_resistance_wall_tangential
     call wall_tangential_resistance(eps * (1.0_dp + 1.0e-12_dp), w(1), w(2), w(3))
     worst = max(worst, maxval(abs(w / v - 1.0_dp)))
   end do
-  call check('5. continuity at eps = 1e-3 and 10, max rel. jump', worst, 1.0e-9_dp)
+  call check_below('5. continuity at eps = 1e-3 and 10, max rel. jump', worst, 1.0e-9_dp)
 
   print '(a)', ' 6.  eps     f_tt      f_tr      f_rr    | former blend: f_tt      f_tr      f_rr'
   do k = 2, size(gaps)
@@ -144,19 +144,6 @@ program test_resistance_wall_tangential
     print '(f7.2,3f10.5,a,3f10.5)', eps, v, '   |             ', old
   end do
 
-  if (failures > 0) error stop 1
-  print '(a)', 'all checks passed'
+  call finish('test_resistance_wall_tangential')
 
-contains
-
-  subroutine check(what, value, tol)
-    character(len=*), intent(in) :: what
-    real(dp), intent(in) :: value, tol
-    if (value <= tol) then
-      print '(a,a,a,es10.3,a,es9.2,a)', '   PASS ', what, ': ', value, ' (tol ', tol, ')'
-    else
-      print '(a,a,a,es10.3,a,es9.2,a)', '   FAIL ', what, ': ', value, ' (tol ', tol, ')'
-      failures = failures + 1
-    end if
-  end subroutine check
 end program test_resistance_wall_tangential

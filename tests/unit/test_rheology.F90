@@ -20,8 +20,9 @@ program test_rheology
   use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
   use mod_rheology, only: rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, rheo_quantities, &
                           rheo_block_of, rheo_state, rheo_restore, slab_volume, NQ, NSUMMARY, summary_names
+  use mod_unit_checks, only: check, finish
   implicit none
-  integer :: nfail = 0, info, k, n
+  integer :: info, k, n
   type(rheology_t) :: r, r2
   real(dp) :: v, vp, box(3), m(NQ), q(NSUMMARY), gd, s_sum
   real(dp), allocatable :: x(:, :), u(:, :), sh(:, :, :), sc(:, :, :), state(:)
@@ -131,11 +132,7 @@ program test_rheology
   call rheo_restore(r2, state(2:), info)
   call check(info == 1, 'accumulators of another set-up are refused')
 
-  if (nfail > 0) then
-    print '(i0,a)', nfail, ' check(s) FAILED'
-    error stop 1
-  end if
-  print '(a)', 'all rheology checks passed'
+  call finish('test_rheology')
 
 contains
 
@@ -144,15 +141,5 @@ contains
     idx = findloc(summary_names, name, 1)
   end function idx
 
-  subroutine check(ok, what)
-    logical, intent(in) :: ok
-    character(len=*), intent(in) :: what
-    if (ok) then
-      print '(2a)', 'ok    ', what
-    else
-      print '(2a)', 'FAIL  ', what
-      nfail = nfail + 1
-    end if
-  end subroutine check
 
 end program test_rheology

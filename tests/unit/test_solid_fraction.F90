@@ -11,12 +11,12 @@
 program test_solid_fraction
   use mod_kinds, only: dp
   use mod_solid_fraction, only: cube_fraction, relaxation_gamma
+  use mod_unit_checks, only: failures, check, finish
   implicit none
   real(dp), parameter :: pi = acos(-1.0_dp)
   real(dp) :: h, err(2), a, b, centre(3), worst
-  integer :: failures, k, i, j, l, level, n
+  integer :: k, i, j, l, level, n
 
-  failures = 0
   call check(cube_fraction([0.0_dp, 0.0_dp, 0.0_dp], 1.0_dp, 0.2_dp) == 1.0_dp, 'inside gives 1')
   call check(cube_fraction([1.3_dp, 0.0_dp, 0.0_dp], 1.0_dp, 0.2_dp) == 0.0_dp, 'outside gives 0')
 
@@ -66,23 +66,9 @@ program test_solid_fraction
   call check(abs(relaxation_gamma(0.25_dp, 0.5_dp, 10.0_dp, 0.2_dp, 1.0_dp) - 0.15_dp) < 1e-15_dp, &
              'gamma = kappa (1-alpha) beta h^2 / eta')
 
-  if (failures > 0) then
-    write(*, '(i0,a)') failures, ' check(s) failed'
-    stop 1
-  end if
-  write(*, '(a)') 'all checks passed'
+  call finish('test_solid_fraction')
 
 contains
 
-  subroutine check(ok, what)
-    logical, intent(in) :: ok
-    character(len=*), intent(in) :: what
-    if (ok) then
-      write(*, '(2a)') 'ok    ', what
-    else
-      write(*, '(2a)') 'FAIL  ', what
-      failures = failures + 1
-    end if
-  end subroutine check
 
 end program test_solid_fraction
