@@ -247,16 +247,17 @@ def main():
     L.append("  character(len=2), parameter :: resistance_series_names(resistance_series_families) = [ &")
     L += data_lines([f'"{n}"' for n in names], per_line=10)
     L.append("    ]")
+    # one parameter per family: a single array constructor of all of them would need ~670
+    # continuation lines, beyond the 255 the standard allows (gfortran warns under -std=f2018)
+    for name in names:
+        L.append(f"  real(dp), parameter :: series_{name.lower()}(0:resistance_series_nmax) = [ &")
+        col = [f"{float(v):.17e}" + "_dp" for v in coef[name]]
+        col = [c.replace("e+", "e").replace("e-0", "e-").replace("e0", "e") for c in col]
+        L += data_lines(col, per_line=3)
+        L.append("    ]")
     L.append("  real(dp), parameter :: resistance_series_coef(0:resistance_series_nmax, &")
     L.append("                                                resistance_series_families) = reshape([ &")
-    for j, name in enumerate(names):
-        L.append(f"    ! {name}")
-        col = [f"{float(v):.17e}".replace("e", "e") + "_dp" for v in coef[name]]
-        col = [c.replace("e+", "e").replace("e-0", "e-").replace("e0", "e") for c in col]
-        lines = data_lines(col, per_line=3)
-        if j < len(names) - 1:
-            lines[-1] = lines[-1][:-2] + ", &"
-        L += lines
+    L += data_lines([f"series_{name.lower()}" for name in names], per_line=5)
     L.append("    ], [resistance_series_nmax + 1, resistance_series_families])")
     L.append("end module mod_resistance_table")
     with open(OUT_PATH, "w") as f:
