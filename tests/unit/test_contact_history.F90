@@ -30,6 +30,7 @@ program test_contact_history
   use mod_neighbours, only: nlist_t, nlist_init, nlist_build, nlist_needs_rebuild
   use mod_packing, only: rng_t, rng_seed, rng_uniform, random_packing, packing_report_t, &
                          packing_count
+  use mod_unit_checks, only: fail, finish
   implicit none
   real(dp), parameter :: box(3) = [16.0_dp, 10.0_dp, 16.0_dp], dt = 1.0e-3_dp
   logical, parameter :: per(3) = [.true., .false., .true.]
@@ -44,11 +45,10 @@ program test_contact_history
   real(dp), allocatable :: fc(:,:), tc(:,:), sc(:,:,:), upa(:,:), upb(:,:), upc(:,:)
   integer, allocatable :: pb(:,:), ida(:,:), idb(:,:), idc(:,:), perm(:)
   real(dp) :: vw(3, 2), err_ups, err_f, umax
-  integer :: n, info, nfail, step, i, k, m, npa, npb, crossings, rebuilds, nmax, np_out, tmp
+  integer :: n, info, step, i, k, m, npa, npb, crossings, rebuilds, nmax, np_out, tmp
   character(len=200) :: msg
   logical :: identical, same_ids
 
-  nfail = 0
   call contact_setup(p, 1.0_dp, 0.02_dp, 0.5_dp, 0.05_dp, 0.0_dp, 1.0_dp, 1.0_dp, info, msg)
   n = packing_count(0.45_dp, box, 1.0_dp)
   call random_packing(n, box, per, 1.0_dp, 0.0_dp, 21, 100, x0, info, msg, rep)
@@ -199,19 +199,9 @@ program test_contact_history
   if (allocated(hbad%partner) .or. allocated(hbad%first) .or. history_size(hbad) /= 0 .or. &
       st%pair_contacts == 0) call fail('mu_d = 0 allocated a history')
 
-  if (nfail > 0) then
-    print '(i0,a)', nfail, ' check(s) FAILED'
-    error stop 1
-  end if
-  print '(a)', 'test_contact_history: all checks passed'
+  call finish('test_contact_history')
 
 contains
-
-  subroutine fail(what)
-    character(len=*), intent(in) :: what
-    print '(2a)', '  FAIL  ', what
-    nfail = nfail + 1
-  end subroutine fail
 
   !> The pairs of nl, every other one written (j, i), in a random order.
   subroutine shuffled_pairs(nl, out)

@@ -29,18 +29,18 @@ program test_contact_kinematics
   use mod_kinds, only: dp, pi
   use mod_contact, only: contact_params_t, contact_setup, contact_history_t, history_size, &
                          history_lookup, contact_forces, contact_stats_t
+  use mod_unit_checks, only: fail, finish
   implicit none
   type(contact_params_t) :: p
   type(contact_history_t) :: h
   type(contact_stats_t) :: st
-  integer :: info, nfail, step, nstick, first_slide, pairs(2, 1), walls(2, 1)
+  integer :: info, step, nstick, first_slide, pairs(2, 1), walls(2, 1)
   character(len=200) :: msg
   real(dp) :: dt, t, dlt, x(3, 2), u(3, 2), om(3, 2), box(3), vw(3, 2), force(3, 2), torque(3, 2)
   real(dp) :: ss(3, 3, 2), kt, fn, ft(3), n(3), err_stick, err_slide, err_torque, fmax_t
   real(dp) :: slip(3), err_cos, ups(3), tstick
   logical :: per(3), was_negative, slid_back
 
-  nfail = 0
   call contact_setup(p, 1.0_dp, 5.0e-3_dp, 0.5_dp, 0.05_dp, 0.0_dp, 1.0_dp, 1.0_dp, info, msg)
   box = 20
   per = [.true., .false., .true.]
@@ -180,11 +180,7 @@ program test_contact_kinematics
   if (first_slide == 0 .or. err_slide > 1.0e-13_dp) call fail('pair sliding: |F_t| /= mu_d |F_n|')
   if (err_cos > 1.0e-12_dp) call fail('pair sliding: F_t does not oppose the slip')
 
-  if (nfail > 0) then
-    print '(i0,a)', nfail, ' check(s) FAILED'
-    error stop 1
-  end if
-  print '(a)', 'test_contact_kinematics: all checks passed'
+  call finish('test_contact_kinematics')
 
 contains
 
@@ -204,11 +200,6 @@ contains
     h = contact_history_t()       ! the default: no contacts, nothing allocated
   end subroutine clear_history
 
-  subroutine fail(what)
-    character(len=*), intent(in) :: what
-    print '(2a)', '  FAIL  ', what
-    nfail = nfail + 1
-  end subroutine fail
 
   pure function cross(a, b) result(c)
     real(dp), intent(in) :: a(3), b(3)

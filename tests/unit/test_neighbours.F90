@@ -20,8 +20,9 @@ program test_neighbours
   use mod_neighbours, only: nlist_t, nlist_init, nlist_build, nlist_needs_rebuild, min_image
   use mod_packing, only: rng_t, rng_seed, rng_uniform, random_packing, packing_report_t, &
                          packing_box_for
+  use mod_unit_checks, only: fail, finish
   implicit none
-  integer :: nfail, k, info
+  integer :: k, info
   real(dp), parameter :: phis(6) = [0.1_dp, 0.2_dp, 0.3_dp, 0.4_dp, 0.5_dp, 0.55_dp]
   integer, parameter :: ns(6) = [5000, 3000, 2000, 1500, 1000, 5000]
   real(dp), parameter :: cutoff = 2.25_dp, wall_cutoff = 1.25_dp
@@ -33,7 +34,6 @@ program test_neighbours
   integer(i8) :: work(2)
   real(dp) :: box(3), t0, t1
 
-  nfail = 0
   call rng_seed(g, 4)
   do k = 1, size(phis)
     ! uniform random points, triply periodic cube
@@ -84,19 +84,9 @@ program test_neighbours
     ', N = 5000: ', work(2), ' (build ', t1 - t0, ' s)'
   if (real(work(2), dp) > 1.3_dp * real(work(1), dp)) call fail('work per particle grows with N')
 
-  if (nfail > 0) then
-    print '(i0,a)', nfail, ' check(s) FAILED'
-    error stop 1
-  end if
-  print '(a)', 'test_neighbours: all checks passed'
+  call finish('test_neighbours')
 
 contains
-
-  subroutine fail(what)
-    character(len=*), intent(in) :: what
-    print '(2a)', '  FAIL  ', what
-    nfail = nfail + 1
-  end subroutine fail
 
   !> n uniform random points at number density phi / (4/3 pi): a box of the given shape.
   !> Couette (periodic_y false): y uniform in [0.99, Ly - 0.99] (slightly inside the walls).

@@ -18,6 +18,7 @@ program test_packing
   use mod_kinds, only: dp, i8, pi
   use mod_packing, only: rng_t, rng_uniform, random_packing, packing_report_t, packing_count, &
                          packing_box_for, phi_max
+  use mod_unit_checks, only: fail, finish
   implicit none
   integer, parameter :: nphi = 5
   real(dp), parameter :: phis(nphi) = [0.1_dp, 0.3_dp, 0.45_dp, 0.5_dp, 0.55_dp]
@@ -28,13 +29,12 @@ program test_packing
   type(packing_report_t) :: rep
   real(dp), allocatable :: x(:,:), y(:,:)
   real(dp) :: box(3), u
-  integer :: nfail, k, n, info, geo
+  integer :: k, n, info, geo
   integer(i8) :: z
   integer(i8) :: c0, c1, rate
   character(len=200) :: msg
   logical :: per(3)
 
-  nfail = 0
   ! 1. generator
   g%s = 12345_i8
   do k = 1, 5
@@ -93,19 +93,9 @@ program test_packing
   print '(2a)', '   Ly = 3.9a: ', trim(msg)
   if (info /= 2) call fail('box below 4a accepted')
 
-  if (nfail > 0) then
-    print '(i0,a)', nfail, ' check(s) FAILED'
-    error stop 1
-  end if
-  print '(a)', 'test_packing: all checks passed'
+  call finish('test_packing')
 
 contains
-
-  subroutine fail(what)
-    character(len=*), intent(in) :: what
-    print '(2a)', '  FAIL  ', what
-    nfail = nfail + 1
-  end subroutine fail
 
   subroutine check_configuration(xx, bx, pr, phi, gmin, ticks, tick_rate)
     real(dp), intent(in) :: xx(:,:), bx(3), phi, gmin

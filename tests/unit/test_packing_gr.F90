@@ -17,11 +17,12 @@ program test_packing_gr
   use mod_packing, only: rng_t, rng_seed, random_packing, hs_monte_carlo, packing_report_t, &
                          packing_box_for, min_separation
   use mod_neighbours, only: nlist_t, nlist_init, nlist_build
+  use mod_unit_checks, only: fail, finish
   implicit none
   integer, parameter :: n = 2000, nbin = 10, nsamp = 400, nblk = 10, gap_sweeps = 4
   real(dp), parameter :: dr = 0.02_dp
   real(dp), parameter :: phis(3) = [0.2_dp, 0.3_dp, 0.4_dp]
-  integer :: nfail, k, info, s, b, m, ib
+  integer :: k, info, s, b, m, ib
   real(dp), allocatable :: x(:,:)
   real(dp) :: box(3), step, acc, cnt(nbin, nblk), g0, g0b(nblk), se, gcs, r(3), d, t0, t1
   real(dp) :: g3, g1, pg, wg
@@ -30,7 +31,6 @@ program test_packing_gr
   type(packing_report_t) :: rep
   character(len=200) :: msg
 
-  nfail = 0
   do k = 1, size(phis)
     call cpu_time(t0)
     box = packing_box_for(n, phis(k), [1.0_dp, 1.0_dp, 1.0_dp], 1.0_dp)
@@ -75,19 +75,9 @@ program test_packing_gr
       call fail('extrapolation to contact depends on the fit by > 2 %')
   end do
 
-  if (nfail > 0) then
-    print '(i0,a)', nfail, ' check(s) FAILED'
-    error stop 1
-  end if
-  print '(a)', 'test_packing_gr: all checks passed'
+  call finish('test_packing_gr')
 
 contains
-
-  subroutine fail(what)
-    character(len=*), intent(in) :: what
-    print '(2a)', '  FAIL  ', what
-    nfail = nfail + 1
-  end subroutine fail
 
   !> g(2a) from shell counts c(1:nb) accumulated over ns samples: ln g fitted by a polynomial of
   !> degree deg in r - 2a at the shells' volume-weighted mean radii, weights = counts (the

@@ -28,17 +28,17 @@
 program test_resistance_bispherical
   use mod_kinds, only: dp
   use mod_resistance, only: n_pair_scalars, resistance_scalars, i_xa11, i_xa12, i_xc11, i_xc12
+  use mod_unit_checks, only: failures, finish
   implicit none
   real(dp), parameter :: gaps(16) = [1.0e-5_dp, 1.0e-4_dp, 1.0e-3_dp, 5.0e-3_dp, 0.01_dp, 0.02_dp, &
                                      0.035_dp, 0.07_dp, 0.15_dp, 0.33_dp, 0.7_dp, 1.45_dp, 2.2_dp, &
                                      3.3_dp, 6.0_dp, 15.0_dp]
   real(dp) :: f(n_pair_scalars), e(4), worst(4), ex(4), s
-  integer :: k, failures
+  integer :: k
   character(len=*), parameter :: names(4) = [character(len=22) :: 'co-translation XA+', &
     'squeeze XA-', 'co-rotation XC+', 'counter-rotation XC-']
   real(dp), parameter :: tol(4) = [3.0e-5_dp, 3.0e-5_dp, 1.0e-4_dp, 1.0e-4_dp]
 
-  failures = 0
   worst = 0.0_dp
   print '(a)', '    gap       XA+ exact   rel.err    XA- exact   rel.err    XC+ exact   rel.err    XC- exact   rel.err'
   do k = 1, size(gaps)
@@ -75,8 +75,7 @@ program test_resistance_bispherical
     print '(a)', 'FAIL Jeffery counter-rotation series does not tend to zeta(3)'
     failures = failures + 1
   end if
-  if (failures > 0) error stop 1
-  print '(a)', 'all checks passed'
+  call finish('test_resistance_bispherical')
 
 contains
 

@@ -68,7 +68,4 @@ program test_solid_fraction
 
   call finish('test_solid_fraction')
 
-contains
-
-
 end program test_solid_fraction

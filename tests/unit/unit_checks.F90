@@ -4,7 +4,7 @@ module mod_unit_checks
   use mod_kinds, only: dp
   implicit none
   private
-  public :: failures, check, check_below, finish
+  public :: failures, check, check_below, fail, finish
 
   !> failed checks so far (a test may also count its own failures here)
   integer :: failures = 0
@@ -23,16 +23,20 @@ contains
     end if
   end subroutine check
 
+  !> A failure found by the test's own logic.
+  subroutine fail(what)
+    character(len=*), intent(in) :: what
+    call check(.false., what)
+  end subroutine fail
+
   !> A measured error against its tolerance (passes when value <= tol).
   subroutine check_below(what, value, tol)
     character(len=*), intent(in) :: what
     real(dp), intent(in) :: value, tol
-    if (value <= tol) then
-      print '(a,a,a,es10.3,a,es9.2,a)', '  ok    ', what, ': ', value, ' (tol ', tol, ')'
-    else
-      print '(a,a,a,es10.3,a,es9.2,a)', '  FAIL  ', what, ': ', value, ' (tol ', tol, ')'
-      failures = failures + 1
-    end if
+    character(len=:), allocatable :: verdict
+    verdict = merge('  ok    ', '  FAIL  ', value <= tol)
+    print '(a,a,a,es10.3,a,es9.2,a)', verdict, what, ': ', value, ' (tol ', tol, ')'
+    if (.not. value <= tol) failures = failures + 1
   end subroutine check_below
 
   !> The verdict: a failed test exits with status 1.
