@@ -33,10 +33,10 @@ contains
   subroutine check_below(what, value, tol)
     character(len=*), intent(in) :: what
     real(dp), intent(in) :: value, tol
-    character(len=:), allocatable :: verdict
-    verdict = merge('  ok    ', '  FAIL  ', value <= tol)
-    print '(a,a,a,es10.3,a,es9.2,a)', verdict, what, ': ', value, ' (tol ', tol, ')'
-    if (.not. value <= tol) failures = failures + 1
+    logical :: ok
+    ok = value <= tol                   ! false for NaN
+    print '(a,a,a,es10.3,a,es9.2,a)', merge('  ok    ', '  FAIL  ', ok), what, ': ', value, ' (tol ', tol, ')'
+    if (.not. ok) failures = failures + 1
   end subroutine check_below
 
   !> The verdict: a failed test exits with status 1.
