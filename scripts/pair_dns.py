@@ -3,7 +3,7 @@
 issue 5): two free rough spheres in a Couette cell, sphere 2 starting at r = x2 - x1 = (start, 0.5a, 0)
 from sphere 1, the pair centred in the box, until sphere 2 has passed to x = -start.
 
-    scripts/pair_dns.py [--cases eps0 eps1e-3 eps1e-2 eps1e-2_mu03] [--box 20] [--cells 5]
+    scripts/pair_dns.py [--cases eps0 eps1e-3 eps1e-3_mu03 eps1e-2 eps1e-2_mu03] [--box 20] [--cells 5]
                         [--dt 1e-3] [--start -6] [--reynolds 0.01] [--ranks 1] [--jobs 2]
                         [--hours 0] [--[no-]branch] [--work out/pair_dns] [--figures doc/figures] [--plot-only]
 
@@ -52,11 +52,14 @@ S_INF = 20.0 / 3.0 * math.pi
 # case: (pairtraj deck under input/ used as the template, eps_r, mu_d)
 CASES = {'eps0': ('pair_eps0', 0.0, 0.0),
          'eps1e-3': ('pair_eps1e-3', 1e-3, 0.0),
+         'eps1e-3_mu03': ('pair_eps1e-3_mu03', 1e-3, 0.3),
          'eps1e-2': ('pair_eps1e-2', 1e-2, 0.0),
          'eps1e-2_mu03': ('pair_eps1e-2_mu03', 1e-2, 0.3)}
 LABELS = {'eps0': r'$\epsilon_r = 0$', 'eps1e-3': r'$\epsilon_r = 10^{-3}$',
+          'eps1e-3_mu03': r'$\epsilon_r = 10^{-3}$, $\mu_d = 0.3$',
           'eps1e-2': r'$\epsilon_r = 10^{-2}$', 'eps1e-2_mu03': r'$\epsilon_r = 10^{-2}$, $\mu_d = 0.3$'}
-COLOURS = {'eps0': 'k', 'eps1e-3': 'tab:blue', 'eps1e-2': 'tab:red', 'eps1e-2_mu03': 'tab:orange'}
+COLOURS = {'eps0': 'k', 'eps1e-3': 'tab:blue', 'eps1e-3_mu03': 'tab:cyan', 'eps1e-2': 'tab:red',
+           'eps1e-2_mu03': 'tab:orange'}
 Y0 = 0.5          # initial offset across the shear, a (the paper's)
 STARTUP = 0.25    # strain over which the DNS stresslets build up from zero (lambda starts at 0)
 BRANCH_GAP = 0.1  # the trunk of --branch ends before pairtraj's gap falls below this: 10 h_r of the roughest case
@@ -277,8 +280,10 @@ def plot(results, start, figures, tag):
     for k, (case, (dns, ref)) in enumerate(results.items()):
         part, _ = upto(dns, -start)
         ax.plot(ref['x'], ref['y'], '-', color=COLOURS[case], label=LABELS[case])
-        ax.plot(part['x'][::5], part['y'][::5], 'o', ms=2.5, color=COLOURS[case],
-                label='DNS (markers; lines pairtraj)' if k == 0 else None)
+        # the paper's fig. 3 markers: circles frictionless, open squares mu_d = 0.3 (over the circles)
+        style = dict(marker='s', ms=4, mfc='none', mew=0.6) if case.endswith('mu03') else dict(marker='o', ms=2.5)
+        ax.plot(part['x'][::5], part['y'][::5], ls='none', color=COLOURS[case],
+                label='DNS (markers; lines pairtraj)' if k == 0 else None, **style)
     ax.set_xlim(start, -start)
     ax.set_ylim(0, 2.4)
     ax.set_xlabel('$x/a$')
