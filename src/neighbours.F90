@@ -13,6 +13,7 @@ module mod_neighbours
   implicit none
   private
   public :: nlist_t, nlist_init, nlist_build, nlist_needs_rebuild, nlist_candidates, min_image
+  public :: cell_coord, cell_index, cells_around
 
   type :: nlist_t
     integer :: np = 0
@@ -80,30 +81,33 @@ contains
     nl%nwalls = 0
   end subroutine nlist_init
 
-  !> Cell coordinates (0-based) of a position; wrapped in periodic directions, clamped to the
-  !> edge cells in bounded ones (a particle slightly inside a wall stays in the edge cell).
-  pure function cell_coord(nl, x) result(c)
-    type(nlist_t), intent(in) :: nl
-    real(dp), intent(in) :: x(3)
+  !> Cell coordinates (0-based) of a position in a grid of ncell cells over box; wrapped in
+  !> periodic directions, clamped to the edge cells in bounded ones (a particle slightly inside a
+  !> wall stays in the edge cell). Shared with the packing generator's cell lists.
+  pure function cell_coord(x, box, periodic, ncell) result(c)
+    real(dp), intent(in) :: x(3), box(3)
+    logical, intent(in) :: periodic(3)
+    integer, intent(in) :: ncell(3)
     integer :: c(3), k
     real(dp) :: s
     do k = 1, 3
-      s = x(k) / nl%box(k)
-      if (nl%periodic(k)) s = s - floor(s)
-      c(k) = min(nl%ncell(k) - 1, max(0, int(s * nl%ncell(k))))
+      s = x(k) / box(k)
+      if (periodic(k)) s = s - floor(s)
+      c(k) = min(ncell(k) - 1, max(0, int(s * ncell(k))))
     end do
   end function cell_coord
 
-  pure integer function cell_index(nl, c)
-    type(nlist_t), intent(in) :: nl
-    integer, intent(in) :: c(3)
-    cell_index = 1 + c(1) + nl%ncell(1) * (c(2) + nl%ncell(2) * c(3))
+  !> 1-based index of the cell of coordinates c (x fastest).
+  pure integer function cell_index(c, ncell)
+    integer, intent(in) :: c(3), ncell(3)
+    cell_index = 1 + c(1) + ncell(1) * (c(2) + ncell(2) * c(3))
   end function cell_index
 
-  !> The distinct cells around cell c (27, fewer when a direction has < 3 cells or at a wall).
-  pure subroutine around(nl, c, cells, nc)
-    type(nlist_t), intent(in) :: nl
-    integer, intent(in) :: c(3)
+  !> The distinct cells (indices) around cell c: 27, fewer when a periodic direction has < 3
+  !> cells (the images coincide) or at a wall.
+  pure subroutine cells_around(c, ncell, periodic, cells, nc)
+    integer, intent(in) :: c(3), ncell(3)
+    logical, intent(in) :: periodic(3)
     integer, intent(out) :: cells(27), nc
     integer :: o1, o2, o3, k, cn(3), idx
     logical :: outside
@@ -115,23 +119,23 @@ contains
           cn = c + [o1, o2, o3]
           outside = .false.
           do k = 1, 3
-            if (cn(k) < 0 .or. cn(k) >= nl%ncell(k)) then
-              if (nl%periodic(k)) then
-                cn(k) = modulo(cn(k), nl%ncell(k))
+            if (cn(k) < 0 .or. cn(k) >= ncell(k)) then
+              if (periodic(k)) then
+                cn(k) = modulo(cn(k), ncell(k))
               else
                 outside = .true.
               end if
             end if
           end do
           if (outside) cycle
-          idx = cell_index(nl, cn)
+          idx = cell_index(cn, ncell)
           if (any(cells(1:nc) == idx)) cycle
           nc = nc + 1
           cells(nc) = idx
         end do
       end do
     end do
-  end subroutine around
+  end subroutine cells_around
 
   !> Build the pair and wall lists from positions x(3, np). The arrays grow as needed.
   subroutine nlist_build(nl, x)
@@ -146,7 +150,7 @@ contains
     ncells = product(nl%ncell)
     nl%cell_start = 0
     do i = 1, nl%np
-      c = cell_index(nl, cell_coord(nl, x(:, i)))
+      c = cell_index(cell_coord(x(:, i), nl%box, nl%periodic, nl%ncell), nl%ncell)
       nl%cell_of(i) = c
       nl%cell_start(c + 1) = nl%cell_start(c + 1) + 1
     end do
@@ -166,7 +170,7 @@ contains
     nl%npairs = 0
     nd = 0
     do i = 1, nl%np
-      call around(nl, cell_coord(nl, x(:, i)), cells, ncl)
+      call cells_around(cell_coord(x(:, i), nl%box, nl%periodic, nl%ncell), nl%ncell, nl%periodic, cells, ncl)
       do m = 1, ncl
         do q = nl%cell_start(cells(m)), nl%cell_start(cells(m) + 1) - 1
           j = nl%order(q)

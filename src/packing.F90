@@ -26,6 +26,7 @@
 ! so a seed gives the same stream with every compiler; positions are identical for a given build.
 module mod_packing
   use mod_kinds, only: dp, i8, pi
+  use mod_neighbours, only: cell_coord, cell_index, cells_around, min_image
   implicit none
   private
   public :: rng_t, rng_seed, rng_uniform, packing_count, packing_box_for
@@ -62,7 +63,6 @@ module mod_packing
     integer :: nc(3) = 1
     real(dp) :: box(3) = 1
     logical :: periodic(3) = .true.
-    logical :: dedup = .false.          ! a periodic direction has < 3 cells: neighbours repeat
     integer, allocatable :: head(:), next(:), prev(:), cell(:)
   end type cells_t
 
@@ -132,7 +132,6 @@ contains
     cl%box = box
     cl%periodic = periodic
     cl%nc = max(1, int(box / side))
-    cl%dedup = any(periodic .and. cl%nc < 3)
     if (allocated(cl%head)) deallocate(cl%head, cl%next, cl%prev, cl%cell)
     allocate(cl%head(product(cl%nc)), cl%next(n), cl%prev(n), cl%cell(n))
   end subroutine cells_init
@@ -140,15 +139,16 @@ contains
   pure integer function cell_of(cl, x) result(idx)
     type(cells_t), intent(in) :: cl
     real(dp), intent(in) :: x(3)
-    integer :: c(3), k
-    real(dp) :: s
-    do k = 1, 3
-      s = x(k) / cl%box(k)
-      if (cl%periodic(k)) s = s - floor(s)
-      c(k) = min(cl%nc(k) - 1, max(0, int(s * cl%nc(k))))
-    end do
-    idx = 1 + c(1) + cl%nc(1) * (c(2) + cl%nc(2) * c(3))
+    idx = cell_index(cell_coord(x, cl%box, cl%periodic, cl%nc), cl%nc)
   end function cell_of
+
+  !> The distinct cells around the cell of position x.
+  pure subroutine cells_near(cl, x, cells, nu)
+    type(cells_t), intent(in) :: cl
+    real(dp), intent(in) :: x(3)
+    integer, intent(out) :: cells(27), nu
+    call cells_around(cell_coord(x, cl%box, cl%periodic, cl%nc), cl%nc, cl%periodic, cells, nu)
+  end subroutine cells_near
 
   subroutine cells_fill(cl, x, n)
     type(cells_t), intent(inout) :: cl
@@ -181,58 +181,6 @@ contains
     end if
     if (cl%next(i) > 0) cl%prev(cl%next(i)) = cl%prev(i)
   end subroutine cells_remove
-
-  !> The distinct cells around the cell of position x.
-  pure subroutine cells_around(cl, x, cells, nu)
-    type(cells_t), intent(in) :: cl
-    real(dp), intent(in) :: x(3)
-    integer, intent(out) :: cells(27), nu
-    integer :: c(3), cn(3), k, o1, o2, o3, idx
-    real(dp) :: s
-    logical :: out
-    do k = 1, 3
-      s = x(k) / cl%box(k)
-      if (cl%periodic(k)) s = s - floor(s)
-      c(k) = min(cl%nc(k) - 1, max(0, int(s * cl%nc(k))))
-    end do
-    nu = 0
-    cells = 0
-    do o3 = -1, 1
-      do o2 = -1, 1
-        do o1 = -1, 1
-          cn = c + [o1, o2, o3]
-          out = .false.
-          do k = 1, 3
-            if (cn(k) < 0 .or. cn(k) >= cl%nc(k)) then
-              if (cl%periodic(k)) then
-                cn(k) = modulo(cn(k), cl%nc(k))
-              else
-                out = .true.
-              end if
-            end if
-          end do
-          if (out) cycle
-          idx = 1 + cn(1) + cl%nc(1) * (cn(2) + cl%nc(2) * cn(3))
-          if (cl%dedup) then
-            if (any(cells(1:nu) == idx)) cycle
-          end if
-          nu = nu + 1
-          cells(nu) = idx
-        end do
-      end do
-    end do
-  end subroutine cells_around
-
-  pure function mimg(d, box, periodic) result(r)
-    real(dp), intent(in) :: d(3), box(3)
-    logical, intent(in) :: periodic(3)
-    real(dp) :: r(3)
-    integer :: k
-    r = d
-    do k = 1, 3
-      if (periodic(k)) r(k) = r(k) - box(k) * anint(r(k) / box(k))
-    end do
-  end function mimg
 
   ! ---- the packing --------------------------------------------------------------------------
 
@@ -358,12 +306,12 @@ contains
       call cells_fill(cl, x, n)
       maxov = 0
       do i = 1, n
-        call cells_around(cl, x(:, i), cells, nu)
+        call cells_near(cl, x(:, i), cells, nu)
         do m = 1, nu
           j = cl%head(cells(m))
           do while (j > 0)
             if (j > i) then
-              r = mimg(x(:, j) - x(:, i), box, periodic)
+              r = min_image(x(:, j) - x(:, i), box, periodic)
               d = norm2(r)
               ov = 2 * rr - d
               if (ov > 0) then
@@ -483,12 +431,12 @@ contains
       real(dp), intent(in) :: y(3)
       integer :: cells(27), nu, mm, jj
       yes = .true.
-      call cells_around(cl, y, cells, nu)
+      call cells_near(cl, y, cells, nu)
       do mm = 1, nu
         jj = cl%head(cells(mm))
         do while (jj > 0)
           if (jj /= ip) then
-            if (sum(mimg(x(:, jj) - y, box, periodic)**2) < d2) then
+            if (sum(min_image(x(:, jj) - y, box, periodic)**2) < d2) then
               yes = .false.
               return
             end if
@@ -516,11 +464,11 @@ contains
     call cells_init(cl, box, periodic, min(side, minval(box) / 2), n)
     call cells_fill(cl, x, n)
     do i = 1, n
-      call cells_around(cl, x(:, i), cells, nu)
+      call cells_near(cl, x(:, i), cells, nu)
       do m = 1, nu
         j = cl%head(cells(m))
         do while (j > 0)
-          if (j > i) d2min = min(d2min, sum(mimg(x(:, j) - x(:, i), box, periodic)**2))
+          if (j > i) d2min = min(d2min, sum(min_image(x(:, j) - x(:, i), box, periodic)**2))
           j = cl%next(j)
         end do
       end do
