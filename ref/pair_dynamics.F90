@@ -31,6 +31,7 @@
 ! of one sphere and S_inf = (20/3) pi eta a^3 gamma_dot (JFM 3.1, 3.2).
 module mod_pair_dynamics
   use mod_kinds, only: dp, pi
+  use mod_vector, only: cross, outer
   use mod_resistance, only: n_pair_scalars, resistance_scalars, pair_resistance_fu, &
                             pair_resistance_fe, pair_stresslets
   implicit none
@@ -197,21 +198,6 @@ contains
     changed = any(ups /= y(4:6))
     y(4:6) = ups
   end subroutine project_spring
-
-  pure function cross(a, b) result(c)
-    real(dp), intent(in) :: a(3), b(3)
-    real(dp) :: c(3)
-    c = [a(2) * b(3) - a(3) * b(2), a(3) * b(1) - a(1) * b(3), a(1) * b(2) - a(2) * b(1)]
-  end function cross
-
-  pure function outer(a, b) result(c)
-    real(dp), intent(in) :: a(3), b(3)
-    real(dp) :: c(3, 3)
-    integer :: j
-    do j = 1, 3
-      c(:, j) = a * b(j)
-    end do
-  end function outer
 
   !> Solve A x = b for symmetric positive definite A (Cholesky).
   pure function solve_spd(a_in, b) result(x)

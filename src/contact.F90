@@ -23,6 +23,7 @@
 ! changes when a particle is wrapped into the box during a contact.
 module mod_contact
   use mod_kinds, only: dp, pi
+  use mod_vector, only: cross
   implicit none
   private
   public :: contact_params_t, contact_setup, contact_stats_t
@@ -205,12 +206,6 @@ contains
       end do
     end do
   end function contact_stresslet
-
-  pure function cross(u, v) result(w)
-    real(dp), intent(in) :: u(3), v(3)
-    real(dp) :: w(3)
-    w = [u(2) * v(3) - u(3) * v(2), u(3) * v(1) - u(1) * v(3), u(1) * v(2) - u(2) * v(1)]
-  end function cross
 
   ! ---- all contacts of one step ------------------------------------------------------------
 

@@ -32,6 +32,7 @@ module mod_fictitious_domain
   use petscdmda
   use petscksp
   use mod_kinds, only: dp
+  use mod_vector, only: cross
   use mod_grid, only: grid_t, FIELD_U, FIELD_V, FIELD_W, FIELD_P
   use mod_particles, only: particles_t, MOTION_FREE, MOTION_PRESCRIBED, MOTION_FROZEN, MOTION_RESISTANCE, &
                            MOTION_FIXED
@@ -316,7 +317,7 @@ contains
     e = 0.0_dp
     e(c) = 1.0_dp
     g(1:3) = e
-    g(4:6) = [r(2) * e(3) - r(3) * e(2), r(3) * e(1) - r(1) * e(3), r(1) * e(2) - r(2) * e(1)]
+    g(4:6) = cross(r, e)
   end function rigid_row
 
   ! The particle sub-problem after the fluid step: velocities, lambda^{n+1}, u^{n+1}, and the

@@ -42,6 +42,7 @@
 !      continuous in value and slope, and decays like the neglected terms.
 module mod_resistance
   use mod_kinds, only: dp, pi
+  use mod_vector, only: cross
   use mod_resistance_table, only: resistance_table_size, resistance_table_sep, &
                                   resistance_table_values, resistance_series_nmax, &
                                   resistance_series_coef
@@ -744,12 +745,6 @@ contains
       end do
     end do
   end function pair_stresslets
-
-  pure function cross(a, b) result(c)
-    real(dp), intent(in) :: a(3), b(3)
-    real(dp) :: c(3)
-    c = [a(2) * b(3) - a(3) * b(2), a(3) * b(1) - a(1) * b(3), a(1) * b(2) - a(2) * b(1)]
-  end function cross
 
   ! ---------------------------------------------------------------------------------------------
   ! Sphere - plane wall (method.md section 2.8)

@@ -32,6 +32,7 @@
 !      at phi = 0 (one pair under the force scale).
 program test_contact
   use mod_kinds, only: dp, pi
+  use mod_vector, only: cross
   use mod_contact, only: contact_params_t, contact_setup, chatter_number, flattening_estimate, contact_history_t, history_size, &
                          contact_pair, contact_forces, contact_stats_t, history_lookup
   use mod_unit_checks, only: check, finish
@@ -253,11 +254,5 @@ contains
     h = contact_history_t()       ! the default: no contacts, nothing allocated
   end subroutine clear_history
 
-
-  pure function cross(a, b) result(c)
-    real(dp), intent(in) :: a(3), b(3)
-    real(dp) :: c(3)
-    c = [a(2) * b(3) - a(3) * b(2), a(3) * b(1) - a(1) * b(3), a(1) * b(2) - a(2) * b(1)]
-  end function cross
 
 end program test_contact

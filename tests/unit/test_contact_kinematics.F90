@@ -27,6 +27,7 @@
 !      slip of i relative to j (1 + cos < 1e-12).
 program test_contact_kinematics
   use mod_kinds, only: dp, pi
+  use mod_vector, only: cross
   use mod_contact, only: contact_params_t, contact_setup, contact_history_t, history_size, &
                          history_lookup, contact_forces, contact_stats_t
   use mod_unit_checks, only: fail, finish
@@ -200,11 +201,5 @@ contains
     h = contact_history_t()       ! the default: no contacts, nothing allocated
   end subroutine clear_history
 
-
-  pure function cross(a, b) result(c)
-    real(dp), intent(in) :: a(3), b(3)
-    real(dp) :: c(3)
-    c = [a(2) * b(3) - a(3) * b(2), a(3) * b(1) - a(1) * b(3), a(1) * b(2) - a(2) * b(1)]
-  end function cross
 
 end program test_contact_kinematics
