@@ -110,9 +110,10 @@ contains
     logical, intent(in) :: periodic(3)
     integer, intent(out) :: cells(27), nc
     integer :: o1, o2, o3, k, cn(3), idx
-    logical :: outside
+    logical :: outside, repeats
     nc = 0
     cells = 0
+    repeats = any(periodic .and. ncell < 3)     ! only then do two offsets wrap onto one cell
     do o3 = -1, 1
       do o2 = -1, 1
         do o1 = -1, 1
@@ -129,7 +130,9 @@ contains
           end do
           if (outside) cycle
           idx = cell_index(cn, ncell)
-          if (any(cells(1:nc) == idx)) cycle
+          if (repeats) then
+            if (any(cells(1:nc) == idx)) cycle
+          end if
           nc = nc + 1
           cells(nc) = idx
         end do
