@@ -143,10 +143,9 @@ tradeoff: all
 # -6a; five cases: eps_r = 0, 1e-3 and 1e-2, the rough ones also with mu_d = 0.3): the approach the
 # cases share runs once on both cores (1 h), then the cases branch from it before their first
 # contact, two at a time (scripts/pair_dns.py --branch; 1-1.6 h per case on 2 cores, the smooth
-# pair's transit the longest; doc/VALIDATION.md §4.4).
-# Resumable (PAIR_DNS_ARGS="--hours 1" stops each run with a checkpoint after an hour; the same
-# command continues). Figures
-# doc/figures/pair_dns_paper_*.png, table on stdout (doc/VALIDATION.md §4.4).
+# pair's transit the longest). Resumable (PAIR_DNS_ARGS="--hours 1" stops each run with a
+# checkpoint after an hour; the same command continues). Figures doc/figures/pair_dns_paper_*.png,
+# table on stdout (doc/VALIDATION.md §4.4).
 PAIR_DNS_ARGS ?=
 pair-dns: all
 	$(PYTHON) scripts/pair_dns.py $(PAIR_DNS_ARGS)

@@ -201,5 +201,4 @@ contains
     h = contact_history_t()       ! the default: no contacts, nothing allocated
   end subroutine clear_history
 
-
 end program test_contact_kinematics
