@@ -32,7 +32,6 @@ module mod_fictitious_domain
   use petscdmda
   use petscksp
   use mod_kinds, only: dp
-  use mod_vector, only: cross
   use mod_grid, only: grid_t, FIELD_U, FIELD_V, FIELD_W, FIELD_P
   use mod_particles, only: particles_t, MOTION_FREE, MOTION_PRESCRIBED, MOTION_FROZEN, MOTION_RESISTANCE, &
                            MOTION_FIXED
@@ -43,7 +42,7 @@ module mod_fictitious_domain
   use mod_errors, only: fatal_error
   implicit none
   private
-  public :: fd_t, fd_create, fd_geometry, fd_follow, fd_particle_step, fd_destroy
+  public :: fd_t, fd_create, fd_geometry, fd_follow, fd_moments, fd_solve_motion, fd_update, fd_destroy
 
   type :: fd_t
     real(dp) :: beta = 0.0_dp           ! rho/dt = Re/dt
@@ -61,6 +60,7 @@ module mod_fictitious_domain
     real(dp), allocatable :: f_r(:, :), f_alpha(:), f_relax(:)   ! r, alpha, 1/(1+gamma)
     real(dp), allocatable :: rigid_matrix(:, :, :)               ! M_p (6, 6, n), summed over ranks
     real(dp), allocatable :: lambda_new(:)   ! Lambda^{n+1} per listed face (kept: no allocation per step)
+    real(dp), allocatable :: moments(:, :)   ! (12, n): b(u~) and m(Lambda^n) of the step (fd_moments)
     type(particle_system_t) :: system
     type(particle_solver_t) :: solver     ! the 6N system once pairs couple it
     integer :: solver_iterations = 0
@@ -309,52 +309,49 @@ contains
     end do
   end subroutine fd_follow
 
-  ! g such that (U + Omega x r)_c = g . (U, Omega): g = (e_c, r x e_c).
+  ! g = (e_c, r x e_c) such that (U + Omega x r)_c = g . (U, Omega); r x e_c written out, since
+  ! the face loops below are most of the particle step's cost (doc/BENCHMARKS.md §8).
   pure function rigid_row(c, r) result(g)
     integer, intent(in) :: c
     real(dp), intent(in) :: r(3)
-    real(dp) :: g(6), e(3)
-    e = 0.0_dp
-    e(c) = 1.0_dp
-    g(1:3) = e
-    g(4:6) = cross(r, e)
+    real(dp) :: g(6)
+    g = 0.0_dp
+    g(c) = 1.0_dp
+    select case (c)
+    case (1)
+      g(5) = r(3); g(6) = -r(2)
+    case (2)
+      g(4) = -r(3); g(6) = r(1)
+    case (3)
+      g(4) = r(2); g(5) = -r(1)
+    end select
   end function rigid_row
 
-  ! The particle sub-problem after the fluid step: velocities, lambda^{n+1}, u^{n+1}, and the
-  ! resolved force, torque and stresslet. vel: the projected velocity u~ on entry, u^{n+1} on exit.
-  ! extra_force, extra_torque (3, n), optional: further forces on the particles (contacts), added
-  ! to the right-hand side next to external_force/external_torque (free motion only).
-  ! lubrication, optional: the links of this configuration (mod_particle_lubrication); their
-  ! resistance enters the 6N system implicitly (method.md §1.5 eq. (1)) and their corrections are
-  ! added to the resolved force, torque and stresslet, which then hold the total hydrodynamics.
-  subroutine fd_particle_step(grid, fd, vel, pressure, parts, ierr, extra_force, extra_torque, lubrication)
+  ! The particle sub-problem after the fluid step, in three named parts that main.F90 calls in
+  ! turn (method.md §1.5 eq. (1), §1.5b):
+  !   fd_moments       b(u~) and m(Lambda^n) of every sphere, summed over ranks;
+  !   fd_solve_motion  the 6N system (rigid-body matrices, lubrication, contacts): U, Omega;
+  !   fd_update        Lambda^{n+1}, u^{n+1} = u~ + (Lambda^{n+1} - Lambda^n)/beta, and the
+  !                    resolved force, torque and stresslet (plus the lubrication corrections).
+
+  ! b = sum_f w u~_c g dV and m = sum_f Lambda^n_f/(1+gamma) g dV per sphere (rows 1-6, 7-12 of
+  ! fd%moments). vel: the projected velocity u~. Collective.
+  subroutine fd_moments(grid, fd, vel, n, ierr)
     type(grid_t), intent(in) :: grid
     type(fd_t), intent(inout) :: fd
-    Vec, intent(inout) :: vel(3)
-    Vec, intent(in) :: pressure
-    type(particles_t), intent(inout) :: parts
+    Vec, intent(in) :: vel(3)
+    integer, intent(in) :: n
     PetscErrorCode, intent(out) :: ierr
-    real(dp), intent(in), optional :: extra_force(:, :), extra_torque(:, :)
-    type(particle_lubrication_t), intent(inout), optional :: lubrication
-    real(dp), allocatable :: moments(:, :), rhs(:, :), x(:, :), sums(:, :)
     type(field_pointer) :: u(3), lam(3)
-    PetscScalar, pointer :: p(:,:,:)
-    real(dp) :: g(6), dv, b, rigid, r(3), integral
-    integer :: f, c, q, i, j, k, n, d
-    logical :: ok
-    character(len=200) :: text
-    KSPConvergedReason :: reason
+    real(dp) :: g(6), dv
+    integer :: f, c, q, i, j, k
 
-    n = parts%n
     dv = grid%h**3
-    allocate(moments(12, n), rhs(6, n), x(6, n), sums(16, n))
-    if (allocated(fd%lambda_new)) then
-      if (size(fd%lambda_new) < fd%nf) deallocate(fd%lambda_new)
+    if (allocated(fd%moments)) then
+      if (size(fd%moments, 2) /= n) deallocate(fd%moments)
     end if
-    if (.not. allocated(fd%lambda_new)) allocate(fd%lambda_new(size(fd%f_comp)))
-
-    ! moments b(u~) and m(Lambda^n) (rows 1-6 and 7-12)
-    moments = 0.0_dp
+    if (.not. allocated(fd%moments)) allocate(fd%moments(12, n))
+    fd%moments = 0.0_dp
     do c = 1, 3
       PetscCall(DMDAVecGetArrayReadF90(grid%da(c), vel(c), u(c)%ptr, ierr))
       PetscCall(DMDAVecGetArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
@@ -365,18 +362,43 @@ contains
       i = fd%f_ijk(1, f); j = fd%f_ijk(2, f); k = fd%f_ijk(3, f)
       q = fd%f_part(f)
       g = rigid_row(c, fd%f_r(:, f))
-      moments(1:6, q) = moments(1:6, q) + fd%f_alpha(f) * fd%f_relax(f) * u(c)%ptr(i, j, k) * dv * g
-      moments(7:12, q) = moments(7:12, q) + lam(c)%ptr(i, j, k) * fd%f_relax(f) * dv * g
+      fd%moments(1:6, q) = fd%moments(1:6, q) + fd%f_alpha(f) * fd%f_relax(f) * u(c)%ptr(i, j, k) * dv * g
+      fd%moments(7:12, q) = fd%moments(7:12, q) + lam(c)%ptr(i, j, k) * fd%f_relax(f) * dv * g
     end do
-    call MPI_Allreduce(MPI_IN_PLACE, moments, 12 * n, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
+    do c = 1, 3
+      PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
+      PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), vel(c), u(c)%ptr, ierr))
+    end do
+    call MPI_Allreduce(MPI_IN_PLACE, fd%moments, 12 * n, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
+  end subroutine fd_moments
 
-    ! the 6N system (method.md eq. (1))
+  ! The velocities of the spheres: beta M U = beta b(u~) - m(Lambda^n) + F_ext (method.md eq. (1)
+  ! with the weights), for free motion; prescribed, resistance and fixed motions set them.
+  ! extra_force, extra_torque (3, n), optional: further forces on the particles (contacts), added
+  ! to the right-hand side next to external_force/external_torque (free motion only).
+  ! lubrication, optional: the links of this configuration (mod_particle_lubrication); their
+  ! resistance enters the 6N system implicitly. Identical on every rank (replicated data).
+  subroutine fd_solve_motion(fd, parts, ierr, extra_force, extra_torque, lubrication)
+    type(fd_t), intent(inout) :: fd
+    type(particles_t), intent(inout) :: parts
+    PetscErrorCode, intent(out) :: ierr
+    real(dp), intent(in), optional :: extra_force(:, :), extra_torque(:, :)
+    type(particle_lubrication_t), intent(in), optional :: lubrication
+    real(dp), allocatable :: rhs(:, :), x(:, :)
+    integer :: q, n
+    logical :: ok
+    character(len=200) :: text
+    KSPConvergedReason :: reason
+
+    ierr = 0
+    n = parts%n
     select case (parts%motion)
     case (MOTION_FREE, MOTION_FROZEN)
+      allocate(rhs(6, n), x(6, n))
       call psys_reset(fd%system, n)
       do q = 1, n
         call psys_add_diagonal(fd%system, q, fd%beta * fd%rigid_matrix(:, :, q))
-        rhs(:, q) = fd%beta * moments(1:6, q) - moments(7:12, q) &
+        rhs(:, q) = fd%beta * fd%moments(1:6, q) - fd%moments(7:12, q) &
              + [parts%external_force(:, q), parts%external_torque(:, q)]
         if (present(extra_force)) rhs(1:3, q) = rhs(1:3, q) + extra_force(:, q)
         if (present(extra_torque)) rhs(4:6, q) = rhs(4:6, q) + extra_torque(:, q)
@@ -407,8 +429,40 @@ contains
       parts%velocity = 0.0_dp
       parts%omega = 0.0_dp
     end select
+  end subroutine fd_solve_motion
+
+  ! Lambda^{n+1} = [Lambda^n + beta alpha (g.U - u~)]/(1 + gamma) on owned faces, 0 elsewhere;
+  ! u^{n+1} = u~ + (Lambda^{n+1} - Lambda^n)/beta; the moments F = -sum Lambda e_c dV,
+  ! T = -sum r x Lambda e_c dV, S = -1/2 sum Lambda (r e_c + e_c r) dV - (sum_cells alpha p dV) I
+  ! (§1.6). vel: u~ on entry, u^{n+1} on exit. lubrication, optional: its corrections are added to
+  ! the resolved force, torque and stresslet, which then hold the total hydrodynamics. Collective.
+  subroutine fd_update(grid, fd, vel, pressure, parts, ierr, lubrication)
+    type(grid_t), intent(in) :: grid
+    type(fd_t), intent(inout) :: fd
+    Vec, intent(inout) :: vel(3)
+    Vec, intent(in) :: pressure
+    type(particles_t), intent(inout) :: parts
+    PetscErrorCode, intent(out) :: ierr
+    type(particle_lubrication_t), intent(inout), optional :: lubrication
+    real(dp), allocatable :: sums(:, :)
+    type(field_pointer) :: u(3), lam(3)
+    PetscScalar, pointer :: p(:,:,:)
+    real(dp) :: g(6), dv, b, rigid, r(3), integral
+    integer :: f, c, q, i, j, k, n, d
+
+    n = parts%n
+    dv = grid%h**3
+    allocate(sums(16, n))
+    if (allocated(fd%lambda_new)) then
+      if (size(fd%lambda_new) < fd%nf) deallocate(fd%lambda_new)
+    end if
+    if (.not. allocated(fd%lambda_new)) allocate(fd%lambda_new(size(fd%f_comp)))
 
     ! Lambda^{n+1} on the owned faces of each particle (from u~ and Lambda^n)
+    do c = 1, 3
+      PetscCall(DMDAVecGetArrayReadF90(grid%da(c), vel(c), u(c)%ptr, ierr))
+      PetscCall(DMDAVecGetArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
+    end do
     do f = 1, fd%nf
       c = fd%f_comp(f)
       if (c == FIELD_P) cycle
@@ -476,7 +530,7 @@ contains
       parts%torque_hydro = parts%torque_hydro + lubrication%torque
       parts%stresslet_hydro = parts%stresslet_hydro + lubrication%stresslet
     end if
-  end subroutine fd_particle_step
+  end subroutine fd_update
 
   ! The lubrication links into the 6N system: each pair's 12x12 R_sub_FU as two diagonal blocks and
   ! one coupling block, each wall link's 6x6 on its particle's diagonal; their velocity-independent

@@ -23,7 +23,8 @@ program fdsusp
   use mod_particles_io, only: particles_load, particles_snapshot
   use mod_rheology, only: rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, rheo_state, rheo_restore, &
                           rheo_write_summary, rheo_summarise, summary_names, NSUMMARY
-  use mod_fictitious_domain, only: fd_t, fd_create, fd_geometry, fd_follow, fd_particle_step, fd_destroy
+  use mod_fictitious_domain, only: fd_t, fd_create, fd_geometry, fd_follow, fd_moments, fd_solve_motion, fd_update, &
+                                   fd_destroy
   use mod_particle_contacts, only: particle_contacts_t, pcontacts_create, pcontacts_step
   use mod_contact, only: chatter_number, flattening_estimate, wall_lower, wall_upper
   use mod_lubrication, only: lubrication_t, LUB_NONE, LUB_SIMPLE
@@ -254,8 +255,12 @@ program fdsusp
       PetscCallA(fluid_step(grid, fl, ierr, fd%lambda))
       PetscCallA(stage_pop(ierr))
       PetscCallA(stage_push(STAGE_PARTICLES, ierr))
-      ! contact forces and lubrication links, each absent when not allocated (no such model)
-      PetscCallA(fd_particle_step(grid, fd, fl%vel, fl%pressure, parts, ierr, pc%force, pc%torque, pl))
+      ! the particle sub-problem (method.md §1.5 eq. (1)): moments of u~ and Lambda^n, the 6N
+      ! system for U, Omega (contact forces and lubrication links, each absent when not
+      ! allocated), then Lambda^{n+1}, u^{n+1} and the hydrodynamic force, torque, stresslet
+      PetscCallA(fd_moments(grid, fd, fl%vel, parts%n, ierr))
+      PetscCallA(fd_solve_motion(fd, parts, ierr, pc%force, pc%torque, pl))
+      PetscCallA(fd_update(grid, fd, fl%vel, fl%pressure, parts, ierr, pl))
       ! the core statistics of this configuration, before it moves on
       ! (pc%stresslet is absent, as unallocated, when there are no contacts)
       if (allocated(rh)) then
