@@ -37,6 +37,7 @@ module mod_fictitious_domain
                            MOTION_FIXED
   use mod_particle_system, only: particle_system_t, psys_reset, psys_add_diagonal, psys_add_pair, psys_solve
   use mod_particle_lubrication, only: particle_lubrication_t, plub_corrections
+  use mod_particle_contacts, only: particle_contacts_t, pcontacts_add_stiffness, pcontacts_implicit_update
   use mod_particle_solver, only: particle_solver_t, psolver_create, psolver_solve, psolver_destroy
   use mod_solid_fraction, only: cube_fraction, relaxation_gamma
   use mod_errors, only: fatal_error
@@ -59,6 +60,10 @@ module mod_fictitious_domain
     integer, allocatable :: f_comp(:), f_ijk(:, :), f_part(:)
     real(dp), allocatable :: f_r(:, :), f_alpha(:), f_relax(:)   ! r, alpha, 1/(1+gamma)
     real(dp), allocatable :: rigid_matrix(:, :, :)               ! M_p (6, 6, n), summed over ranks
+    ! every unknown a sphere covers (alpha > 0), owned or not, in the order they were visited
+    integer :: ncand = 0
+    integer, allocatable :: cand_comp(:), cand_part(:), cand_ijk(:, :)
+    real(dp), allocatable :: cand_r(:, :)
     real(dp), allocatable :: lambda_new(:)   ! Lambda^{n+1} per listed face (kept: no allocation per step)
     real(dp), allocatable :: moments(:, :)   ! (12, n): b(u~) and m(Lambda^n) of the step (fd_moments)
     type(particle_system_t) :: system
@@ -94,6 +99,11 @@ contains
     allocate(fd%owner(grid%lo(1):grid%hi(1), grid%lo(2):grid%hi(2), grid%lo(3):grid%hi(3), 4))
     allocate(fd%alpha(grid%lo(1):grid%hi(1), grid%lo(2):grid%hi(2), grid%lo(3):grid%hi(3), 4))
     allocate(fd%alpha_second, mold=fd%alpha)
+    ! zero once: fd_geometry then resets only the entries its candidates touched
+    fd%owner = 0
+    fd%alpha = 0.0_dp
+    fd%alpha_second = 0.0_dp
+    allocate(fd%cand_comp(1024), fd%cand_part(1024), fd%cand_ijk(3, 1024), fd%cand_r(3, 1024))
     PetscCall(psolver_create(fd%solver, ierr))
     allocate(fd%f_comp(1024), fd%f_ijk(3, 1024), fd%f_part(1024), fd%f_r(3, 1024), &
              fd%f_alpha(1024), fd%f_relax(1024))
@@ -101,25 +111,41 @@ contains
 
   ! The geometry at the current positions: face ownership, alpha, the face list and M_p.
   ! Collective (M_p is summed over ranks).
+  ! Pass 1 visits, sphere by sphere, the unknowns each sphere's control volumes can meet, computes
+  ! alpha once and keeps every one it covers (the candidates), claiming ownership as it goes (the
+  ! largest alpha wins; ties to the lower index); pass 2 walks the candidates, in the same order,
+  ! and lists those their sphere owns. Only the entries the candidates touched are reset the
+  ! next time, not the whole grid (issue 31: the geometry was half of the paper scene's step).
   subroutine fd_geometry(grid, fd, parts)
     type(grid_t), intent(in) :: grid
     type(fd_t), intent(inout) :: fd
     type(particles_t), intent(in) :: parts
-    integer :: q, c, pass, ierr
-    real(dp) :: radius
+    integer :: q, c, m, ierr, iw, jw, kw, nnz, s, t, idx(3)
+    real(dp) :: radius, a, gamma, w, dv, val(3)
 
     radius = parts%radius + fd%radius_offset * grid%h
-    fd%owner = 0
-    fd%alpha = 0.0_dp
-    fd%alpha_second = 0.0_dp
-    fd%nf = 0
-    ! pass 1: ownership (the largest alpha wins; ties to the lower index); pass 2: the face list
-    do pass = 1, 2
-      do q = 1, parts%n
-        do c = 1, 4
-          call visit(grid, fd, q, c, parts%position(:, q), radius, pass)
-        end do
+    do m = 1, fd%ncand
+      iw = fd%cand_ijk(1, m); jw = fd%cand_ijk(2, m); kw = fd%cand_ijk(3, m); c = fd%cand_comp(m)
+      fd%owner(iw, jw, kw, c) = 0
+      fd%alpha(iw, jw, kw, c) = 0.0_dp
+      fd%alpha_second(iw, jw, kw, c) = 0.0_dp
+    end do
+    fd%ncand = 0
+    do q = 1, parts%n
+      do c = 1, 4
+        call visit(grid, fd, q, c, parts%position(:, q), radius)
       end do
+    end do
+    fd%nf = 0
+    do m = 1, fd%ncand
+      iw = fd%cand_ijk(1, m); jw = fd%cand_ijk(2, m); kw = fd%cand_ijk(3, m); c = fd%cand_comp(m)
+      q = fd%cand_part(m)
+      if (fd%owner(iw, jw, kw, c) /= q) cycle
+      a = fd%alpha(iw, jw, kw, c) - fd%alpha_second(iw, jw, kw, c)
+      if (a <= 0.0_dp) cycle
+      gamma = 0.0_dp
+      if (c /= FIELD_P) gamma = relaxation_gamma(a, fd%kappa, fd%beta, grid%h, fd%eta)
+      call push_face(fd, c, fd%cand_ijk(:, m), q, fd%cand_r(:, m), a, 1.0_dp / (1.0_dp + gamma))
     end do
 
     if (allocated(fd%rigid_matrix)) then
@@ -127,36 +153,37 @@ contains
     end if
     if (.not. allocated(fd%rigid_matrix)) allocate(fd%rigid_matrix(6, 6, parts%n))
     fd%rigid_matrix = 0.0_dp
-    block
-      integer :: f, b
-      real(dp) :: g(6), w, dv
-      dv = grid%h**3
-      do f = 1, fd%nf
-        if (fd%f_comp(f) == FIELD_P) cycle
-        g = rigid_row(fd%f_comp(f), fd%f_r(:, f))
-        w = fd%f_alpha(f) * fd%f_relax(f) * dv
-        do b = 1, 6
-          fd%rigid_matrix(:, b, fd%f_part(f)) = fd%rigid_matrix(:, b, fd%f_part(f)) + (w * g(b)) * g
+    ! M_p = sum_f w g g^T dV over the three non-zeros of each g
+    dv = grid%h**3
+    do m = 1, fd%nf
+      c = fd%f_comp(m)
+      if (c == FIELD_P) cycle
+      q = fd%f_part(m)
+      call rigid_row_nonzeros(c, fd%f_r(:, m), idx, val, nnz)
+      w = fd%f_alpha(m) * fd%f_relax(m) * dv
+      do t = 1, nnz
+        do s = 1, nnz
+          fd%rigid_matrix(idx(s), idx(t), q) = fd%rigid_matrix(idx(s), idx(t), q) + (w * val(t)) * val(s)
         end do
       end do
-    end block
+    end do
     call MPI_Allreduce(MPI_IN_PLACE, fd%rigid_matrix, 36 * parts%n, MPI_DOUBLE_PRECISION, MPI_SUM, &
                        PETSC_COMM_WORLD, ierr)
   end subroutine fd_geometry
 
-  ! Every unknown of component c (1..4, 4 = cell centres) whose control volume may meet particle q,
-  ! with its owned (wrapped) index and its offset r from the centre (unwrapped, so no image logic).
-  ! Pass 1 claims ownership, pass 2 lists the unknowns particle q owns.
-  subroutine visit(grid, fd, q, c, centre, radius, pass)
+  ! Every unknown of component c (1..4, 4 = cell centres) whose control volume meets particle q,
+  ! with its owned (wrapped) index and its offset r from the centre (unwrapped, so no image logic):
+  ! alpha computed, ownership claimed, the unknown kept as a candidate.
+  subroutine visit(grid, fd, q, c, centre, radius)
     type(grid_t), intent(in) :: grid
     type(fd_t), intent(inout) :: fd
-    integer, intent(in) :: q, c, pass
+    integer, intent(in) :: q, c
     real(dp), intent(in) :: centre(3), radius
     ! indices per axis: at most 2R/h + 2 (the box below), with one to spare for round-off
     integer :: wrapped(ceiling(2.0_dp * radius / grid%h) + 3, 3)
     logical :: mine(ceiling(2.0_dp * radius / grid%h) + 3, 3)
-    integer :: lo(3), hi(3), i, j, k, d, m
-    real(dp) :: r(3), a, h, gamma, reach2
+    integer :: lo(3), hi(3), i, j, k, d, m, ilo, ihi, iw, jw, kw
+    real(dp) :: r(3), a, h, reach2, inside2, rest2, chord
     h = grid%h
     ! The control volume of unknown i spans (i + stagger +- 1/2) h, so only |(i + stagger) h - x_d|
     ! < R + h/2 can meet the sphere: the box below is that range, no wider (issue 7: the loops are
@@ -179,40 +206,67 @@ contains
     end do
     ! beyond this distance from the centre a control volume lies wholly outside (its half-diagonal)
     reach2 = (radius + 0.5_dp * sqrt(3.0_dp) * h)**2
+    ! within this distance it lies wholly inside (alpha = 1)
+    inside2 = -1.0_dp
+    if (radius > 0.5_dp * sqrt(3.0_dp) * h) inside2 = (radius - 0.5_dp * sqrt(3.0_dp) * h)**2
     do k = lo(3), hi(3)
       if (.not. mine(k - lo(3) + 1, 3)) cycle
+      kw = wrapped(k - lo(3) + 1, 3)
+      r(3) = (k + stagger(3, c)) * h - centre(3)
       do j = lo(2), hi(2)
         if (.not. mine(j - lo(2) + 1, 2)) cycle
-        do i = lo(1), hi(1)
+        jw = wrapped(j - lo(2) + 1, 2)
+        r(2) = (j + stagger(2, c)) * h - centre(2)
+        rest2 = reach2 - r(2)**2 - r(3)**2
+        if (rest2 <= 0.0_dp) cycle
+        ! the row's chord, widened by a cell for round-off; the test below decides
+        chord = sqrt(rest2)
+        ilo = max(lo(1), floor((centre(1) - chord) / h - stagger(1, c)) - 1)
+        ihi = min(hi(1), ceiling((centre(1) + chord) / h - stagger(1, c)) + 1)
+        do i = ilo, ihi
           if (.not. mine(i - lo(1) + 1, 1)) cycle
-          r = ([i, j, k] + stagger(:, c)) * h - centre
-          if (sum(r**2) >= reach2) cycle
-          call claim(wrapped(i - lo(1) + 1, 1), wrapped(j - lo(2) + 1, 2), wrapped(k - lo(3) + 1, 3))
+          r(1) = (i + stagger(1, c)) * h - centre(1)
+          if (r(1)**2 + r(2)**2 + r(3)**2 >= reach2) cycle
+          if (r(1)**2 + r(2)**2 + r(3)**2 <= inside2) then
+            a = 1.0_dp      ! the whole control volume is inside (cube_fraction's first test)
+          else
+            a = cube_fraction(r, radius, h)
+            if (a <= 0.0_dp) cycle
+          end if
+          iw = wrapped(i - lo(1) + 1, 1)
+          if (a > fd%alpha(iw, jw, kw, c)) then
+            fd%alpha_second(iw, jw, kw, c) = fd%alpha(iw, jw, kw, c)
+            fd%alpha(iw, jw, kw, c) = a
+            fd%owner(iw, jw, kw, c) = q
+          else if (a > fd%alpha_second(iw, jw, kw, c)) then
+            fd%alpha_second(iw, jw, kw, c) = a
+          end if
+          call push_candidate(fd, c, iw, jw, kw, q, r)
         end do
       end do
     end do
-  contains
-    ! pass 1: the largest alpha owns the unknown; pass 2: list the unknowns particle q owns
-    subroutine claim(iw, jw, kw)
-      integer, intent(in) :: iw, jw, kw
-      if (pass == 1) then
-        a = cube_fraction(r, radius, h)
-        if (a > fd%alpha(iw, jw, kw, c)) then
-          fd%alpha_second(iw, jw, kw, c) = fd%alpha(iw, jw, kw, c)
-          fd%alpha(iw, jw, kw, c) = a
-          fd%owner(iw, jw, kw, c) = q
-        else if (a > fd%alpha_second(iw, jw, kw, c)) then
-          fd%alpha_second(iw, jw, kw, c) = a
-        end if
-      else if (fd%owner(iw, jw, kw, c) == q) then
-        a = fd%alpha(iw, jw, kw, c) - fd%alpha_second(iw, jw, kw, c)
-        if (a <= 0.0_dp) return
-        gamma = 0.0_dp
-        if (c /= FIELD_P) gamma = relaxation_gamma(a, fd%kappa, fd%beta, h, fd%eta)
-        call push_face(fd, c, [iw, jw, kw], q, r, a, 1.0_dp / (1.0_dp + gamma))
-      end if
-    end subroutine claim
   end subroutine visit
+
+  subroutine push_candidate(fd, c, iw, jw, kw, q, r)
+    type(fd_t), intent(inout) :: fd
+    integer, intent(in) :: c, iw, jw, kw, q
+    real(dp), intent(in) :: r(3)
+    integer :: m
+    integer, allocatable :: ti(:), t3(:, :)
+    real(dp), allocatable :: tr3(:, :)
+    if (fd%ncand == size(fd%cand_comp)) then
+      m = 2 * fd%ncand
+      allocate(ti(m)); ti(1:fd%ncand) = fd%cand_comp(1:fd%ncand); call move_alloc(ti, fd%cand_comp)
+      allocate(ti(m)); ti(1:fd%ncand) = fd%cand_part(1:fd%ncand); call move_alloc(ti, fd%cand_part)
+      allocate(t3(3, m)); t3(:, 1:fd%ncand) = fd%cand_ijk(:, 1:fd%ncand); call move_alloc(t3, fd%cand_ijk)
+      allocate(tr3(3, m)); tr3(:, 1:fd%ncand) = fd%cand_r(:, 1:fd%ncand); call move_alloc(tr3, fd%cand_r)
+    end if
+    fd%ncand = fd%ncand + 1
+    fd%cand_comp(fd%ncand) = c
+    fd%cand_part(fd%ncand) = q
+    fd%cand_ijk(:, fd%ncand) = [iw, jw, kw]
+    fd%cand_r(:, fd%ncand) = r
+  end subroutine push_candidate
 
   subroutine push_face(fd, c, ijk, q, r, a, relax)
     type(fd_t), intent(inout) :: fd
@@ -256,8 +310,9 @@ contains
     PetscErrorCode, intent(out) :: ierr
     Vec :: old(3)
     type(field_pointer) :: lam_old(3), lam(3)
-    real(dp) :: t(3), w(3), value, weight
-    integer :: f, c, q, o(3), a, b, e, idx(3)
+    real(dp) :: t(3), w(3), value, weight(8)
+    integer :: f, c, q, q_weights, o(3), a, b, e, m, idx(3), corner(3, 8)
+    logical :: moved
     character(len=200) :: text
 
     call fd_geometry(grid, fd, parts)
@@ -274,31 +329,43 @@ contains
       PetscCall(DMDAVecGetArrayReadF90(grid%da(c), old(c), lam_old(c)%ptr, ierr))
       PetscCall(DMDAVecGetArrayF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
     end do
+    ! The list is grouped by sphere: its eight corner offsets and weights are set once per sphere.
+    q_weights = 0
+    moved = .false.
     do f = 1, fd%nf
       c = fd%f_comp(f)
       if (c == FIELD_P) cycle
       q = fd%f_part(f)
-      ! x_f - dX in cells from the face itself: offsets o and o + 1 in {-1, 0, 1}, weights w of o + 1
-      t = -displacement(:, q) / grid%h
-      o = floor(t)
-      w = t - o
-      if (all(displacement(:, q) == 0.0_dp)) then
+      if (q /= q_weights) then
+        q_weights = q
+        moved = any(displacement(:, q) /= 0.0_dp)
+        ! x_f - dX in cells from the face itself: offsets o and o + 1 in {-1, 0, 1}, weights w of o + 1
+        t = -displacement(:, q) / grid%h
+        o = floor(t)
+        w = t - o
+        m = 0
+        do e = 0, 1
+          do b = 0, 1
+            do a = 0, 1
+              m = m + 1
+              corner(:, m) = o + [a, b, e]
+              weight(m) = merge(w(1), 1.0_dp - w(1), a == 1) * merge(w(2), 1.0_dp - w(2), b == 1) &
+                        * merge(w(3), 1.0_dp - w(3), e == 1)
+            end do
+          end do
+        end do
+      end if
+      if (.not. moved) then
         lam(c)%ptr(fd%f_ijk(1, f), fd%f_ijk(2, f), fd%f_ijk(3, f)) = &
              lam_old(c)%ptr(fd%f_ijk(1, f), fd%f_ijk(2, f), fd%f_ijk(3, f))
         cycle
       end if
       value = 0.0_dp
-      do e = 0, 1
-        do b = 0, 1
-          do a = 0, 1
-            idx = fd%f_ijk(:, f) + o + [a, b, e]
-            ! beyond a wall there is no fluid and no Lambda (the periodic ghost would wrap)
-            if (grid%walls .and. (idx(2) < 0 .or. idx(2) >= grid%n(2))) cycle
-            weight = merge(w(1), 1.0_dp - w(1), a == 1) * merge(w(2), 1.0_dp - w(2), b == 1) &
-                   * merge(w(3), 1.0_dp - w(3), e == 1)
-            value = value + weight * lam_old(c)%ptr(idx(1), idx(2), idx(3))
-          end do
-        end do
+      do m = 1, 8
+        idx = fd%f_ijk(:, f) + corner(:, m)
+        ! beyond a wall there is no fluid and no Lambda (the periodic ghost would wrap)
+        if (grid%walls .and. (idx(2) < 0 .or. idx(2) >= grid%n(2))) cycle
+        value = value + weight(m) * lam_old(c)%ptr(idx(1), idx(2), idx(3))
       end do
       lam(c)%ptr(fd%f_ijk(1, f), fd%f_ijk(2, f), fd%f_ijk(3, f)) = value
     end do
@@ -326,6 +393,26 @@ contains
       g(4) = r(2); g(5) = -r(1)
     end select
   end function rigid_row
+
+  ! The non-zeros of g = (e_c, r x e_c): index and value, three for a velocity component (e_c and
+  ! the two entries of r x e_c), none for the cell centres (c = 4).
+  pure subroutine rigid_row_nonzeros(c, r, idx, val, nnz)
+    integer, intent(in) :: c
+    real(dp), intent(in) :: r(3)
+    integer, intent(out) :: idx(3), nnz
+    real(dp), intent(out) :: val(3)
+    nnz = 3
+    select case (c)
+    case (1)
+      idx = [1, 5, 6]; val = [1.0_dp, r(3), -r(2)]
+    case (2)
+      idx = [2, 4, 6]; val = [1.0_dp, -r(3), r(1)]
+    case (3)
+      idx = [3, 4, 5]; val = [1.0_dp, r(2), -r(1)]
+    case default
+      nnz = 0; idx = 1; val = 0.0_dp
+    end select
+  end subroutine rigid_row_nonzeros
 
   ! The particle sub-problem after the fluid step, in three named parts that main.F90 calls in
   ! turn (method.md §1.5 eq. (1), §1.5b):
@@ -377,13 +464,18 @@ contains
   ! extra_force, extra_torque (3, n), optional: further forces on the particles (contacts), added
   ! to the right-hand side next to external_force/external_torque (free motion only).
   ! lubrication, optional: the links of this configuration (mod_particle_lubrication); their
-  ! resistance enters the 6N system implicitly. Identical on every rank (replicated data).
-  subroutine fd_solve_motion(fd, parts, ierr, extra_force, extra_torque, lubrication)
+  ! resistance enters the 6N system implicitly. contacts, optional: the contacts of this step
+  ! (pcontacts_step at X^n): their forces and torques join the right-hand side (free and frozen
+  ! motion) and, for free motion with implicit contacts, their linearised stiffness the 6N system;
+  ! after the solve their force, torque and stresslet are those the balance used
+  ! (mod_particle_contacts). Identical on every rank (replicated data).
+  subroutine fd_solve_motion(fd, parts, ierr, extra_force, extra_torque, lubrication, contacts)
     type(fd_t), intent(inout) :: fd
     type(particles_t), intent(inout) :: parts
     PetscErrorCode, intent(out) :: ierr
     real(dp), intent(in), optional :: extra_force(:, :), extra_torque(:, :)
     type(particle_lubrication_t), intent(in), optional :: lubrication
+    type(particle_contacts_t), intent(inout), optional :: contacts
     real(dp), allocatable :: rhs(:, :), x(:, :)
     integer :: q, n
     logical :: ok
@@ -402,8 +494,11 @@ contains
              + [parts%external_force(:, q), parts%external_torque(:, q)]
         if (present(extra_force)) rhs(1:3, q) = rhs(1:3, q) + extra_force(:, q)
         if (present(extra_torque)) rhs(4:6, q) = rhs(4:6, q) + extra_torque(:, q)
+        if (present(contacts)) rhs(:, q) = rhs(:, q) + [contacts%force(:, q), contacts%torque(:, q)]
       end do
       if (present(lubrication)) call add_lubrication(fd, lubrication, rhs)
+      if (present(contacts) .and. parts%motion == MOTION_FREE) &
+        call pcontacts_add_stiffness(contacts, fd%system, rhs, parts%velocity, parts%omega, parts%have_prev)
       if (fd%system%npairs == 0) then
         ! block diagonal: a direct solve, block by block
         call psys_solve(fd%system, rhs, x, 1.0e-12_dp, fd%solver_iterations, ok)
@@ -422,6 +517,7 @@ contains
       end if
       parts%velocity = x(1:3, :)
       parts%omega = x(4:6, :)
+      if (present(contacts)) call pcontacts_implicit_update(contacts, parts%velocity, parts%omega)
     case (MOTION_PRESCRIBED, MOTION_RESISTANCE)
       parts%velocity = parts%prescribed_velocity
       parts%omega = parts%prescribed_omega

@@ -18,24 +18,29 @@ module mod_solid_fraction
 contains
 
   ! Fraction of the cube of side h centred at offset r from the sphere centre inside radius R.
+  ! Each sub-sample counts min(1, max(0, (radius - dist)/s + 1/2)): 1 inside radius - s/2, 0
+  ! beyond radius + s/2. The samples lie on n_sub^2 rows along x; a row wholly inside or wholly
+  ! outside that band is counted at once, and only the rows that cross it evaluate their samples,
+  ! without branches (issue 31: this routine was the largest single cost of the particle step,
+  ! mostly mispredicted branches per sample).
   pure real(dp) function cube_fraction(r, radius, h) result(alpha)
     real(dp), intent(in) :: r(3), radius, h
-    real(dp) :: d, half_diag, s, dist2, inner2, outer2, x2(n_sub), y2(n_sub), z2(n_sub)
+    real(dp) :: half_diag, s, inv_s, d2, inner2, outer2, yz, x2min, x2max, x2(n_sub), y2(n_sub), z2(n_sub)
     integer :: a, b, c
-    d = norm2(r)
+    d2 = r(1)**2 + r(2)**2 + r(3)**2
     half_diag = 0.5_dp * sqrt(3.0_dp) * h
-    if (d <= radius - half_diag) then
-      alpha = 1.0_dp
-      return
+    if (radius > half_diag) then
+      if (d2 <= (radius - half_diag)**2) then
+        alpha = 1.0_dp
+        return
+      end if
     end if
-    if (d >= radius + half_diag) then
+    if (d2 >= (radius + half_diag)**2) then
       alpha = 0.0_dp
       return
     end if
     s = h / n_sub
-    ! Each sub-sample counts min(1, max(0, (radius - dist)/s + 1/2)): 1 inside radius - s/2, 0
-    ! beyond radius + s/2, so only the samples in that band need the square root (this routine
-    ! is most of the geometry's cost: doc/BENCHMARKS.md §7).
+    inv_s = 1.0_dp / s
     inner2 = max(0.0_dp, radius - 0.5_dp * s)**2
     outer2 = (radius + 0.5_dp * s)**2
     do a = 1, n_sub
@@ -43,16 +48,19 @@ contains
       y2(a) = (r(2) + (a - 0.5_dp * (n_sub + 1)) * s)**2
       z2(a) = (r(3) + (a - 0.5_dp * (n_sub + 1)) * s)**2
     end do
+    x2min = minval(x2)
+    x2max = maxval(x2)
     alpha = 0.0_dp
     do c = 1, n_sub
       do b = 1, n_sub
+        yz = y2(b) + z2(c)
+        if (yz + x2min >= outer2) cycle
+        if (yz + x2max <= inner2) then
+          alpha = alpha + n_sub
+          cycle
+        end if
         do a = 1, n_sub
-          dist2 = x2(a) + y2(b) + z2(c)
-          if (dist2 <= inner2) then
-            alpha = alpha + 1.0_dp
-          else if (dist2 < outer2) then
-            alpha = alpha + min(1.0_dp, max(0.0_dp, (radius - sqrt(dist2)) / s + 0.5_dp))
-          end if
+          alpha = alpha + min(1.0_dp, max(0.0_dp, (radius - sqrt(x2(a) + yz)) * inv_s + 0.5_dp))
         end do
       end do
     end do
