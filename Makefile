@@ -32,6 +32,10 @@ include $(PETSC_DIR)/lib/petsc/conf/variables
 
 # HDF5's Fortran API (series files); PETSc's link line already holds the C library and its path.
 HDF5_FC_LIB ?= -lhdf5_fortran
+# FFTW's Fortran 2003 interface (fftw3-mpi.f03, Debian's libfftw3-dev / libfftw3-mpi-dev): the direct
+# fluid solves (src/fft_solver.F90); PETSc's link line already holds -lfftw3_mpi -lfftw3.
+FFTW_FC_INCLUDE ?= -I/usr/include
+FDSUSP_FFTW_LIB := -lfftw3_mpi -lfftw3
 
 MODE ?= opt
 ifeq ($(MODE),debug)
@@ -51,9 +55,9 @@ WARN := -Wall -Wextra -Wno-unused-dummy-argument -Wno-compare-reals \
 TABLE_DIR := $(CURDIR)/input/lubrication
 FCFLAGS_ALL := $(FC_FLAGS) $(OPTFLAGS) $(WARN) -fimplicit-none -std=f2018 -fall-intrinsics \
                -ffree-line-length-none -DFDSUSP_TABLE_DIR='"$(TABLE_DIR)"' \
-               -J $(BUILD) -I $(BUILD) $(PETSC_FC_INCLUDES)
+               -J $(BUILD) -I $(BUILD) $(PETSC_FC_INCLUDES) $(FFTW_FC_INCLUDE)
 CFLAGS_ALL := $(CC_FLAGS) $(COPTFLAGS) -Wall -Wextra $(PETSC_CC_INCLUDES)
-LIBS := $(HDF5_FC_LIB) $(PETSC_LIB)
+LIBS := $(HDF5_FC_LIB) $(FDSUSP_FFTW_LIB) $(PETSC_LIB)
 
 # Program sources: everything else in src/ is a module linked into every program.
 PROGRAM_SRC := src/main.F90 src/pack_main.F90 src/resistance_main.F90

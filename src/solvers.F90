@@ -9,13 +9,15 @@
 module mod_solvers
   use petscksp
   use petscdmda
+  use, intrinsic :: iso_c_binding, only: C_INT
   use mod_kinds, only: dp
   use mod_grid, only: grid_t, FIELD_U, FIELD_V, FIELD_W, FIELD_P, field_names
   use mod_errors, only: fatal_error, log_line
+  use mod_fft_solver, only: fft_solver_t, fft_create, fft_solve, fft_destroy
   implicit none
   private
   public :: solver_t, solvers_configure, solver_create, solver_solve, solver_destroy
-  public :: set_default_option, solver_cold_solve
+  public :: set_default_option, solver_cold_solve, direct_solves_wanted
 
   type :: solver_t
     KSP :: ksp
@@ -24,6 +26,8 @@ module mod_solvers
     logical :: singular = .false.   ! pressure: constant null space
     real(dp) :: cell_volume = 1.0_dp   ! rows are scaled by the cell volume (see compute_operator)
     MatNullSpace :: nullspace
+    logical :: direct = .false.     ! solved by fast transforms (mod_fft_solver), no KSP
+    type(fft_solver_t) :: fft
   end type solver_t
 
   ! Operator coefficients, shared with the callback (set once by solvers_configure).
@@ -60,18 +64,34 @@ contains
   ! rtol: relative tolerance from the deck. atol: the residual norm at which the solve stops
   ! whatever |b| is; the caller sets it at round-off level of a physically sized right-hand side,
   ! so a right-hand side that is itself round-off (a steady state) costs no iterations.
-  subroutine solver_create(grid, field, rtol, atol, s, ierr)
+  ! krylov, optional (its value is not read): a Krylov solver whatever -fluid_solver says (the
+  ! multigrid yardstick of -bench_cold_poisson).
+  subroutine solver_create(grid, field, rtol, atol, s, ierr, krylov)
     type(grid_t), intent(in) :: grid
     integer, intent(in) :: field
     real(dp), intent(in) :: rtol, atol
     type(solver_t), intent(inout) :: s
     PetscErrorCode, intent(out) :: ierr
+    logical, intent(in), optional :: krylov
     character(len=3) :: prefix
     character(len=32) :: text
 
     s%field = field
     s%singular = (field == FIELD_P)
     s%cell_volume = grid%h**3
+    s%direct = .false.
+    if (.not. present(krylov)) then
+      s%direct = direct_solves_wanted()
+    end if
+    if (s%direct) then
+      ! the operators have constant coefficients on a uniform grid: solved exactly by transforms
+      if (s%singular) then
+        PetscCall(fft_create(grid, field, 0.0_dp, 1.0_dp, fft_planner_flags(), s%fft, ierr))
+      else
+        PetscCall(fft_create(grid, field, mass_coefficient, diffusion_coefficient, fft_planner_flags(), s%fft, ierr))
+      end if
+      return
+    end if
     prefix = '-'//field_names(field)//'_'
     PetscCall(set_default_option(prefix//'ksp_type', 'cg', ierr))
     PetscCall(set_default_option(prefix//'ksp_norm_type', 'unpreconditioned', ierr))
@@ -232,6 +252,46 @@ contains
     PetscCall(MatAssemblyEnd(P, MAT_FINAL_ASSEMBLY, ierr))
   end subroutine cell_centred_prolongation
 
+  ! -fluid_solver fft (default): the four solves of a fluid step by fast transforms, exact to
+  ! round-off (mod_fft_solver); -fluid_solver krylov: CG with multigrid or Jacobi, to the deck's
+  ! tolerances, with every -u_/-v_/-w_/-p_ KSP option (doc/INPUT.md).
+  logical function direct_solves_wanted()
+    character(len=16) :: choice
+    PetscBool :: found
+    PetscErrorCode :: ierr
+    choice = 'fft'
+    PetscCallA(PetscOptionsGetString(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-fluid_solver', choice, found, ierr))
+    select case (trim(choice))
+    case ('fft')
+      direct_solves_wanted = .true.
+    case ('krylov')
+      direct_solves_wanted = .false.
+    case default
+      call fatal_error('fdsusp: error: -fluid_solver '//trim(choice)//' is not known (fft or krylov)', 2)
+      direct_solves_wanted = .false.
+    end select
+  end function direct_solves_wanted
+
+  ! -fluid_fft_plan measure (default: FFTW times candidate algorithms once at start-up) or
+  ! estimate (no timing: a faster start, possibly slower transforms).
+  integer(C_INT) function fft_planner_flags()
+    character(len=16) :: choice
+    PetscBool :: found
+    PetscErrorCode :: ierr
+    integer(C_INT), parameter :: FFTW_MEASURE = 0, FFTW_ESTIMATE = 64   ! fftw3.f03
+    choice = 'measure'
+    PetscCallA(PetscOptionsGetString(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-fluid_fft_plan', choice, found, ierr))
+    select case (trim(choice))
+    case ('measure')
+      fft_planner_flags = FFTW_MEASURE
+    case ('estimate')
+      fft_planner_flags = FFTW_ESTIMATE
+    case default
+      call fatal_error('fdsusp: error: -fluid_fft_plan '//trim(choice)//' is not known (measure or estimate)', 2)
+      fft_planner_flags = FFTW_MEASURE
+    end select
+  end function fft_planner_flags
+
   ! The Helmholtz operator m I - d lap with Jacobi has condition number at most 1 + r,
   ! r = 12 d / (m h^2) (Gershgorin: the 7-point Laplacian's eigenvalues lie in [0, 12/h^2]), so CG
   ! needs ~sqrt(r) iterations of one product each, against ~8 V-cycles of ~10 products for
@@ -266,6 +326,11 @@ contains
     DM :: dm
     character(len=200) :: text
 
+    if (s%direct) then
+      PetscCall(fft_solve(s%fft, b, x, ierr))
+      s%iterations = 0
+      return
+    end if
     PetscCall(VecScale(b, s%cell_volume, ierr))
     if (s%singular) then
       PetscCall(MatNullSpaceRemove(s%nullspace, b, ierr))
@@ -354,6 +419,10 @@ contains
   subroutine solver_destroy(s, ierr)
     type(solver_t), intent(inout) :: s
     PetscErrorCode, intent(out) :: ierr
+    if (s%direct) then
+      PetscCall(fft_destroy(s%fft, ierr))
+      return
+    end if
     PetscCall(KSPDestroy(s%ksp, ierr))
     if (s%singular) then
       PetscCall(MatNullSpaceDestroy(s%nullspace, ierr))

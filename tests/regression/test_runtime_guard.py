@@ -12,7 +12,7 @@ message naming the particle and the wall, and failed_state.h5.
 Third guard: a linear solver that does not converge stops the run (status 3) with one message
 naming the solver, its KSP reason and iterations, and the last good checkpoint survives: the
 run of the first guard is restarted from its step-14 checkpoint with the pressure solver capped
-at one iteration (-p_ksp_max_it 1, a stand-in for a diverging or stagnating solve).
+at one iteration (-fluid_solver krylov -p_ksp_max_it 1, a stand-in for a diverging or stagnating solve).
 Fourth guard: a contact overlap beyond h_r (see the last case)."""
 import os
 import sys
@@ -45,7 +45,7 @@ status, out, err = T.run(deck, d, np_ranks=2, args=['-restart', ck], expect_ok=F
 T.check(status == 0 and 'finished at step 14' in out, 'restart from the kept checkpoint runs to step 14 (status %d)' % status)
 os.replace(ck, os.path.join(d, 'good.h5'))
 deck = T.write_deck(d, 'g.nml', DECK.format(steps=30))
-status, out, err = T.run(deck, d, np_ranks=2, args=['-restart', 'good.h5', '-p_ksp_max_it', '1'], expect_ok=False)
+status, out, err = T.run(deck, d, np_ranks=2, args=['-restart', 'good.h5', '-fluid_solver', 'krylov', '-p_ksp_max_it', '1'], expect_ok=False)
 messages = [l for l in err.splitlines() if l.startswith('fdsusp:')]
 T.check(status == 3 and len(messages) == 1 and 'p solver diverged' in messages[0] and 'KSPConvergedReason -3' in messages[0],
         'a pressure solve that does not converge stops the run: status %d, %s' % (status, messages[:1]))
