@@ -40,6 +40,7 @@ module mod_fictitious_domain
   use mod_particle_contacts, only: particle_contacts_t, pcontacts_add_stiffness, pcontacts_implicit_update
   use mod_particle_solver, only: particle_solver_t, psolver_create, psolver_solve, psolver_destroy
   use mod_solid_fraction, only: cube_fraction, relaxation_gamma
+  use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates, min_image
   use mod_errors, only: fatal_error
   implicit none
   private
@@ -60,7 +61,15 @@ module mod_fictitious_domain
     integer, allocatable :: f_comp(:), f_ijk(:, :), f_part(:)
     real(dp), allocatable :: f_r(:, :), f_alpha(:), f_relax(:)   ! r, alpha, 1/(1+gamma)
     real(dp), allocatable :: rigid_matrix(:, :, :)               ! M_p (6, 6, n), summed over ranks
-    ! every unknown a sphere covers (alpha > 0), owned or not, in the order they were visited
+    ! the spheres whose control-volume reach meets another's (centres closer than 2 x reach):
+    ! only there can a face be contested; elsewhere a sphere owns what it covers outright
+    type(nlist_t) :: reach_list
+    logical :: use_reach_list = .false.          ! false: every face is treated as contested
+    integer :: nreach_pairs = 0, nreach_walls = 0
+    integer, allocatable :: reach_pairs(:, :), reach_walls(:, :)
+    integer, allocatable :: rival_start(:)       ! (n + 1): rivals of sphere q in rival_offset(:, rival_start(q):rival_start(q+1)-1)
+    real(dp), allocatable :: rival_offset(:, :)  ! (3, :): centre of the rival minus the centre of q (minimum image)
+    ! every contested unknown a sphere covers (alpha > 0), owned or not, in the order they were visited
     integer :: ncand = 0
     integer, allocatable :: cand_comp(:), cand_part(:), cand_ijk(:, :)
     real(dp), allocatable :: cand_r(:, :)
@@ -111,11 +120,13 @@ contains
 
   ! The geometry at the current positions: face ownership, alpha, the face list and M_p.
   ! Collective (M_p is summed over ranks).
-  ! Pass 1 visits, sphere by sphere, the unknowns each sphere's control volumes can meet, computes
-  ! alpha once and keeps every one it covers (the candidates), claiming ownership as it goes (the
-  ! largest alpha wins; ties to the lower index); pass 2 walks the candidates, in the same order,
-  ! and lists those their sphere owns. Only the entries the candidates touched are reset the
-  ! next time, not the whole grid (issue 31: the geometry was half of the paper scene's step).
+  ! Pass 1 visits, sphere by sphere, the unknowns each sphere's control volumes can meet and
+  ! computes alpha once. An unknown no other sphere can reach (its distance to every rival centre
+  ! is at least the reach R + sqrt(3) h/2) belongs to this sphere outright and is listed at once;
+  ! the others (the candidates, a few per cent in a dense suspension) claim ownership on the grid
+  ! (the largest alpha wins; ties to the lower index), and pass 2 walks them, in the same order,
+  ! and lists those their sphere owns. Only the entries the candidates touched are reset the next
+  ! time, not the whole grid (issue 31: the geometry was half of the paper scene's step).
   subroutine fd_geometry(grid, fd, parts)
     type(grid_t), intent(in) :: grid
     type(fd_t), intent(inout) :: fd
@@ -124,6 +135,7 @@ contains
     real(dp) :: radius, a, gamma, w, dv, val(3)
 
     radius = parts%radius + fd%radius_offset * grid%h
+    call find_rivals(grid, fd, parts, radius)
     do m = 1, fd%ncand
       iw = fd%cand_ijk(1, m); jw = fd%cand_ijk(2, m); kw = fd%cand_ijk(3, m); c = fd%cand_comp(m)
       fd%owner(iw, jw, kw, c) = 0
@@ -131,12 +143,12 @@ contains
       fd%alpha_second(iw, jw, kw, c) = 0.0_dp
     end do
     fd%ncand = 0
+    fd%nf = 0
     do q = 1, parts%n
       do c = 1, 4
         call visit(grid, fd, q, c, parts%position(:, q), radius)
       end do
     end do
-    fd%nf = 0
     do m = 1, fd%ncand
       iw = fd%cand_ijk(1, m); jw = fd%cand_ijk(2, m); kw = fd%cand_ijk(3, m); c = fd%cand_comp(m)
       q = fd%cand_part(m)
@@ -182,8 +194,12 @@ contains
     ! indices per axis: at most 2R/h + 2 (the box below), with one to spare for round-off
     integer :: wrapped(ceiling(2.0_dp * radius / grid%h) + 3, 3)
     logical :: mine(ceiling(2.0_dp * radius / grid%h) + 3, 3)
-    integer :: lo(3), hi(3), i, j, k, d, m, ilo, ihi, iw, jw, kw
-    real(dp) :: r(3), a, h, reach2, inside2, rest2, chord
+    integer :: lo(3), hi(3), i, j, k, d, m, ilo, ihi, iw, jw, kw, f, nrow
+    real(dp) :: r(3), a, h, reach2, inside2, rest2, chord, gamma_unit, rival2
+    logical :: contested
+    ! the rivals that reach the current row, and what is left of the reach there
+    integer :: row_rival(size(fd%rival_offset, 2))
+    real(dp) :: row_rest2(size(fd%rival_offset, 2))
     h = grid%h
     ! The control volume of unknown i spans (i + stagger +- 1/2) h, so only |(i + stagger) h - x_d|
     ! < R + h/2 can meet the sphere: the box below is that range, no wider (issue 7: the loops are
@@ -209,6 +225,11 @@ contains
     ! within this distance it lies wholly inside (alpha = 1)
     inside2 = -1.0_dp
     if (radius > 0.5_dp * sqrt(3.0_dp) * h) inside2 = (radius - 0.5_dp * sqrt(3.0_dp) * h)**2
+    ! room for every unknown of the box, once, so that the loop below stores without checks
+    call reserve_faces(fd, fd%nf + product(hi - lo + 1))
+    ! gamma = kappa (1 - alpha) beta h^2 / eta (relaxation_gamma, method.md §1.5b), written out
+    gamma_unit = 0.0_dp
+    if (c /= FIELD_P) gamma_unit = fd%kappa * fd%beta * h**2 / fd%eta
     do k = lo(3), hi(3)
       if (.not. mine(k - lo(3) + 1, 3)) cycle
       kw = wrapped(k - lo(3) + 1, 3)
@@ -223,6 +244,18 @@ contains
         chord = sqrt(rest2)
         ilo = max(lo(1), floor((centre(1) - chord) / h - stagger(1, c)) - 1)
         ihi = min(hi(1), ceiling((centre(1) + chord) / h - stagger(1, c)) + 1)
+        ! the rivals whose reach meets this row at all: only they can contest its unknowns
+        nrow = 0
+        if (fd%use_reach_list) then
+          do m = fd%rival_start(q), fd%rival_start(q + 1) - 1
+            rival2 = (r(2) - fd%rival_offset(2, m))**2 + (r(3) - fd%rival_offset(3, m))**2
+            ! (a margin of 1e-12 keeps the test on the safe side of round-off: contested if in doubt)
+            if (rival2 >= reach2 * (1.0_dp + 1.0e-12_dp)) cycle
+            nrow = nrow + 1
+            row_rival(nrow) = m
+            row_rest2(nrow) = reach2 * (1.0_dp + 1.0e-12_dp) - rival2
+          end do
+        end if
         do i = ilo, ihi
           if (.not. mine(i - lo(1) + 1, 1)) cycle
           r(1) = (i + stagger(1, c)) * h - centre(1)
@@ -234,6 +267,25 @@ contains
             if (a <= 0.0_dp) cycle
           end if
           iw = wrapped(i - lo(1) + 1, 1)
+          contested = .not. fd%use_reach_list
+          do m = 1, nrow
+            if ((r(1) - fd%rival_offset(1, row_rival(m)))**2 < row_rest2(m)) then
+              contested = .true.
+              exit
+            end if
+          end do
+          if (.not. contested) then
+            ! no other sphere reaches it: this sphere owns it outright (alpha_second = 0)
+            f = fd%nf + 1
+            fd%nf = f
+            fd%f_comp(f) = c
+            fd%f_ijk(:, f) = [iw, jw, kw]
+            fd%f_part(f) = q
+            fd%f_r(:, f) = r
+            fd%f_alpha(f) = a
+            fd%f_relax(f) = 1.0_dp / (1.0_dp + gamma_unit * (1.0_dp - a))
+            cycle
+          end if
           if (a > fd%alpha(iw, jw, kw, c)) then
             fd%alpha_second(iw, jw, kw, c) = fd%alpha(iw, jw, kw, c)
             fd%alpha(iw, jw, kw, c) = a
@@ -246,6 +298,80 @@ contains
       end do
     end do
   end subroutine visit
+
+  ! Room for n faces in the face list (its arrays grow by doubling, kept between steps).
+  subroutine reserve_faces(fd, n)
+    type(fd_t), intent(inout) :: fd
+    integer, intent(in) :: n
+    integer :: m
+    integer, allocatable :: ti(:), t3(:, :)
+    real(dp), allocatable :: tr(:), tr3(:, :)
+    if (n <= size(fd%f_comp)) return
+    m = max(n, 2 * size(fd%f_comp))
+    allocate(ti(m)); ti(1:fd%nf) = fd%f_comp(1:fd%nf); call move_alloc(ti, fd%f_comp)
+    allocate(ti(m)); ti(1:fd%nf) = fd%f_part(1:fd%nf); call move_alloc(ti, fd%f_part)
+    allocate(t3(3, m)); t3(:, 1:fd%nf) = fd%f_ijk(:, 1:fd%nf); call move_alloc(t3, fd%f_ijk)
+    allocate(tr3(3, m)); tr3(:, 1:fd%nf) = fd%f_r(:, 1:fd%nf); call move_alloc(tr3, fd%f_r)
+    allocate(tr(m)); tr(1:fd%nf) = fd%f_alpha(1:fd%nf); call move_alloc(tr, fd%f_alpha)
+    allocate(tr(m)); tr(1:fd%nf) = fd%f_relax(1:fd%nf); call move_alloc(tr, fd%f_relax)
+  end subroutine reserve_faces
+
+  ! The rivals of each sphere: the spheres whose centres are closer than twice the reach
+  ! R + sqrt(3) h/2, so that some control volume may meet both (mod_neighbours' cell lists, with a
+  ! skin of one cell). Without a neighbour list (a periodic length below twice its cut-off) every
+  ! face is treated as contested, which is always right, only slower.
+  subroutine find_rivals(grid, fd, parts, radius)
+    type(grid_t), intent(in) :: grid
+    type(fd_t), intent(inout) :: fd
+    type(particles_t), intent(in) :: parts
+    real(dp), intent(in) :: radius
+    real(dp) :: reach, d(3)
+    integer :: info, l, i, j, n
+    logical :: periodic(3)
+    integer, allocatable :: count(:)
+
+    n = parts%n
+    reach = radius + 0.5_dp * sqrt(3.0_dp) * grid%h
+    periodic = [.true., .not. grid%walls, .true.]
+    if (.not. allocated(fd%rival_start)) then
+      call nlist_init(fd%reach_list, n, grid%box, periodic, 2.0_dp * reach + grid%h, reach + grid%h, grid%h, info)
+      fd%use_reach_list = (info == 0 .and. n > 1)
+      allocate(fd%rival_start(n + 1), fd%rival_offset(3, 64))
+    end if
+    fd%rival_start = 1
+    if (.not. fd%use_reach_list) return
+    call nlist_candidates(fd%reach_list, parts%position, fd%reach_pairs, fd%nreach_pairs, fd%reach_walls, fd%nreach_walls)
+    ! count, then fill (each close pair is a rival of both its spheres)
+    allocate(count(n))
+    count = 0
+    do l = 1, fd%nreach_pairs
+      i = fd%reach_pairs(1, l)
+      j = fd%reach_pairs(2, l)
+      d = min_image(parts%position(:, j) - parts%position(:, i), grid%box, periodic)
+      if (sum(d**2) >= (2.0_dp * reach)**2) cycle
+      count(i) = count(i) + 1
+      count(j) = count(j) + 1
+    end do
+    fd%rival_start(1) = 1
+    do i = 1, n
+      fd%rival_start(i + 1) = fd%rival_start(i) + count(i)
+    end do
+    if (size(fd%rival_offset, 2) < fd%rival_start(n + 1)) then
+      deallocate(fd%rival_offset)
+      allocate(fd%rival_offset(3, 2 * fd%rival_start(n + 1)))
+    end if
+    count = 0
+    do l = 1, fd%nreach_pairs
+      i = fd%reach_pairs(1, l)
+      j = fd%reach_pairs(2, l)
+      d = min_image(parts%position(:, j) - parts%position(:, i), grid%box, periodic)
+      if (sum(d**2) >= (2.0_dp * reach)**2) cycle
+      fd%rival_offset(:, fd%rival_start(i) + count(i)) = d
+      fd%rival_offset(:, fd%rival_start(j) + count(j)) = -d
+      count(i) = count(i) + 1
+      count(j) = count(j) + 1
+    end do
+  end subroutine find_rivals
 
   subroutine push_candidate(fd, c, iw, jw, kw, q, r)
     type(fd_t), intent(inout) :: fd
@@ -272,18 +398,7 @@ contains
     type(fd_t), intent(inout) :: fd
     integer, intent(in) :: c, ijk(3), q
     real(dp), intent(in) :: r(3), a, relax
-    integer :: m
-    integer, allocatable :: ti(:), t3(:, :)
-    real(dp), allocatable :: tr(:), tr3(:, :)
-    if (fd%nf == size(fd%f_comp)) then
-      m = 2 * fd%nf
-      allocate(ti(m)); ti(1:fd%nf) = fd%f_comp(1:fd%nf); call move_alloc(ti, fd%f_comp)
-      allocate(ti(m)); ti(1:fd%nf) = fd%f_part(1:fd%nf); call move_alloc(ti, fd%f_part)
-      allocate(t3(3, m)); t3(:, 1:fd%nf) = fd%f_ijk(:, 1:fd%nf); call move_alloc(t3, fd%f_ijk)
-      allocate(tr3(3, m)); tr3(:, 1:fd%nf) = fd%f_r(:, 1:fd%nf); call move_alloc(tr3, fd%f_r)
-      allocate(tr(m)); tr(1:fd%nf) = fd%f_alpha(1:fd%nf); call move_alloc(tr, fd%f_alpha)
-      allocate(tr(m)); tr(1:fd%nf) = fd%f_relax(1:fd%nf); call move_alloc(tr, fd%f_relax)
-    end if
+    call reserve_faces(fd, fd%nf + 1)
     fd%nf = fd%nf + 1
     fd%f_comp(fd%nf) = c
     fd%f_ijk(:, fd%nf) = ijk
