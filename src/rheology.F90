@@ -50,6 +50,10 @@ module mod_rheology
     integer :: nbins = 0, nangles = 0       ! profile bins across y, angle bins of g over [0, 2 pi)
     integer :: blocks = 5, discard_step = 0, block_steps = 1
     type(nlist_t) :: nl
+    ! the pair candidates of nl: kept here between samples, because nlist_candidates refreshes them
+    ! only when it rebuilds the list (a list local to rheo_sample was empty between rebuilds)
+    integer :: npairs = 0, nwalls = 0
+    integer, allocatable :: pairs(:, :), walls(:, :)
     ! the last sample
     real(dp) :: values(NQ) = 0              ! stress_hydro(5), stress_contact(5), phi_core, fit(5), flow fit(5)
     real(dp) :: shear_rate_core = 0         ! this record's particle-phase slope (for the series only)
@@ -125,9 +129,7 @@ contains
     real(dp), intent(in) :: position(:, :), velocity(:, :), stresslet_hydro(:, :, :)
     real(dp), intent(in), optional :: stresslet_contact(:, :, :)
     real(dp) :: a, vp, v_core, w, y, u, dbin, d(3), dist, theta, sin_half, gap
-    integer :: n, i, b, b1, b2, k, p, np
-    integer, allocatable :: pairs(:, :), walls(:, :)
-    integer :: nw
+    integer :: n, i, b, b1, b2, k, p, i1, i2
     logical :: ref_i, ref_j
 
     n = size(position, 2)
@@ -166,16 +168,18 @@ contains
     ! pairs in the shear plane: polar angle from the vorticity axis within pi/2 -+ half an angle bin
     sin_half = sin(pi / r%nangles)
     r%min_pair_gap = max(r%r_outer, r%r_contact) - 2 * a
-    call nlist_candidates(r%nl, position, pairs, np, walls, nw)
-    do p = 1, np
-      d = min_image(position(:, pairs(2, p)) - position(:, pairs(1, p)), r%box, [.true., .false., .true.])
+    call nlist_candidates(r%nl, position, r%pairs, r%npairs, r%walls, r%nwalls)
+    do p = 1, r%npairs
+      i1 = r%pairs(1, p)
+      i2 = r%pairs(2, p)
+      d = min_image(position(:, i2) - position(:, i1), r%box, [.true., .false., .true.])
       dist = norm2(d)
       gap = dist - 2 * a
       r%min_pair_gap = min(r%min_pair_gap, gap)
       if (dist >= r%r_outer .and. dist >= r%r_contact) cycle
       if (abs(d(3)) >= dist * sin_half) cycle
-      ref_i = position(2, pairs(1, p)) >= r%core(1) .and. position(2, pairs(1, p)) < r%core(2)
-      ref_j = position(2, pairs(2, p)) >= r%core(1) .and. position(2, pairs(2, p)) < r%core(2)
+      ref_i = position(2, i1) >= r%core(1) .and. position(2, i1) < r%core(2)
+      ref_j = position(2, i2) >= r%core(1) .and. position(2, i2) < r%core(2)
       ! seen from i the partner is at d; seen from j at -d (theta + pi)
       theta = modulo(atan2(d(2), d(1)), 2 * pi)
       if (ref_i) call count_pair(theta)

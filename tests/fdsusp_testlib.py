@@ -96,6 +96,55 @@ def series(outdir):
     return out
 
 
+def h5_contents(path):
+    """Every dataset and attribute of an HDF5 file by name: datasets by their path ('u',
+    'particles/position'), attributes as 'OWNER@name' ('@step' on the root, 'contacts@count')."""
+    out = {}
+    with h5py.File(path, 'r') as f:
+        for k, v in f.attrs.items():
+            out['@' + k] = np.array(v)
+
+        def visit(name, obj):
+            if isinstance(obj, h5py.Dataset):
+                out[name] = np.array(obj)
+            for k, v in obj.attrs.items():
+                out[name + '@' + k] = np.array(v)
+        f.visititems(visit)
+    return out
+
+
+def compare_h5(path_a, path_b, what, skip=(), rtol=1e-12):
+    """Check that two HDF5 files hold the same datasets and attributes (names in skip excepted)
+    with the same values: numbers to rtol of the entry's largest magnitude (at least 1), anything
+    else exactly; one check per entry. Returns the names compared."""
+    a, b = h5_contents(path_a), h5_contents(path_b)
+    names_a = sorted(n for n in a if n not in skip)
+    names_b = sorted(n for n in b if n not in skip)
+    check(names_a == names_b, '%s: the same %d datasets and attributes (only in the first: %s; only in the '
+          'second: %s)' % (what, len(names_a), sorted(set(names_a) - set(names_b)) or 'none',
+                           sorted(set(names_b) - set(names_a)) or 'none'))
+    for n in names_a:
+        if n not in b:
+            continue
+        x, y = a[n], b[n]
+        if x.shape != y.shape:
+            check(False, '%s: %s has shape %s and %s' % (what, n, x.shape, y.shape))
+        elif x.dtype.kind in 'fiub' and y.dtype.kind in 'fiub':
+            x, y = x.astype(float), y.astype(float)
+            same_nan = np.array_equal(np.isnan(x), np.isnan(y))
+            diff = float(np.nanmax(np.abs(x - y), initial=0.0))
+            scale = max(1.0, float(np.nanmax(np.abs(x), initial=0.0)))
+            where = ''
+            if diff > 0:
+                k = np.unravel_index(np.nanargmax(np.abs(x - y)), x.shape)
+                where = ' at %s: %r vs %r' % (k, x[k], y[k])
+            check(same_nan and diff <= rtol * scale, '%s: %s max difference %.1e <= %.0e x %.3g%s'
+                  % (what, n, diff, rtol, scale, where))
+        else:
+            check(np.array_equal(x, y), '%s: %s identical' % (what, n))
+    return names_a
+
+
 def check(condition, message):
     """Record one assertion; print it either way."""
     print(('ok    ' if condition else 'FAIL  ') + message)

@@ -4,7 +4,8 @@ particles, the tangential springs of the open contacts (/contacts), and the cont
 in a canonical order whatever neighbour list is in use (the restarted run builds a fresh one), so
 the continued run repeats the same arithmetic; asserted to 1e-12 (fields, positions, velocities:
 O(1) values, absolute; contact forces, torques and stresslets: relative to the largest contact
-force, O(20)). Bitwise in practice.
+force, O(20)); and every other dataset and attribute of the final checkpoints and of series.h5 (but
+wall_time) to 1e-12 of its largest magnitude (at least 1). Bitwise in practice.
 Set-up: three free spheres with friction 0.5 in a sheared Couette cell (Re = 0.01, dt = 1e-3,
 k_n = 1e5 prescribed, h_r = 0.01 a): spheres 1 and 2 stacked along y and pressed together by
 opposite external forces (the shear slides them past each other: a tangential spring), sphere 3
@@ -76,6 +77,10 @@ scale = np.abs(sa['particles/force_contact']).max()
 for k in CONTACT:
     diff = np.abs(sa[k] - sb[k]).max() / scale
     T.check(diff <= 1e-12, 'series %s identical (max diff %.1e of max|F_c| = %.1f)' % (k, diff, scale))
+T.compare_h5(os.path.join(a, 'out', 'checkpoint.h5'), os.path.join(b, 'out', 'checkpoint.h5'),
+             '20 steps vs 10 + restart + 10, checkpoint')
+T.compare_h5(os.path.join(a, 'out', 'series.h5'), os.path.join(b, 'out', 'series.h5'),
+             '20 steps vs 10 + restart + 10, series', skip=('wall_time',))
 ia, ua = springs(a)
 ib, ub = springs(b)
 T.check(np.array_equal(ia, ib) and np.abs(ua - ub).max() <= 1e-12,

@@ -12,7 +12,8 @@
 !     contact pressure;
 !  5. pair angles: a pair along +x, one along +y (in the core), one out of the shear plane: the
 !     counts fall in the bins of theta = 0 and pi (pair 1), pi/2 and 3 pi/2 (pair 2), none for
-!     pair 3; only core centres are references;
+!     pair 3; only core centres are references; samples between neighbour-list rebuilds count the
+!     same pairs (the counts do not depend on when the list was built, so a restart repeats them);
 !  6. blocks: records after discard_step go to blocks of block_steps, none outside the window;
 !     the accumulators survive rheo_state/rheo_restore bit for bit.
 program test_rheology
@@ -116,6 +117,16 @@ program test_rheology
   x(:, 4) = [4.5_dp, 7.0_dp, 5.05_dp]          ! partner of 3 along z: out of the shear plane
   call rheo_sample(r, x, u, sh, sc)
   call check(sum(r%angles(:, 1)) == 2, 'pair along the vorticity axis is not in the shear plane')
+  ! the next samples reuse the neighbour list (nothing moved beyond skin/2): the same pairs count
+  ! (they were counted only on the records that rebuilt it, which a restart shifts)
+  call rheo_sample(r, x, u, sh, sc)
+  call check(sum(r%angles(:, 1)) == 2 .and. r%angles(1, 1) == 1 .and. r%angles(5, 1) == 1, &
+             'a sample that reuses the neighbour list counts the same pairs')
+  x(1, 2) = 3.07_dp                            ! 0.02 a further: still listed, still in the shell
+  call rheo_sample(r, x, u, sh, sc)
+  call check(sum(r%angles(:, 1)) == 2 .and. r%angles(1, 1) == 1 .and. abs(r%min_pair_gap - 0.05_dp) < 1e-12_dp, &
+             'a pair that moved less than skin/2 is still counted (smallest gap: the z pair''s 0.05)')
+  x(1, 2) = 3.05_dp
 
   ! 6. blocks and the checkpoint round trip
   call check(rheo_block_of(r, 10) == -1 .and. rheo_block_of(r, 11) == 0 .and. rheo_block_of(r, 15) == 0 .and. &
