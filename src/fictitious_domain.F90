@@ -602,6 +602,10 @@ contains
     select case (parts%motion)
     case (MOTION_FREE, MOTION_FROZEN)
       allocate(rhs(6, n), x(6, n))
+      ! the last velocities start the iterative solve (they are in the checkpoint: a restart
+      ! repeats the same iterations)
+      x(1:3, :) = parts%velocity
+      x(4:6, :) = parts%omega
       call psys_reset(fd%system, n)
       do q = 1, n
         call psys_add_diagonal(fd%system, q, fd%beta * fd%rigid_matrix(:, :, q))
