@@ -1,6 +1,7 @@
 """Helpers shared by the tests/physics/test_pairtraj_*.py tests (Python standard library only).
 
-run_deck() runs bin/pairtraj ($FDSUSP_BIN, default /work/main/bin) on a copy of a project deck
+run_deck() runs bin/pairtraj ($FDSUSP_BIN, default the bin/ of the checkout holding this file) on
+a copy of a project deck
 with some variables overridden and the CSV redirected to a temporary directory, and returns the
 summary printed on stdout and the CSV rows.
 """
@@ -12,8 +13,9 @@ import subprocess
 import sys
 import tempfile
 
-ROOT = os.environ.get("FDSUSP_ROOT", os.getcwd())
-BIN = os.environ.get("FDSUSP_BIN", "/work/main/bin")
+# the checkout: $FDSUSP_ROOT (tests/run_tests.sh exports it), else the one holding this file
+ROOT = os.environ.get("FDSUSP_ROOT", os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..")))
+BIN = os.environ.get("FDSUSP_BIN", os.path.join(ROOT, "bin"))
 PAIRTRAJ = os.path.join(BIN, "pairtraj")
 TMP = tempfile.mkdtemp(prefix="pairtraj_test_")
 

@@ -7,7 +7,9 @@
 # missing file. Exact text matching
 # (no tolerance involved).
 set -u
-bin=${FDSUSP_BIN:-/work/main/bin}/pairtraj
+# the checkout holding this script (tests/run_tests.sh exports FDSUSP_ROOT and FDSUSP_BIN)
+root=${FDSUSP_ROOT:-$(cd "$(dirname "$0")/../.." && pwd)}
+bin=${FDSUSP_BIN:-$root/bin}/pairtraj
 tmp=$(mktemp -d)
 fail=0
 
