@@ -74,6 +74,7 @@ module mod_fictitious_domain
     integer, allocatable :: cand_comp(:), cand_part(:), cand_ijk(:, :)
     real(dp), allocatable :: cand_r(:, :)
     real(dp), allocatable :: lambda_new(:)   ! Lambda^{n+1} per listed face (kept: no allocation per step)
+    logical :: lambda_listed = .false.       ! Lambda^n is zero off the listed faces (fd_follow put it there)
     real(dp), allocatable :: moments(:, :)   ! (12, n): b(u~) and m(Lambda^n) of the step (fd_moments)
     type(particle_system_t) :: system
     type(particle_solver_t) :: solver     ! the 6N system once pairs couple it
@@ -135,6 +136,7 @@ contains
     real(dp) :: radius, a, gamma, w, dv, val(3)
 
     radius = parts%radius + fd%radius_offset * grid%h
+    fd%lambda_listed = .false.      ! Lambda^n may sit on faces of another geometry (fd_follow carries it)
     call find_rivals(grid, fd, parts, radius)
     do m = 1, fd%ncand
       iw = fd%cand_ijk(1, m); jw = fd%cand_ijk(2, m); kw = fd%cand_ijk(3, m); c = fd%cand_comp(m)
@@ -425,9 +427,8 @@ contains
     PetscErrorCode, intent(out) :: ierr
     Vec :: old(3)
     type(field_pointer) :: lam_old(3), lam(3)
-    real(dp) :: t(3), w(3), value, weight(8)
-    integer :: f, c, q, q_weights, o(3), a, b, e, m, idx(3), corner(3, 8)
-    logical :: moved
+    real(dp) :: t(3), w(3), weight(8)
+    integer :: f0, f1, c, q, o(3), a, b, e, m, corner(3, 8)
     character(len=200) :: text
 
     call fd_geometry(grid, fd, parts)
@@ -444,16 +445,14 @@ contains
       PetscCall(DMDAVecGetArrayReadF90(grid%da(c), old(c), lam_old(c)%ptr, ierr))
       PetscCall(DMDAVecGetArrayF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
     end do
-    ! The list is grouped by sphere: its eight corner offsets and weights are set once per sphere.
-    q_weights = 0
-    moved = .false.
-    do f = 1, fd%nf
-      c = fd%f_comp(f)
-      if (c == FIELD_P) cycle
-      q = fd%f_part(f)
-      if (q /= q_weights) then
-        q_weights = q
-        moved = any(displacement(:, q) /= 0.0_dp)
+    ! The list comes in runs of one sphere and one component: the eight corner offsets and
+    ! weights are set once per run, and each run is carried by a kernel on plain arrays.
+    f0 = 1
+    do while (f0 <= fd%nf)
+      f1 = run_end(fd, f0)
+      c = fd%f_comp(f0)
+      q = fd%f_part(f0)
+      if (c /= FIELD_P) then
         ! x_f - dX in cells from the face itself: offsets o and o + 1 in {-1, 0, 1}, weights w of o + 1
         t = -displacement(:, q) / grid%h
         o = floor(t)
@@ -469,21 +468,13 @@ contains
             end do
           end do
         end do
+        call carry_run(lam_old(c)%ptr, lam(c)%ptr, grid%glo, grid%ghi, grid%lo, grid%hi, f1 - f0 + 1, &
+                       fd%f_ijk(:, f0:f1), corner, weight, any(displacement(:, q) /= 0.0_dp), &
+                       grid%walls, grid%n(2))
       end if
-      if (.not. moved) then
-        lam(c)%ptr(fd%f_ijk(1, f), fd%f_ijk(2, f), fd%f_ijk(3, f)) = &
-             lam_old(c)%ptr(fd%f_ijk(1, f), fd%f_ijk(2, f), fd%f_ijk(3, f))
-        cycle
-      end if
-      value = 0.0_dp
-      do m = 1, 8
-        idx = fd%f_ijk(:, f) + corner(:, m)
-        ! beyond a wall there is no fluid and no Lambda (the periodic ghost would wrap)
-        if (grid%walls .and. (idx(2) < 0 .or. idx(2) >= grid%n(2))) cycle
-        value = value + weight(m) * lam_old(c)%ptr(idx(1), idx(2), idx(3))
-      end do
-      lam(c)%ptr(fd%f_ijk(1, f), fd%f_ijk(2, f), fd%f_ijk(3, f)) = value
+      f0 = f1 + 1
     end do
+    fd%lambda_listed = .true.
     do c = 1, 3
       PetscCall(DMDAVecRestoreArrayF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
       PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), old(c), lam_old(c)%ptr, ierr))
@@ -491,26 +482,9 @@ contains
     end do
   end subroutine fd_follow
 
-  ! g = (e_c, r x e_c) such that (U + Omega x r)_c = g . (U, Omega); r x e_c written out, since
-  ! the face loops below are most of the particle step's cost (doc/BENCHMARKS.md §8).
-  pure function rigid_row(c, r) result(g)
-    integer, intent(in) :: c
-    real(dp), intent(in) :: r(3)
-    real(dp) :: g(6)
-    g = 0.0_dp
-    g(c) = 1.0_dp
-    select case (c)
-    case (1)
-      g(5) = r(3); g(6) = -r(2)
-    case (2)
-      g(4) = -r(3); g(6) = r(1)
-    case (3)
-      g(4) = r(2); g(5) = -r(1)
-    end select
-  end function rigid_row
-
-  ! The non-zeros of g = (e_c, r x e_c): index and value, three for a velocity component (e_c and
-  ! the two entries of r x e_c), none for the cell centres (c = 4).
+  ! The non-zeros of g = (e_c, r x e_c), such that (U + Omega x r)_c = g . (U, Omega): index and
+  ! value, three for a velocity component (e_c and the two entries of r x e_c), none for the cell
+  ! centres (c = 4).
   pure subroutine rigid_row_nonzeros(c, r, idx, val, nnz)
     integer, intent(in) :: c
     real(dp), intent(in) :: r(3)
@@ -545,8 +519,8 @@ contains
     integer, intent(in) :: n
     PetscErrorCode, intent(out) :: ierr
     type(field_pointer) :: u(3), lam(3)
-    real(dp) :: g(6), dv
-    integer :: f, c, q, i, j, k
+    real(dp) :: dv
+    integer :: f0, f1, c, q
 
     dv = grid%h**3
     if (allocated(fd%moments)) then
@@ -558,14 +532,14 @@ contains
       PetscCall(DMDAVecGetArrayReadF90(grid%da(c), vel(c), u(c)%ptr, ierr))
       PetscCall(DMDAVecGetArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
     end do
-    do f = 1, fd%nf
-      c = fd%f_comp(f)
-      if (c == FIELD_P) cycle
-      i = fd%f_ijk(1, f); j = fd%f_ijk(2, f); k = fd%f_ijk(3, f)
-      q = fd%f_part(f)
-      g = rigid_row(c, fd%f_r(:, f))
-      fd%moments(1:6, q) = fd%moments(1:6, q) + fd%f_alpha(f) * fd%f_relax(f) * u(c)%ptr(i, j, k) * dv * g
-      fd%moments(7:12, q) = fd%moments(7:12, q) + lam(c)%ptr(i, j, k) * fd%f_relax(f) * dv * g
+    f0 = 1
+    do while (f0 <= fd%nf)
+      f1 = run_end(fd, f0)
+      c = fd%f_comp(f0)
+      q = fd%f_part(f0)
+      if (c /= FIELD_P) call moments_run(c, u(c)%ptr, lam(c)%ptr, grid%lo, grid%hi, f1 - f0 + 1, fd%f_ijk(:, f0:f1), &
+                                         fd%f_r(:, f0:f1), fd%f_alpha(f0:f1), fd%f_relax(f0:f1), dv, fd%moments(:, q))
+      f0 = f1 + 1
     end do
     do c = 1, 3
       PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
@@ -662,67 +636,68 @@ contains
     real(dp), allocatable :: sums(:, :)
     type(field_pointer) :: u(3), lam(3)
     PetscScalar, pointer :: p(:,:,:)
-    real(dp) :: g(6), dv, b, rigid, r(3), integral
-    integer :: f, c, q, i, j, k, n, d
+    real(dp) :: dv, integral
+    integer :: f0, f1, c, q, n
+    logical :: removed
 
     n = parts%n
     dv = grid%h**3
     allocate(sums(16, n))
-    if (allocated(fd%lambda_new)) then
-      if (size(fd%lambda_new) < fd%nf) deallocate(fd%lambda_new)
+    sums = 0.0_dp
+    ! Lambda^n is non-zero only on the listed faces once fd_follow has carried it there; then
+    ! removing it and adding Lambda^{n+1} is one pass over the list. Otherwise (the first step
+    ! of a run, -fd_carry_lambda 0) Lambda^{n+1} is computed first and Lambda^n removed from the
+    ! whole grid, as the formula says; both give the same numbers where both apply.
+    removed = .not. fd%lambda_listed
+    if (removed) then
+      if (allocated(fd%lambda_new)) then
+        if (size(fd%lambda_new) < fd%nf) deallocate(fd%lambda_new)
+      end if
+      if (.not. allocated(fd%lambda_new)) allocate(fd%lambda_new(size(fd%f_comp)))
+      do c = 1, 3
+        PetscCall(DMDAVecGetArrayReadF90(grid%da(c), vel(c), u(c)%ptr, ierr))
+        PetscCall(DMDAVecGetArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
+      end do
+      f0 = 1
+      do while (f0 <= fd%nf)
+        f1 = run_end(fd, f0)
+        c = fd%f_comp(f0)
+        q = fd%f_part(f0)
+        if (c /= FIELD_P) call new_lambda_run(c, u(c)%ptr, lam(c)%ptr, grid%lo, grid%hi, f1 - f0 + 1, &
+             fd%f_ijk(:, f0:f1), fd%f_r(:, f0:f1), fd%f_alpha(f0:f1), fd%f_relax(f0:f1), fd%beta, &
+             parts%velocity(:, q), parts%omega(:, q), fd%lambda_new(f0:f1))
+        f0 = f1 + 1
+      end do
+      do c = 1, 3
+        PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
+        PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), vel(c), u(c)%ptr, ierr))
+        PetscCall(VecAXPY(vel(c), -1.0_dp / fd%beta, fd%lambda(c), ierr))
+        PetscCall(VecSet(fd%lambda(c), 0.0_dp, ierr))
+      end do
     end if
-    if (.not. allocated(fd%lambda_new)) allocate(fd%lambda_new(size(fd%f_comp)))
-
-    ! Lambda^{n+1} on the owned faces of each particle (from u~ and Lambda^n)
     do c = 1, 3
-      PetscCall(DMDAVecGetArrayReadF90(grid%da(c), vel(c), u(c)%ptr, ierr))
-      PetscCall(DMDAVecGetArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
-    end do
-    do f = 1, fd%nf
-      c = fd%f_comp(f)
-      if (c == FIELD_P) cycle
-      i = fd%f_ijk(1, f); j = fd%f_ijk(2, f); k = fd%f_ijk(3, f)
-      q = fd%f_part(f)
-      g = rigid_row(c, fd%f_r(:, f))
-      rigid = dot_product(g(1:3), parts%velocity(:, q)) + dot_product(g(4:6), parts%omega(:, q))
-      fd%lambda_new(f) = (lam(c)%ptr(i, j, k) + fd%beta * fd%f_alpha(f) * (rigid - u(c)%ptr(i, j, k))) &
-           * fd%f_relax(f)
-    end do
-    do c = 1, 3
-      PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
-      PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), vel(c), u(c)%ptr, ierr))
-    end do
-
-    ! u^{n+1} = u~ + (Lambda^{n+1} - Lambda^n)/beta everywhere: first remove Lambda^n (faces a
-    ! particle has left get their force back), then add Lambda^{n+1} on the covered faces.
-    do c = 1, 3
-      PetscCall(VecAXPY(vel(c), -1.0_dp / fd%beta, fd%lambda(c), ierr))
-      PetscCall(VecSet(fd%lambda(c), 0.0_dp, ierr))
       PetscCall(DMDAVecGetArrayF90(grid%da(c), vel(c), u(c)%ptr, ierr))
       PetscCall(DMDAVecGetArrayF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
     end do
     PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_P), pressure, p, ierr))
-    sums = 0.0_dp
-    do f = 1, fd%nf
-      c = fd%f_comp(f)
-      i = fd%f_ijk(1, f); j = fd%f_ijk(2, f); k = fd%f_ijk(3, f)
-      q = fd%f_part(f)
+    f0 = 1
+    do while (f0 <= fd%nf)
+      f1 = run_end(fd, f0)
+      c = fd%f_comp(f0)
+      q = fd%f_part(f0)
       if (c == FIELD_P) then
-        sums(16, q) = sums(16, q) + fd%f_alpha(f) * p(i, j, k) * dv     ! interior pressure
-        cycle
+        ! the interior pressure of §1.6
+        call pressure_run(p, grid%lo, grid%hi, f1 - f0 + 1, fd%f_ijk(:, f0:f1), fd%f_alpha(f0:f1), dv, sums(16, q))
+      else if (removed) then
+        call update_run(c, u(c)%ptr, lam(c)%ptr, grid%lo, grid%hi, f1 - f0 + 1, fd%f_ijk(:, f0:f1), &
+             fd%f_r(:, f0:f1), fd%f_alpha(f0:f1), fd%f_relax(f0:f1), fd%beta, dv, parts%velocity(:, q), &
+             parts%omega(:, q), sums(:, q), fd%lambda_new(f0:f1))
+      else
+        call update_run(c, u(c)%ptr, lam(c)%ptr, grid%lo, grid%hi, f1 - f0 + 1, fd%f_ijk(:, f0:f1), &
+             fd%f_r(:, f0:f1), fd%f_alpha(f0:f1), fd%f_relax(f0:f1), fd%beta, dv, parts%velocity(:, q), &
+             parts%omega(:, q), sums(:, q))
       end if
-      b = fd%lambda_new(f)
-      lam(c)%ptr(i, j, k) = b
-      u(c)%ptr(i, j, k) = u(c)%ptr(i, j, k) + b / fd%beta
-      ! force -Lambda e_c dV and torque -r x (Lambda e_c) dV are -Lambda dV times g = (e_c, r x e_c)
-      r = fd%f_r(:, f)
-      g = rigid_row(c, r)
-      sums(1:6, q) = sums(1:6, q) - b * dv * g
-      ! -1/2 Lambda dV (r e_c + e_c r): column c and row c of the 3x3 block (stored by columns)
-      do d = 1, 3
-        sums(6 + d + 3 * (c - 1), q) = sums(6 + d + 3 * (c - 1), q) - 0.5_dp * b * dv * r(d)
-        sums(6 + c + 3 * (d - 1), q) = sums(6 + c + 3 * (d - 1), q) - 0.5_dp * b * dv * r(d)
-      end do
+      f0 = f1 + 1
     end do
     PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_P), pressure, p, ierr))
     do c = 1, 3
@@ -770,6 +745,138 @@ contains
       rhs(:, i) = rhs(:, i) + pl%wall_drive(:, l)
     end do
   end subroutine add_lubrication
+
+  ! The last face of the run that starts at f0: the same sphere and the same component.
+  pure integer function run_end(fd, f0) result(f1)
+    type(fd_t), intent(in) :: fd
+    integer, intent(in) :: f0
+    f1 = f0
+    do while (f1 < fd%nf)
+      if (fd%f_comp(f1 + 1) /= fd%f_comp(f0) .or. fd%f_part(f1 + 1) /= fd%f_part(f0)) exit
+      f1 = f1 + 1
+    end do
+  end function run_end
+
+  ! The kernels below take one run (one sphere, one velocity component c) on plain arrays with the
+  ! bounds of the rank's part of the grid, so that the compiler sees fixed strides (issue 31).
+  ! g = (e_c, r x e_c) enters through its three non-zeros (rigid_row_nonzeros).
+
+  ! Lambda carried by the displacement: trilinear from the eight corners of x_f - dX (fd_follow).
+  subroutine carry_run(old, new, glo, ghi, lo, hi, nfaces, ijk, corner, weight, moved, walls, ny)
+    integer, intent(in) :: glo(3), ghi(3), lo(3), hi(3), nfaces, ijk(3, nfaces), corner(3, 8), ny
+    real(dp), intent(in) :: old(glo(1):ghi(1), glo(2):ghi(2), glo(3):ghi(3)), weight(8)
+    real(dp), intent(inout) :: new(lo(1):hi(1), lo(2):hi(2), lo(3):hi(3))
+    logical, intent(in) :: moved, walls
+    integer :: f, m, i, j, k, jj
+    real(dp) :: value
+    do f = 1, nfaces
+      i = ijk(1, f); j = ijk(2, f); k = ijk(3, f)
+      if (.not. moved) then
+        new(i, j, k) = old(i, j, k)
+        cycle
+      end if
+      value = 0.0_dp
+      do m = 1, 8
+        jj = j + corner(2, m)
+        ! beyond a wall there is no fluid and no Lambda (the periodic ghost would wrap)
+        if (walls .and. (jj < 0 .or. jj >= ny)) cycle
+        value = value + weight(m) * old(i + corner(1, m), jj, k + corner(3, m))
+      end do
+      new(i, j, k) = value
+    end do
+  end subroutine carry_run
+
+  ! moments(1:6) += sum w u~_c g dV, moments(7:12) += sum Lambda^n/(1+gamma) g dV (fd_moments).
+  subroutine moments_run(c, u, lam, lo, hi, nfaces, ijk, r, alpha, relax, dv, moments)
+    integer, intent(in) :: c, lo(3), hi(3), nfaces, ijk(3, nfaces)
+    real(dp), intent(in) :: u(lo(1):hi(1), lo(2):hi(2), lo(3):hi(3)), lam(lo(1):hi(1), lo(2):hi(2), lo(3):hi(3))
+    real(dp), intent(in) :: r(3, nfaces), alpha(nfaces), relax(nfaces), dv
+    real(dp), intent(inout) :: moments(12)
+    integer :: f, idx(3), nnz
+    real(dp) :: val(3), b(3), m(3), su, sl
+    b = 0.0_dp
+    m = 0.0_dp
+    do f = 1, nfaces
+      call rigid_row_nonzeros(c, r(:, f), idx, val, nnz)
+      su = alpha(f) * relax(f) * u(ijk(1, f), ijk(2, f), ijk(3, f)) * dv
+      sl = lam(ijk(1, f), ijk(2, f), ijk(3, f)) * relax(f) * dv
+      b = b + su * val
+      m = m + sl * val
+    end do
+    call rigid_row_nonzeros(c, [0.0_dp, 0.0_dp, 0.0_dp], idx, val, nnz)
+    moments(idx) = moments(idx) + b
+    moments(6 + idx) = moments(6 + idx) + m
+  end subroutine moments_run
+
+  ! Lambda^{n+1} = [Lambda^n + beta alpha (g.U - u~)]/(1 + gamma) of each face of the run.
+  subroutine new_lambda_run(c, u, lam, lo, hi, nfaces, ijk, r, alpha, relax, beta, velocity, omega, lambda_new)
+    integer, intent(in) :: c, lo(3), hi(3), nfaces, ijk(3, nfaces)
+    real(dp), intent(in) :: u(lo(1):hi(1), lo(2):hi(2), lo(3):hi(3)), lam(lo(1):hi(1), lo(2):hi(2), lo(3):hi(3))
+    real(dp), intent(in) :: r(3, nfaces), alpha(nfaces), relax(nfaces), beta, velocity(3), omega(3)
+    real(dp), intent(out) :: lambda_new(nfaces)
+    integer :: f, idx(3), nnz
+    real(dp) :: val(3), rigid
+    do f = 1, nfaces
+      call rigid_row_nonzeros(c, r(:, f), idx, val, nnz)
+      rigid = velocity(c) + val(2) * omega(idx(2) - 3) + val(3) * omega(idx(3) - 3)
+      lambda_new(f) = (lam(ijk(1, f), ijk(2, f), ijk(3, f)) + beta * alpha(f) &
+                       * (rigid - u(ijk(1, f), ijk(2, f), ijk(3, f)))) * relax(f)
+    end do
+  end subroutine new_lambda_run
+
+  ! One run of fd_update: Lambda^{n+1} (from lambda_new when given, the grid then already free
+  ! of Lambda^n), u^{n+1} = u~ - Lambda^n/beta + Lambda^{n+1}/beta, and the run's force, torque
+  ! and stresslet added to sums(1:15) (the 3x3 block stored by columns in 7:15).
+  subroutine update_run(c, u, lam, lo, hi, nfaces, ijk, r, alpha, relax, beta, dv, velocity, omega, sums, lambda_new)
+    integer, intent(in) :: c, lo(3), hi(3), nfaces, ijk(3, nfaces)
+    real(dp), intent(inout) :: u(lo(1):hi(1), lo(2):hi(2), lo(3):hi(3)), lam(lo(1):hi(1), lo(2):hi(2), lo(3):hi(3))
+    real(dp), intent(in) :: r(3, nfaces), alpha(nfaces), relax(nfaces), beta, dv, velocity(3), omega(3)
+    real(dp), intent(inout) :: sums(16)
+    real(dp), intent(in), optional :: lambda_new(nfaces)
+    integer :: f, i, j, k, idx(3), nnz, d
+    real(dp) :: val(3), rigid, b, force(3), first(3), bd
+    force = 0.0_dp
+    first = 0.0_dp
+    do f = 1, nfaces
+      i = ijk(1, f); j = ijk(2, f); k = ijk(3, f)
+      call rigid_row_nonzeros(c, r(:, f), idx, val, nnz)
+      if (present(lambda_new)) then
+        b = lambda_new(f)
+        u(i, j, k) = u(i, j, k) + b / beta
+      else
+        rigid = velocity(c) + val(2) * omega(idx(2) - 3) + val(3) * omega(idx(3) - 3)
+        b = (lam(i, j, k) + beta * alpha(f) * (rigid - u(i, j, k))) * relax(f)
+        u(i, j, k) = (u(i, j, k) + (-1.0_dp / beta) * lam(i, j, k)) + b / beta
+      end if
+      lam(i, j, k) = b
+      ! force -Lambda e_c dV and torque -r x (Lambda e_c) dV: -Lambda dV times g
+      bd = b * dv
+      force = force - bd * val
+      ! -1/2 Lambda dV (r e_c + e_c r): column c and row c of the 3x3 block; r_d Lambda dV summed here
+      first = first + bd * r(:, f)
+    end do
+    call rigid_row_nonzeros(c, [0.0_dp, 0.0_dp, 0.0_dp], idx, val, nnz)
+    sums(idx) = sums(idx) + force
+    do d = 1, 3
+      sums(6 + d + 3 * (c - 1)) = sums(6 + d + 3 * (c - 1)) - 0.5_dp * first(d)
+      sums(6 + c + 3 * (d - 1)) = sums(6 + c + 3 * (d - 1)) - 0.5_dp * first(d)
+    end do
+  end subroutine update_run
+
+  ! The interior pressure sum_cells alpha p dV of one run of cell centres (method.md §1.6).
+  subroutine pressure_run(p, lo, hi, nfaces, ijk, alpha, dv, integral)
+    integer, intent(in) :: lo(3), hi(3), nfaces, ijk(3, nfaces)
+    real(dp), intent(in) :: p(lo(1):hi(1), lo(2):hi(2), lo(3):hi(3)), alpha(nfaces), dv
+    real(dp), intent(inout) :: integral
+    integer :: f
+    real(dp) :: total
+    total = 0.0_dp
+    do f = 1, nfaces
+      total = total + alpha(f) * p(ijk(1, f), ijk(2, f), ijk(3, f))
+    end do
+    integral = integral + total * dv
+  end subroutine pressure_run
+
 
   subroutine fd_destroy(fd, ierr)
     type(fd_t), intent(inout) :: fd
