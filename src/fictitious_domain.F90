@@ -52,27 +52,22 @@ module mod_fictitious_domain
     real(dp) :: radius_offset = 0.38_dp ! in grid cells
     real(dp) :: eta = 1.0_dp
     Vec :: lambda(3)                    ! Lambda = rho*lambda on the u, v, w faces
-    ! ownership of the owned faces (and cell centres, c = 4): particle index, alpha
-    integer, allocatable :: owner(:, :, :, :)   ! (lo1:hi1, lo2:hi2, lo3:hi3, 4)
-    real(dp), allocatable :: alpha(:, :, :, :)
-    real(dp), allocatable :: alpha_second(:, :, :, :)   ! the runner-up's cover of the same face
-    ! the covered faces and cells of this rank, grouped by nothing (one list)
+    ! the covered faces and cells of this rank, in runs of one sphere and one component
     integer :: nf = 0
     integer, allocatable :: f_comp(:), f_ijk(:, :), f_part(:)
     real(dp), allocatable :: f_r(:, :), f_alpha(:), f_relax(:)   ! r, alpha, 1/(1+gamma)
     real(dp), allocatable :: rigid_matrix(:, :, :)               ! M_p (6, 6, n), summed over ranks
-    ! the spheres whose control-volume reach meets another's (centres closer than 2 x reach):
-    ! only there can a face be contested; elsewhere a sphere owns what it covers outright
+    ! The rivals of each sphere: the spheres whose control-volume reach meets its own (centres
+    ! closer than twice the reach). Only they can contest a face; elsewhere a sphere owns what it
+    ! covers outright. Found by mod_neighbours' cell lists, or among all spheres in a box too
+    ! small for them.
     type(nlist_t) :: reach_list
-    logical :: use_reach_list = .false.          ! false: every face is treated as contested
+    logical :: use_reach_list = .false.
     integer :: nreach_pairs = 0, nreach_walls = 0
     integer, allocatable :: reach_pairs(:, :), reach_walls(:, :)
-    integer, allocatable :: rival_start(:)       ! (n + 1): rivals of sphere q in rival_offset(:, rival_start(q):rival_start(q+1)-1)
+    integer, allocatable :: rival_start(:)       ! (n + 1): rivals of q are rival_start(q) .. rival_start(q+1)-1
+    integer, allocatable :: rival_part(:)        ! the rival's index
     real(dp), allocatable :: rival_offset(:, :)  ! (3, :): centre of the rival minus the centre of q (minimum image)
-    ! every contested unknown a sphere covers (alpha > 0), owned or not, in the order they were visited
-    integer :: ncand = 0
-    integer, allocatable :: cand_comp(:), cand_part(:), cand_ijk(:, :)
-    real(dp), allocatable :: cand_r(:, :)
     real(dp), allocatable :: lambda_new(:)   ! Lambda^{n+1} per listed face (kept: no allocation per step)
     logical :: lambda_listed = .false.       ! Lambda^n is zero off the listed faces (fd_follow put it there)
     real(dp), allocatable :: moments(:, :)   ! (12, n): b(u~) and m(Lambda^n) of the step (fd_moments)
@@ -106,14 +101,6 @@ contains
       PetscCall(VecSet(fd%lambda(c), 0.0_dp, ierr))
       PetscCall(PetscObjectSetName(fd%lambda(c), trim(names(c)), ierr))
     end do
-    allocate(fd%owner(grid%lo(1):grid%hi(1), grid%lo(2):grid%hi(2), grid%lo(3):grid%hi(3), 4))
-    allocate(fd%alpha(grid%lo(1):grid%hi(1), grid%lo(2):grid%hi(2), grid%lo(3):grid%hi(3), 4))
-    allocate(fd%alpha_second, mold=fd%alpha)
-    ! zero once: fd_geometry then resets only the entries its candidates touched
-    fd%owner = 0
-    fd%alpha = 0.0_dp
-    fd%alpha_second = 0.0_dp
-    allocate(fd%cand_comp(1024), fd%cand_part(1024), fd%cand_ijk(3, 1024), fd%cand_r(3, 1024))
     PetscCall(psolver_create(fd%solver, ierr))
     allocate(fd%f_comp(1024), fd%f_ijk(3, 1024), fd%f_part(1024), fd%f_r(3, 1024), &
              fd%f_alpha(1024), fd%f_relax(1024))
@@ -121,88 +108,60 @@ contains
 
   ! The geometry at the current positions: face ownership, alpha, the face list and M_p.
   ! Collective (M_p is summed over ranks).
-  ! Pass 1 visits, sphere by sphere, the unknowns each sphere's control volumes can meet and
-  ! computes alpha once. An unknown no other sphere can reach (its distance to every rival centre
-  ! is at least the reach R + sqrt(3) h/2) belongs to this sphere outright and is listed at once;
-  ! the others (the candidates, a few per cent in a dense suspension) claim ownership on the grid
-  ! (the largest alpha wins; ties to the lower index), and pass 2 walks them, in the same order,
-  ! and lists those their sphere owns. Only the entries the candidates touched are reset the next
-  ! time, not the whole grid (issue 31: the geometry was half of the paper scene's step).
+  ! Each sphere visits the unknowns its control volumes can meet and computes alpha once. An
+  ! unknown no rival can reach is its own outright. Where rivals reach (15 % of the faces of the
+  ! paper scene), the sphere computes their alphas there itself, with the very arithmetic each
+  ! rival's own visit uses (the same unwrapped index, the same expressions), so every sphere
+  ! takes the same decision: the largest alpha owns the unknown (ties to the lower index) with
+  ! weight alpha - the runner-up's. No grid-sized ownership arrays, no second pass (issue 31: the
+  ! geometry was half of the paper scene's step).
   subroutine fd_geometry(grid, fd, parts)
     type(grid_t), intent(in) :: grid
     type(fd_t), intent(inout) :: fd
     type(particles_t), intent(in) :: parts
-    integer :: q, c, m, ierr, iw, jw, kw, nnz, s, t, idx(3)
-    real(dp) :: radius, a, gamma, w, dv, val(3)
+    integer :: q, c, ierr
+    real(dp) :: radius
 
     radius = parts%radius + fd%radius_offset * grid%h
     fd%lambda_listed = .false.      ! Lambda^n may sit on faces of another geometry (fd_follow carries it)
     call find_rivals(grid, fd, parts, radius)
-    do m = 1, fd%ncand
-      iw = fd%cand_ijk(1, m); jw = fd%cand_ijk(2, m); kw = fd%cand_ijk(3, m); c = fd%cand_comp(m)
-      fd%owner(iw, jw, kw, c) = 0
-      fd%alpha(iw, jw, kw, c) = 0.0_dp
-      fd%alpha_second(iw, jw, kw, c) = 0.0_dp
-    end do
-    fd%ncand = 0
-    fd%nf = 0
-    do q = 1, parts%n
-      do c = 1, 4
-        call visit(grid, fd, q, c, parts%position(:, q), radius)
-      end do
-    end do
-    do m = 1, fd%ncand
-      iw = fd%cand_ijk(1, m); jw = fd%cand_ijk(2, m); kw = fd%cand_ijk(3, m); c = fd%cand_comp(m)
-      q = fd%cand_part(m)
-      if (fd%owner(iw, jw, kw, c) /= q) cycle
-      a = fd%alpha(iw, jw, kw, c) - fd%alpha_second(iw, jw, kw, c)
-      if (a <= 0.0_dp) cycle
-      gamma = 0.0_dp
-      if (c /= FIELD_P) gamma = relaxation_gamma(a, fd%kappa, fd%beta, grid%h, fd%eta)
-      call push_face(fd, c, fd%cand_ijk(:, m), q, fd%cand_r(:, m), a, 1.0_dp / (1.0_dp + gamma))
-    end do
-
     if (allocated(fd%rigid_matrix)) then
       if (size(fd%rigid_matrix, 3) /= parts%n) deallocate(fd%rigid_matrix)
     end if
     if (.not. allocated(fd%rigid_matrix)) allocate(fd%rigid_matrix(6, 6, parts%n))
     fd%rigid_matrix = 0.0_dp
-    ! M_p = sum_f w g g^T dV over the three non-zeros of each g
-    dv = grid%h**3
-    do m = 1, fd%nf
-      c = fd%f_comp(m)
-      if (c == FIELD_P) cycle
-      q = fd%f_part(m)
-      call rigid_row_nonzeros(c, fd%f_r(:, m), idx, val, nnz)
-      w = fd%f_alpha(m) * fd%f_relax(m) * dv
-      do t = 1, nnz
-        do s = 1, nnz
-          fd%rigid_matrix(idx(s), idx(t), q) = fd%rigid_matrix(idx(s), idx(t), q) + (w * val(t)) * val(s)
-        end do
+    fd%nf = 0
+    do q = 1, parts%n
+      do c = 1, 4
+        call visit(grid, fd, parts, q, c, radius)
       end do
     end do
     call MPI_Allreduce(MPI_IN_PLACE, fd%rigid_matrix, 36 * parts%n, MPI_DOUBLE_PRECISION, MPI_SUM, &
                        PETSC_COMM_WORLD, ierr)
   end subroutine fd_geometry
 
-  ! Every unknown of component c (1..4, 4 = cell centres) whose control volume meets particle q,
-  ! with its owned (wrapped) index and its offset r from the centre (unwrapped, so no image logic):
-  ! alpha computed, ownership claimed, the unknown kept as a candidate.
-  subroutine visit(grid, fd, q, c, centre, radius)
+  ! The unknowns of component c (1..4, 4 = cell centres) that particle q owns, listed with their
+  ! owned (wrapped) index, their offset r from the centre (unwrapped, so no image logic), their
+  ! weight and relaxation; M_p of q accumulated (sum_f w g g^T dV over the non-zeros of g).
+  subroutine visit(grid, fd, parts, q, c, radius)
     type(grid_t), intent(in) :: grid
     type(fd_t), intent(inout) :: fd
+    type(particles_t), intent(in) :: parts
     integer, intent(in) :: q, c
-    real(dp), intent(in) :: centre(3), radius
+    real(dp), intent(in) :: radius
     ! indices per axis: at most 2R/h + 2 (the box below), with one to spare for round-off
     integer :: wrapped(ceiling(2.0_dp * radius / grid%h) + 3, 3)
     logical :: mine(ceiling(2.0_dp * radius / grid%h) + 3, 3)
-    integer :: lo(3), hi(3), i, j, k, d, m, ilo, ihi, iw, jw, kw, f, nrow
-    real(dp) :: r(3), a, h, reach2, inside2, rest2, chord, gamma_unit, rival2
-    logical :: contested
+    integer :: lo(3), hi(3), i, j, k, d, m, ilo, ihi, iw, jw, kw, f, nrow, idx(3), nnz, s, t
+    real(dp) :: centre(3), r(3), a, h, reach2, inside2, rest2, chord, gamma_unit, rival2, second, rival_alpha
+    real(dp) :: val(3), w, dv
+    logical :: owned
     ! the rivals that reach the current row, and what is left of the reach there
-    integer :: row_rival(size(fd%rival_offset, 2))
-    real(dp) :: row_rest2(size(fd%rival_offset, 2))
+    integer :: row_rival(max(1, fd%rival_start(q + 1) - fd%rival_start(q)))
+    real(dp) :: row_rest2(max(1, fd%rival_start(q + 1) - fd%rival_start(q)))
     h = grid%h
+    dv = h**3
+    centre = parts%position(:, q)
     ! The control volume of unknown i spans (i + stagger +- 1/2) h, so only |(i + stagger) h - x_d|
     ! < R + h/2 can meet the sphere: the box below is that range, no wider (issue 7: the loops are
     ! most of the geometry's cost). Each index is wrapped and tested for ownership once per axis.
@@ -246,59 +205,85 @@ contains
         chord = sqrt(rest2)
         ilo = max(lo(1), floor((centre(1) - chord) / h - stagger(1, c)) - 1)
         ihi = min(hi(1), ceiling((centre(1) + chord) / h - stagger(1, c)) + 1)
-        ! the rivals whose reach meets this row at all: only they can contest its unknowns
+        ! the rivals whose reach meets this row at all: only they can contest its unknowns (a
+        ! margin of 1e-12 keeps the test on the safe side of round-off: contested if in doubt)
         nrow = 0
-        if (fd%use_reach_list) then
-          do m = fd%rival_start(q), fd%rival_start(q + 1) - 1
-            rival2 = (r(2) - fd%rival_offset(2, m))**2 + (r(3) - fd%rival_offset(3, m))**2
-            ! (a margin of 1e-12 keeps the test on the safe side of round-off: contested if in doubt)
-            if (rival2 >= reach2 * (1.0_dp + 1.0e-12_dp)) cycle
-            nrow = nrow + 1
-            row_rival(nrow) = m
-            row_rest2(nrow) = reach2 * (1.0_dp + 1.0e-12_dp) - rival2
-          end do
-        end if
+        do m = fd%rival_start(q), fd%rival_start(q + 1) - 1
+          rival2 = (r(2) - fd%rival_offset(2, m))**2 + (r(3) - fd%rival_offset(3, m))**2
+          if (rival2 >= reach2 * (1.0_dp + 1.0e-12_dp)) cycle
+          nrow = nrow + 1
+          row_rival(nrow) = m
+          row_rest2(nrow) = reach2 * (1.0_dp + 1.0e-12_dp) - rival2
+        end do
         do i = ilo, ihi
           if (.not. mine(i - lo(1) + 1, 1)) cycle
           r(1) = (i + stagger(1, c)) * h - centre(1)
-          if (r(1)**2 + r(2)**2 + r(3)**2 >= reach2) cycle
-          if (r(1)**2 + r(2)**2 + r(3)**2 <= inside2) then
-            a = 1.0_dp      ! the whole control volume is inside (cube_fraction's first test)
-          else
-            a = cube_fraction(r, radius, h)
-            if (a <= 0.0_dp) cycle
-          end if
+          a = alpha_at(r)
+          if (a <= 0.0_dp) cycle
           iw = wrapped(i - lo(1) + 1, 1)
-          contested = .not. fd%use_reach_list
+          ! the rivals that reach this unknown: the largest alpha owns it, the runner-up's is taken off
+          second = 0.0_dp
+          owned = .true.
           do m = 1, nrow
-            if ((r(1) - fd%rival_offset(1, row_rival(m)))**2 < row_rest2(m)) then
-              contested = .true.
+            if ((r(1) - fd%rival_offset(1, row_rival(m)))**2 >= row_rest2(m)) cycle
+            rival_alpha = alpha_of_rival(fd%rival_part(row_rival(m)), [iw, jw, kw])
+            if (rival_alpha > a .or. (rival_alpha == a .and. fd%rival_part(row_rival(m)) < q)) then
+              owned = .false.
               exit
             end if
+            second = max(second, rival_alpha)
           end do
-          if (.not. contested) then
-            ! no other sphere reaches it: this sphere owns it outright (alpha_second = 0)
-            f = fd%nf + 1
-            fd%nf = f
-            fd%f_comp(f) = c
-            fd%f_ijk(:, f) = [iw, jw, kw]
-            fd%f_part(f) = q
-            fd%f_r(:, f) = r
-            fd%f_alpha(f) = a
-            fd%f_relax(f) = 1.0_dp / (1.0_dp + gamma_unit * (1.0_dp - a))
-            cycle
-          end if
-          if (a > fd%alpha(iw, jw, kw, c)) then
-            fd%alpha_second(iw, jw, kw, c) = fd%alpha(iw, jw, kw, c)
-            fd%alpha(iw, jw, kw, c) = a
-            fd%owner(iw, jw, kw, c) = q
-          else if (a > fd%alpha_second(iw, jw, kw, c)) then
-            fd%alpha_second(iw, jw, kw, c) = a
-          end if
-          call push_candidate(fd, c, iw, jw, kw, q, r)
+          if (.not. owned) cycle
+          a = a - second
+          if (a <= 0.0_dp) cycle
+          f = fd%nf + 1
+          fd%nf = f
+          fd%f_comp(f) = c
+          fd%f_ijk(:, f) = [iw, jw, kw]
+          fd%f_part(f) = q
+          fd%f_r(:, f) = r
+          fd%f_alpha(f) = a
+          fd%f_relax(f) = 1.0_dp / (1.0_dp + gamma_unit * (1.0_dp - a))
+          if (c == FIELD_P) cycle
+          call rigid_row_nonzeros(c, r, idx, val, nnz)
+          w = fd%f_alpha(f) * fd%f_relax(f) * dv
+          do t = 1, nnz
+            do s = 1, nnz
+              fd%rigid_matrix(idx(s), idx(t), q) = fd%rigid_matrix(idx(s), idx(t), q) + (w * val(t)) * val(s)
+            end do
+          end do
         end do
       end do
     end do
+  contains
+    ! The cover of the control volume at offset x from a centre (0 beyond the reach).
+    real(dp) function alpha_at(x)
+      real(dp), intent(in) :: x(3)
+      real(dp) :: d2
+      d2 = x(1)**2 + x(2)**2 + x(3)**2
+      if (d2 >= reach2) then
+        alpha_at = 0.0_dp
+      else if (d2 <= inside2) then
+        alpha_at = 1.0_dp      ! the whole control volume is inside (cube_fraction's first test)
+      else
+        alpha_at = cube_fraction(x, radius, h)
+      end if
+    end function alpha_at
+
+    ! Rival p's alpha of the unknown with wrapped index ijk, computed as p's own visit does: from
+    ! the image of the unknown nearest to p's centre (the one p's box holds).
+    real(dp) function alpha_of_rival(p, ijk)
+      integer, intent(in) :: p, ijk(3)
+      integer :: d, unwrapped
+      real(dp) :: x(3)
+      do d = 1, 3
+        unwrapped = ijk(d)
+        if (.not. (d == 2 .and. grid%walls)) unwrapped = ijk(d) + grid%n(d) * &
+             nint((parts%position(d, p) - (ijk(d) + stagger(d, c)) * h) / grid%box(d))
+        x(d) = (unwrapped + stagger(d, c)) * h - parts%position(d, p)
+      end do
+      alpha_of_rival = alpha_at(x)
+    end function alpha_of_rival
   end subroutine visit
 
   ! Room for n faces in the face list (its arrays grow by doubling, kept between steps).
@@ -320,95 +305,86 @@ contains
 
   ! The rivals of each sphere: the spheres whose centres are closer than twice the reach
   ! R + sqrt(3) h/2, so that some control volume may meet both (mod_neighbours' cell lists, with a
-  ! skin of one cell). Without a neighbour list (a periodic length below twice its cut-off) every
-  ! face is treated as contested, which is always right, only slower.
+  ! skin of one cell; every pair when a periodic length is below twice the list's cut-off).
+  ! A periodic length below twice the reach would let a sphere reach its own image: refused.
   subroutine find_rivals(grid, fd, parts, radius)
     type(grid_t), intent(in) :: grid
     type(fd_t), intent(inout) :: fd
     type(particles_t), intent(in) :: parts
     real(dp), intent(in) :: radius
-    real(dp) :: reach, d(3)
-    integer :: info, l, i, j, n
+    real(dp) :: reach
+    integer :: info, l, i, j, n, pass
     logical :: periodic(3)
     integer, allocatable :: count(:)
+    character(len=200) :: text
 
     n = parts%n
     reach = radius + 0.5_dp * sqrt(3.0_dp) * grid%h
     periodic = [.true., .not. grid%walls, .true.]
     if (.not. allocated(fd%rival_start)) then
+      if (any(periodic .and. grid%box < 2.0_dp * reach)) then
+        write(text, '(a,f8.4,a)') 'fdsusp: error: &domain box: every periodic length must be at least ', &
+             2.0_dp * reach, ' a (twice a sphere''s reach on the grid), or a sphere meets its own image'
+        call fatal_error(text, 2)
+      end if
       call nlist_init(fd%reach_list, n, grid%box, periodic, 2.0_dp * reach + grid%h, reach + grid%h, grid%h, info)
-      fd%use_reach_list = (info == 0 .and. n > 1)
-      allocate(fd%rival_start(n + 1), fd%rival_offset(3, 64))
+      fd%use_reach_list = (info == 0)
+      allocate(fd%rival_start(n + 1), fd%rival_part(64), fd%rival_offset(3, 64))
     end if
-    fd%rival_start = 1
-    if (.not. fd%use_reach_list) return
-    call nlist_candidates(fd%reach_list, parts%position, fd%reach_pairs, fd%nreach_pairs, fd%reach_walls, fd%nreach_walls)
+    if (fd%use_reach_list .and. n > 1) then
+      call nlist_candidates(fd%reach_list, parts%position, fd%reach_pairs, fd%nreach_pairs, fd%reach_walls, &
+                            fd%nreach_walls)
+    else
+      ! every pair, in the same canonical order
+      fd%nreach_pairs = n * (n - 1) / 2
+      if (allocated(fd%reach_pairs)) then
+        if (size(fd%reach_pairs, 2) < fd%nreach_pairs) deallocate(fd%reach_pairs)
+      end if
+      if (.not. allocated(fd%reach_pairs)) allocate(fd%reach_pairs(2, max(1, fd%nreach_pairs)))
+      l = 0
+      do i = 1, n - 1
+        do j = i + 1, n
+          l = l + 1
+          fd%reach_pairs(:, l) = [i, j]
+        end do
+      end do
+    end if
     ! count, then fill (each close pair is a rival of both its spheres)
     allocate(count(n))
-    count = 0
-    do l = 1, fd%nreach_pairs
-      i = fd%reach_pairs(1, l)
-      j = fd%reach_pairs(2, l)
+    do pass = 1, 2
+      count = 0
+      do l = 1, fd%nreach_pairs
+        i = fd%reach_pairs(1, l)
+        j = fd%reach_pairs(2, l)
+        call add_pair(i, j, pass)
+      end do
+      if (pass == 1) then
+        fd%rival_start(1) = 1
+        do i = 1, n
+          fd%rival_start(i + 1) = fd%rival_start(i) + count(i)
+        end do
+        if (size(fd%rival_part) < fd%rival_start(n + 1)) then
+          deallocate(fd%rival_part, fd%rival_offset)
+          allocate(fd%rival_part(2 * fd%rival_start(n + 1)), fd%rival_offset(3, 2 * fd%rival_start(n + 1)))
+        end if
+      end if
+    end do
+  contains
+    subroutine add_pair(i, j, pass)
+      integer, intent(in) :: i, j, pass
+      real(dp) :: d(3)
       d = min_image(parts%position(:, j) - parts%position(:, i), grid%box, periodic)
-      if (sum(d**2) >= (2.0_dp * reach)**2) cycle
+      if (sum(d**2) >= (2.0_dp * reach)**2) return
+      if (pass == 2) then
+        fd%rival_part(fd%rival_start(i) + count(i)) = j
+        fd%rival_offset(:, fd%rival_start(i) + count(i)) = d
+        fd%rival_part(fd%rival_start(j) + count(j)) = i
+        fd%rival_offset(:, fd%rival_start(j) + count(j)) = -d
+      end if
       count(i) = count(i) + 1
       count(j) = count(j) + 1
-    end do
-    fd%rival_start(1) = 1
-    do i = 1, n
-      fd%rival_start(i + 1) = fd%rival_start(i) + count(i)
-    end do
-    if (size(fd%rival_offset, 2) < fd%rival_start(n + 1)) then
-      deallocate(fd%rival_offset)
-      allocate(fd%rival_offset(3, 2 * fd%rival_start(n + 1)))
-    end if
-    count = 0
-    do l = 1, fd%nreach_pairs
-      i = fd%reach_pairs(1, l)
-      j = fd%reach_pairs(2, l)
-      d = min_image(parts%position(:, j) - parts%position(:, i), grid%box, periodic)
-      if (sum(d**2) >= (2.0_dp * reach)**2) cycle
-      fd%rival_offset(:, fd%rival_start(i) + count(i)) = d
-      fd%rival_offset(:, fd%rival_start(j) + count(j)) = -d
-      count(i) = count(i) + 1
-      count(j) = count(j) + 1
-    end do
+    end subroutine add_pair
   end subroutine find_rivals
-
-  subroutine push_candidate(fd, c, iw, jw, kw, q, r)
-    type(fd_t), intent(inout) :: fd
-    integer, intent(in) :: c, iw, jw, kw, q
-    real(dp), intent(in) :: r(3)
-    integer :: m
-    integer, allocatable :: ti(:), t3(:, :)
-    real(dp), allocatable :: tr3(:, :)
-    if (fd%ncand == size(fd%cand_comp)) then
-      m = 2 * fd%ncand
-      allocate(ti(m)); ti(1:fd%ncand) = fd%cand_comp(1:fd%ncand); call move_alloc(ti, fd%cand_comp)
-      allocate(ti(m)); ti(1:fd%ncand) = fd%cand_part(1:fd%ncand); call move_alloc(ti, fd%cand_part)
-      allocate(t3(3, m)); t3(:, 1:fd%ncand) = fd%cand_ijk(:, 1:fd%ncand); call move_alloc(t3, fd%cand_ijk)
-      allocate(tr3(3, m)); tr3(:, 1:fd%ncand) = fd%cand_r(:, 1:fd%ncand); call move_alloc(tr3, fd%cand_r)
-    end if
-    fd%ncand = fd%ncand + 1
-    fd%cand_comp(fd%ncand) = c
-    fd%cand_part(fd%ncand) = q
-    fd%cand_ijk(:, fd%ncand) = [iw, jw, kw]
-    fd%cand_r(:, fd%ncand) = r
-  end subroutine push_candidate
-
-  subroutine push_face(fd, c, ijk, q, r, a, relax)
-    type(fd_t), intent(inout) :: fd
-    integer, intent(in) :: c, ijk(3), q
-    real(dp), intent(in) :: r(3), a, relax
-    call reserve_faces(fd, fd%nf + 1)
-    fd%nf = fd%nf + 1
-    fd%f_comp(fd%nf) = c
-    fd%f_ijk(:, fd%nf) = ijk
-    fd%f_part(fd%nf) = q
-    fd%f_r(:, fd%nf) = r
-    fd%f_alpha(fd%nf) = a
-    fd%f_relax(fd%nf) = relax
-  end subroutine push_face
 
   ! The geometry at the new positions, and Lambda carried with the spheres that moved (issue 7,
   ! doc/VALIDATION.md §5.3). Lambda is incremental: each step only corrects it, so left on the
