@@ -56,6 +56,8 @@ module mod_fictitious_domain
     integer :: nf = 0
     integer, allocatable :: f_comp(:), f_ijk(:, :), f_part(:)
     real(dp), allocatable :: f_r(:, :), f_alpha(:), f_relax(:)   ! r, alpha, 1/(1+gamma)
+    integer :: nruns = 0
+    integer, allocatable :: run_start(:)   ! run r (one sphere, one component) is run_start(r) .. run_start(r+1)-1
     real(dp), allocatable :: rigid_matrix(:, :, :)               ! M_p (6, 6, n), summed over ranks
     ! The rivals of each sphere: the spheres whose control-volume reach meets its own (centres
     ! closer than twice the reach). Only they can contest a face; elsewhere a sphere owns what it
@@ -104,6 +106,7 @@ contains
     PetscCall(psolver_create(fd%solver, ierr))
     allocate(fd%f_comp(1024), fd%f_ijk(3, 1024), fd%f_part(1024), fd%f_r(3, 1024), &
              fd%f_alpha(1024), fd%f_relax(1024))
+    allocate(fd%run_start(1))
   end subroutine fd_create
 
   ! The geometry at the current positions: face ownership, alpha, the face list and M_p.
@@ -119,7 +122,7 @@ contains
     type(grid_t), intent(in) :: grid
     type(fd_t), intent(inout) :: fd
     type(particles_t), intent(in) :: parts
-    integer :: q, c, ierr
+    integer :: q, c, ierr, f0
     real(dp) :: radius
 
     radius = parts%radius + fd%radius_offset * grid%h
@@ -131,11 +134,22 @@ contains
     if (.not. allocated(fd%rigid_matrix)) allocate(fd%rigid_matrix(6, 6, parts%n))
     fd%rigid_matrix = 0.0_dp
     fd%nf = 0
+    fd%nruns = 0
+    if (size(fd%run_start) < 4 * parts%n + 1) then
+      deallocate(fd%run_start)
+      allocate(fd%run_start(4 * parts%n + 1))
+    end if
     do q = 1, parts%n
       do c = 1, 4
+        f0 = fd%nf + 1
         call visit(grid, fd, parts, q, c, radius)
+        if (fd%nf >= f0) then
+          fd%nruns = fd%nruns + 1
+          fd%run_start(fd%nruns) = f0
+        end if
       end do
     end do
+    fd%run_start(fd%nruns + 1) = fd%nf + 1
     call MPI_Allreduce(MPI_IN_PLACE, fd%rigid_matrix, 36 * parts%n, MPI_DOUBLE_PRECISION, MPI_SUM, &
                        PETSC_COMM_WORLD, ierr)
   end subroutine fd_geometry
@@ -152,9 +166,9 @@ contains
     ! indices per axis: at most 2R/h + 2 (the box below), with one to spare for round-off
     integer :: wrapped(ceiling(2.0_dp * radius / grid%h) + 3, 3)
     logical :: mine(ceiling(2.0_dp * radius / grid%h) + 3, 3)
-    integer :: lo(3), hi(3), i, j, k, d, m, ilo, ihi, iw, jw, kw, f, nrow, idx(3), nnz, s, t
+    integer :: lo(3), hi(3), i, j, k, d, m, ilo, ihi, iw, jw, kw, f, nrow, idx(3), arm(2), s, t
     real(dp) :: centre(3), r(3), a, h, reach2, inside2, rest2, chord, gamma_unit, rival2, second, rival_alpha
-    real(dp) :: val(3), w, dv
+    real(dp) :: val(3), w, dv, sgn(2)
     logical :: owned
     ! the rivals that reach the current row, and what is left of the reach there
     integer :: row_rival(max(1, fd%rival_start(q + 1) - fd%rival_start(q)))
@@ -190,7 +204,10 @@ contains
     call reserve_faces(fd, fd%nf + product(hi - lo + 1))
     ! gamma = kappa (1 - alpha) beta h^2 / eta (relaxation_gamma, method.md §1.5b), written out
     gamma_unit = 0.0_dp
-    if (c /= FIELD_P) gamma_unit = fd%kappa * fd%beta * h**2 / fd%eta
+    if (c /= FIELD_P) then
+      gamma_unit = fd%kappa * fd%beta * h**2 / fd%eta
+      call torque_arm(c, idx, arm, sgn)
+    end if
     do k = lo(3), hi(3)
       if (.not. mine(k - lo(3) + 1, 3)) cycle
       kw = wrapped(k - lo(3) + 1, 3)
@@ -245,10 +262,10 @@ contains
           fd%f_alpha(f) = a
           fd%f_relax(f) = 1.0_dp / (1.0_dp + gamma_unit * (1.0_dp - a))
           if (c == FIELD_P) cycle
-          call rigid_row_nonzeros(c, r, idx, val, nnz)
+          val = [1.0_dp, sgn(1) * r(arm(1)), sgn(2) * r(arm(2))]
           w = fd%f_alpha(f) * fd%f_relax(f) * dv
-          do t = 1, nnz
-            do s = 1, nnz
+          do t = 1, 3
+            do s = 1, 3
               fd%rigid_matrix(idx(s), idx(t), q) = fd%rigid_matrix(idx(s), idx(t), q) + (w * val(t)) * val(s)
             end do
           end do
@@ -404,7 +421,7 @@ contains
     Vec :: old(3)
     type(field_pointer) :: lam_old(3), lam(3)
     real(dp) :: t(3), w(3), weight(8)
-    integer :: f0, f1, c, q, o(3), a, b, e, m, corner(3, 8)
+    integer :: run, f0, f1, c, q, o(3), a, b, e, m, corner(3, 8)
     character(len=200) :: text
 
     call fd_geometry(grid, fd, parts)
@@ -423,9 +440,9 @@ contains
     end do
     ! The list comes in runs of one sphere and one component: the eight corner offsets and
     ! weights are set once per run, and each run is carried by a kernel on plain arrays.
-    f0 = 1
-    do while (f0 <= fd%nf)
-      f1 = run_end(fd, f0)
+    do run = 1, fd%nruns
+      f0 = fd%run_start(run)
+      f1 = fd%run_start(run + 1) - 1
       c = fd%f_comp(f0)
       q = fd%f_part(f0)
       if (c /= FIELD_P) then
@@ -448,7 +465,6 @@ contains
                        fd%f_ijk(:, f0:f1), corner, weight, any(displacement(:, q) /= 0.0_dp), &
                        grid%walls, grid%n(2))
       end if
-      f0 = f1 + 1
     end do
     fd%lambda_listed = .true.
     do c = 1, 3
@@ -457,27 +473,6 @@ contains
       PetscCall(DMRestoreLocalVector(grid%da(c), old(c), ierr))
     end do
   end subroutine fd_follow
-
-  ! The non-zeros of g = (e_c, r x e_c), such that (U + Omega x r)_c = g . (U, Omega): index and
-  ! value, three for a velocity component (e_c and the two entries of r x e_c), none for the cell
-  ! centres (c = 4).
-  pure subroutine rigid_row_nonzeros(c, r, idx, val, nnz)
-    integer, intent(in) :: c
-    real(dp), intent(in) :: r(3)
-    integer, intent(out) :: idx(3), nnz
-    real(dp), intent(out) :: val(3)
-    nnz = 3
-    select case (c)
-    case (1)
-      idx = [1, 5, 6]; val = [1.0_dp, r(3), -r(2)]
-    case (2)
-      idx = [2, 4, 6]; val = [1.0_dp, -r(3), r(1)]
-    case (3)
-      idx = [3, 4, 5]; val = [1.0_dp, r(2), -r(1)]
-    case default
-      nnz = 0; idx = 1; val = 0.0_dp
-    end select
-  end subroutine rigid_row_nonzeros
 
   ! The particle sub-problem after the fluid step, in three named parts that main.F90 calls in
   ! turn (method.md §1.5 eq. (1), §1.5b):
@@ -496,7 +491,7 @@ contains
     PetscErrorCode, intent(out) :: ierr
     type(field_pointer) :: u(3), lam(3)
     real(dp) :: dv
-    integer :: f0, f1, c, q
+    integer :: run, f0, f1, c, q
 
     dv = grid%h**3
     if (allocated(fd%moments)) then
@@ -508,14 +503,13 @@ contains
       PetscCall(DMDAVecGetArrayReadF90(grid%da(c), vel(c), u(c)%ptr, ierr))
       PetscCall(DMDAVecGetArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
     end do
-    f0 = 1
-    do while (f0 <= fd%nf)
-      f1 = run_end(fd, f0)
+    do run = 1, fd%nruns
+      f0 = fd%run_start(run)
+      f1 = fd%run_start(run + 1) - 1
       c = fd%f_comp(f0)
       q = fd%f_part(f0)
       if (c /= FIELD_P) call moments_run(c, u(c)%ptr, lam(c)%ptr, grid%lo, grid%hi, f1 - f0 + 1, fd%f_ijk(:, f0:f1), &
                                          fd%f_r(:, f0:f1), fd%f_alpha(f0:f1), fd%f_relax(f0:f1), dv, fd%moments(:, q))
-      f0 = f1 + 1
     end do
     do c = 1, 3
       PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
@@ -613,7 +607,7 @@ contains
     type(field_pointer) :: u(3), lam(3)
     PetscScalar, pointer :: p(:,:,:)
     real(dp) :: dv, integral
-    integer :: f0, f1, c, q, n
+    integer :: run, f0, f1, c, q, n
     logical :: removed
 
     n = parts%n
@@ -634,15 +628,14 @@ contains
         PetscCall(DMDAVecGetArrayReadF90(grid%da(c), vel(c), u(c)%ptr, ierr))
         PetscCall(DMDAVecGetArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
       end do
-      f0 = 1
-      do while (f0 <= fd%nf)
-        f1 = run_end(fd, f0)
+      do run = 1, fd%nruns
+        f0 = fd%run_start(run)
+        f1 = fd%run_start(run + 1) - 1
         c = fd%f_comp(f0)
         q = fd%f_part(f0)
         if (c /= FIELD_P) call new_lambda_run(c, u(c)%ptr, lam(c)%ptr, grid%lo, grid%hi, f1 - f0 + 1, &
              fd%f_ijk(:, f0:f1), fd%f_r(:, f0:f1), fd%f_alpha(f0:f1), fd%f_relax(f0:f1), fd%beta, &
              parts%velocity(:, q), parts%omega(:, q), fd%lambda_new(f0:f1))
-        f0 = f1 + 1
       end do
       do c = 1, 3
         PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
@@ -656,9 +649,9 @@ contains
       PetscCall(DMDAVecGetArrayF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
     end do
     PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_P), pressure, p, ierr))
-    f0 = 1
-    do while (f0 <= fd%nf)
-      f1 = run_end(fd, f0)
+    do run = 1, fd%nruns
+      f0 = fd%run_start(run)
+      f1 = fd%run_start(run + 1) - 1
       c = fd%f_comp(f0)
       q = fd%f_part(f0)
       if (c == FIELD_P) then
@@ -673,7 +666,6 @@ contains
              fd%f_r(:, f0:f1), fd%f_alpha(f0:f1), fd%f_relax(f0:f1), fd%beta, dv, parts%velocity(:, q), &
              parts%omega(:, q), sums(:, q))
       end if
-      f0 = f1 + 1
     end do
     PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_P), pressure, p, ierr))
     do c = 1, 3
@@ -722,20 +714,24 @@ contains
     end do
   end subroutine add_lubrication
 
-  ! The last face of the run that starts at f0: the same sphere and the same component.
-  pure integer function run_end(fd, f0) result(f1)
-    type(fd_t), intent(in) :: fd
-    integer, intent(in) :: f0
-    f1 = f0
-    do while (f1 < fd%nf)
-      if (fd%f_comp(f1 + 1) /= fd%f_comp(f0) .or. fd%f_part(f1 + 1) /= fd%f_part(f0)) exit
-      f1 = f1 + 1
-    end do
-  end function run_end
-
   ! The kernels below take one run (one sphere, one velocity component c) on plain arrays with the
   ! bounds of the rank's part of the grid, so that the compiler sees fixed strides (issue 31).
-  ! g = (e_c, r x e_c) enters through its three non-zeros (rigid_row_nonzeros).
+  ! g = (e_c, r x e_c) enters through its three non-zeros: 1 at idx(1), sgn(1) r(k(1)) at idx(2)
+  ! and sgn(2) r(k(2)) at idx(3) (torque_arm, once per run).
+
+  pure subroutine torque_arm(c, idx, k, sgn)
+    integer, intent(in) :: c
+    integer, intent(out) :: idx(3), k(2)
+    real(dp), intent(out) :: sgn(2)
+    select case (c)
+    case (1)
+      idx = [1, 5, 6]; k = [3, 2]; sgn = [1.0_dp, -1.0_dp]
+    case (2)
+      idx = [2, 4, 6]; k = [3, 1]; sgn = [-1.0_dp, 1.0_dp]
+    case default
+      idx = [3, 4, 5]; k = [2, 1]; sgn = [1.0_dp, -1.0_dp]
+    end select
+  end subroutine torque_arm
 
   ! Lambda carried by the displacement: trilinear from the eight corners of x_f - dX (fd_follow).
   subroutine carry_run(old, new, glo, ghi, lo, hi, nfaces, ijk, corner, weight, moved, walls, ny)
@@ -768,18 +764,18 @@ contains
     real(dp), intent(in) :: u(lo(1):hi(1), lo(2):hi(2), lo(3):hi(3)), lam(lo(1):hi(1), lo(2):hi(2), lo(3):hi(3))
     real(dp), intent(in) :: r(3, nfaces), alpha(nfaces), relax(nfaces), dv
     real(dp), intent(inout) :: moments(12)
-    integer :: f, idx(3), nnz
-    real(dp) :: val(3), b(3), m(3), su, sl
+    integer :: f, idx(3), k(2)
+    real(dp) :: val(3), b(3), m(3), su, sl, sgn(2)
+    call torque_arm(c, idx, k, sgn)
     b = 0.0_dp
     m = 0.0_dp
     do f = 1, nfaces
-      call rigid_row_nonzeros(c, r(:, f), idx, val, nnz)
+      val = [1.0_dp, sgn(1) * r(k(1), f), sgn(2) * r(k(2), f)]
       su = alpha(f) * relax(f) * u(ijk(1, f), ijk(2, f), ijk(3, f)) * dv
       sl = lam(ijk(1, f), ijk(2, f), ijk(3, f)) * relax(f) * dv
       b = b + su * val
       m = m + sl * val
     end do
-    call rigid_row_nonzeros(c, [0.0_dp, 0.0_dp, 0.0_dp], idx, val, nnz)
     moments(idx) = moments(idx) + b
     moments(6 + idx) = moments(6 + idx) + m
   end subroutine moments_run
@@ -790,11 +786,11 @@ contains
     real(dp), intent(in) :: u(lo(1):hi(1), lo(2):hi(2), lo(3):hi(3)), lam(lo(1):hi(1), lo(2):hi(2), lo(3):hi(3))
     real(dp), intent(in) :: r(3, nfaces), alpha(nfaces), relax(nfaces), beta, velocity(3), omega(3)
     real(dp), intent(out) :: lambda_new(nfaces)
-    integer :: f, idx(3), nnz
-    real(dp) :: val(3), rigid
+    integer :: f, idx(3), k(2)
+    real(dp) :: rigid, sgn(2)
+    call torque_arm(c, idx, k, sgn)
     do f = 1, nfaces
-      call rigid_row_nonzeros(c, r(:, f), idx, val, nnz)
-      rigid = velocity(c) + val(2) * omega(idx(2) - 3) + val(3) * omega(idx(3) - 3)
+      rigid = velocity(c) + sgn(1) * r(k(1), f) * omega(idx(2) - 3) + sgn(2) * r(k(2), f) * omega(idx(3) - 3)
       lambda_new(f) = (lam(ijk(1, f), ijk(2, f), ijk(3, f)) + beta * alpha(f) &
                        * (rigid - u(ijk(1, f), ijk(2, f), ijk(3, f)))) * relax(f)
     end do
@@ -809,13 +805,14 @@ contains
     real(dp), intent(in) :: r(3, nfaces), alpha(nfaces), relax(nfaces), beta, dv, velocity(3), omega(3)
     real(dp), intent(inout) :: sums(16)
     real(dp), intent(in), optional :: lambda_new(nfaces)
-    integer :: f, i, j, k, idx(3), nnz, d
-    real(dp) :: val(3), rigid, b, force(3), first(3), bd
+    integer :: f, i, j, k, idx(3), arm(2), d
+    real(dp) :: val(3), rigid, b, force(3), first(3), bd, sgn(2)
+    call torque_arm(c, idx, arm, sgn)
     force = 0.0_dp
     first = 0.0_dp
     do f = 1, nfaces
       i = ijk(1, f); j = ijk(2, f); k = ijk(3, f)
-      call rigid_row_nonzeros(c, r(:, f), idx, val, nnz)
+      val = [1.0_dp, sgn(1) * r(arm(1), f), sgn(2) * r(arm(2), f)]
       if (present(lambda_new)) then
         b = lambda_new(f)
         u(i, j, k) = u(i, j, k) + b / beta
@@ -831,7 +828,6 @@ contains
       ! -1/2 Lambda dV (r e_c + e_c r): column c and row c of the 3x3 block; r_d Lambda dV summed here
       first = first + bd * r(:, f)
     end do
-    call rigid_row_nonzeros(c, [0.0_dp, 0.0_dp, 0.0_dp], idx, val, nnz)
     sums(idx) = sums(idx) + force
     do d = 1, 3
       sums(6 + d + 3 * (c - 1)) = sums(6 + d + 3 * (c - 1)) - 0.5_dp * first(d)
