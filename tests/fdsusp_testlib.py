@@ -11,15 +11,18 @@ import time
 import h5py
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+# the verdict (shared with tests/physics/pairtraj_lib.py): check() records one assertion, finish()
+# exits 1 unless at least one check was made and none failed; a test ending without finish() gets
+# the same verdict at exit (tests/checks.py)
+from checks import check, finish, failures  # noqa: E402,F401
+
 ROOT = os.environ.get('FDSUSP_ROOT', os.path.abspath(os.path.join(os.path.dirname(__file__), '..')))
 BIN = os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin'))
 FDSUSP = os.path.join(BIN, 'fdsusp')
 
 ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT='1', OMPI_ALLOW_RUN_AS_ROOT_CONFIRM='1',
            OMPI_MCA_rmaps_base_oversubscribe='1')
-
-failures = []
-
 
 def scratch(name):
     """A fresh scratch directory under build/test-work."""
@@ -143,18 +146,3 @@ def compare_h5(path_a, path_b, what, skip=(), rtol=1e-12):
         else:
             check(np.array_equal(x, y), '%s: %s identical' % (what, n))
     return names_a
-
-
-def check(condition, message):
-    """Record one assertion; print it either way."""
-    print(('ok    ' if condition else 'FAIL  ') + message)
-    sys.stdout.flush()
-    if not condition:
-        failures.append(message)
-
-
-def finish():
-    if failures:
-        print('%d check(s) failed' % len(failures))
-        sys.exit(1)
-    print('all checks passed')

@@ -13,6 +13,9 @@ import subprocess
 import sys
 import tempfile
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import checks  # noqa: E402  (tests/checks.py: the verdict shared by the Python tests)
+
 # the checkout: $FDSUSP_ROOT (tests/run_tests.sh exports it), else the one holding this file
 ROOT = os.environ.get("FDSUSP_ROOT", os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..")))
 BIN = os.environ.get("FDSUSP_BIN", os.path.join(ROOT, "bin"))
@@ -71,18 +74,11 @@ def interp(xs, ys, x):
 
 
 class Checker:
-    """Prints PASS/FAIL lines and exits non-zero at the end if anything failed."""
-
-    def __init__(self):
-        self.failed = 0
+    """The pairtraj tests' spelling of the shared verdict (tests/checks.py): check(what, ok, detail)
+    records one check, done() exits 1 unless at least one check was made and none failed."""
 
     def check(self, what, ok, detail=""):
-        print("%s %s %s" % ("PASS" if ok else "FAIL", what, detail))
-        if not ok:
-            self.failed += 1
+        checks.check(ok, ("%s %s" % (what, detail)).rstrip())
 
     def done(self):
-        if self.failed:
-            print("%d check(s) failed" % self.failed)
-            sys.exit(1)
-        print("all checks passed")
+        checks.finish()

@@ -7,11 +7,11 @@
 # missing file. Exact text matching
 # (no tolerance involved).
 set -u
+. "$(dirname "$0")/../checks.sh"     # check_result, checks_finish: the verdict shared by shell tests
 # the checkout holding this script (tests/run_tests.sh exports FDSUSP_ROOT and FDSUSP_BIN)
 root=${FDSUSP_ROOT:-$(cd "$(dirname "$0")/../.." && pwd)}
 bin=${FDSUSP_BIN:-$root/bin}/pairtraj
 tmp=$(mktemp -d)
-fail=0
 
 check() {  # check NAME DECKFILE GROUP VARIABLE
   local name=$1 deck=$2 group=$3 var=$4 err rc ok=1
@@ -24,8 +24,7 @@ check() {  # check NAME DECKFILE GROUP VARIABLE
   [ -z "$group" ] || grep -qF "&$group" "$tmp/stderr" || ok=0
   [ -z "$var" ] || grep -qF "variable $var" "$tmp/stderr" || ok=0
   [ ! -e "$tmp/out.csv" ] || ok=0
-  if [ $ok -eq 1 ]; then echo "PASS $name (exit $rc): $err"
-  else echo "FAIL $name (exit $rc): $err"; fail=1; fi
+  check_result $((1 - ok)) "$name (exit $rc): $err"
 }
 
 cat > "$tmp/unknown.nml" <<EOF
@@ -108,5 +107,4 @@ check "too many values" "$tmp/toomany.nml" pair start
 check "missing file" "$tmp/does_not_exist.nml" "" ""
 
 rm -rf "$tmp"
-[ $fail -eq 0 ] && echo "all checks passed"
-exit $fail
+checks_finish

@@ -44,8 +44,9 @@ d = T.scratch('checkout_paths')
 other = os.path.join(d, 'checkout')
 os.makedirs(os.path.join(other, 'tests', 'physics'))
 os.makedirs(os.path.join(other, 'bin'))
-for name in ('pairtraj_lib.py', 'test_pairtraj_deck_errors.sh'):
-    shutil.copy(os.path.join(ROOT, 'tests', 'physics', name), os.path.join(other, 'tests', 'physics', name))
+for name in ('physics/pairtraj_lib.py', 'physics/test_pairtraj_deck_errors.sh', 'checks.py', 'checks.sh'):
+    if os.path.exists(os.path.join(ROOT, 'tests', name)):
+        shutil.copy(os.path.join(ROOT, 'tests', name), os.path.join(other, 'tests', name))
 calls = os.path.join(d, 'calls.txt')
 stand_in = os.path.join(other, 'bin', 'pairtraj')
 with open(stand_in, 'w') as f:
@@ -55,10 +56,11 @@ env = {k: v for k, v in os.environ.items() if k not in ('FDSUSP_ROOT', 'FDSUSP_B
 elsewhere = os.path.join(d, 'elsewhere')
 os.makedirs(elsewhere)
 
-p = subprocess.run([sys.executable, '-c', 'import pairtraj_lib as L; print(L.ROOT); print(L.PAIRTRAJ)'],
-                   cwd=elsewhere, env=dict(env, PYTHONPATH=os.path.join(other, 'tests', 'physics')),
-                   capture_output=True, text=True)
-lines = p.stdout.split()
+# (the probe makes one check: a script that imports the harness and checks nothing fails)
+probe = 'import pairtraj_lib as L; print("ROOT=" + L.ROOT); print("BIN=" + L.PAIRTRAJ); L.checks.check(True, "probe")'
+p = subprocess.run([sys.executable, '-c', probe], cwd=elsewhere,
+                   env=dict(env, PYTHONPATH=os.path.join(other, 'tests', 'physics')), capture_output=True, text=True)
+lines = [l.split('=', 1)[1] for l in p.stdout.splitlines() if l.startswith(('ROOT=', 'BIN='))]
 T.check(p.returncode == 0 and len(lines) == 2 and os.path.realpath(lines[0]) == os.path.realpath(other),
         'pairtraj_lib: ROOT is the checkout holding it (%s)' % (lines[:1] or p.stderr[-300:]))
 T.check(len(lines) == 2 and os.path.realpath(lines[1]) == os.path.realpath(stand_in),

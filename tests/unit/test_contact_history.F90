@@ -30,7 +30,7 @@ program test_contact_history
   use mod_neighbours, only: nlist_t, nlist_init, nlist_build, nlist_needs_rebuild
   use mod_packing, only: rng_t, rng_seed, rng_uniform, random_packing, packing_report_t, &
                          packing_count
-  use mod_unit_checks, only: fail, finish
+  use mod_unit_checks, only: check, fail, finish
   implicit none
   real(dp), parameter :: box(3) = [16.0_dp, 10.0_dp, 16.0_dp], dt = 1.0e-3_dp
   logical, parameter :: per(3) = [.true., .false., .true.]
@@ -125,11 +125,10 @@ program test_contact_history
   print '(a,l1,a,es9.2,a,es9.2,a,i0)', '   same contacts every step ', same_ids, &
     ', max spring difference ', err_ups, ', max force difference ', err_f, &
     ', contacts carried across a periodic boundary ', crossings
-  if (.not. same_ids) call fail('the runs hold different contacts')
-  if (err_ups > 1.0e-10_dp .or. err_f > 1.0e-10_dp) call fail('the runs differ')
-  if (crossings == 0) call fail('no contact crossed a periodic boundary: test not conclusive')
-  if (count(idb(2, 1:npb) < 0) == 0 .or. count(idb(2, 1:npb) > 0) == 0) &
-    call fail('need both pair and wall contacts')
+  call check(same_ids, 'the runs hold the same contacts')
+  call check(err_ups <= 1.0e-10_dp .and. err_f <= 1.0e-10_dp, 'the runs agree (springs and forces to 1e-10)')
+  call check(crossings > 0, 'a contact crossed a periodic boundary (the test is conclusive)')
+  call check(count(idb(2, 1:npb) < 0) > 0 .and. count(idb(2, 1:npb) > 0) > 0, 'both pair and wall contacts')
 
   ! ---- 2. pack -> unpack -> pack, in order and shuffled; continue bitwise
   call history_pack(hb, np_out, idb, upb)
@@ -151,7 +150,7 @@ program test_contact_history
   if (identical) identical = info == 0 .and. all(idc(:, 1:npb) == idb(:, 1:npb)) .and. &
                              all(upc(:, 1:npb) == upb(:, 1:npb))
   print '(a,i0,a,l1)', '2. pack/unpack of ', npb, ' contacts (in order and shuffled) exact: ', identical
-  if (.not. identical) call fail('pack -> unpack -> pack is not the identity')
+  call check(identical, 'pack -> unpack -> pack is the identity')
   identical = .true.
   do step = 1, 100
     if (nlist_needs_rebuild(nlb, xb)) call nlist_build(nlb, xb)
@@ -170,7 +169,7 @@ program test_contact_history
   identical = identical .and. history_size(hc) == npb
   if (identical) identical = all(idc(:, 1:npb) == idb(:, 1:npb)) .and. all(upc(:, 1:npb) == upb(:, 1:npb))
   print '(a,l1)', '   100 steps continued from the unpacked history are bitwise identical: ', identical
-  if (.not. identical) call fail('continuation from the unpacked history differs')
+  call check(identical, 'continuation from the unpacked history is bitwise identical')
 
   ! ---- 3. refusals
   call refuse('owner 0', reshape([0, 2], [2, 1]))
@@ -183,7 +182,7 @@ program test_contact_history
   call contact_forces(p, hb, xb(:, 1:n - 1), u, om, box, per, vw, nlb%pair, 0, nlb%wall, 0, dt, &
                       fb, tb, sb, st, info)
   print '(a,i0)', '3. contact_forces with a history for another N: info ', info
-  if (info /= 1) call fail('history for another particle count accepted')
+  call check(info == 1, 'a history for another particle count is refused')
 
   ! ---- 4. frictionless: no history at all
   call contact_setup(p0, 1.0_dp, 0.02_dp, 0.0_dp, 0.05_dp, 0.0_dp, 1.0_dp, 1.0_dp, info, msg)
@@ -196,8 +195,8 @@ program test_contact_history
   end do
   print '(a,i0,a,l1)', '4. mu_d = 0: contacts ', st%pair_contacts + st%wall_contacts, &
     ', history allocated ', allocated(hbad%partner) .or. allocated(hbad%first)
-  if (allocated(hbad%partner) .or. allocated(hbad%first) .or. history_size(hbad) /= 0 .or. &
-      st%pair_contacts == 0) call fail('mu_d = 0 allocated a history')
+  call check(.not. (allocated(hbad%partner) .or. allocated(hbad%first) .or. history_size(hbad) /= 0 .or. &
+             st%pair_contacts == 0), 'mu_d = 0 allocates no history')
 
   call finish('test_contact_history')
 
@@ -229,7 +228,7 @@ contains
     ups = 1
     call history_unpack(hr, n, size(ids, 2), ids, ups, inf)
     print '(a,a20,a,i0,a,i0)', '3. unpack refuses ', label, ': info ', inf, ', size ', history_size(hr)
-    if (inf == 0 .or. history_size(hr) /= 0) call fail('unpack accepted '//label)
+    call check(inf /= 0 .and. history_size(hr) == 0, 'unpack refuses '//label)
   end subroutine refuse
 
 end program test_contact_history

@@ -30,7 +30,7 @@ program test_contact_kinematics
   use mod_vector, only: cross
   use mod_contact, only: contact_params_t, contact_setup, contact_history_t, history_size, &
                          history_lookup, contact_forces, contact_stats_t
-  use mod_unit_checks, only: fail, finish
+  use mod_unit_checks, only: check, fail, finish
   implicit none
   type(contact_params_t) :: p
   type(contact_history_t) :: h
@@ -104,11 +104,11 @@ program test_contact_kinematics
   print '(a,i0,a,i0,a,es9.2,a,es9.2)', '1. stick for ', nstick, ' steps (first slide predicted at ', &
     step, '), stick error ', err_stick, ', slide |F_t|/(mu|F_n|) - 1 ', err_slide
   print '(a,l1,a,es9.2)', '   reversed wall: slid back ', slid_back, '; torque error ', err_torque
-  if (err_stick > 1.0e-12_dp) call fail('stick phase: F_t /= -k_t (U - V) t')
-  if (first_slide /= step) call fail('stick phase duration')
-  if (err_slide > 1.0e-13_dp) call fail('sliding: |F_t| /= mu_d |F_n|')
-  if (.not. slid_back) call fail('no sliding after the reversal')
-  if (err_torque > 1.0e-15_dp) call fail('torque /= a n x F')
+  call check(err_stick <= 1.0e-12_dp, 'stick phase: F_t = -k_t (U - V) t')
+  call check(first_slide == step, 'stick phase duration')
+  call check(err_slide <= 1.0e-13_dp, 'sliding: |F_t| = mu_d |F_n|')
+  call check(slid_back, 'sliding after the reversal')
+  call check(err_torque <= 1.0e-15_dp, 'torque = a n x F')
 
   ! ---- 2. rolling without slip on the moving wall, wrapped across x = Lx
   call clear_history()
@@ -131,8 +131,8 @@ program test_contact_kinematics
   ups = history_lookup(h, 1, -1)
   print '(a,es9.2,a,f6.3,a,i0,a,es9.2)', '2. rolling on the wall: max |F_t|/|F_n| = ', fmax_t, &
     ', x now ', x(1, 1), ' (wrapped), stored contacts ', history_size(h), ', |Ups| ', norm2(ups)
-  if (fmax_t > 1.0e-14_dp) call fail('rolling without slip gave a tangential force')
-  if (history_size(h) /= 1) call fail('the rolling contact is not in the history')
+  call check(fmax_t <= 1.0e-14_dp, 'rolling without slip gives no tangential force')
+  call check(history_size(h) == 1, 'the rolling contact is in the history')
 
   ! ---- 3. two spheres rolling on each other, oblique normal
   call clear_history()
@@ -153,7 +153,7 @@ program test_contact_kinematics
     if (any(force(:, 1) /= -force(:, 2))) call fail('pair: action /= reaction')
   end do
   print '(a,es9.2)', '3. two spheres rolling on each other: max |F_t|/|F_n| = ', fmax_t
-  if (fmax_t > 1.0e-12_dp) call fail('rolling pair gave a tangential force')
+  call check(fmax_t <= 1.0e-12_dp, 'a rolling pair gives no tangential force')
 
   ! ---- 4. two spheres sliding past each other at a fixed overlap
   call clear_history()
@@ -178,8 +178,8 @@ program test_contact_kinematics
   end do
   print '(a,i0,a,es9.2,a,es9.2)', '4. pair sliding from step ', first_slide, &
     ': |F_t|/(mu|F_n|) - 1 = ', err_slide, ', 1 + cos(F_t, slip) = ', err_cos
-  if (first_slide == 0 .or. err_slide > 1.0e-13_dp) call fail('pair sliding: |F_t| /= mu_d |F_n|')
-  if (err_cos > 1.0e-12_dp) call fail('pair sliding: F_t does not oppose the slip')
+  call check(first_slide /= 0 .and. err_slide <= 1.0e-13_dp, 'pair sliding: |F_t| = mu_d |F_n|')
+  call check(err_cos <= 1.0e-12_dp, 'pair sliding: F_t opposes the slip')
 
   call finish('test_contact_kinematics')
 

@@ -5,14 +5,13 @@
 program test_manufactured
   use mod_kinds, only: dp
   use mod_manufactured, only: mms_velocity, mms_pressure, mms_forcing
+  use mod_unit_checks, only: check, check_below, finish
   implicit none
   real(dp), parameter :: box(3) = [3.2_dp, 4.0_dp, 2.4_dp], step = 1.0e-3_dp, tol = 1.0e-7_dp
   real(dp) :: x(3), div, lap, gradp, f, worst
   integer :: n, c, d, w
   logical :: walls
-  integer :: failures
 
-  failures = 0
   do w = 0, 1
     walls = (w == 1)
     worst = 0.0_dp
@@ -40,15 +39,12 @@ program test_manufactured
       end if
     end do
     ! the field must not be trivial
-    if (abs(mms_velocity(3, [0.3_dp, 0.7_dp, 0.5_dp], box, walls)) < 1.0e-3_dp) then
-      print *, 'FAIL: trivial w'
-      failures = failures + 1
-    end if
-    print '(a,l2,a,es10.3)', 'walls', walls, ': worst residual ', worst
-    if (worst > tol) failures = failures + 1
+    call check(abs(mms_velocity(3, [0.3_dp, 0.7_dp, 0.5_dp], box, walls)) >= 1.0e-3_dp, &
+               trim(merge('walls:    ', 'periodic: ', walls))//' w is not trivial')
+    call check_below(trim(merge('walls:    ', 'periodic: ', walls))//' worst residual of div u, f - (grad p - lap u), u at the walls', &
+                     worst, tol)
   end do
-  if (failures > 0) error stop 'test_manufactured failed'
-  print '(a)', 'test_manufactured: passed'
+  call finish('test_manufactured')
 
 contains
 

@@ -20,7 +20,7 @@ program test_neighbours
   use mod_neighbours, only: nlist_t, nlist_init, nlist_build, nlist_needs_rebuild, min_image
   use mod_packing, only: rng_t, rng_seed, rng_uniform, random_packing, packing_report_t, &
                          packing_box_for
-  use mod_unit_checks, only: fail, finish
+  use mod_unit_checks, only: check, fail, finish
   implicit none
   integer :: k, info
   real(dp), parameter :: phis(6) = [0.1_dp, 0.2_dp, 0.3_dp, 0.4_dp, 0.5_dp, 0.55_dp]
@@ -82,7 +82,7 @@ program test_neighbours
   work(2) = nl%n_dist / 5000
   print '(a,i0,a,i0,a,f7.4,a)', 'distance evaluations per particle: N = 500: ', work(1), &
     ', N = 5000: ', work(2), ' (build ', t1 - t0, ' s)'
-  if (real(work(2), dp) > 1.3_dp * real(work(1), dp)) call fail('work per particle grows with N')
+  call check(real(work(2), dp) <= 1.3_dp * real(work(1), dp), 'work per particle does not grow with N (O(N) build)')
 
   call finish('test_neighbours')
 
@@ -231,8 +231,8 @@ contains
     print '(a,a28,a,i5,a,f5.2,a,i6,a,i6,a,i4,a,l1)', '  ', label, ' N ', n, ' phi ', &
       n * 4 * pi / 3 / product(bx), ' pairs ', nl%npairs, ' O(N^2) ', nb, ' walls ', nl%nwalls, &
       ' equal ', same
-    if (.not. same) call fail(label//': pair sets differ')
-    if (nbw /= nl%nwalls .or. nw_direct /= nl%nwalls) call fail(label//': wall candidates differ')
+    call check(same, label//': the pair set is the O(N^2) search''s')
+    call check(nbw == nl%nwalls .and. nw_direct == nl%nwalls, label//': the wall candidates are the direct search''s')
   end subroutine compare
 
   subroutine skin_check()
@@ -250,7 +250,7 @@ contains
       end do
       y(:, i) = x(:, i) + 0.49_dp * skin * rng_uniform(g) * r / max(norm2(r), 1.0e-12_dp)
     end do
-    if (nlist_needs_rebuild(nl, y)) call fail('skin: rebuild asked after moves < skin/2')
+    call check(.not. nlist_needs_rebuild(nl, y), 'skin: no rebuild asked after moves < skin/2')
     missing = 0
     do i = 1, size(y, 2)
       do j = i + 1, size(y, 2)
@@ -267,9 +267,9 @@ contains
       end do
     end do
     print '(a,i0)', '  skin: pairs within cutoff - skin missing from the old list: ', missing
-    if (missing > 0) call fail('skin: a pair within cutoff - skin is missing')
+    call check(missing == 0, 'skin: every pair within cutoff - skin is in the old list')
     y(:, 7) = x(:, 7) + [0.51_dp * skin, 0.0_dp, 0.0_dp]
-    if (.not. nlist_needs_rebuild(nl, y)) call fail('skin: no rebuild after a move > skin/2')
+    call check(nlist_needs_rebuild(nl, y), 'skin: a rebuild after a move > skin/2')
   end subroutine skin_check
 
   subroutine heapsort(a)

@@ -18,7 +18,7 @@ program test_packing
   use mod_kinds, only: dp, i8, pi
   use mod_packing, only: rng_t, rng_uniform, random_packing, packing_report_t, packing_count, &
                          packing_box_for, phi_max
-  use mod_unit_checks, only: fail, finish
+  use mod_unit_checks, only: check, fail, finish
   implicit none
   integer, parameter :: nphi = 5
   real(dp), parameter :: phis(nphi) = [0.1_dp, 0.3_dp, 0.45_dp, 0.5_dp, 0.55_dp]
@@ -78,9 +78,9 @@ program test_packing
   box = packing_box_for(500, 0.4_dp, [1.0_dp, 1.0_dp, 1.0_dp], 1.0_dp)
   call random_packing(500, box, [.true., .true., .true.], 1.0_dp, 0.0_dp, 3, 50, x, info, msg, rep)
   call random_packing(500, box, [.true., .true., .true.], 1.0_dp, 0.0_dp, 3, 50, y, info, msg, rep)
-  if (.not. all(x == y)) call fail('same seed, different positions')
+  call check(all(x == y), 'the same seed gives the same positions')
   call random_packing(500, box, [.true., .true., .true.], 1.0_dp, 0.0_dp, 4, 50, y, info, msg, rep)
-  if (all(abs(x - y) < 1.0e-6_dp)) call fail('another seed gives the same positions')
+  call check(.not. all(abs(x - y) < 1.0e-6_dp), 'another seed gives other positions')
   print '(a)', '4. same seed: bit-identical positions; seed 4 differs from seed 3'
 
   ! 5. refusals
@@ -88,10 +88,10 @@ program test_packing
   call random_packing(packing_count(phi_max + 0.01_dp, box, 1.0_dp), box, per, 1.0_dp, 0.0_dp, 1, &
                       10, x, info, msg, rep)
   print '(2a)', '5. phi = 0.56: ', trim(msg)
-  if (info /= 1) call fail('phi above 0.55 accepted')
+  call check(info == 1, 'phi above 0.55 is refused')
   call random_packing(10, [20.0_dp, 3.9_dp, 20.0_dp], per, 1.0_dp, 0.0_dp, 1, 10, x, info, msg, rep)
   print '(2a)', '   Ly = 3.9a: ', trim(msg)
-  if (info /= 2) call fail('box below 4a accepted')
+  call check(info == 2, 'a box below 4a is refused')
 
   call finish('test_packing')
 
@@ -103,6 +103,8 @@ contains
     integer(i8), intent(in) :: ticks, tick_rate
     integer :: i, j, d, nn
     real(dp) :: r(3), dmin2, wmin, phin, bound
+    character(len=40) :: label
+    write(label, '(a,l1,a,f5.2)') 'periodic y ', pr(2), ', phi ', phi
     nn = size(xx, 2)
     dmin2 = huge(1.0_dp)
     do i = 1, nn
@@ -121,15 +123,15 @@ contains
     print '(a,l1,a,f5.2,a,i5,a,f8.5,a,es10.3,a,es10.3,a,f7.3,a)', '2. periodic y ', pr(2), &
       ' phi ', phi, ': N ', nn, ' phi_N ', phin, ', min pair gap ', sqrt(dmin2) - 2, &
       ', min wall gap ', wmin, ', ', real(ticks, dp) / real(tick_rate, dp), ' s'
-    if (sqrt(dmin2) - 2 < gmin - 1.0e-12_dp) call fail('overlapping spheres (or gap < min_gap)')
-    if (wmin < gmin - 1.0e-12_dp) call fail('a sphere overlaps a wall (or gap < min_gap)')
+    call check(sqrt(dmin2) - 2 >= gmin - 1.0e-12_dp, trim(label)//': no overlapping spheres (pair gaps >= min_gap)')
+    call check(wmin >= gmin - 1.0e-12_dp, trim(label)//': no sphere overlaps a wall (wall gaps >= min_gap)')
     do d = 1, 3
       if (pr(d)) then
         if (any(xx(d, :) < 0) .or. any(xx(d, :) >= bx(d))) call fail('a coordinate outside [0, L)')
       end if
     end do
-    if (abs(phin / phi - 1) > max(bound, 1.0e-12_dp) .or. abs(phin / phi - 1) > 0.005_dp) &
-      call fail('volume fraction off target')
+    call check(.not. (abs(phin / phi - 1) > max(bound, 1.0e-12_dp) .or. abs(phin / phi - 1) > 0.005_dp), &
+               trim(label)//': volume fraction on target')
   end subroutine check_configuration
 
 end program test_packing

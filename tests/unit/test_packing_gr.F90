@@ -17,7 +17,7 @@ program test_packing_gr
   use mod_packing, only: rng_t, rng_seed, random_packing, hs_monte_carlo, packing_report_t, &
                          packing_box_for, min_separation
   use mod_neighbours, only: nlist_t, nlist_init, nlist_build
-  use mod_unit_checks, only: fail, finish
+  use mod_unit_checks, only: check, finish
   implicit none
   integer, parameter :: n = 2000, nbin = 10, nsamp = 400, nblk = 10, gap_sweeps = 4
   real(dp), parameter :: dr = 0.02_dp
@@ -56,7 +56,7 @@ program test_packing_gr
       end do
     end do
     call min_separation(x, box, [.true., .true., .true.], 1.0_dp, pg, wg)
-    if (pg < 0) call fail('an overlap appeared during Monte Carlo')
+    call check(pg >= 0, 'no overlap appeared during Monte Carlo')
     g0 = contact_value(sum(cnt, 2), nsamp, 2, nbin)
     g3 = contact_value(sum(cnt, 2), nsamp, 3, nbin)
     g1 = contact_value(sum(cnt, 2), nsamp, 1, nbin / 2)
@@ -69,10 +69,10 @@ program test_packing_gr
     print '(a,f4.2,a,f7.4,a,f7.4,a,f7.4,a,f7.4,a,f6.3,a,f6.2,a,f6.3,a,f5.1,a)', 'phi ', phis(k), &
       ': g(2a) = ', g0, ' +- ', se, ' (cubic ', g3, ', linear ', g1, '), CS ', gcs, &
       ', rel. diff ', 100 * (g0 / gcs - 1), ' %, MC step ', step, ' a (', t1 - t0, ' s)'
-    if (se > 0.015_dp * gcs) call fail('statistical error above 1.5 %: not conclusive')
-    if (abs(g0 / gcs - 1) > 0.05_dp) call fail('g(2a) differs from Carnahan-Starling by > 5 %')
-    if (abs(g3 / g0 - 1) > 0.02_dp .or. abs(g1 / g0 - 1) > 0.02_dp) &
-      call fail('extrapolation to contact depends on the fit by > 2 %')
+    call check(se <= 0.015_dp * gcs, 'statistical error at most 1.5 % (conclusive)')
+    call check(abs(g0 / gcs - 1) <= 0.05_dp, 'g(2a) within 5 % of Carnahan-Starling')
+    call check(abs(g3 / g0 - 1) <= 0.02_dp .and. abs(g1 / g0 - 1) <= 0.02_dp, &
+               'extrapolation to contact depends on the fit by at most 2 %')
   end do
 
   call finish('test_packing_gr')

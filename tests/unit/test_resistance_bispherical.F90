@@ -28,7 +28,7 @@
 program test_resistance_bispherical
   use mod_kinds, only: dp
   use mod_resistance, only: n_pair_scalars, resistance_scalars, i_xa11, i_xa12, i_xc11, i_xc12
-  use mod_unit_checks, only: failures, finish
+  use mod_unit_checks, only: check_below, finish
   implicit none
   real(dp), parameter :: gaps(16) = [1.0e-5_dp, 1.0e-4_dp, 1.0e-3_dp, 5.0e-3_dp, 0.01_dp, 0.02_dp, &
                                      0.035_dp, 0.07_dp, 0.15_dp, 0.33_dp, 0.7_dp, 1.45_dp, 2.2_dp, &
@@ -52,29 +52,17 @@ program test_resistance_bispherical
     print '(es10.2, 4(es12.5, es10.2))', gaps(k), ex(1), e(1), ex(2), e(2), ex(3), e(3), ex(4), e(4)
   end do
   do k = 1, 4
-    if (worst(k) <= tol(k)) then
-      print '(a,a,a,es9.2,a,es8.1,a)', 'PASS ', trim(names(k)), ': max rel. error ', worst(k), &
-        ' (tol ', tol(k), ')'
-    else
-      print '(a,a,a,es9.2,a,es8.1,a)', 'FAIL ', trim(names(k)), ': max rel. error ', worst(k), &
-        ' (tol ', tol(k), ')'
-      failures = failures + 1
-    end if
+    call check_below(trim(names(k))//': max rel. error', worst(k), tol(k))
   end do
   f = resistance_scalars(1.0e-9_dp)
   e(1) = abs((f(i_xa11) + f(i_xa12)) / stimson_jeffery(2.0_dp + 1.0e-9_dp) - 1.0_dp)
   print '(a,f10.7,a,f10.7,a,es9.2)', 'co-translation at contact (gap 1e-9): module ', &
     f(i_xa11) + f(i_xa12), ', Stimson & Jeffery ', stimson_jeffery(2.0_dp + 1.0e-9_dp), &
     ', rel. error ', e(1)
-  if (e(1) > 3.0e-5_dp) then
-    print '(a)', 'FAIL co-translation contact constant'
-    failures = failures + 1
-  end if
+  call check_below('co-translation contact constant, rel. error', e(1), 3.0e-5_dp)
   ! Contact limits of the exact solutions themselves (sanity of the series): zeta(3), 3/4 zeta(3).
-  if (abs(jeffery_rotation(2.0_dp + 1.0e-6_dp, .false.) - 1.2020569_dp) > 1.0e-4_dp) then
-    print '(a)', 'FAIL Jeffery counter-rotation series does not tend to zeta(3)'
-    failures = failures + 1
-  end if
+  call check_below('Jeffery counter-rotation series at gap 1e-6 - zeta(3)', &
+                   abs(jeffery_rotation(2.0_dp + 1.0e-6_dp, .false.) - 1.2020569_dp), 1.0e-4_dp)
   call finish('test_resistance_bispherical')
 
 contains

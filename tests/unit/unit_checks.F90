@@ -1,13 +1,16 @@
-! Pass/fail bookkeeping shared by the unit tests (tests/unit/test_*.F90): one counter of failed
-! checks, the two kinds of check they make, and the exit status tests/run_tests.sh reads.
+! Pass/fail bookkeeping shared by the unit tests (tests/unit/test_*.F90): counters of the checks
+! made and failed, the two kinds of check they make, and the exit status tests/run_tests.sh reads:
+! a test passes only when it made at least one check and none failed.
 module mod_unit_checks
   use mod_kinds, only: dp
   implicit none
   private
-  public :: failures, check, check_below, fail, finish
+  public :: failures, checks, check, check_below, fail, finish
 
   !> failed checks so far (a test may also count its own failures here)
   integer :: failures = 0
+  !> checks made so far
+  integer :: checks = 0
 
 contains
 
@@ -15,6 +18,7 @@ contains
   subroutine check(ok, what)
     logical, intent(in) :: ok
     character(len=*), intent(in) :: what
+    checks = checks + 1
     if (ok) then
       print '(2a)', '  ok    ', what
     else
@@ -35,17 +39,22 @@ contains
     real(dp), intent(in) :: value, tol
     logical :: ok
     ok = value <= tol                   ! false for NaN
+    checks = checks + 1
     print '(a,a,a,es10.3,a,es9.2,a)', merge('  ok    ', '  FAIL  ', ok), what, ': ', value, ' (tol ', tol, ')'
     if (.not. ok) failures = failures + 1
   end subroutine check_below
 
-  !> The verdict: a failed test exits with status 1.
+  !> The verdict: a test that failed a check, or made none, exits with status 1.
   subroutine finish(name)
     character(len=*), intent(in) :: name
     if (failures > 0) then
       print '(a,a,i0,a)', name, ': ', failures, ' check(s) FAILED'
       error stop 1
     end if
-    print '(2a)', name, ': all checks passed'
+    if (checks == 0) then
+      print '(2a)', name, ': FAIL  the test made no checks'
+      error stop 1
+    end if
+    print '(a,a,i0,a)', name, ': all ', checks, ' checks passed'
   end subroutine finish
 end module mod_unit_checks
