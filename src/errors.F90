@@ -5,6 +5,7 @@
 #include <petsc/finclude/petscsys.h>
 module mod_errors
   use petscsys
+  use mod_system, only: release_directory
   implicit none
   private
   public :: input_error, file_error, fatal_error, abort_run, is_root, log_line, warn_line
@@ -54,7 +55,8 @@ contains
     call fatal_error(where//': '//trim(message), 2)
   end subroutine file_error
 
-  ! A collective fatal error: every rank calls it. Rank 0 prints; all ranks finalise and exit.
+  ! A collective fatal error: every rank calls it. Rank 0 prints and releases the output
+  ! directory (mod_system; a no-op before it is locked); all ranks finalise and exit.
   subroutine fatal_error(message, status)
     character(len=*), intent(in) :: message
     integer, intent(in) :: status
@@ -63,6 +65,7 @@ contains
       write(0, '(a)') trim(message)
       flush(0)
     end if
+    call release_directory()
     call PetscFinalize(ierr)
     call exit(status)
   end subroutine fatal_error

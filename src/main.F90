@@ -16,7 +16,8 @@ program fdsusp
   use mod_series, only: series_t, series_open, series_record, series_flush, series_attributes
   use mod_output, only: write_fields, progress_line
   use mod_checkpoint, only: checkpoint_write, checkpoint_check, checkpoint_read
-  use mod_system, only: install_signal_handlers, stop_signal, make_directory, probe_directory
+  use mod_system, only: install_signal_handlers, stop_signal, make_directory, probe_directory, lock_directory, &
+                        release_directory
   use mod_timers, only: timers_register, stage_push, stage_pop, STAGE_SETUP, STAGE_FLUID, STAGE_OUTPUT, &
                         STAGE_PARTICLES, STAGE_CONTACTS, STAGE_LUBRICATION
   use mod_particles, only: particles_t, advance_positions, displacements, MOTION_FREE
@@ -381,6 +382,7 @@ program fdsusp
   end if
   PetscCallA(fluid_destroy(fl, ierr))
   PetscCallA(grid_destroy(grid, ierr))
+  call release_directory()
   PetscCallA(PetscFinalize(ierr))
 
 contains
@@ -401,22 +403,43 @@ contains
       call fatal_error('fdsusp: -restart needs the path of a checkpoint', 2)
   end subroutine command_line
 
-  ! The output directory must exist (it is created) and be writable now, not hours from now.
+  ! The output directory must exist (it is created), be this run's alone (a lock, before anything
+  ! is written there) and be writable now, not hours from now. The lock (src/system_c.c) is held by
+  ! rank 0's process until it ends and dies with it, so a lock file left by a killed run does not
+  ! block the next start.
   subroutine prepare_output_directory(cfg)
     type(config_t), intent(in) :: cfg
-    integer :: err
+    integer :: state(2)                        ! errno, lock status
     character(len=16) :: code
-    err = 0
+    character(len=400) :: holder
+    character(len=:), allocatable :: dir
+    dir = trim(cfg%output_directory)
+    state = 0
+    holder = ''
     if (is_rank0()) then
-      err = make_directory(cfg%output_directory)
-      if (err == 0) err = probe_directory(cfg%output_directory)
+      state(1) = make_directory(dir)
+      if (state(1) == 0) then
+        state(2) = lock_directory(dir, holder)
+        if (state(2) > 0) state(1) = state(2)
+      end if
+      if (state(1) == 0 .and. state(2) /= -1) state(1) = probe_directory(dir)
     end if
-    call MPI_Bcast(err, 1, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
-    if (err /= 0) then
-      write(code, '(i0)') err
-      call input_error(cfg%deck_file, 'output', 'directory', '"'//trim(cfg%output_directory)// &
+    call MPI_Bcast(state, 2, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
+    call MPI_Bcast(holder, len(holder), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
+    if (state(2) == -1) then
+      call input_error(cfg%deck_file, 'output', 'directory', '"'//dir//'" is in use by another run ('// &
+           trim(holder)//', lock file '//dir//'/.fdsusp.lock): wait for it to end, or choose another directory')
+    end if
+    if (state(1) /= 0) then
+      write(code, '(i0)') state(1)
+      call input_error(cfg%deck_file, 'output', 'directory', '"'//dir// &
            '" cannot be created or written (errno '//trim(code)//')')
     end if
+    if (state(2) == -2) call warn_line('the file system of "'//dir//'" offers no locks: a second run '// &
+         'started into it would not be refused')
+    if (state(2) == 0 .and. len_trim(holder) > 0) call log_line('output directory '//dir//': its lock file '// &
+         'names '//trim(holder)//', a run that ended without releasing it (killed or crashed); that lock '// &
+         'ended with its process: taken over')
   end subroutine prepare_output_directory
 
   logical function is_rank0()

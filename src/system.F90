@@ -1,9 +1,10 @@
-! Fortran side of src/system_c.c: signals and atomic file publication.
+! Fortran side of src/system_c.c: signals, atomic file publication and the output directory's lock.
 module mod_system
   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
   implicit none
   private
-  public :: install_signal_handlers, stop_signal, publish_file, make_directory, probe_directory
+  public :: install_signal_handlers, stop_signal, publish_file, make_directory, probe_directory, &
+            lock_directory, release_directory
 
   interface
     subroutine fdsusp_install_signal_handlers() bind(C, name='fdsusp_install_signal_handlers')
@@ -23,6 +24,14 @@ module mod_system
       import :: c_int, c_char
       character(kind=c_char), intent(in) :: path(*)
     end function fdsusp_probe_directory
+    integer(c_int) function fdsusp_lock_directory(path, previous, length) bind(C, name='fdsusp_lock_directory')
+      import :: c_int, c_char
+      character(kind=c_char), intent(in) :: path(*)
+      character(kind=c_char), intent(out) :: previous(*)
+      integer(c_int), value :: length
+    end function fdsusp_lock_directory
+    subroutine fdsusp_release_directory() bind(C, name='fdsusp_release_directory')
+    end subroutine fdsusp_release_directory
   end interface
 
 contains
@@ -51,5 +60,26 @@ contains
     character(len=*), intent(in) :: path
     probe_directory = int(fdsusp_probe_directory(trim(path)//c_null_char))
   end function probe_directory
+
+  ! Lock the output directory for this process (rank 0; src/system_c.c): 0 taken, -1 another live
+  ! run holds it, -2 the file system offers no locks, else the errno of creating the lock file.
+  ! holder: who holds it (refused) or held it last without releasing it (taken), '' if nobody.
+  integer function lock_directory(path, holder)
+    character(len=*), intent(in) :: path
+    character(len=*), intent(out) :: holder
+    character(kind=c_char) :: text(400)
+    integer :: k
+    lock_directory = int(fdsusp_lock_directory(trim(path)//c_null_char, text, int(size(text), c_int)))
+    holder = ''
+    do k = 1, min(len(holder), size(text))
+      if (text(k) == c_null_char) exit
+      holder(k:k) = text(k)
+    end do
+  end function lock_directory
+
+  ! A clean end: the lock file emptied and the lock dropped (a no-op without a lock).
+  subroutine release_directory()
+    call fdsusp_release_directory()
+  end subroutine release_directory
 
 end module mod_system

@@ -1,5 +1,6 @@
 /* Operating-system services fdsusp needs and Fortran lacks: catching the signals batch
- * schedulers send before they kill a job, and publishing a file atomically.
+ * schedulers send before they kill a job, publishing a file atomically, and locking the output
+ * directory against a second run.
  * Called from Fortran through mod_system (system.F90) (bind(C)). */
 #include <errno.h>
 #include <fcntl.h>
@@ -10,6 +11,7 @@
 #include <unistd.h>
 #include <libgen.h>
 #include <stdlib.h>
+#include <sys/types.h>
 
 static volatile sig_atomic_t stop_signal = 0;
 
@@ -76,4 +78,75 @@ int fdsusp_probe_directory(const char *path)
   close(fd);
   unlink(buf);
   return 0;
+}
+
+/* The output directory's lock: an exclusive POSIX record lock (fcntl F_SETLK, whole file) on
+ * DIR/.fdsusp.lock, taken by rank 0 at the start of a run and held by its process until it ends.
+ * The kernel drops the lock when the process ends, however it ends (exit, crash, SIGKILL), so a
+ * lock file left behind is not a lock: the next run takes it. That is how staleness is
+ * recognised; the file's text ("pid PID on host HOST") only names the holder in messages. On NFS
+ * the lock lives on the server (NLM, or NFSv4 state), which frees it when the client's lease
+ * expires if the node itself died (typically 90 s).
+ * Returns 0: taken (the file now names this process; `previous` is what it named before, the
+ * holder of a run that ended without releasing the directory, "" after a clean release);
+ * -1: a live process holds it (`previous` names it); -2: the file system offers no locks (the
+ * run goes on unprotected); else the errno of creating the lock file. */
+static int lock_fd = -1;
+
+static void read_holder(int fd, char *text, int len)
+{
+  ssize_t n = pread(fd, text, (size_t)(len - 1), 0);
+  if (n < 0) n = 0;
+  text[n] = '\0';
+  for (ssize_t k = n - 1; k >= 0 && (text[k] == '\n' || text[k] == ' '); --k) text[k] = '\0';
+}
+
+int fdsusp_lock_directory(const char *dir, char *previous, int len)
+{
+  char path[4200], host[256], me[400];
+  struct flock fl;
+  int fd, e;
+  previous[0] = '\0';
+  if (lock_fd >= 0) return 0;
+  snprintf(path, sizeof(path), "%s/.fdsusp.lock", dir);
+  fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0) return errno;
+  memset(&fl, 0, sizeof(fl));
+  fl.l_type = F_WRLCK;
+  fl.l_whence = SEEK_SET;
+  fl.l_start = 0;
+  fl.l_len = 0;                                /* the whole file */
+  if (fcntl(fd, F_SETLK, &fl) != 0) {
+    e = errno;
+    if (e == EACCES || e == EAGAIN) {
+      read_holder(fd, previous, len);
+      e = -1;
+    } else if (e == ENOLCK || e == EOPNOTSUPP || e == ENOSYS || e == EINVAL) {
+      e = -2;
+    }
+    close(fd);
+    return e;
+  }
+  read_holder(fd, previous, len);
+  if (gethostname(host, sizeof(host)) != 0) strcpy(host, "?");
+  host[sizeof(host) - 1] = '\0';
+  snprintf(me, sizeof(me), "pid %ld on host %s\n", (long)getpid(), host);
+  if (ftruncate(fd, 0) != 0 || pwrite(fd, me, strlen(me), 0) != (ssize_t)strlen(me)) {
+    e = errno;
+    close(fd);
+    return e;
+  }
+  fsync(fd);
+  lock_fd = fd;                                /* kept open: closing any descriptor of the file drops the lock */
+  return 0;
+}
+
+/* A clean end: empty the lock file (so the next run does not report a run that ended without
+ * releasing it) and drop the lock. Nothing when no lock is held. */
+void fdsusp_release_directory(void)
+{
+  if (lock_fd < 0) return;
+  if (ftruncate(lock_fd, 0) == 0) fsync(lock_fd);
+  close(lock_fd);
+  lock_fd = -1;
 }
