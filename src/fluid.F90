@@ -249,7 +249,10 @@ contains
         PetscCall(VecAXPY(fl%rhs(c), 1.0_dp, source(c), ierr))
         ! the wall row of v stays a fixed row (v = 0): a particle never forces it
       end if
-      if (fl%star_history == STAR_HISTORY_FULL .and. fl%extrapolate) then
+      if (fl%solver(c)%direct) then
+        ! exact solves need no guess: u*^n is kept only for the Krylov path's extrapolation
+        call solver_solve(fl%solver(c), fl%rhs(c), fl%vel_star(c), ierr)
+      else if (fl%star_history == STAR_HISTORY_FULL .and. fl%extrapolate) then
         ! vel_star_old := 2 u*^n - u*^{n-1}, then swapped: the guess in vel_star, u*^n in vel_star_old
         PetscCall(VecAXPBY(fl%vel_star_old(c), 2.0_dp, -1.0_dp, fl%vel_star(c), ierr))
         PetscCall(VecSwap(fl%vel_star_old(c), fl%vel_star(c), ierr))
@@ -261,7 +264,8 @@ contains
         call solver_solve(fl%solver(c), fl%rhs(c), fl%vel_star(c), ierr)
       end if
     end do
-    fl%star_history = min(STAR_HISTORY_FULL, fl%star_history + 1)
+    ! (direct solves keep no history: a Krylov run restarted from their checkpoint starts from u^n)
+    if (.not. fl%solver(FIELD_U)%direct) fl%star_history = min(STAR_HISTORY_FULL, fl%star_history + 1)
     PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_P), fl%loc(FIELD_P), p, ierr))
 
     ! 2. pressure increment: -lap phi = -(Re/dt) div u*
