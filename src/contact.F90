@@ -30,6 +30,7 @@ module mod_contact
   public :: contact_history_t, history_size, history_pack, history_unpack, history_clear
   public :: history_lookup, contact_pair, contact_forces, contact_stresslet
   public :: wall_lower, wall_upper, chatter_number, flattening_estimate
+  public :: contact_links_t, contact_stiffness
 
   integer, parameter :: wall_lower = -1, wall_upper = -2   ! history partner ids of the walls
 
@@ -51,6 +52,19 @@ module mod_contact
     integer :: max_overlap_pair(2) = 0  ! its particles (partner wall_lower/wall_upper for a wall)
     real(dp) :: max_normal_force = 0
   end type contact_stats_t
+
+  !> The open contacts of one step, for their implicit stiffness (contact_stiffness): one entry per
+  !> contact found by contact_forces, in the order it met them. partner: the other particle (> i)
+  !> or wall_lower/wall_upper; normal: unit normal from i towards the partner; overlap: delta'
+  !> (<= 0); lever: centre of i to the middle of the gap (the stresslet's lever, r/2 for a pair);
+  !> sliding: at the Coulomb limit (no tangential stiffness).
+  type :: contact_links_t
+    integer :: n = 0
+    integer, allocatable :: i(:), partner(:)
+    real(dp), allocatable :: normal(:,:), lever(:,:)   ! (3, n)
+    real(dp), allocatable :: overlap(:)
+    logical, allocatable :: sliding(:)
+  end type contact_links_t
 
   !> Tangential springs of the open contacts, in compressed-row form over the owner particle:
   !> the contacts owned by particle i (i < partner, or i with a wall) are entries
@@ -207,6 +221,54 @@ contains
     end do
   end function contact_stresslet
 
+  !> The linearised stiffness of one contact (doc/CONTACT.md "Implicit contacts"), in the
+  !> generalised coordinates q = (U_i, Omega_i, U_partner, Omega_partner) (12) of contact_pair
+  !> (for a wall: its translation and zero rotation). n, dlt, sliding: as contact_pair saw them.
+  !>   k_norm = k b b^T, b = (n, 0, -n, 0), k = dF_n/d|delta'| = (3/2) k_n |delta'|^{1/2}: the
+  !>            generalised force changes by -k_norm dX for displacements dX of the two bodies
+  !>            (the geometric term |F_n|/|r| (I - n n^T) of the turning normal, smaller by
+  !>            |delta'|/|r| and not positive semi-definite, is left out);
+  !>   k_tan  = k_t B^T B, B = (P, -a [n]x, -P, -a [n]x), P = I - n n^T, so that B q is the slip
+  !>            velocity U^s of (2.21); the force changes by -k_tan dq dt when the spring takes one
+  !>            more increment U^s dt (sticking contacts only: a sliding or frictionless contact,
+  !>            or one at delta' = 0, has none).
+  !> Both symmetric positive semi-definite by construction (sums of outer products). Open
+  !> contacts (dlt > 0) give zero blocks.
+  pure subroutine contact_stiffness(p, n, dlt, sliding, k_norm, k_tan)
+    type(contact_params_t), intent(in) :: p
+    real(dp), intent(in) :: n(3), dlt
+    logical, intent(in) :: sliding
+    real(dp), intent(out) :: k_norm(12, 12), k_tan(12, 12)
+    real(dp) :: b(12), bt(3, 12), k, k_t
+    integer :: c
+    k_norm = 0
+    k_tan = 0
+    if (dlt > 0) return
+    k = 1.5_dp * p%k_n * sqrt(abs(dlt))
+    b = 0
+    b(1:3) = n
+    b(7:9) = -n
+    k_norm = k * spread(b, 2, 12) * spread(b, 1, 12)
+    if (p%mu_d <= 0 .or. sliding .or. dlt == 0) return
+    k_t = p%kt_coeff * p%k_n * sqrt(abs(dlt))
+    bt = 0
+    do c = 1, 3
+      bt(c, c) = 1
+      bt(:, c) = bt(:, c) - n(c) * n                       ! P
+      bt(:, 6 + c) = -bt(:, c)                             ! -P
+      bt(:, 3 + c) = -p%a * cross(n, unit(c))              ! -a n x e_c
+      bt(:, 9 + c) = bt(:, 3 + c)
+    end do
+    k_tan = k_t * matmul(transpose(bt), bt)
+  contains
+    pure function unit(c) result(e)
+      integer, intent(in) :: c
+      real(dp) :: e(3)
+      e = 0
+      e(c) = 1
+    end function unit
+  end subroutine contact_stiffness
+
   ! ---- all contacts of one step ------------------------------------------------------------
 
   !> All contacts of one step. x, u, om: (3, np) positions, velocities, angular velocities;
@@ -215,9 +277,10 @@ contains
   !> order, each pair once, e.g. from mod_neighbours); walls(2, nwalls): candidates (particle,
   !> wall 1 = lower | 2 = upper). Outputs per particle: force, torque (3, np), symmetric contact
   !> stresslet (3, 3, np); stats. The history h advances by one step (not touched if mu_d = 0).
-  !> info: 0 ok; 1 the history was built for another particle count.
+  !> info: 0 ok; 1 the history was built for another particle count. links, optional: the open
+  !> contacts of this step (for their implicit stiffness, contact_stiffness).
   subroutine contact_forces(p, h, x, u, om, box, periodic, vw, pairs, npairs, walls, nwalls, dt, &
-                            force, torque, stresslet, stats, info)
+                            force, torque, stresslet, stats, info, links)
     type(contact_params_t), intent(in) :: p
     type(contact_history_t), intent(inout) :: h
     real(dp), intent(in) :: x(:,:), u(:,:), om(:,:), box(3), vw(3, 2), dt
@@ -226,6 +289,7 @@ contains
     real(dp), intent(out) :: force(:,:), torque(:,:), stresslet(:,:,:)
     type(contact_stats_t), intent(out) :: stats
     integer, intent(out) :: info
+    type(contact_links_t), intent(inout), optional :: links
     integer :: m, i, j, k, w, np, nnew
     integer, allocatable :: new_owner(:), new_partner(:)
     real(dp), allocatable :: new_ups(:,:)
@@ -247,6 +311,7 @@ contains
     nnew = 0
     scale = p%h_r
     if (scale <= 0) scale = p%a
+    if (present(links)) call links_reserve(links, npairs + nwalls)
 
     do m = 1, npairs
       i = min(pairs(1, m), pairs(2, m))
@@ -271,6 +336,7 @@ contains
       s = contact_stresslet(f, 0.5_dp * r)
       stresslet(:, :, i) = stresslet(:, :, i) + s
       stresslet(:, :, j) = stresslet(:, :, j) + s
+      if (present(links)) call add_link(j, 0.5_dp * r)
       call tally(.false., j)
     end do
 
@@ -293,6 +359,7 @@ contains
       force(:, i) = force(:, i) + f
       torque(:, i) = torque(:, i) + tq
       stresslet(:, :, i) = stresslet(:, :, i) + contact_stresslet(f, 0.5_dp * (p%a + d) * n)
+      if (present(links)) call add_link(-w, 0.5_dp * (p%a + d) * n)
       call tally(.true., -w)
     end do
 
@@ -307,6 +374,18 @@ contains
       new_partner(nnew) = other
       new_ups(:, nnew) = ups
     end subroutine append
+
+    subroutine add_link(other, lever)
+      integer, intent(in) :: other
+      real(dp), intent(in) :: lever(3)
+      links%n = links%n + 1
+      links%i(links%n) = i
+      links%partner(links%n) = other
+      links%normal(:, links%n) = n
+      links%lever(:, links%n) = lever
+      links%overlap(links%n) = dlt
+      links%sliding(links%n) = sliding
+    end subroutine add_link
 
     subroutine tally(wall, partner)
       logical, intent(in) :: wall
@@ -325,6 +404,19 @@ contains
     end subroutine tally
 
   end subroutine contact_forces
+
+  !> Empty links with room for at least m contacts (kept allocated from step to step).
+  pure subroutine links_reserve(links, m)
+    type(contact_links_t), intent(inout) :: links
+    integer, intent(in) :: m
+    links%n = 0
+    if (allocated(links%i)) then
+      if (size(links%i) >= m) return
+      deallocate(links%i, links%partner, links%normal, links%lever, links%overlap, links%sliding)
+    end if
+    allocate(links%i(max(m, 16)), links%partner(max(m, 16)), links%normal(3, max(m, 16)), &
+             links%lever(3, max(m, 16)), links%overlap(max(m, 16)), links%sliding(max(m, 16)))
+  end subroutine links_reserve
 
   ! ---- the history -------------------------------------------------------------------------
 

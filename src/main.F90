@@ -87,7 +87,7 @@ program fdsusp
   if (has_contacts) then
     call pcontacts_create(pc, parts%n, parts%radius, cfg%roughness, cfg%friction, cfg%eps_bar, &
          cfg%normal_stiffness, cfg%neighbour_skin, 1.0_dp, cfg%shear_rate, cfg%box, cfg%walls, cfg%dt, &
-         info, text)
+         info, text, cfg%contact_implicit)
     if (info /= 0) call input_error(cfg%deck_file, 'contact', '', trim(text))
   end if
   ! lubrication: pairs or walls to lubricate (doc/LUBRICATION.md); the table is read and checked now
@@ -268,7 +268,11 @@ program fdsusp
       ! system for U, Omega (contact forces and lubrication links, each absent when not
       ! allocated), then Lambda^{n+1}, u^{n+1} and the hydrodynamic force, torque, stresslet
       PetscCallA(fd_moments(grid, fd, fl%vel, parts%n, ierr))
-      PetscCallA(fd_solve_motion(fd, parts, ierr, pc%force, pc%torque, pl))
+      if (has_contacts) then
+        PetscCallA(fd_solve_motion(fd, parts, ierr, lubrication=pl, contacts=pc))
+      else
+        PetscCallA(fd_solve_motion(fd, parts, ierr, lubrication=pl))
+      end if
       PetscCallA(fd_update(grid, fd, fl%vel, fl%pressure, parts, ierr, pl))
       ! the core statistics of this configuration, before it moves on
       ! (pc%stresslet is absent, as unallocated, when there are no contacts)
@@ -571,7 +575,7 @@ contains
   subroutine check_contact_limits()
     real(dp) :: chatter, solid_fraction, expected_overlap
     chatter = chatter_number(pc%params, cfg%dt)
-    if (chatter > CHATTER_LIMIT) then
+    if (.not. pc%implicit .and. chatter > CHATTER_LIMIT) then
       write(text, '(a,f6.3,a,f5.3,a,es9.2,a)') 'the rough contacts would chatter: dt gamma_dot h_r/delta_0 = ', &
            chatter, ' exceeds ', CHATTER_LIMIT, &
            ' (period-two oscillation measured above it; doc/CONTACT.md): the largest stable dt here is ', &

@@ -77,6 +77,7 @@ module mod_params
     real(dp) :: friction = 0.0_dp                       ! mu_d [-]
     real(dp) :: normal_stiffness = 0.0_dp               ! k_n [eta gamma_dot a^(1/2)] (0: from eps_bar)
     real(dp) :: neighbour_skin = 0.2_dp                 ! neighbour-list skin [a]
+    logical :: contact_implicit = .true.                ! linearised contact stiffness in the particle solve
     ! &lubrication (doc/LUBRICATION.md)
     character(len=16) :: lubrication_model = 'full'     ! 'none', 'simple' or 'full'
     character(len=max_line) :: lubrication_table = ''   ! '' = the shipped table for this a/Delta
@@ -220,10 +221,11 @@ contains
     namelist /rheology/ discard_strain, average_strain, blocks, core, profile_bins, angle_bins, pair_shell, contact_shell
     ! &contact
     real(dp) :: roughness, eps_bar, friction, normal_stiffness, neighbour_skin
+    logical :: implicit
     namelist /particles/ number, position, position_file, radius, motion, velocity, omega, &
          external_force, external_torque, radius_offset, slip_kappa, solid_fraction, seed, packing_sweeps, &
          packing_min_gap
-    namelist /contact/ roughness, eps_bar, friction, normal_stiffness, neighbour_skin
+    namelist /contact/ roughness, eps_bar, friction, normal_stiffness, neighbour_skin, implicit
     ! &lubrication
     character(len=16) :: model
     character(len=max_line) :: table
@@ -260,6 +262,7 @@ contains
     pair_shell = cfg%pair_shell; contact_shell = cfg%contact_shell
     roughness = cfg%roughness; eps_bar = cfg%eps_bar; friction = cfg%friction
     normal_stiffness = cfg%normal_stiffness; neighbour_skin = cfg%neighbour_skin
+    implicit = cfg%contact_implicit
     model = cfg%lubrication_model; table = cfg%lubrication_table; outer_cutoff = cfg%outer_cutoff
     inner_cutoff = cfg%inner_cutoff; skin = cfg%lubrication_skin
 
@@ -302,6 +305,7 @@ contains
       cfg%pair_shell = pair_shell; cfg%contact_shell = contact_shell
       cfg%roughness = roughness; cfg%eps_bar = eps_bar; cfg%friction = friction
       cfg%normal_stiffness = normal_stiffness; cfg%neighbour_skin = neighbour_skin
+      cfg%contact_implicit = implicit
       cfg%lubrication_model = to_lower(model); cfg%lubrication_table = table
       cfg%outer_cutoff = outer_cutoff; cfg%inner_cutoff = inner_cutoff; cfg%lubrication_skin = skin
       if (group == 'contact') cfg%contact_group = .true.

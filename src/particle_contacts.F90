@@ -12,14 +12,21 @@
 !   3. contact_forces with the latest velocities U, Omega (those of the previous step) and the
 !      wall velocities (-+ shear_rate Ly/2 along x): per-particle force, torque and symmetric
 !      stresslet, the history advanced by one step.
+! Implicit contacts (doc/CONTACT.md "Implicit contacts"; the default, pc%implicit): the particle
+! solve then adds the linearised stiffness of every open contact to its 6N system
+! (pcontacts_add_stiffness) and, once U^n is known, the force it implied to the step's contact
+! force, torque and stresslet (pcontacts_implicit_update): the force the balance used is the
+! contact force at the end of the step, X^{n+1}, linearised about X^n.
 module mod_particle_contacts
   use mod_kinds, only: dp
   use mod_contact, only: contact_params_t, contact_setup, contact_stats_t, contact_history_t, &
-                         contact_forces
+                         contact_forces, contact_links_t, contact_stiffness, contact_stresslet
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates
+  use mod_particle_system, only: particle_system_t, psys_add_diagonal, psys_add_pair
   implicit none
   private
   public :: particle_contacts_t, pcontacts_create, pcontacts_step
+  public :: pcontacts_add_stiffness, pcontacts_implicit_update
 
   type :: particle_contacts_t
     type(contact_params_t) :: params
@@ -35,6 +42,13 @@ module mod_particle_contacts
     type(contact_stats_t) :: stats           ! of the last step
     real(dp) :: max_overlap = 0              ! max |delta'| of the last step [a]
     real(dp), allocatable :: force(:,:), torque(:,:), stresslet(:,:,:)   ! of the last step
+    ! implicit contacts: the switch, the open contacts of the step, and what
+    ! pcontacts_add_stiffness keeps for pcontacts_implicit_update
+    logical :: implicit = .true.
+    type(contact_links_t) :: links
+    logical :: stiffness_added = .false.
+    real(dp) :: c_now = 0, c_before = 0      ! X^{n+1} - X^n = c_now U^n + c_before U^{n-1}
+    real(dp), allocatable :: u_before(:,:), om_before(:,:)   ! U^{n-1}, Omega^{n-1}
   end type particle_contacts_t
 
 contains
@@ -43,16 +57,19 @@ contains
   !> values (doc/INPUT.md); skin: neighbour-list skin [a]; eta: viscosity; shear_rate: imposed
   !> shear rate (walls at -+ shear_rate Ly/2 when walls); box, walls: the domain; dt: time step.
   !> info: 0 ok, else msg says what is wrong (contact_setup or nlist_init refused).
+  !> implicit, optional: the contact stiffness enters the particle solve (default .true.).
   subroutine pcontacts_create(pc, np, a, eps_r, mu_d, eps_bar, k_n_prescribed, skin, eta, &
-                              shear_rate, box, walls, dt, info, msg)
+                              shear_rate, box, walls, dt, info, msg, implicit)
     type(particle_contacts_t), intent(out) :: pc
     integer, intent(in) :: np
     real(dp), intent(in) :: a, eps_r, mu_d, eps_bar, k_n_prescribed, skin, eta, shear_rate, box(3), dt
     logical, intent(in) :: walls
     integer, intent(out) :: info
     character(len=*), intent(out) :: msg
+    logical, intent(in), optional :: implicit
     call contact_setup(pc%params, a, eps_r, mu_d, eps_bar, k_n_prescribed, eta, shear_rate, info, msg)
     if (info /= 0) return
+    if (present(implicit)) pc%implicit = implicit
     pc%np = np
     pc%box = box
     pc%dt = dt
@@ -86,14 +103,113 @@ contains
     real(dp), intent(in) :: x(:,:), u(:,:), om(:,:)
     integer, intent(out) :: info
     call nlist_candidates(pc%nlist, x, pc%pairs, pc%npairs, pc%walls, pc%nwalls)
-    call contact_forces(pc%params, pc%history, x, u, om, pc%box, pc%periodic, pc%wall_velocity, &
-                        pc%pairs, pc%npairs, pc%walls, pc%nwalls, pc%dt, pc%force, pc%torque, &
-                        pc%stresslet, pc%stats, info)
+    pc%stiffness_added = .false.
+    if (pc%implicit) then
+      call contact_forces(pc%params, pc%history, x, u, om, pc%box, pc%periodic, pc%wall_velocity, &
+                          pc%pairs, pc%npairs, pc%walls, pc%nwalls, pc%dt, pc%force, pc%torque, &
+                          pc%stresslet, pc%stats, info, pc%links)
+    else
+      call contact_forces(pc%params, pc%history, x, u, om, pc%box, pc%periodic, pc%wall_velocity, &
+                          pc%pairs, pc%npairs, pc%walls, pc%nwalls, pc%dt, pc%force, pc%torque, &
+                          pc%stresslet, pc%stats, info)
+    end if
     if (info /= 0) return
     pc%max_overlap = pc%stats%max_overlap * pc%params%h_r
     if (pc%params%h_r <= 0) pc%max_overlap = pc%stats%max_overlap * pc%params%a
     if (pc%max_overlap > pc%overlap_limit) info = 2
   end subroutine pcontacts_step
+
+  !> The implicit part of this step's contacts into the 6N system [(rho/dt) M + R + K] U = rhs of
+  !> the particle solve (free motion; after pcontacts_step, whose forces stay on the right-hand
+  !> side). Positions advance by X^{n+1} - X^n = c_now U^n + c_before U^{n-1} (advance_positions:
+  !> Adams-Bashforth 2, c_now = 3/2 dt, c_before = -1/2 dt; forward Euler on a run's first step,
+  !> ab2 = .false.: dt, 0), and the next step's spring by U^s(U^n) dt. The force the solve sees is
+  !> the contact force at the end of the step linearised about X^n,
+  !>   F + dF,  dF = -(c_now K_n + dt K_t) q^n - c_before K_n q^{n-1}
+  !> (contact_stiffness; q = the two bodies' velocities, a wall's own translation for a wall):
+  !> c_now K_n + dt K_t goes into the matrix (two 6x6 diagonal blocks and one coupling block per
+  !> pair, one diagonal block per wall contact), the rest onto rhs (6, np). u, om (3, np): the
+  !> velocities of the previous step, U^{n-1}, Omega^{n-1}. Nothing when pc%implicit is off.
+  subroutine pcontacts_add_stiffness(pc, sys, rhs, u, om, ab2)
+    type(particle_contacts_t), intent(inout) :: pc
+    type(particle_system_t), intent(inout) :: sys
+    real(dp), intent(inout) :: rhs(:,:)
+    real(dp), intent(in) :: u(:,:), om(:,:)
+    logical, intent(in) :: ab2
+    real(dp) :: kn(12, 12), kt(12, 12), a(12, 12), q(12), qw(6), g(12)
+    integer :: m, i, j
+    pc%stiffness_added = .false.
+    if (.not. pc%implicit) return
+    if (ab2) then
+      pc%c_now = 1.5_dp * pc%dt
+      pc%c_before = -0.5_dp * pc%dt
+    else
+      pc%c_now = pc%dt
+      pc%c_before = 0
+    end if
+    pc%u_before = u
+    pc%om_before = om
+    do m = 1, pc%links%n
+      call contact_stiffness(pc%params, pc%links%normal(:, m), pc%links%overlap(m), &
+                             pc%links%sliding(m), kn, kt)
+      a = pc%c_now * kn + pc%dt * kt
+      i = pc%links%i(m)
+      j = pc%links%partner(m)
+      call psys_add_diagonal(sys, i, a(1:6, 1:6))
+      if (j > 0) then
+        call psys_add_diagonal(sys, j, a(7:12, 7:12))
+        call psys_add_pair(sys, i, j, a(1:6, 7:12))
+        q = [u(:, i), om(:, i), u(:, j), om(:, j)]
+        g = -pc%c_before * matmul(kn, q)
+        rhs(:, i) = rhs(:, i) + g(1:6)
+        rhs(:, j) = rhs(:, j) + g(7:12)
+      else
+        qw = [pc%wall_velocity(:, -j), 0.0_dp, 0.0_dp, 0.0_dp]
+        q = [u(:, i), om(:, i), qw]
+        g(1:6) = -matmul(a(1:6, 7:12), qw) - pc%c_before * matmul(kn(1:6, :), q)
+        rhs(:, i) = rhs(:, i) + g(1:6)
+      end if
+    end do
+    pc%stiffness_added = .true.
+  end subroutine pcontacts_add_stiffness
+
+  !> After the solve: u, om (3, np) = U^n, Omega^n. Adds dF of pcontacts_add_stiffness to the
+  !> step's contact force, torque and stresslet (lever as in contact_forces), which then hold the
+  !> contact force the particle balance used. Nothing unless pcontacts_add_stiffness ran this step.
+  subroutine pcontacts_implicit_update(pc, u, om)
+    type(particle_contacts_t), intent(inout) :: pc
+    real(dp), intent(in) :: u(:,:), om(:,:)
+    real(dp) :: kn(12, 12), kt(12, 12), q(12), q0(12), g(12), s(3, 3)
+    integer :: m, i, j
+    if (.not. pc%stiffness_added) return
+    do m = 1, pc%links%n
+      call contact_stiffness(pc%params, pc%links%normal(:, m), pc%links%overlap(m), &
+                             pc%links%sliding(m), kn, kt)
+      i = pc%links%i(m)
+      j = pc%links%partner(m)
+      if (j > 0) then
+        q = [u(:, i), om(:, i), u(:, j), om(:, j)]
+        q0 = [pc%u_before(:, i), pc%om_before(:, i), pc%u_before(:, j), pc%om_before(:, j)]
+      else
+        q = [u(:, i), om(:, i), pc%wall_velocity(:, -j), 0.0_dp, 0.0_dp, 0.0_dp]
+        q0 = [pc%u_before(:, i), pc%om_before(:, i), pc%wall_velocity(:, -j), 0.0_dp, 0.0_dp, 0.0_dp]
+      end if
+      ! the generalised force on i; the partner takes -dF and the same torque (rows 7-12 of K
+      ! are those of -F and of the same torque), set from rows 1-6 so that action = reaction
+      ! exactly
+      g(1:6) = -matmul(pc%c_now * kn(1:6, :) + pc%dt * kt(1:6, :), q) - pc%c_before * matmul(kn(1:6, :), q0)
+      pc%force(:, i) = pc%force(:, i) + g(1:3)
+      pc%torque(:, i) = pc%torque(:, i) + g(4:6)
+      s = contact_stresslet(g(1:3), pc%links%lever(:, m))
+      pc%stresslet(:, :, i) = pc%stresslet(:, :, i) + s
+      if (j > 0) then
+        pc%force(:, j) = pc%force(:, j) - g(1:3)
+        pc%torque(:, j) = pc%torque(:, j) + g(4:6)
+        pc%stresslet(:, :, j) = pc%stresslet(:, :, j) + s
+      end if
+    end do
+    pc%stiffness_added = .false.
+  end subroutine pcontacts_implicit_update
 
 
 end module mod_particle_contacts
