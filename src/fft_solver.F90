@@ -28,6 +28,7 @@ module mod_fft_solver
   use, intrinsic :: iso_c_binding
   use mod_kinds, only: dp, pi
   use mod_grid, only: grid_t, FIELD_V, FIELD_P
+  use mod_timers, only: event_begin, event_end, EVENT_FFT
   implicit none
   private
   include 'fftw3-mpi.f03'
@@ -197,6 +198,7 @@ contains
     Vec, intent(inout) :: x
     PetscErrorCode, intent(out) :: ierr
     integer :: n
+    PetscCall(event_begin(EVENT_FFT, ierr))
     PetscCall(VecScatterBegin(s%scatter, b, s%slab, INSERT_VALUES, SCATTER_FORWARD, ierr))
     PetscCall(VecScatterEnd(s%scatter, b, s%slab, INSERT_VALUES, SCATTER_FORWARD, ierr))
     n = s%local_spectral
@@ -208,6 +210,7 @@ contains
     end if
     PetscCall(VecScatterBegin(s%scatter, s%slab, x, INSERT_VALUES, SCATTER_REVERSE, ierr))
     PetscCall(VecScatterEnd(s%scatter, s%slab, x, INSERT_VALUES, SCATTER_REVERSE, ierr))
+    PetscCall(event_end(EVENT_FFT, ierr))
   end subroutine fft_solve
 
   subroutine fft_destroy(s, ierr)

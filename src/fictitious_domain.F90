@@ -42,6 +42,8 @@ module mod_fictitious_domain
   use mod_solid_fraction, only: cube_fraction, relaxation_gamma
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates, min_image
   use mod_errors, only: fatal_error
+  use mod_timers, only: event_begin, event_end, EVENT_GEOMETRY, EVENT_CARRY, EVENT_MOMENTS, EVENT_MOTION, &
+                        EVENT_UPDATE
   implicit none
   private
   public :: fd_t, fd_create, fd_geometry, fd_follow, fd_moments, fd_solve_motion, fd_update, fd_destroy
@@ -54,10 +56,11 @@ module mod_fictitious_domain
     Vec :: lambda(3)                    ! Lambda = rho*lambda on the u, v, w faces
     ! the covered faces and cells of this rank, in runs of one sphere and one component
     integer :: nf = 0
-    integer, allocatable :: f_comp(:), f_ijk(:, :), f_part(:)
+    integer, allocatable :: f_ijk(:, :)
     real(dp), allocatable :: f_r(:, :), f_alpha(:), f_relax(:)   ! r, alpha, 1/(1+gamma)
     integer :: nruns = 0
     integer, allocatable :: run_start(:)   ! run r (one sphere, one component) is run_start(r) .. run_start(r+1)-1
+    integer, allocatable :: run_comp(:), run_part(:)   ! its component and its sphere
     real(dp), allocatable :: rigid_matrix(:, :, :)               ! M_p (6, 6, n), summed over ranks
     ! The rivals of each sphere: the spheres whose control-volume reach meets its own (centres
     ! closer than twice the reach). Only they can contest a face; elsewhere a sphere owns what it
@@ -104,9 +107,8 @@ contains
       PetscCall(PetscObjectSetName(fd%lambda(c), trim(names(c)), ierr))
     end do
     PetscCall(psolver_create(fd%solver, ierr))
-    allocate(fd%f_comp(1024), fd%f_ijk(3, 1024), fd%f_part(1024), fd%f_r(3, 1024), &
-             fd%f_alpha(1024), fd%f_relax(1024))
-    allocate(fd%run_start(1))
+    allocate(fd%f_ijk(3, 1024), fd%f_r(3, 1024), fd%f_alpha(1024), fd%f_relax(1024))
+    allocate(fd%run_start(1), fd%run_comp(0), fd%run_part(0))
   end subroutine fd_create
 
   ! The geometry at the current positions: face ownership, alpha, the face list and M_p.
@@ -125,6 +127,7 @@ contains
     integer :: q, c, ierr, f0
     real(dp) :: radius
 
+    PetscCallA(event_begin(EVENT_GEOMETRY, ierr))
     radius = parts%radius + fd%radius_offset * grid%h
     fd%lambda_listed = .false.      ! Lambda^n may sit on faces of another geometry (fd_follow carries it)
     call find_rivals(grid, fd, parts, radius)
@@ -136,8 +139,8 @@ contains
     fd%nf = 0
     fd%nruns = 0
     if (size(fd%run_start) < 4 * parts%n + 1) then
-      deallocate(fd%run_start)
-      allocate(fd%run_start(4 * parts%n + 1))
+      deallocate(fd%run_start, fd%run_comp, fd%run_part)
+      allocate(fd%run_start(4 * parts%n + 1), fd%run_comp(4 * parts%n), fd%run_part(4 * parts%n))
     end if
     do q = 1, parts%n
       do c = 1, 4
@@ -146,12 +149,15 @@ contains
         if (fd%nf >= f0) then
           fd%nruns = fd%nruns + 1
           fd%run_start(fd%nruns) = f0
+          fd%run_comp(fd%nruns) = c
+          fd%run_part(fd%nruns) = q
         end if
       end do
     end do
     fd%run_start(fd%nruns + 1) = fd%nf + 1
     call MPI_Allreduce(MPI_IN_PLACE, fd%rigid_matrix, 36 * parts%n, MPI_DOUBLE_PRECISION, MPI_SUM, &
                        PETSC_COMM_WORLD, ierr)
+    PetscCallA(event_end(EVENT_GEOMETRY, ierr))
   end subroutine fd_geometry
 
   ! The unknowns of component c (1..4, 4 = cell centres) that particle q owns, listed with their
@@ -168,7 +174,7 @@ contains
     logical :: mine(ceiling(2.0_dp * radius / grid%h) + 3, 3)
     integer :: lo(3), hi(3), i, j, k, d, m, ilo, ihi, iw, jw, kw, f, nrow, idx(3), arm(2), s, t
     real(dp) :: centre(3), r(3), a, h, reach2, inside2, rest2, chord, gamma_unit, rival2, second, rival_alpha
-    real(dp) :: val(3), w, dv, sgn(2)
+    real(dp) :: val(3), w, dv, sgn(2), block3(3, 3)
     logical :: owned
     ! the rivals that reach the current row, and what is left of the reach there
     integer :: row_rival(max(1, fd%rival_start(q + 1) - fd%rival_start(q)))
@@ -204,6 +210,7 @@ contains
     call reserve_faces(fd, fd%nf + product(hi - lo + 1))
     ! gamma = kappa (1 - alpha) beta h^2 / eta (relaxation_gamma, method.md §1.5b), written out
     gamma_unit = 0.0_dp
+    block3 = 0.0_dp
     if (c /= FIELD_P) then
       gamma_unit = fd%kappa * fd%beta * h**2 / fd%eta
       call torque_arm(c, idx, arm, sgn)
@@ -255,9 +262,7 @@ contains
           if (a <= 0.0_dp) cycle
           f = fd%nf + 1
           fd%nf = f
-          fd%f_comp(f) = c
           fd%f_ijk(:, f) = [iw, jw, kw]
-          fd%f_part(f) = q
           fd%f_r(:, f) = r
           fd%f_alpha(f) = a
           fd%f_relax(f) = 1.0_dp / (1.0_dp + gamma_unit * (1.0_dp - a))
@@ -266,12 +271,14 @@ contains
           w = fd%f_alpha(f) * fd%f_relax(f) * dv
           do t = 1, 3
             do s = 1, 3
-              fd%rigid_matrix(idx(s), idx(t), q) = fd%rigid_matrix(idx(s), idx(t), q) + (w * val(t)) * val(s)
+              block3(s, t) = block3(s, t) + (w * val(t)) * val(s)
             end do
           end do
         end do
       end do
     end do
+    ! M_p gains w g g^T on the three non-zeros of g
+    if (c /= FIELD_P) fd%rigid_matrix(idx, idx, q) = fd%rigid_matrix(idx, idx, q) + block3
   contains
     ! The cover of the control volume at offset x from a centre (0 beyond the reach).
     real(dp) function alpha_at(x)
@@ -308,12 +315,10 @@ contains
     type(fd_t), intent(inout) :: fd
     integer, intent(in) :: n
     integer :: m
-    integer, allocatable :: ti(:), t3(:, :)
+    integer, allocatable :: t3(:, :)
     real(dp), allocatable :: tr(:), tr3(:, :)
-    if (n <= size(fd%f_comp)) return
-    m = max(n, 2 * size(fd%f_comp))
-    allocate(ti(m)); ti(1:fd%nf) = fd%f_comp(1:fd%nf); call move_alloc(ti, fd%f_comp)
-    allocate(ti(m)); ti(1:fd%nf) = fd%f_part(1:fd%nf); call move_alloc(ti, fd%f_part)
+    if (n <= size(fd%f_alpha)) return
+    m = max(n, 2 * size(fd%f_alpha))
     allocate(t3(3, m)); t3(:, 1:fd%nf) = fd%f_ijk(:, 1:fd%nf); call move_alloc(t3, fd%f_ijk)
     allocate(tr3(3, m)); tr3(:, 1:fd%nf) = fd%f_r(:, 1:fd%nf); call move_alloc(tr3, fd%f_r)
     allocate(tr(m)); tr(1:fd%nf) = fd%f_alpha(1:fd%nf); call move_alloc(tr, fd%f_alpha)
@@ -430,6 +435,7 @@ contains
            ' cells in one step (its force density can follow at most one): reduce &time dt'
       call fatal_error(text, 3)
     end if
+    PetscCall(event_begin(EVENT_CARRY, ierr))
     do c = 1, 3
       PetscCall(DMGetLocalVector(grid%da(c), old(c), ierr))
       PetscCall(DMGlobalToLocalBegin(grid%da(c), fd%lambda(c), INSERT_VALUES, old(c), ierr))
@@ -443,8 +449,8 @@ contains
     do run = 1, fd%nruns
       f0 = fd%run_start(run)
       f1 = fd%run_start(run + 1) - 1
-      c = fd%f_comp(f0)
-      q = fd%f_part(f0)
+      c = fd%run_comp(run)
+      q = fd%run_part(run)
       if (c /= FIELD_P) then
         ! x_f - dX in cells from the face itself: offsets o and o + 1 in {-1, 0, 1}, weights w of o + 1
         t = -displacement(:, q) / grid%h
@@ -472,6 +478,7 @@ contains
       PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), old(c), lam_old(c)%ptr, ierr))
       PetscCall(DMRestoreLocalVector(grid%da(c), old(c), ierr))
     end do
+    PetscCall(event_end(EVENT_CARRY, ierr))
   end subroutine fd_follow
 
   ! The particle sub-problem after the fluid step, in three named parts that main.F90 calls in
@@ -493,6 +500,7 @@ contains
     real(dp) :: dv
     integer :: run, f0, f1, c, q
 
+    PetscCall(event_begin(EVENT_MOMENTS, ierr))
     dv = grid%h**3
     if (allocated(fd%moments)) then
       if (size(fd%moments, 2) /= n) deallocate(fd%moments)
@@ -506,8 +514,8 @@ contains
     do run = 1, fd%nruns
       f0 = fd%run_start(run)
       f1 = fd%run_start(run + 1) - 1
-      c = fd%f_comp(f0)
-      q = fd%f_part(f0)
+      c = fd%run_comp(run)
+      q = fd%run_part(run)
       if (c /= FIELD_P) call moments_run(c, u(c)%ptr, lam(c)%ptr, grid%lo, grid%hi, f1 - f0 + 1, fd%f_ijk(:, f0:f1), &
                                          fd%f_r(:, f0:f1), fd%f_alpha(f0:f1), fd%f_relax(f0:f1), dv, fd%moments(:, q))
     end do
@@ -516,6 +524,7 @@ contains
       PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), vel(c), u(c)%ptr, ierr))
     end do
     call MPI_Allreduce(MPI_IN_PLACE, fd%moments, 12 * n, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
+    PetscCall(event_end(EVENT_MOMENTS, ierr))
   end subroutine fd_moments
 
   ! The velocities of the spheres: beta M U = beta b(u~) - m(Lambda^n) + F_ext (method.md eq. (1)
@@ -541,7 +550,7 @@ contains
     character(len=200) :: text
     KSPConvergedReason :: reason
 
-    ierr = 0
+    PetscCall(event_begin(EVENT_MOTION, ierr))
     n = parts%n
     select case (parts%motion)
     case (MOTION_FREE, MOTION_FROZEN)
@@ -588,6 +597,7 @@ contains
       parts%velocity = 0.0_dp
       parts%omega = 0.0_dp
     end select
+    PetscCall(event_end(EVENT_MOTION, ierr))
   end subroutine fd_solve_motion
 
   ! Lambda^{n+1} = [Lambda^n + beta alpha (g.U - u~)]/(1 + gamma) on owned faces, 0 elsewhere;
@@ -610,6 +620,7 @@ contains
     integer :: run, f0, f1, c, q, n
     logical :: removed
 
+    PetscCall(event_begin(EVENT_UPDATE, ierr))
     n = parts%n
     dv = grid%h**3
     allocate(sums(16, n))
@@ -623,7 +634,7 @@ contains
       if (allocated(fd%lambda_new)) then
         if (size(fd%lambda_new) < fd%nf) deallocate(fd%lambda_new)
       end if
-      if (.not. allocated(fd%lambda_new)) allocate(fd%lambda_new(size(fd%f_comp)))
+      if (.not. allocated(fd%lambda_new)) allocate(fd%lambda_new(size(fd%f_alpha)))
       do c = 1, 3
         PetscCall(DMDAVecGetArrayReadF90(grid%da(c), vel(c), u(c)%ptr, ierr))
         PetscCall(DMDAVecGetArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
@@ -631,8 +642,8 @@ contains
       do run = 1, fd%nruns
         f0 = fd%run_start(run)
         f1 = fd%run_start(run + 1) - 1
-        c = fd%f_comp(f0)
-        q = fd%f_part(f0)
+        c = fd%run_comp(run)
+        q = fd%run_part(run)
         if (c /= FIELD_P) call new_lambda_run(c, u(c)%ptr, lam(c)%ptr, grid%lo, grid%hi, f1 - f0 + 1, &
              fd%f_ijk(:, f0:f1), fd%f_r(:, f0:f1), fd%f_alpha(f0:f1), fd%f_relax(f0:f1), fd%beta, &
              parts%velocity(:, q), parts%omega(:, q), fd%lambda_new(f0:f1))
@@ -652,8 +663,8 @@ contains
     do run = 1, fd%nruns
       f0 = fd%run_start(run)
       f1 = fd%run_start(run + 1) - 1
-      c = fd%f_comp(f0)
-      q = fd%f_part(f0)
+      c = fd%run_comp(run)
+      q = fd%run_part(run)
       if (c == FIELD_P) then
         ! the interior pressure of §1.6
         call pressure_run(p, grid%lo, grid%hi, f1 - f0 + 1, fd%f_ijk(:, f0:f1), fd%f_alpha(f0:f1), dv, sums(16, q))
@@ -688,6 +699,7 @@ contains
       parts%torque_hydro = parts%torque_hydro + lubrication%torque
       parts%stresslet_hydro = parts%stresslet_hydro + lubrication%stresslet
     end if
+    PetscCall(event_end(EVENT_UPDATE, ierr))
   end subroutine fd_update
 
   ! The lubrication links into the 6N system: each pair's 12x12 R_sub_FU as two diagonal blocks and
