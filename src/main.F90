@@ -1,5 +1,5 @@
 ! fdsusp: fictitious-domain simulation of sheared suspensions (design.md).
-!   bin/fdsusp DECK [-restart CHECKPOINT] [PETSc options]
+!   bin/fdsusp DECK [-restart CHECKPOINT | -continue] [PETSc options]
 ! Reads and checks everything before any work, then steps the flow in time, writing the series,
 ! field snapshots and checkpoints the deck asks for. SIGTERM or SIGUSR1 (what batch schedulers
 ! send before the kill) ends the run at the end of the current step with a checkpoint, status 0.
@@ -66,7 +66,7 @@ program fdsusp
   PetscBool :: bench_cold, fault_set
   PetscInt :: fault_nan_step
   real(dp) :: err_vel, err_p_max, err_p_rms
-  logical :: restarting
+  logical :: restarting, continuing
   integer, parameter :: RUNNING = 0, DONE = 1, SIGNALLED = 2, WALL_LIMIT = 3, STEADY = 4
   real(dp), parameter :: CHATTER_LIMIT = 0.025_dp    ! largest chatter_number accepted (doc/CONTACT.md)
 
@@ -75,11 +75,12 @@ program fdsusp
   call h5util_init()
 
   ! ---- everything is checked before any work ----
-  call command_line(deck, restart, restarting)
+  call command_line(deck, restart, restarting, continuing)
   call read_deck(deck, cfg)
   call log_line('fdsusp: '//trim(cfg%title))
   call echo_deck(cfg)
   call prepare_output_directory(cfg)
+  if (continuing) call continue_from_directory()
   call particles_load(cfg, parts)
   has_particles = parts%n > 0
   ! contacts: the deck has &contact and the run has particles (doc/CONTACT.md)
@@ -227,6 +228,14 @@ program fdsusp
   ! -fault_nan_step N: poison the velocity at step N (tests of the runtime guard only)
   fault_nan_step = -1
   PetscCallA(PetscOptionsGetInt(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-fault_nan_step', fault_nan_step, fault_set, ierr))
+  ! a run from the start publishes its initial state as checkpoint.h5 before the first step, so the
+  ! directory holds a whole checkpoint whatever kills the run later (a kill during a write leaves
+  ! the previous one; doc/DESIGN.md "Files, restart and signals")
+  if (.not. restarting .and. step < cfg%steps) then
+    PetscCallA(stage_push(STAGE_OUTPUT, ierr))
+    call checkpoint()
+    PetscCallA(stage_pop(ierr))
+  end if
   iterations_sum = 0
   wall_loop = MPI_Wtime()
 
@@ -391,29 +400,56 @@ program fdsusp
 
 contains
 
-  ! DECK is the first argument; -restart FILE is read from PETSc's options database.
-  subroutine command_line(deck, restart, restarting)
+  ! DECK is the first argument; -restart FILE and -continue are read from PETSc's options database.
+  ! -continue: restart from the deck's output directory's checkpoint.h5 when there is one, else
+  ! start (what each job of a batch chain runs, scripts/slurm/).
+  subroutine command_line(deck, restart, restarting, continuing)
     character(len=*), intent(out) :: deck, restart
-    logical, intent(out) :: restarting
+    logical, intent(out) :: restarting, continuing
     PetscBool :: set
     PetscErrorCode :: ierr
     call get_command_argument(1, deck)
     if (len_trim(deck) == 0 .or. deck(1:1) == '-') &
-      call fatal_error('usage: fdsusp DECK [-restart CHECKPOINT] [PETSc options]', 2)
+      call fatal_error('usage: fdsusp DECK [-restart CHECKPOINT | -continue] [PETSc options]', 2)
     restart = ''
     PetscCallA(PetscOptionsGetString(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-restart', restart, set, ierr))
     restarting = logical(set)
     if (restarting .and. len_trim(restart) == 0) &
       call fatal_error('fdsusp: -restart needs the path of a checkpoint', 2)
+    PetscCallA(PetscOptionsHasName(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-continue', set, ierr))
+    continuing = logical(set)
+    if (restarting .and. continuing) &
+      call fatal_error('fdsusp: -restart and -continue exclude each other (-continue restarts from the '// &
+                       'output directory''s checkpoint.h5)', 2)
   end subroutine command_line
+
+  ! -continue: the output directory's checkpoint.h5 if it exists (looked for under the directory's
+  ! lock, so no other run is writing it), else a start from the beginning.
+  subroutine continue_from_directory()
+    integer :: found
+    found = 0
+    if (is_rank0()) then
+      inquire(file=trim(cfg%output_directory)//'/checkpoint.h5', exist=restarting)
+      found = merge(1, 0, restarting)
+    end if
+    call MPI_Bcast(found, 1, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
+    restarting = found == 1
+    if (restarting) then
+      restart = trim(cfg%output_directory)//'/checkpoint.h5'
+      call log_line('-continue: continuing from '//trim(restart))
+    else
+      call log_line('-continue: no checkpoint in '//trim(cfg%output_directory)//' yet: starting from the beginning')
+    end if
+  end subroutine continue_from_directory
 
   ! The output directory must exist (it is created), be this run's alone (a lock, before anything
   ! is written there) and be writable now, not hours from now. The lock (src/system_c.c) is held by
   ! rank 0's process until it ends and dies with it, so a lock file left by a killed run does not
-  ! block the next start.
+  ! block the next start. A checkpoint.h5.tmp left by a run killed while writing is removed.
   subroutine prepare_output_directory(cfg)
     type(config_t), intent(in) :: cfg
-    integer :: state(2)                        ! errno, lock status
+    integer :: state(3)                        ! errno, lock status, a stale checkpoint.h5.tmp removed
+    integer :: u, e
     character(len=16) :: code
     character(len=400) :: holder
     character(len=:), allocatable :: dir
@@ -427,8 +463,15 @@ contains
         if (state(2) > 0) state(1) = state(2)
       end if
       if (state(1) == 0 .and. state(2) /= -1) state(1) = probe_directory(dir)
+      if (state(1) == 0 .and. state(2) /= -1) then
+        open(newunit=u, file=dir//'/checkpoint.h5.tmp', status='old', action='read', iostat=e)
+        if (e == 0) then
+          close(u, status='delete', iostat=e)
+          state(3) = 1
+        end if
+      end if
     end if
-    call MPI_Bcast(state, 2, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
+    call MPI_Bcast(state, 3, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
     call MPI_Bcast(holder, len(holder), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
     if (state(2) == -1) then
       call input_error(cfg%deck_file, 'output', 'directory', '"'//dir//'" is in use by another run ('// &
@@ -444,6 +487,8 @@ contains
     if (state(2) == 0 .and. len_trim(holder) > 0) call log_line('output directory '//dir//': its lock file '// &
          'names '//trim(holder)//', a run that ended without releasing it (killed or crashed); that lock '// &
          'ended with its process: taken over')
+    if (state(3) == 1) call log_line('output directory '//dir//': removed checkpoint.h5.tmp, the partial '// &
+         'write of a killed run (checkpoint.h5, if there, is the last whole checkpoint)')
   end subroutine prepare_output_directory
 
   logical function is_rank0()
