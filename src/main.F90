@@ -71,6 +71,9 @@ program fdsusp
   real(dp), parameter :: CHATTER_LIMIT = 0.025_dp    ! largest chatter_number accepted (doc/CONTACT.md)
 
   PetscCallA(PetscInitialize(ierr))
+  ! SIGTERM/SIGUSR1 from now on only ask the run to stop after its next step (they replace
+  ! PETSc's handlers, which would abort a run signalled during its set-up)
+  call install_signal_handlers()
   wall_start = MPI_Wtime()
   call h5util_init()
 
@@ -200,7 +203,6 @@ program fdsusp
          rh%r_outer, rh%r_contact, real([cfg%blocks, cfg%discard_step, cfg%block_steps, cfg%series_every], dp), &
          merge(cfg%friction, 0.0_dp, has_contacts), merge(cfg%roughness, 0.0_dp, has_contacts)])
   end if
-  call install_signal_handlers()
   PetscCallA(stage_pop(ierr))
   if (has_particles .and. has_lubrication .and. parts%motion == MOTION_FREE) call check_pair_lag()
   if (has_particles) then

@@ -10,7 +10,9 @@ series.h5 of the continued run holds each step exactly once."""
 import os
 import shutil
 import signal
+import subprocess
 import sys
+import time
 import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
@@ -65,4 +67,27 @@ T.check(status == 0, 'SIGUSR1 on 2 ranks: exit status %d == 0' % status)
 T.check('stopped by signal 10' in out, 'SIGUSR1: the log says the run stopped on the signal')
 k = int(T.h5_attr(os.path.join(f, 'out', 'checkpoint.h5'), 'step')[0])
 T.check(k >= 3, 'SIGUSR1: checkpoint written at step %d' % k)
+
+# SIGUSR1 during the set-up (after PetscInitialize, while the spheres are packed): the run still
+# stops cleanly, after its first step (PETSc's own handler, in place until the set-up ended,
+# aborted it)
+g = T.scratch('restart_setup_signal')
+deck = T.write_deck(g, 'pack.nml', """&domain box = 16, 20, 16, cells_per_radius = 2, shear_rate = 1 /
+&time dt = 1e-3, steps = 100000 /
+&output directory = 'out', progress_every = 1 /
+&particles solid_fraction = 0.45, seed = 3, packing_sweeps = 4000 /
+&lubrication model = 'none' /
+""")
+log = open(os.path.join(g, 'run.log'), 'w+')
+p = subprocess.Popen(T.command(deck), cwd=g, env=T.ENV, stdout=log, stderr=subprocess.STDOUT, text=True)
+t0 = time.time()
+while time.time() - t0 < 120 and p.poll() is None and '# end of effective deck' not in open(log.name).read():
+    time.sleep(0.01)
+p.send_signal(signal.SIGUSR1)
+during_setup = 'models:' not in open(log.name).read()
+status = p.wait(timeout=300)
+out = open(log.name).read()
+T.check(during_setup, 'SIGUSR1 sent during the set-up (the deck read, no models line yet)')
+T.check(status == 0 and 'stopped by signal 10 at step 1:' in out,
+        'a signal during the set-up stops the run after its first step, status %d' % status)
 T.finish()
