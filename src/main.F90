@@ -30,7 +30,8 @@ program fdsusp
   use mod_contact, only: chatter_number, flattening_estimate, wall_lower, wall_upper
   use mod_lubrication, only: lubrication_t, LUB_NONE, LUB_SIMPLE
   use mod_lubrication_io, only: lubrication_load
-  use mod_particle_lubrication, only: particle_lubrication_t, plub_create, plub_links
+  use mod_particle_lubrication, only: particle_lubrication_t, plub_create
+  use mod_lubrication_links, only: lubrication_links
   use mod_h5util, only: h5util_init
   use mod_solvers, only: solver_t, solver_create, solver_cold_solve, solver_destroy
   use mod_grid, only: FIELD_P
@@ -268,7 +269,7 @@ program fdsusp
       if (has_lubrication) then
         ! the lubrication links at X^n, taken implicitly in the particle problem below
         PetscCallA(stage_push(STAGE_LUBRICATION, ierr))
-        call plub_links(pl, parts%position)
+        PetscCallA(lubrication_links(pl, parts%position, ierr))
         PetscCallA(stage_pop(ierr))
       end if
       PetscCallA(stage_push(STAGE_FLUID, ierr))

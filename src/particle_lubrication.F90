@@ -7,14 +7,14 @@
 ! The undisturbed flow is the imposed shear of the Couette cell: U_inf = shear_rate (y - Ly/2) e_x,
 ! Om_inf = -shear_rate/2 e_z, E_inf = shear_rate/2 (e_x e_y + e_y e_x); at rest in a periodic box.
 module mod_particle_lubrication
-  use mod_kinds, only: dp
+  use mod_kinds, only: dp, i8
   use mod_resistance, only: n_pair_scalars
   use mod_lubrication, only: lubrication_t, lub_pair_scalars, lub_wall_scalars, lub_pair_link, &
        lub_wall_link, lub_pair_stresslets, lub_wall_stresslet, n_wall_scalars, LUB_NONE
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates
   implicit none
   private
-  public :: particle_lubrication_t, plub_create, plub_links, plub_corrections
+  public :: particle_lubrication_t, plub_create, plub_links, plub_corrections, plub_reserve_pairs
 
   type :: particle_lubrication_t
     type(lubrication_t) :: lub
@@ -105,10 +105,13 @@ contains
 
   !> The lubrication links at positions x (3, np): which pairs and walls are within the outer
   !> cut-off, and their blocks. Call once per step before the particle problem.
-  subroutine plub_links(pl, x)
+  !> part, parts (optional): only the part-th of parts contiguous shares of the pair candidates
+  !> (0-based; mod_lubrication_links gathers the shares of all ranks in order); walls always all.
+  subroutine plub_links(pl, x, part, parts)
     type(particle_lubrication_t), intent(inout) :: pl
     real(dp), intent(in) :: x(:, :)
-    integer :: c, i, j, side
+    integer, intent(in), optional :: part, parts
+    integer :: c, i, j, side, first, last
     real(dp) :: r(3), dist, gap, d(3), om_inf(3), e_inf(3, 3), u_inf(3, 2), normal(3), u_wall(3), w(n_wall_scalars)
     pl%npairs = 0
     pl%nwalls = 0
@@ -117,7 +120,13 @@ contains
     ! one sphere: its wall candidates were set once by plub_create
     if (pl%np > 1) call nlist_candidates(pl%nlist, x, pl%cand, pl%ncand, pl%cand_walls, pl%ncand_walls)
     call ambient_gradients(pl, om_inf, e_inf)
-    do c = 1, pl%ncand
+    first = 1
+    last = pl%ncand
+    if (present(part) .and. present(parts)) then
+      first = int(int(part, i8) * pl%ncand / parts) + 1
+      last = int(int(part + 1, i8) * pl%ncand / parts)
+    end if
+    do c = first, last
       i = pl%cand(1, c)
       j = pl%cand(2, c)
       r = x(:, j) - x(:, i)
@@ -164,17 +173,8 @@ contains
   contains
 
     subroutine grow_pairs()
-      integer :: m
-      integer, allocatable :: ip(:, :)
-      real(dp), allocatable :: t2(:, :), t3(:, :, :)
       if (pl%npairs < size(pl%pair, 2)) return
-      m = 2 * size(pl%pair, 2)
-      allocate(ip(2, m)); ip(:, 1:pl%npairs) = pl%pair(:, 1:pl%npairs); call move_alloc(ip, pl%pair)
-      allocate(t2(3, m)); t2(:, 1:pl%npairs) = pl%pair_d(:, 1:pl%npairs); call move_alloc(t2, pl%pair_d)
-      allocate(t2(n_pair_scalars, m)); t2(:, 1:pl%npairs) = pl%pair_f(:, 1:pl%npairs); call move_alloc(t2, pl%pair_f)
-      allocate(t2(6, m)); t2(:, 1:pl%npairs) = pl%pair_uinf(:, 1:pl%npairs); call move_alloc(t2, pl%pair_uinf)
-      allocate(t3(12, 12, m)); t3(:, :, 1:pl%npairs) = pl%pair_r(:, :, 1:pl%npairs); call move_alloc(t3, pl%pair_r)
-      allocate(t2(12, m)); t2(:, 1:pl%npairs) = pl%pair_drive(:, 1:pl%npairs); call move_alloc(t2, pl%pair_drive)
+      call plub_reserve_pairs(pl, 2 * size(pl%pair, 2))
     end subroutine grow_pairs
 
     subroutine grow_walls()
@@ -190,6 +190,23 @@ contains
     end subroutine grow_walls
 
   end subroutine plub_links
+
+  !> Room for n pair links (the first npairs kept).
+  subroutine plub_reserve_pairs(pl, n)
+    type(particle_lubrication_t), intent(inout) :: pl
+    integer, intent(in) :: n
+    integer :: m
+    integer, allocatable :: ip(:, :)
+    real(dp), allocatable :: t2(:, :), t3(:, :, :)
+    if (n <= size(pl%pair, 2)) return
+    m = n
+    allocate(ip(2, m)); ip(:, 1:pl%npairs) = pl%pair(:, 1:pl%npairs); call move_alloc(ip, pl%pair)
+    allocate(t2(3, m)); t2(:, 1:pl%npairs) = pl%pair_d(:, 1:pl%npairs); call move_alloc(t2, pl%pair_d)
+    allocate(t2(n_pair_scalars, m)); t2(:, 1:pl%npairs) = pl%pair_f(:, 1:pl%npairs); call move_alloc(t2, pl%pair_f)
+    allocate(t2(6, m)); t2(:, 1:pl%npairs) = pl%pair_uinf(:, 1:pl%npairs); call move_alloc(t2, pl%pair_uinf)
+    allocate(t3(12, 12, m)); t3(:, :, 1:pl%npairs) = pl%pair_r(:, :, 1:pl%npairs); call move_alloc(t3, pl%pair_r)
+    allocate(t2(12, m)); t2(:, 1:pl%npairs) = pl%pair_drive(:, 1:pl%npairs); call move_alloc(t2, pl%pair_drive)
+  end subroutine plub_reserve_pairs
 
   !> The corrections with the velocities of this step, u and om (3, np): force, torque and
   !> stresslet on each particle (pl%force, pl%torque, pl%stresslet).
