@@ -278,7 +278,7 @@ contains
     character(len=16) :: choice
     PetscBool :: found
     PetscErrorCode :: ierr
-    integer(C_INT), parameter :: FFTW_MEASURE = 0, FFTW_ESTIMATE = 64   ! fftw3.f03
+    integer(C_INT), parameter :: FFTW_MEASURE = 0, FFTW_PATIENT = 32, FFTW_ESTIMATE = 64   ! fftw3.f03
     choice = 'measure'
     PetscCallA(PetscOptionsGetString(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-fluid_fft_plan', choice, found, ierr))
     select case (trim(choice))
@@ -286,8 +286,10 @@ contains
       fft_planner_flags = FFTW_MEASURE
     case ('estimate')
       fft_planner_flags = FFTW_ESTIMATE
+    case ('patient')
+      fft_planner_flags = FFTW_PATIENT
     case default
-      call fatal_error('fdsusp: error: -fluid_fft_plan '//trim(choice)//' is not known (measure or estimate)', 2)
+      call fatal_error('fdsusp: error: -fluid_fft_plan '//trim(choice)//' is not known (measure, patient or estimate)', 2)
       fft_planner_flags = FFTW_MEASURE
     end select
   end function fft_planner_flags
