@@ -272,14 +272,16 @@ contains
     end select
   end function direct_solves_wanted
 
-  ! -fluid_fft_plan measure (default: FFTW times candidate algorithms once at start-up) or
-  ! estimate (no timing: a faster start, possibly slower transforms).
+  ! -fluid_fft_plan estimate (default: FFTW picks its algorithms by rule, the same every run, so a
+  ! run and its restart repeat the same round-off, bitwise), measure or patient (FFTW times
+  ! candidates at start-up: no faster on 100^3 here, doc/BENCHMARKS.md §8, and the choice, hence
+  ! the round-off, may differ from run to run).
   integer(C_INT) function fft_planner_flags()
     character(len=16) :: choice
     PetscBool :: found
     PetscErrorCode :: ierr
     integer(C_INT), parameter :: FFTW_MEASURE = 0, FFTW_PATIENT = 32, FFTW_ESTIMATE = 64   ! fftw3.f03
-    choice = 'measure'
+    choice = 'estimate'
     PetscCallA(PetscOptionsGetString(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-fluid_fft_plan', choice, found, ierr))
     select case (trim(choice))
     case ('measure')
