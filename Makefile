@@ -118,7 +118,7 @@ $(BUILD)/deps.mk: $(SRC_F90) $(PROGRAM_SRC) $(REF_F90) $(UNIT_F90) $(UNIT_CHECKS
 
 NP ?= 2
 MPIRUN := mpiexec --oversubscribe
-# the demo suspension (input/demo.nml, ~7 min on 2 cores), then its summary recomputed from the
+# the demo suspension (input/demo.nml, ~2 min on 2 cores), then its summary recomputed from the
 # series and its figures (doc/RHEOLOGY.md)
 run: all
 	$(MPIRUN) -n $(NP) $(BIN)/fdsusp input/demo.nml
