@@ -57,11 +57,11 @@ module mod_contact
   !> contact found by contact_forces, in the order it met them. partner: the other particle (> i)
   !> or wall_lower/wall_upper; normal: unit normal from i towards the partner; overlap: delta'
   !> (<= 0); lever: centre of i to the middle of the gap (the stresslet's lever, r/2 for a pair);
-  !> sliding: at the Coulomb limit (no tangential stiffness).
+  !> spring: the spring after the step (0 without friction); sliding: at the Coulomb limit.
   type :: contact_links_t
     integer :: n = 0
     integer, allocatable :: i(:), partner(:)
-    real(dp), allocatable :: normal(:,:), lever(:,:)   ! (3, n)
+    real(dp), allocatable :: normal(:,:), lever(:,:), spring(:,:)   ! (3, n)
     real(dp), allocatable :: overlap(:)
     logical, allocatable :: sliding(:)
   end type contact_links_t
@@ -223,23 +223,28 @@ contains
 
   !> The linearised stiffness of one contact (doc/CONTACT.md "Implicit contacts"), in the
   !> generalised coordinates q = (U_i, Omega_i, U_partner, Omega_partner) (12) of contact_pair
-  !> (for a wall: its translation and zero rotation). n, dlt, sliding: as contact_pair saw them.
+  !> (for a wall: its translation and zero rotation). n, dlt, sliding: as contact_pair saw them;
+  !> ups: the spring contact_pair left (at the Coulomb limit when sliding).
   !>   k_norm = k b b^T, b = (n, 0, -n, 0), k = dF_n/d|delta'| = (3/2) k_n |delta'|^{1/2}: the
   !>            generalised force changes by -k_norm dX for displacements dX of the two bodies
   !>            (the geometric term |F_n|/|r| (I - n n^T) of the turning normal, smaller by
   !>            |delta'|/|r| and not positive semi-definite, is left out);
   !>   k_tan  = k_t B^T B, B = (P, -a [n]x, -P, -a [n]x), P = I - n n^T, so that B q is the slip
   !>            velocity U^s of (2.21); the force changes by -k_tan dq dt when the spring takes one
-  !>            more increment U^s dt (sticking contacts only: a sliding or frictionless contact,
-  !>            or one at delta' = 0, has none).
+  !>            more increment U^s dt. A sliding contact (|F_t| = mu_d |F_n|, spring ups at the
+  !>            limit) keeps that stiffness across its slip direction s = ups/|ups| only:
+  !>            k_t B^T (I - s s^T) B, the derivative of the capped force -mu_d |F_n| s' with
+  !>            s' the direction of ups + U^s dt (the consistent tangent of the Coulomb return:
+  !>            mu_d |F_n|/|ups| = k_t; along s the force stays mu_d |F_n|). Frictionless
+  !>            contacts, and those at delta' = 0, have none.
   !> Both symmetric positive semi-definite by construction (sums of outer products). Open
   !> contacts (dlt > 0) give zero blocks.
-  pure subroutine contact_stiffness(p, n, dlt, sliding, k_norm, k_tan)
+  pure subroutine contact_stiffness(p, n, dlt, ups, sliding, k_norm, k_tan)
     type(contact_params_t), intent(in) :: p
-    real(dp), intent(in) :: n(3), dlt
+    real(dp), intent(in) :: n(3), dlt, ups(3)
     logical, intent(in) :: sliding
     real(dp), intent(out) :: k_norm(12, 12), k_tan(12, 12)
-    real(dp) :: b(12), bt(3, 12), k, k_t
+    real(dp) :: b(12), bt(3, 12), k, k_t, s(3)
     integer :: c
     k_norm = 0
     k_tan = 0
@@ -249,7 +254,7 @@ contains
     b(1:3) = n
     b(7:9) = -n
     k_norm = k * spread(b, 2, 12) * spread(b, 1, 12)
-    if (p%mu_d <= 0 .or. sliding .or. dlt == 0) return
+    if (p%mu_d <= 0 .or. dlt == 0) return
     k_t = p%kt_coeff * p%k_n * sqrt(abs(dlt))
     bt = 0
     do c = 1, 3
@@ -260,6 +265,12 @@ contains
       bt(:, 9 + c) = bt(:, 3 + c)
     end do
     k_tan = k_t * matmul(transpose(bt), bt)
+    if (sliding) then
+      s = 0
+      if (norm2(ups) > 0) s = ups / norm2(ups)
+      b = matmul(s, bt)                                    ! B^T s
+      k_tan = k_tan - k_t * spread(b, 2, 12) * spread(b, 1, 12)
+    end if
   contains
     pure function unit(c) result(e)
       integer, intent(in) :: c
@@ -384,6 +395,7 @@ contains
       links%normal(:, links%n) = n
       links%lever(:, links%n) = lever
       links%overlap(links%n) = dlt
+      links%spring(:, links%n) = ups
       links%sliding(links%n) = sliding
     end subroutine add_link
 
@@ -412,10 +424,11 @@ contains
     links%n = 0
     if (allocated(links%i)) then
       if (size(links%i) >= m) return
-      deallocate(links%i, links%partner, links%normal, links%lever, links%overlap, links%sliding)
+      deallocate(links%i, links%partner, links%normal, links%lever, links%spring, links%overlap, links%sliding)
     end if
     allocate(links%i(max(m, 16)), links%partner(max(m, 16)), links%normal(3, max(m, 16)), &
-             links%lever(3, max(m, 16)), links%overlap(max(m, 16)), links%sliding(max(m, 16)))
+             links%lever(3, max(m, 16)), links%spring(3, max(m, 16)), links%overlap(max(m, 16)), &
+             links%sliding(max(m, 16)))
   end subroutine links_reserve
 
   ! ---- the history -------------------------------------------------------------------------

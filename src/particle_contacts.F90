@@ -151,7 +151,7 @@ contains
     pc%om_before = om
     do m = 1, pc%links%n
       call contact_stiffness(pc%params, pc%links%normal(:, m), pc%links%overlap(m), &
-                             pc%links%sliding(m), kn, kt)
+                             pc%links%spring(:, m), pc%links%sliding(m), kn, kt)
       a = pc%c_now * kn + pc%dt * kt
       i = pc%links%i(m)
       j = pc%links%partner(m)
@@ -184,7 +184,7 @@ contains
     if (.not. pc%stiffness_added) return
     do m = 1, pc%links%n
       call contact_stiffness(pc%params, pc%links%normal(:, m), pc%links%overlap(m), &
-                             pc%links%sliding(m), kn, kt)
+                             pc%links%spring(:, m), pc%links%sliding(m), kn, kt)
       i = pc%links%i(m)
       j = pc%links%partner(m)
       if (j > 0) then

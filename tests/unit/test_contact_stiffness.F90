@@ -6,7 +6,8 @@
 ! Invariants:
 !   1. Both blocks are symmetric (bitwise) and positive semi-definite with the exact spectrum:
 !      k_norm has the single eigenvalue 2k, k = (3/2) k_n |delta'|^{1/2}; k_tan the double
-!      eigenvalue 2 (1 + a^2) k_t, k_t = (2/7) k_n |delta'|^{1/2} (B B^T = 2 (1 + a^2) P); all
+!      eigenvalue 2 (1 + a^2) k_t, k_t = (2/7) k_n |delta'|^{1/2} (B B^T = 2 (1 + a^2) P), and
+!      for a sliding contact (stiffness across its slip direction only) that eigenvalue once; all
 !      others 0 (LAPACK dsyev; 1e-12 of the largest: a few ulps of a 12 x 12 eigensolve).
 !   2. Normal stiffness = the derivative of contact_pair's force: central differences of G in the
 !      positions (step 1e-4 |delta'|, error ~1e-8 relative) equal -k_norm dX plus the geometric
@@ -15,11 +16,14 @@
 !      at |delta'| = h_r, the largest overlap a run accepts (checked below 2e-3).
 !   3. Tangential stiffness = the derivative of contact_pair's force in the velocities over one
 !      step, for a sticking contact: G(q + e dq) - G(q - e dq) = -2 e dt k_tan dq (the spring is
-!      linear in the slip: 1e-9 relative, rounding of the differences).
+!      linear in the slip: 1e-9 relative, rounding of the differences); for a sliding contact
+!      (spring 1 + 1e-7 times the Coulomb length along s, so both sides of the difference slide)
+!      and slips across s, the capped force turns: the same with the sliding k_tan (1e-6: the
+!      1e-7 offset beyond the limit enters the derivative, plus differences at e^2).
 !   4. Null spaces: a common translation of both bodies and rolling without slip
 !      (U_i - U_j = -a (Omega_i + Omega_j) x n) give no force (1e-12 of |K||q|).
-!   5. No stiffness where there is no spring or no contact: sliding, frictionless and
-!      delta' = 0 give k_tan = 0; an open contact gives both 0 (bitwise).
+!   5. No stiffness where there is no spring or no contact: frictionless and delta' = 0 give
+!      k_tan = 0; an open contact gives both 0 (bitwise).
 !   6. The assembly in a mock particle system (two spheres of resistance r I_6, no fluid, pressed
 !      together by +-F = 6 pi; positions by Adams-Bashforth 2 as advance_positions): with
 !      r = 75, k dt/r = 1.5 at the Hertz overlap (the explicit AB2 limit is 1), the explicit force
@@ -50,7 +54,8 @@ program test_contact_stiffness
   real(dp) :: kn(12, 12), kt(12, 12), n(3), dlt, k, k_t, err, eig(12), geo(12), pred(12)
   real(dp) :: xi(3), xj(3), dx(12), eps, gp(12), gm(12), dq(12), q(12), ups(3), dt, fn
   integer :: info, trial
-  real(dp), parameter :: fractions(3) = [0.05_dp, 0.3_dp, 1.0_dp]
+  real(dp), parameter :: fractions(3) = [0.05_dp, 0.3_dp, 1.0_dp], zero3(3) = 0
+  real(dp) :: s(3), slip(3), cap
   character(len=200) :: msg
   logical :: sliding
 
@@ -62,7 +67,7 @@ program test_contact_stiffness
   do trial = 1, 3
     n = unit_vector(trial)
     dlt = -fractions(trial) * p%h_r
-    call contact_stiffness(p, n, dlt, .false., kn, kt)
+    call contact_stiffness(p, n, dlt, zero3, .false., kn, kt)
     call check(all(kn == transpose(kn)) .and. all(kt == transpose(kt)), 'blocks symmetric (bitwise)')
     k = 1.5_dp * p%k_n * sqrt(-dlt)
     k_t = p%kt_coeff * p%k_n * sqrt(-dlt)
@@ -70,8 +75,16 @@ program test_contact_stiffness
     err = max(err, abs(eig(12) - 2 * k) / (2 * k), maxval(abs(eig(1:11))) / (2 * k))
     eig = eigenvalues(kt)
     err = max(err, maxval(abs(eig(11:12) - 4 * k_t)) / (4 * k_t), maxval(abs(eig(1:10))) / (4 * k_t))
+    ! sliding along s (a tangent direction): the stiffness across s only
+    s = cross(n, unit_vector(mod(trial, 3) + 1))
+    s = s / norm2(s)
+    call contact_stiffness(p, n, dlt, 1e-4_dp * s, .true., kn, kt)
+    call check(all(kt == transpose(kt)), 'sliding block symmetric (bitwise)')
+    eig = eigenvalues(kt)
+    err = max(err, abs(eig(12) - 4 * k_t) / (4 * k_t), maxval(abs(eig(1:11))) / (4 * k_t))
   end do
-  call check_below('1. spectra {2k, 0 x 11} and {2(1+a^2)k_t x 2, 0 x 10}', err, 1e-12_dp)
+  call check_below('1. spectra {2k, 0 x 11}, {2(1+a^2)k_t x 2, 0 x 10}, sliding {2(1+a^2)k_t, 0 x 11}', &
+                   err, 1e-12_dp)
 
   ! ---- 2. normal stiffness against central differences of contact_pair's force
   err = 0
@@ -87,7 +100,7 @@ program test_contact_stiffness
     eps = 1e-4_dp * abs(dlt)
     gp = normal_force(xi + eps * dx(1:3), xj + eps * dx(7:9))
     gm = normal_force(xi - eps * dx(1:3), xj - eps * dx(7:9))
-    call contact_stiffness(p0, n, dlt, .false., kn, kt)
+    call contact_stiffness(p0, n, dlt, zero3, .false., kn, kt)
     pred = -matmul(kn, dx)
     fn = p%k_n * abs(dlt)**1.5_dp
     geo = 0
@@ -115,15 +128,38 @@ program test_contact_stiffness
     gp = pair_force(p, n, dlt, q + eps * dq, ups, dt, sliding)
     call check(.not. sliding, '3. the contact sticks')
     gm = pair_force(p, n, dlt, q - eps * dq, ups, dt, sliding)
-    call contact_stiffness(p, n, dlt, .false., kn, kt)
+    call contact_stiffness(p, n, dlt, zero3, .false., kn, kt)
     pred = -dt * matmul(kt, dq)
     err = max(err, norm2((gp - gm) / (2 * eps) - pred) / norm2(pred))
   end do
   call check_below('3. tangential stiffness vs differences of the force in the velocities', err, 1e-9_dp)
+  ! sliding: the spring at the Coulomb limit along s (1 + 1e-7 beyond it, so that both sides of
+  ! the difference slide), no slip at q, perturbations whose slip is across s
+  err = 0
+  do trial = 1, 3
+    n = unit_vector(trial)
+    dlt = -0.3_dp * p%h_r
+    s = cross(n, unit_vector(mod(trial, 3) + 1))
+    s = s / norm2(s)
+    cap = p%mu_d * p%k_n * abs(dlt)**1.5_dp / (p%kt_coeff * p%k_n * sqrt(abs(dlt)))
+    ups = (1 + 1e-7_dp) * cap * s
+    q = 0
+    dq = [0.7_dp, 0.1_dp, -0.3_dp, 0.2_dp, -0.5_dp, 0.4_dp, -0.4_dp, 0.6_dp, 0.2_dp, 0.1_dp, 0.3_dp, -0.6_dp] * trial
+    slip = dq(1:3) - dq(7:9) - dot_product(dq(1:3) - dq(7:9), n) * n + p%a * cross(dq(4:6) + dq(10:12), n)
+    dq(1:3) = dq(1:3) - dot_product(slip, s) * s
+    eps = 1e-4_dp
+    gp = pair_force(p, n, dlt, q + eps * dq, ups, dt, sliding)
+    call check(sliding, '3. the contact slides')
+    gm = pair_force(p, n, dlt, q - eps * dq, ups, dt, sliding)
+    call contact_stiffness(p, n, dlt, cap * s, .true., kn, kt)
+    pred = -dt * matmul(kt, dq)
+    err = max(err, norm2((gp - gm) / (2 * eps) - pred) / norm2(pred))
+  end do
+  call check_below('3. sliding: stiffness across the slip vs differences of the capped force', err, 1e-6_dp)
 
   ! ---- 4. null spaces
   n = unit_vector(2)
-  call contact_stiffness(p, n, -0.3_dp * p%h_r, .false., kn, kt)
+  call contact_stiffness(p, n, -0.3_dp * p%h_r, zero3, .false., kn, kt)
   q = [0.3_dp, -0.2_dp, 0.5_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.3_dp, -0.2_dp, 0.5_dp, 0.0_dp, 0.0_dp, 0.0_dp]
   err = norm2(matmul(kn + kt, q)) / (maxval(abs(kn + kt)) * norm2(q))
   q(4:6) = [0.2_dp, 0.1_dp, -0.4_dp]
@@ -133,13 +169,11 @@ program test_contact_stiffness
   call check_below('4. common translation and rolling without slip give no force', err, 1e-12_dp)
 
   ! ---- 5. no spring, no stiffness
-  call contact_stiffness(p, n, -0.3_dp * p%h_r, .true., kn, kt)
-  call check(all(kt == 0) .and. any(kn /= 0), '5. sliding: no tangential stiffness, normal kept')
-  call contact_stiffness(p0, n, -0.3_dp * p%h_r, .false., kn, kt)
+  call contact_stiffness(p0, n, -0.3_dp * p%h_r, zero3, .false., kn, kt)
   call check(all(kt == 0), '5. frictionless: no tangential stiffness')
-  call contact_stiffness(p, n, 0.0_dp, .false., kn, kt)
+  call contact_stiffness(p, n, 0.0_dp, zero3, .false., kn, kt)
   call check(all(kt == 0) .and. all(kn == 0), '5. delta'' = 0: no stiffness')
-  call contact_stiffness(p, n, 1e-4_dp, .false., kn, kt)
+  call contact_stiffness(p, n, 1e-4_dp, zero3, .false., kn, kt)
   call check(all(kt == 0) .and. all(kn == 0), '5. open contact: no stiffness')
 
   ! ---- 6, 7. the assembly in a mock particle system
