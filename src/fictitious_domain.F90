@@ -751,22 +751,32 @@ contains
     real(dp), intent(in) :: old(glo(1):ghi(1), glo(2):ghi(2), glo(3):ghi(3)), weight(8)
     real(dp), intent(inout) :: new(lo(1):hi(1), lo(2):hi(2), lo(3):hi(3))
     logical, intent(in) :: moved, walls
-    integer :: f, m, i, j, k, jj
+    integer :: f, m, i, j, k, jj, i0, j0, k0
     real(dp) :: value
-    do f = 1, nfaces
-      i = ijk(1, f); j = ijk(2, f); k = ijk(3, f)
-      if (.not. moved) then
-        new(i, j, k) = old(i, j, k)
-        cycle
-      end if
-      value = 0.0_dp
-      do m = 1, 8
-        jj = j + corner(2, m)
-        ! beyond a wall there is no fluid and no Lambda (the periodic ghost would wrap)
-        if (walls .and. (jj < 0 .or. jj >= ny)) cycle
-        value = value + weight(m) * old(i + corner(1, m), jj, k + corner(3, m))
+    if (.not. moved) then
+      do f = 1, nfaces
+        new(ijk(1, f), ijk(2, f), ijk(3, f)) = old(ijk(1, f), ijk(2, f), ijk(3, f))
       end do
-      new(i, j, k) = value
+      return
+    end if
+    ! corner m = 1..8 is (o1 + a, o2 + b, o3 + e), a fastest (fd_follow)
+    i0 = corner(1, 1); j0 = corner(2, 1); k0 = corner(3, 1)
+    do f = 1, nfaces
+      i = ijk(1, f) + i0; j = ijk(2, f) + j0; k = ijk(3, f) + k0
+      if (walls .and. (j < 0 .or. j + 1 >= ny)) then
+        ! beyond a wall there is no fluid and no Lambda (the periodic ghost would wrap)
+        value = 0.0_dp
+        do m = 1, 8
+          jj = ijk(2, f) + corner(2, m)
+          if (jj < 0 .or. jj >= ny) cycle
+          value = value + weight(m) * old(ijk(1, f) + corner(1, m), jj, ijk(3, f) + corner(3, m))
+        end do
+      else
+        value = ((((((weight(1) * old(i, j, k) + weight(2) * old(i + 1, j, k)) + weight(3) * old(i, j + 1, k)) &
+                + weight(4) * old(i + 1, j + 1, k)) + weight(5) * old(i, j, k + 1)) + weight(6) * old(i + 1, j, k + 1)) &
+                + weight(7) * old(i, j + 1, k + 1)) + weight(8) * old(i + 1, j + 1, k + 1)
+      end if
+      new(ijk(1, f), ijk(2, f), ijk(3, f)) = value
     end do
   end subroutine carry_run
 
