@@ -172,9 +172,9 @@ contains
     ! indices per axis: at most 2R/h + 2 (the box below), with one to spare for round-off
     integer :: wrapped(ceiling(2.0_dp * radius / grid%h) + 3, 3)
     logical :: mine(ceiling(2.0_dp * radius / grid%h) + 3, 3)
-    integer :: lo(3), hi(3), i, j, k, d, m, ilo, ihi, iw, jw, kw, f, nrow, idx(3), arm(2), s, t
+    integer :: lo(3), hi(3), i, j, k, d, m, ilo, ihi, iw, jw, kw, f, nrow, idx(3), arm(2)
     real(dp) :: centre(3), r(3), a, h, reach2, inside2, rest2, chord, gamma_unit, rival2, second, rival_alpha
-    real(dp) :: val(3), w, dv, sgn(2), block3(3, 3)
+    real(dp) :: w, dv, sgn(2), block3(3, 3), sums6(6), v2, v3
     logical :: owned
     ! the rivals that reach the current row, and what is left of the reach there
     integer :: row_rival(max(1, fd%rival_start(q + 1) - fd%rival_start(q)))
@@ -210,7 +210,7 @@ contains
     call reserve_faces(fd, fd%nf + product(hi - lo + 1))
     ! gamma = kappa (1 - alpha) beta h^2 / eta (relaxation_gamma, method.md §1.5b), written out
     gamma_unit = 0.0_dp
-    block3 = 0.0_dp
+    sums6 = 0.0_dp
     if (c /= FIELD_P) then
       gamma_unit = fd%kappa * fd%beta * h**2 / fd%eta
       call torque_arm(c, idx, arm, sgn)
@@ -265,20 +265,26 @@ contains
           fd%f_ijk(:, f) = [iw, jw, kw]
           fd%f_r(:, f) = r
           fd%f_alpha(f) = a
-          fd%f_relax(f) = 1.0_dp / (1.0_dp + gamma_unit * (1.0_dp - a))
+          if (a == 1.0_dp) then
+            fd%f_relax(f) = 1.0_dp       ! a covered face does not relax (gamma = 0)
+          else
+            fd%f_relax(f) = 1.0_dp / (1.0_dp + gamma_unit * (1.0_dp - a))
+          end if
           if (c == FIELD_P) cycle
-          val = [1.0_dp, sgn(1) * r(arm(1)), sgn(2) * r(arm(2))]
+          ! w g g^T on the non-zeros (1, v2, v3) of g: six distinct sums
+          v2 = sgn(1) * r(arm(1))
+          v3 = sgn(2) * r(arm(2))
           w = fd%f_alpha(f) * fd%f_relax(f) * dv
-          do t = 1, 3
-            do s = 1, 3
-              block3(s, t) = block3(s, t) + (w * val(t)) * val(s)
-            end do
-          end do
+          sums6 = sums6 + [w, w * v2, w * v3, w * v2 * v2, w * v2 * v3, w * v3 * v3]
         end do
       end do
     end do
     ! M_p gains w g g^T on the three non-zeros of g
-    if (c /= FIELD_P) fd%rigid_matrix(idx, idx, q) = fd%rigid_matrix(idx, idx, q) + block3
+    if (c /= FIELD_P) then
+      block3 = reshape([sums6(1), sums6(2), sums6(3), sums6(2), sums6(4), sums6(5), sums6(3), sums6(5), sums6(6)], &
+                       [3, 3])
+      fd%rigid_matrix(idx, idx, q) = fd%rigid_matrix(idx, idx, q) + block3
+    end if
   contains
     ! The cover of the control volume at offset x from a centre (0 beyond the reach).
     real(dp) function alpha_at(x)
