@@ -69,7 +69,9 @@ program fdsusp
   real(dp) :: err_vel, err_p_max, err_p_rms
   logical :: restarting, continuing
   integer, parameter :: RUNNING = 0, DONE = 1, SIGNALLED = 2, WALL_LIMIT = 3, STEADY = 4
-  real(dp), parameter :: CHATTER_LIMIT = 0.025_dp    ! largest chatter_number accepted (doc/CONTACT.md)
+  ! largest chatter_number accepted (doc/CONTACT.md "Time-step considerations"): explicit contacts
+  ! chatter beyond it; implicit ones were measured free of chatter up to IMPLICIT_CHATTER_LIMIT
+  real(dp), parameter :: CHATTER_LIMIT = 0.025_dp, IMPLICIT_CHATTER_LIMIT = 0.2_dp
 
   PetscCallA(PetscInitialize(ierr))
   ! SIGTERM/SIGUSR1 from now on only ask the run to stop after its next step (they replace
@@ -617,17 +619,24 @@ contains
     end if
   end subroutine check_pair_lag
 
-  ! The explicit rough contacts against the lubricated response: refused where they chatter
-  ! (doc/CONTACT.md "Time-step considerations": clean at 0.02, period-two chatter from 0.03 on),
-  ! and where the roughness of a dense suspension would flatten completely (doc/VALIDATION.md §6).
+  ! The rough contacts against the lubricated response: refused beyond the chatter numbers measured
+  ! (doc/CONTACT.md "Time-step considerations": explicit contacts chatter from ~0.02 on and are
+  ! refused above 0.025; implicit ones were measured clean up to 0.2 and are refused beyond), and
+  ! where the roughness of a dense suspension would flatten completely (doc/VALIDATION.md §6).
   subroutine check_contact_limits()
     real(dp) :: chatter, solid_fraction, expected_overlap
     chatter = chatter_number(pc%params, cfg%dt)
     if (.not. pc%implicit .and. chatter > CHATTER_LIMIT) then
-      write(text, '(a,f6.3,a,f5.3,a,es9.2,a)') 'the rough contacts would chatter: dt gamma_dot h_r/delta_0 = ', &
+      write(text, '(a,f6.3,a,f5.3,a,es9.2,a)') 'the explicit rough contacts would chatter: dt gamma_dot h_r/delta_0 = ', &
            chatter, ' exceeds ', CHATTER_LIMIT, &
            ' (period-two oscillation measured above it; doc/CONTACT.md): the largest stable dt here is ', &
-           CHATTER_LIMIT * cfg%dt / chatter, ' (or raise &contact eps_bar)'
+           CHATTER_LIMIT * cfg%dt / chatter, ' (or raise &contact eps_bar, or take them implicitly: &contact implicit)'
+      call input_error(cfg%deck_file, 'time', 'dt', trim(text))
+    else if (pc%implicit .and. chatter > IMPLICIT_CHATTER_LIMIT) then
+      write(text, '(a,f6.3,a,f5.3,a,es9.2,a)') 'the rough contacts: dt gamma_dot h_r/delta_0 = ', chatter, &
+           ' exceeds ', IMPLICIT_CHATTER_LIMIT, ', the largest chatter number at which implicit contacts were '// &
+           'measured free of chatter (doc/CONTACT.md): the largest dt measured stable here is ', &
+           IMPLICIT_CHATTER_LIMIT * cfg%dt / chatter, ' (or raise &contact eps_bar)'
       call input_error(cfg%deck_file, 'time', 'dt', trim(text))
     end if
     ! the roughness of a dense suspension flattens under its force chains (doc/VALIDATION.md §6)
@@ -654,7 +663,8 @@ contains
     if (largest_overlap <= 0.5_dp * pc%params%h_r .and. pc%max_overlap > 0.5_dp * pc%params%h_r) then
       write(text, '(a,i0,a,f6.3,a)') 'at step ', step, ' a contact overlap reaches ', &
            pc%max_overlap / pc%params%h_r, ' h_r (> h_r/2): stiffer contacts (a smaller &contact eps_bar '// &
-           'or a larger normal_stiffness, with dt gamma_dot h_r/delta_0 <= 0.025) keep the roughness from flattening'
+           'or a larger normal_stiffness, with dt gamma_dot h_r/delta_0 within its limit, doc/CONTACT.md) keep the '// &
+           'roughness from flattening'
       call warn_line(text)
     end if
     largest_overlap = pc%max_overlap

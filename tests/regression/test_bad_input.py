@@ -63,10 +63,15 @@ cases = [
     ('rough sphere touching a wall', GOOD.replace('3.2, 3.2, 3.2', '6.4, 6.4, 6.4') +
      '&particles number = 1, position(:,1) = 3.2, 1.0, 3.2 /\n&contact roughness = 0.01 /\n', [],
      ['bad.nml', '&particles', 'position(:,1)', 'wall gap', 'h_r/2']),
-    ('rough contacts that would chatter', GOOD.replace('3.2, 3.2, 3.2, cells_per_radius = 5 /',
-                                                       '6.4, 6.4, 6.4, cells_per_radius = 5, shear_rate = 1 /') +
-     '&particles number = 1, position(:,1) = 3.2, 3.2, 3.2 /\n&contact roughness = 0.01 /\n', [],
+    ('explicit rough contacts that would chatter', GOOD.replace('3.2, 3.2, 3.2, cells_per_radius = 5 /',
+                                                                '6.4, 6.4, 6.4, cells_per_radius = 5, shear_rate = 1 /') +
+     '&particles number = 1, position(:,1) = 3.2, 3.2, 3.2 /\n&contact roughness = 0.01, implicit = .false. /\n', [],
      ['bad.nml', '&time', 'dt', 'chatter', 'largest stable dt here is  1.25E-03']),
+    ('implicit rough contacts beyond the chatter numbers measured',
+     GOOD.replace('3.2, 3.2, 3.2, cells_per_radius = 5 /', '6.4, 6.4, 6.4, cells_per_radius = 5, shear_rate = 1 /')
+     .replace('dt = 0.005', 'dt = 0.02') +
+     '&particles number = 1, position(:,1) = 3.2, 3.2, 3.2 /\n&contact roughness = 0.01 /\n', [],
+     ['bad.nml', '&time', 'dt', 'free of chatter', 'largest dt measured stable here is  1.00E-02']),
     ('rough packing closer than h_r/2', GOOD.replace('3.2, 3.2, 3.2', '6.4, 6.4, 6.4') +
      '&particles solid_fraction = 0.1, packing_min_gap = 1e-3 /\n&contact roughness = 0.01 /\n', [],
      ['bad.nml', '&particles', 'packing_min_gap', 'h_r/2']),
