@@ -73,6 +73,9 @@ contains
         nnz(j) = nnz(j) + 1
       end do
     end do
+    ! a pair may come more than once (lubrication and contact stiffness): its blocks add up in
+    ! one, and a row never holds more blocks than there are particles
+    nnz = min(nnz, sys%n)
     PetscCall(MatCreateSeqBAIJ(PETSC_COMM_SELF, six, n6, n6, zero, nnz, a, ierr))
     PetscCall(MatSetOption(a, MAT_SYMMETRIC, PETSC_TRUE, ierr))
     do q = 1, sys%n
