@@ -19,10 +19,10 @@ module mod_grid
   use petscdmda
   use mod_kinds, only: dp
   use mod_params, only: config_t
-  use mod_errors, only: log_line
+  use mod_errors, only: log_line, fatal_error
   implicit none
   private
-  public :: grid_t, grid_create, grid_destroy, grid_position
+  public :: grid_t, grid_create, grid_destroy, grid_position, direct_solves_wanted
   public :: FIELD_U, FIELD_V, FIELD_W, FIELD_P, field_names
 
   integer, parameter :: FIELD_U = 1, FIELD_V = 2, FIELD_W = 3, FIELD_P = 4
@@ -64,6 +64,10 @@ contains
     PetscCall(DMSetUp(trial, ierr))
     PetscCall(DMDAGetInfo(trial, dim, mx, my, mz, m(1), m(2), m(3), dof, sw, bt(1), bt(2), bt(3), st, ierr))
     PetscCall(DMDestroy(trial, ierr))
+    ! The direct (FFT) solves of the fluid step move each field to z-slabs (mod_fft_solver): split
+    ! the grid the same way, so that the move is a copy on each rank instead of an exchange between
+    ! all of them (PETSc picked 1 x 2 x 1 for 100^3 on 2 ranks; doc/BENCHMARKS.md §8).
+    if (direct_solves_wanted() .and. product(m) <= grid%n(3) / 2) m = [1, 1, product(m)]
     grid%nprocs = m
 
     nlev = 1
@@ -132,5 +136,25 @@ contains
       PetscCall(DMDestroy(grid%da(f), ierr))
     end do
   end subroutine grid_destroy
+
+  ! -fluid_solver fft (default): the four solves of a fluid step by fast transforms, exact to
+  ! round-off (mod_fft_solver); -fluid_solver krylov: CG with multigrid or Jacobi, to the deck's
+  ! tolerances, with every -u_/-v_/-w_/-p_ KSP option (doc/INPUT.md).
+  logical function direct_solves_wanted()
+    character(len=16) :: choice
+    PetscBool :: found
+    PetscErrorCode :: ierr
+    choice = 'fft'
+    PetscCallA(PetscOptionsGetString(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-fluid_solver', choice, found, ierr))
+    select case (trim(choice))
+    case ('fft')
+      direct_solves_wanted = .true.
+    case ('krylov')
+      direct_solves_wanted = .false.
+    case default
+      call fatal_error('fdsusp: error: -fluid_solver '//trim(choice)//' is not known (fft or krylov)', 2)
+      direct_solves_wanted = .false.
+    end select
+  end function direct_solves_wanted
 
 end module mod_grid

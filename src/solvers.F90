@@ -11,13 +11,13 @@ module mod_solvers
   use petscdmda
   use, intrinsic :: iso_c_binding, only: C_INT
   use mod_kinds, only: dp
-  use mod_grid, only: grid_t, FIELD_U, FIELD_V, FIELD_W, FIELD_P, field_names
+  use mod_grid, only: grid_t, FIELD_U, FIELD_V, FIELD_W, FIELD_P, field_names, direct_solves_wanted
   use mod_errors, only: fatal_error, log_line
   use mod_fft_solver, only: fft_solver_t, fft_create, fft_solve, fft_destroy
   implicit none
   private
   public :: solver_t, solvers_configure, solver_create, solver_solve, solver_destroy
-  public :: set_default_option, solver_cold_solve, direct_solves_wanted
+  public :: set_default_option, solver_cold_solve
 
   type :: solver_t
     KSP :: ksp
@@ -251,26 +251,6 @@ contains
     PetscCall(MatAssemblyBegin(P, MAT_FINAL_ASSEMBLY, ierr))
     PetscCall(MatAssemblyEnd(P, MAT_FINAL_ASSEMBLY, ierr))
   end subroutine cell_centred_prolongation
-
-  ! -fluid_solver fft (default): the four solves of a fluid step by fast transforms, exact to
-  ! round-off (mod_fft_solver); -fluid_solver krylov: CG with multigrid or Jacobi, to the deck's
-  ! tolerances, with every -u_/-v_/-w_/-p_ KSP option (doc/INPUT.md).
-  logical function direct_solves_wanted()
-    character(len=16) :: choice
-    PetscBool :: found
-    PetscErrorCode :: ierr
-    choice = 'fft'
-    PetscCallA(PetscOptionsGetString(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-fluid_solver', choice, found, ierr))
-    select case (trim(choice))
-    case ('fft')
-      direct_solves_wanted = .true.
-    case ('krylov')
-      direct_solves_wanted = .false.
-    case default
-      call fatal_error('fdsusp: error: -fluid_solver '//trim(choice)//' is not known (fft or krylov)', 2)
-      direct_solves_wanted = .false.
-    end select
-  end function direct_solves_wanted
 
   ! -fluid_fft_plan estimate (default: FFTW picks its algorithms by rule, the same every run, so a
   ! run and its restart repeat the same round-off, bitwise), measure or patient (FFTW times
