@@ -535,8 +535,8 @@ contains
 
   ! The velocities of the spheres: beta M U = beta b(u~) - m(Lambda^n) + F_ext (method.md eq. (1)
   ! with the weights), for free motion; prescribed, resistance and fixed motions set them.
-  ! extra_force, extra_torque (3, n), optional: further forces on the particles (contacts), added
-  ! to the right-hand side next to external_force/external_torque (free motion only).
+  ! extra_force, extra_torque (3, n), optional: further given forces on the particles, added to
+  ! the right-hand side next to external_force/external_torque (free and frozen motion).
   ! lubrication, optional: the links of this configuration (mod_particle_lubrication); their
   ! resistance enters the 6N system implicitly. contacts, optional: the contacts of this step
   ! (pcontacts_step at X^n): their forces and torques join the right-hand side (free and frozen
