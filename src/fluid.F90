@@ -94,8 +94,10 @@ contains
 
     ! -fluid_extrapolate 0: the warm start from u^n (for the comparison of doc/BENCHMARKS.md §10)
     PetscCall(PetscOptionsGetBool(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-fluid_extrapolate', fl%extrapolate, found, ierr))
-    call set_forcing(cfg, grid, fl, ierr)
-    if (cfg%initial_flow == 'shear' .and. grid%walls) call set_linear_shear(grid, fl, ierr)
+    PetscCall(set_forcing(cfg, grid, fl, ierr))
+    if (cfg%initial_flow == 'shear' .and. grid%walls) then
+      PetscCall(set_linear_shear(grid, fl, ierr))
+    end if
 
     call solvers_configure(fl%reynolds / fl%dt, fl%theta * fl%viscosity, grid%box, grid%walls)
     ! Round-off floor of each solve: 100 machine epsilons of the right-hand side that a field of
@@ -113,7 +115,7 @@ contains
         tol = cfg%pressure_tolerance
         floor = floor / grid%h
       end if
-      call solver_create(grid, c, tol, floor, fl%solver(c), ierr)
+      PetscCall(solver_create(grid, c, tol, floor, fl%solver(c), ierr))
     end do
   end subroutine fluid_create
 
@@ -212,12 +214,12 @@ contains
     implicit = fl%theta * fl%viscosity
 
     ! 1. provisional velocity
-    call ghosted(grid, fl, FIELD_P, fl%pressure, ierr)
+    PetscCall(ghosted(grid, fl, FIELD_P, fl%pressure, ierr))
     PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_P), fl%loc(FIELD_P), p, ierr))
     do c = 1, 3
       e = 0
       e(c) = 1
-      call ghosted(grid, fl, c, fl%vel(c), ierr)
+      PetscCall(ghosted(grid, fl, c, fl%vel(c), ierr))
       PetscCall(DMDAVecGetArrayReadF90(grid%da(c), fl%loc(c), a, ierr))
       PetscCall(DMDAVecGetArrayF90(grid%da(c), fl%rhs(c), r, ierr))
       PetscCall(DMDAVecGetArrayReadF90(grid%da(c), fl%forcing(c), f, ierr))
@@ -251,17 +253,17 @@ contains
       end if
       if (fl%solver(c)%direct) then
         ! exact solves need no guess: u*^n is kept only for the Krylov path's extrapolation
-        call solver_solve(fl%solver(c), fl%rhs(c), fl%vel_star(c), ierr)
+        PetscCall(solver_solve(fl%solver(c), fl%rhs(c), fl%vel_star(c), ierr))
       else if (fl%star_history == STAR_HISTORY_FULL .and. fl%extrapolate) then
         ! vel_star_old := 2 u*^n - u*^{n-1}, then swapped: the guess in vel_star, u*^n in vel_star_old
         PetscCall(VecAXPBY(fl%vel_star_old(c), 2.0_dp, -1.0_dp, fl%vel_star(c), ierr))
         PetscCall(VecSwap(fl%vel_star_old(c), fl%vel_star(c), ierr))
         ! u^n where it already solves the step (a settled flow: no drift, mod_solvers)
-        call solver_solve(fl%solver(c), fl%rhs(c), fl%vel_star(c), ierr, settled=fl%vel(c))
+        PetscCall(solver_solve(fl%solver(c), fl%rhs(c), fl%vel_star(c), ierr, settled=fl%vel(c)))
       else
         PetscCall(VecCopy(fl%vel_star(c), fl%vel_star_old(c), ierr))
         PetscCall(VecCopy(fl%vel(c), fl%vel_star(c), ierr))    ! warm start from u^n
-        call solver_solve(fl%solver(c), fl%rhs(c), fl%vel_star(c), ierr)
+        PetscCall(solver_solve(fl%solver(c), fl%rhs(c), fl%vel_star(c), ierr))
       end if
     end do
     ! (direct solves keep no history: a Krylov run restarted from their checkpoint starts from u^n)
@@ -269,12 +271,12 @@ contains
     PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_P), fl%loc(FIELD_P), p, ierr))
 
     ! 2. pressure increment: -lap phi = -(Re/dt) div u*
-    call divergence(grid, fl, fl%vel_star, fl%div_star, ierr)
+    PetscCall(divergence(grid, fl, fl%vel_star, fl%div_star, ierr))
     PetscCall(VecAXPBY(fl%rhs_p, -mass, 0.0_dp, fl%div_star, ierr))
-    call solver_solve(fl%solver(FIELD_P), fl%rhs_p, fl%phi, ierr)
+    PetscCall(solver_solve(fl%solver(FIELD_P), fl%rhs_p, fl%phi, ierr))
 
     ! 3. projection, with the rate of change for steady-state detection
-    call ghosted(grid, fl, FIELD_P, fl%phi, ierr)
+    PetscCall(ghosted(grid, fl, FIELD_P, fl%phi, ierr))
     PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_P), fl%loc(FIELD_P), ph, ierr))
     local_max = 0.0_dp
     do c = 1, 3
@@ -308,7 +310,7 @@ contains
     PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_P), fl%phi, ph, ierr))
     PetscCall(DMDAVecRestoreArrayF90(grid%da(FIELD_P), fl%pressure, p, ierr))
 
-    call diagnostics(grid, fl, ierr)
+    PetscCall(diagnostics(grid, fl, ierr))
   end subroutine fluid_step
 
   ! div of a face field at the cell centres: (u(i+1)-u(i) + v(j+1)-v(j) + w(k+1)-w(k))/h.
@@ -354,7 +356,7 @@ contains
     PetscErrorCode :: mpierr
     integer :: c, ny
 
-    call divergence(grid, fl, fl%vel, fl%div_star, ierr)
+    PetscCall(divergence(grid, fl, fl%vel, fl%div_star, ierr))
     PetscCall(VecNorm(fl%div_star, NORM_INFINITY, dmax, ierr))
     umax = 0.0_dp
     do c = 1, 3
