@@ -4,9 +4,10 @@
 ! -1 / -2 is the lower / upper wall) and spring (count x 3 doubles: Upsilon in units of a), in
 ! the canonical order of history_pack. Written by rank 0 into the open checkpoint; read by rank 0
 ! and broadcast, every rank then unpacks the same history.
+#include <petsc/finclude/petscsys.h>
 module mod_contacts_io
   use hdf5
-  use mpi
+  use petscsys
   use mod_kinds, only: dp
   use mod_contact, only: contact_history_t, history_size, history_pack, history_unpack, history_clear
   use mod_h5util, only: write_attribute, read_attribute, has_object, write_dataset, read_dataset
@@ -83,9 +84,9 @@ contains
       end if
       call h5fclose_f(file, err)
     end if
-    call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, MPI_COMM_WORLD, ierr)
+    call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
     if (len_trim(message) > 0) call file_error(path, 'contacts', trim(message))
-    call MPI_Bcast(meta, 3, MPI_INTEGER, 0, MPI_COMM_WORLD, ierr)
+    call MPI_Bcast(meta, 3, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
     call history_clear(h)
     if (meta(1) == 0) then
       call warn_line(trim(path)//' holds no contact history (/contacts): the tangential springs start at zero')
@@ -93,8 +94,8 @@ contains
     end if
     if (meta(3) == 0) return
     if (.not. is_root()) allocate(ids(2, meta(3)), ups(3, meta(3)))
-    call MPI_Bcast(ids, 2 * meta(3), MPI_INTEGER, 0, MPI_COMM_WORLD, ierr)
-    call MPI_Bcast(ups, 3 * meta(3), MPI_DOUBLE_PRECISION, 0, MPI_COMM_WORLD, ierr)
+    call MPI_Bcast(ids, 2 * meta(3), MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
+    call MPI_Bcast(ups, 3 * meta(3), MPI_DOUBLE_PRECISION, 0, PETSC_COMM_WORLD, ierr)
     call history_unpack(h, np, meta(3), ids, ups, info)
     if (info /= 0) call file_error(path, 'contacts/ids', 'invalid or repeated contact ids')
   end subroutine contacts_read

@@ -4,9 +4,10 @@
 ! FDSUSP_TABLE_DIR, or &lubrication table). Everything is checked before any work: a resolution
 ! with no table, a table calibrated with another fictitious-domain set-up (radius_offset,
 ! slip_kappa) or an unreadable file stops the run with one message. Collective.
+#include <petsc/finclude/petscsys.h>
 module mod_lubrication_io
   use hdf5
-  use mpi
+  use petscsys
   use mod_kinds, only: dp, pi
   use mod_params, only: config_t
   use mod_lubrication, only: lubrication_t, lub_setup, model_code, LUB_FULL, LUB_NONE, n_wall_scalars
@@ -64,13 +65,13 @@ contains
       message = ''
       dims = 0
       if (is_root()) call read_table(path, cfg, pair, wall, message)
-      call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, MPI_COMM_WORLD, ierr)
+      call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
       if (len_trim(message) > 0) call file_error(path, 'lubrication table', trim(message))
       if (is_root()) dims = [size(pair, 2), size(wall, 2)]
-      call MPI_Bcast(dims, 2, MPI_INTEGER, 0, MPI_COMM_WORLD, ierr)
+      call MPI_Bcast(dims, 2, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
       if (.not. is_root()) allocate(pair(1 + n_pair_scalars, dims(1)), wall(1 + n_wall_scalars, dims(2)))
-      call MPI_Bcast(pair, size(pair), MPI_DOUBLE_PRECISION, 0, MPI_COMM_WORLD, ierr)
-      call MPI_Bcast(wall, size(wall), MPI_DOUBLE_PRECISION, 0, MPI_COMM_WORLD, ierr)
+      call MPI_Bcast(pair, size(pair), MPI_DOUBLE_PRECISION, 0, PETSC_COMM_WORLD, ierr)
+      call MPI_Bcast(wall, size(wall), MPI_DOUBLE_PRECISION, 0, PETSC_COMM_WORLD, ierr)
       lub%pair_gap = pair(1, :)
       lub%pair_resolved = transpose(pair(2:, :))
       lub%wall_gap = wall(1, :)

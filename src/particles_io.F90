@@ -3,9 +3,10 @@
 ! holds particles, plus in checkpoints the state an exact restart needs (velocity, omega, the
 ! Adams-Bashforth history). Reading is done by rank 0 and broadcast; a bad file stops the run
 ! with one message naming the file and the item.
+#include <petsc/finclude/petscsys.h>
 module mod_particles_io
   use hdf5
-  use mpi
+  use petscsys
   use mod_kinds, only: dp
   use mod_params, only: config_t
   use mod_particles, only: particles_t, particles_init, motion_code, configuration_fault
@@ -71,12 +72,12 @@ contains
     message = ''
     n = 0
     if (is_root()) call read_positions(trim(cfg%position_file), position, message)
-    call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, MPI_COMM_WORLD, ierr)
+    call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
     if (len_trim(message) > 0) call file_error(trim(cfg%position_file), 'particles/position', trim(message))
     if (is_root()) n = size(position, 2)
-    call MPI_Bcast(n, 1, MPI_INTEGER, 0, MPI_COMM_WORLD, ierr)
+    call MPI_Bcast(n, 1, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
     if (.not. is_root()) allocate(position(3, n))
-    call MPI_Bcast(position, 3 * n, MPI_DOUBLE_PRECISION, 0, MPI_COMM_WORLD, ierr)
+    call MPI_Bcast(position, 3 * n, MPI_DOUBLE_PRECISION, 0, PETSC_COMM_WORLD, ierr)
     call particles_init(parts, n, cfg%radius, motion_code(cfg%motion))
     parts%position = position
     message = configuration_fault(parts%position, parts%radius, cfg%box, cfg%walls, culprit, start_gap_roughness(cfg))
@@ -267,10 +268,10 @@ contains
       end if
       call h5fclose_f(file, err)
     end if
-    call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, MPI_COMM_WORLD, ierr)
+    call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
     if (len_trim(message) > 0) call file_error(path, 'particles', trim(message))
-    call MPI_Bcast(buffer, size(buffer), MPI_DOUBLE_PRECISION, 0, MPI_COMM_WORLD, ierr)
-    call MPI_Bcast(flag, 1, MPI_INTEGER, 0, MPI_COMM_WORLD, ierr)
+    call MPI_Bcast(buffer, size(buffer), MPI_DOUBLE_PRECISION, 0, PETSC_COMM_WORLD, ierr)
+    call MPI_Bcast(flag, 1, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
     parts%position = buffer(:, :, 1)
     parts%velocity = buffer(:, :, 2)
     parts%omega = buffer(:, :, 3)
