@@ -27,6 +27,7 @@
 ! Pure: no PETSc, MPI or files (the tables are read by mod_lubrication_io).
 module mod_lubrication
   use mod_kinds, only: dp, pi
+  use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use mod_resistance, only: n_pair_scalars, resistance_scalars, leading_singular_part, &
        pair_resistance_fu, pair_force_torque_from_strain, pair_stresslets, wall_resistance_block, &
        wall_normal_resistance, wall_tangential_resistance, &
@@ -204,23 +205,28 @@ contains
   !> strain rate. r (12x12): R_sub_FU made positive semi-definite; drive (12): the part of the
   !> correction that does not depend on the particle velocities, R.U_inf + R_FE : E_inf, so that
   !> (F_1, T_1, F_2, T_2)_lub = drive - r . (U_1, Om_1, U_2, Om_2).
-  subroutine lub_pair_link(lub, f, d, u_inf, om_inf, e_inf, r, drive)
+  !> info (optional): 0, or LAPACK's code when the block could not be decomposed (non-finite input);
+  !> the caller reports it with the pair (the kernel does not stop the run).
+  subroutine lub_pair_link(lub, f, d, u_inf, om_inf, e_inf, r, drive, info)
     type(lubrication_t), intent(in) :: lub
     real(dp), intent(in) :: f(n_pair_scalars), d(3), u_inf(3, 2), om_inf(3), e_inf(3, 3)
     real(dp), intent(out) :: r(12, 12), drive(12)
-    r = clip_to_psd(pair_resistance_fu(f, d, lub%radius, lub%viscosity))
+    integer, intent(out), optional :: info
+    r = clip_to_psd(pair_resistance_fu(f, d, lub%radius, lub%viscosity), info=info)
     drive = matmul(r, [u_inf(:, 1), om_inf, u_inf(:, 2), om_inf]) &
           + pair_force_torque_from_strain(f, d, e_inf, lub%radius, lub%viscosity)
   end subroutine lub_pair_link
 
   !> One sphere-wall link: normal n from the wall into the fluid, w the subgrid wall scalars,
   !> u_wall the wall velocity. (F, T)_lub = drive - r . (U, Om), drive = r . (u_wall, 0).
-  subroutine lub_wall_link(lub, w, normal, u_wall, r, drive)
+  !> info (optional): as for lub_pair_link.
+  subroutine lub_wall_link(lub, w, normal, u_wall, r, drive, info)
     type(lubrication_t), intent(in) :: lub
     real(dp), intent(in) :: w(n_wall_scalars), normal(3), u_wall(3)
     real(dp), intent(out) :: r(6, 6), drive(6)
+    integer, intent(out), optional :: info
     r = clip_to_psd(wall_resistance_block(w(1), w(2), w(3), w(4), w(5), normal, lub%radius, lub%viscosity), &
-                    lub%wall_floor)
+                    lub%wall_floor, info)
     drive = matmul(r(:, 1:3), u_wall)
   end subroutine lub_wall_link
 
@@ -263,12 +269,15 @@ contains
 
   !> The nearest positive semi-definite matrix (Frobenius norm) of a symmetric matrix: negative
   !> eigenvalues set to zero; with floor (<= 0), eigenvalues below floor set to floor instead.
-  function clip_to_psd(a, floor) result(b)
+  !> info (optional): 0, or dsyev's code when the decomposition failed (non-finite a); the result
+  !> is then NaN, so that a caller without info still cannot go on with a wrong block unseen.
+  function clip_to_psd(a, floor, info) result(b)
     real(dp), intent(in) :: a(:, :)
     real(dp), intent(in), optional :: floor
+    integer, intent(out), optional :: info
     real(dp) :: b(size(a, 1), size(a, 2)), lowest
     real(dp) :: v(size(a, 1), size(a, 1)), ev(size(a, 1)), work(64 * size(a, 1))
-    integer :: n, info, k
+    integer :: n, status, k
     external :: dsyev, dpotrf, dsyr
     n = size(a, 1)
     b = 0.5_dp * (a + transpose(a))
@@ -280,14 +289,19 @@ contains
     do k = 1, n
       v(k, k) = v(k, k) - lowest
     end do
-    call dpotrf('U', n, v, n, info)
-    if (info == 0) return
+    if (present(info)) info = 0
+    call dpotrf('U', n, v, n, status)
+    if (status == 0) return
     ! Otherwise b = sum_k max(ev_k, lowest) v_k v_k^T = b - sum_{ev_k < lowest} (ev_k - lowest) v_k v_k^T:
     ! a rank-one update per clipped eigenvalue (LAPACK's dsyevr with a range was measured no faster
     ! than dsyev on these blocks, whose spectra span 1e4 with pairs of equal eigenvalues).
     v = b
-    call dsyev('V', 'U', n, v, n, ev, work, size(work), info)
-    if (info /= 0) error stop 'clip_to_psd: dsyev failed'
+    call dsyev('V', 'U', n, v, n, ev, work, size(work), status)
+    if (status /= 0) then
+      b = ieee_value(1.0_dp, ieee_quiet_nan)
+      if (present(info)) info = status
+      return
+    end if
     if (ev(1) >= lowest) return
     do k = 1, n
       if (ev(k) >= lowest) exit

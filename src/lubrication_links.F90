@@ -58,8 +58,10 @@ contains
     call gather(pl%pair_r, 144)
     call gather(pl%pair_drive, 12)
     pl%npairs = total
-    ! the smallest gap of all shares (the walls are the same on every rank)
+    ! the smallest gap of all shares (the walls are the same on every rank), and a failed link of
+    ! any share (the largest particle index that failed, so that every rank names the same one)
     PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, pl%min_gap, 1, MPI_DOUBLE_PRECISION, MPI_MIN, PETSC_COMM_WORLD, ierr))
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, pl%failed_link, 2, MPI_INTEGER, MPI_MAX, PETSC_COMM_WORLD, ierr))
   contains
     subroutine gather(a, per_link)
       real(dp), intent(inout) :: a(*)

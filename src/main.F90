@@ -272,6 +272,7 @@ program fdsusp
         ! the lubrication links at X^n, taken implicitly in the particle problem below
         PetscCallA(stage_push(STAGE_LUBRICATION, ierr))
         PetscCallA(lubrication_links(pl, parts%position, ierr))
+        if (pl%failed_link(1) /= 0) call lubrication_failure(pl%failed_link)
         PetscCallA(stage_pop(ierr))
       end if
       PetscCallA(stage_push(STAGE_FLUID, ierr))
@@ -694,6 +695,21 @@ contains
     end if
     call fatal_error('fdsusp: fatal: the contact history does not belong to this particle set', 4)
   end subroutine contact_failure
+
+  ! A lubrication block LAPACK could not decompose (the kernels return the status, issue 29):
+  ! non-finite positions or resistance. Collective (every rank holds the same links).
+  subroutine lubrication_failure(link)
+    integer, intent(in) :: link(2)
+    character(len=200) :: what
+    if (link(2) == 0) then
+      write(what, '(a,i0,a)') 'the lubrication block of particle ', link(1), ' and a wall could not be '// &
+           'decomposed (LAPACK dsyev failed: non-finite position or resistance)'
+    else
+      write(what, '(a,i0,a,i0,a)') 'the lubrication block of particles ', link(1), ' and ', link(2), &
+           ' could not be decomposed (LAPACK dsyev failed: non-finite positions or resistance)'
+    end if
+    call stop_with_state(step, what)
+  end subroutine lubrication_failure
 
   ! Runtime guard (design.md "Errors"): a non-finite velocity, pressure or particle quantity, or a
   ! sphere half way through a wall, stops

@@ -33,6 +33,9 @@ module mod_particle_lubrication
     integer, allocatable :: wall_part(:)
     real(dp), allocatable :: wall_n(:, :), wall_r(:, :, :), wall_drive(:, :)   ! (3, :), (6, 6, :), (6, :)
     real(dp) :: min_gap = huge(1.0_dp)                         ! smallest pair or wall gap [a]
+    ! the first link whose block could not be decomposed (non-finite input): particle, partner
+    ! (0 for a wall); 0, 0 when all were
+    integer :: failed_link(2) = 0
     ! corrections of the last step, on each particle
     real(dp), allocatable :: force(:, :), torque(:, :), stresslet(:, :, :)
   end type particle_lubrication_t
@@ -104,18 +107,20 @@ contains
   end subroutine ambient_gradients
 
   !> The lubrication links at positions x (3, np): which pairs and walls are within the outer
-  !> cut-off, and their blocks. Call once per step before the particle problem.
+  !> cut-off, and their blocks. Call once per step before the particle problem. A block that
+  !> cannot be decomposed is named in pl%failed_link for the caller to report.
   !> part, parts (optional): only the part-th of parts contiguous shares of the pair candidates
   !> (0-based; mod_lubrication_links gathers the shares of all ranks in order); walls always all.
   subroutine plub_links(pl, x, part, parts)
     type(particle_lubrication_t), intent(inout) :: pl
     real(dp), intent(in) :: x(:, :)
     integer, intent(in), optional :: part, parts
-    integer :: c, i, j, side, first, last
+    integer :: c, i, j, side, first, last, status
     real(dp) :: r(3), dist, gap, d(3), om_inf(3), e_inf(3, 3), u_inf(3, 2), normal(3), u_wall(3), w(n_wall_scalars)
     pl%npairs = 0
     pl%nwalls = 0
     pl%min_gap = huge(1.0_dp)
+    pl%failed_link = 0
     if (pl%lub%model == LUB_NONE) return
     ! one sphere: its wall candidates were set once by plub_create
     if (pl%np > 1) call nlist_candidates(pl%nlist, x, pl%cand, pl%ncand, pl%cand_walls, pl%ncand_walls)
@@ -146,7 +151,8 @@ contains
       pl%pair_uinf(:, pl%npairs) = [u_inf(:, 1), u_inf(:, 2)]
       pl%pair_f(:, pl%npairs) = lub_pair_scalars(pl%lub, gap)
       call lub_pair_link(pl%lub, pl%pair_f(:, pl%npairs), d, u_inf, om_inf, e_inf, &
-                         pl%pair_r(:, :, pl%npairs), pl%pair_drive(:, pl%npairs))
+                         pl%pair_r(:, :, pl%npairs), pl%pair_drive(:, pl%npairs), status)
+      if (status /= 0 .and. pl%failed_link(1) == 0) pl%failed_link = [i, j]
     end do
     do c = 1, pl%ncand_walls
       i = pl%cand_walls(1, c)
@@ -167,7 +173,8 @@ contains
       w = lub_wall_scalars(pl%lub, gap)
       pl%wall_part(pl%nwalls) = i
       pl%wall_n(:, pl%nwalls) = normal
-      call lub_wall_link(pl%lub, w, normal, u_wall, pl%wall_r(:, :, pl%nwalls), pl%wall_drive(:, pl%nwalls))
+      call lub_wall_link(pl%lub, w, normal, u_wall, pl%wall_r(:, :, pl%nwalls), pl%wall_drive(:, pl%nwalls), status)
+      if (status /= 0 .and. pl%failed_link(1) == 0) pl%failed_link = [i, 0]
     end do
 
   contains

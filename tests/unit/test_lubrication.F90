@@ -14,7 +14,8 @@
 !     over-resolves (clip_to_psd at work);
 !  6. clip_to_psd leaves a positive definite matrix unchanged (1e-12) and returns the nearest
 !     PSD matrix otherwise (its negative eigenvalue removed, the rest kept to 1e-10); with a floor
-!     the smallest eigenvalue becomes the floor (the wall blocks' allowance);
+!     the smallest eigenvalue becomes the floor (the wall blocks' allowance); a non-finite block
+!     gives a status and NaN instead of stopping the program (the caller reports it);
 !  7. wall link: a sphere moving with the wall feels no correction (drive = R.(u_wall, 0));
 !     the simple normal function equals 1/e + ln(1/e)/5 minus its value at the cut-off;
 !  8. pair stresslet: symmetric, and its trace is a d.F_1 for a squeeze (method.md §2.7).
@@ -25,7 +26,9 @@ program test_lubrication
   use mod_lubrication, only: lubrication_t, lub_setup, lub_pair_scalars, lub_wall_scalars, lub_pair_link, &
        lub_wall_link, lub_pair_stresslets, clip_to_psd, LUB_SIMPLE, LUB_FULL
   use mod_unit_checks, only: check, finish
+  use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_nan
   implicit none
+  integer :: info
   type(lubrication_t) :: simple, full
   integer :: k
   real(dp) :: f(n_pair_scalars), f_exact(n_pair_scalars), xi, expect, r(12, 12), drive(12), ft(12), d(3), u_inf(3, 2), e0(3, 3)
@@ -97,6 +100,11 @@ program test_lubrication
   call check(min_eig(b) > -1.0e-10_dp * maxval(abs(b)), 'clip_to_psd: result PSD')
   b = clip_to_psd(a, -0.5_dp)
   call check(abs(min_eig(b) + 0.5_dp) < 1.0e-10_dp * maxval(abs(b)), 'clip_to_psd: eigenvalues raised to the floor')
+  ! a block LAPACK cannot decompose (non-finite) returns a status and NaN, the run is not stopped here
+  a(2, 3) = ieee_value(1.0_dp, ieee_quiet_nan)
+  a(3, 2) = a(2, 3)
+  b = clip_to_psd(a, info=info)
+  call check(info /= 0 .and. all(ieee_is_nan(b)), 'clip_to_psd: a non-finite block gives a status and NaN, no stop')
 
   ! 7. wall link
   w = lub_wall_scalars(simple, 0.01_dp)
