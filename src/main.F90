@@ -10,7 +10,7 @@ program fdsusp
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
   use mod_params, only: config_t, read_deck, echo_deck, max_line
   use mod_errors, only: log_line, warn_line, input_error, fatal_error, is_root
-  use mod_grid, only: grid_t, grid_create, grid_destroy
+  use mod_grid, only: grid_t, grid_create, grid_destroy, direct_solves_wanted
   use mod_fluid, only: fluid_t, fluid_create, fluid_step, fluid_destroy, fluid_errors_vs_manufactured, &
                        fluid_mean_profile
   use mod_series, only: series_t, series_open, series_record, series_flush, series_attributes
@@ -33,7 +33,7 @@ program fdsusp
   use mod_particle_lubrication, only: particle_lubrication_t, plub_create
   use mod_lubrication_links, only: lubrication_links
   use mod_h5util, only: h5util_init
-  use mod_solvers, only: solver_t, solver_create, solver_cold_solve, solver_destroy
+  use mod_solvers, only: solver_t, solver_create, solver_cold_solve, solver_destroy, fft_planner_flags
   use mod_grid, only: FIELD_P
   implicit none
 
@@ -414,6 +414,8 @@ contains
     logical, intent(out) :: restarting, continuing
     PetscBool :: set
     PetscErrorCode :: ierr
+    logical :: direct
+    integer :: plan
     call get_command_argument(1, deck)
     if (len_trim(deck) == 0 .or. deck(1:1) == '-') &
       call fatal_error('usage: fdsusp DECK [-restart CHECKPOINT | -continue] [PETSc options]', 2)
@@ -427,6 +429,9 @@ contains
     if (restarting .and. continuing) &
       call fatal_error('fdsusp: -restart and -continue exclude each other (-continue restarts from the '// &
                        'output directory''s checkpoint.h5)', 2)
+    ! the fluid-solver options are checked now, not after the set-up (each stops with one message)
+    direct = direct_solves_wanted()
+    if (direct) plan = fft_planner_flags()
   end subroutine command_line
 
   ! -continue: the output directory's checkpoint.h5 if it exists (looked for under the directory's

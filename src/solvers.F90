@@ -17,7 +17,7 @@ module mod_solvers
   implicit none
   private
   public :: solver_t, solvers_configure, solver_create, solver_solve, solver_destroy
-  public :: set_default_option, solver_cold_solve
+  public :: set_default_option, solver_cold_solve, fft_planner_flags
 
   type :: solver_t
     KSP :: ksp

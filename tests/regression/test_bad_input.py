@@ -42,6 +42,8 @@ cases = [
      ['bad.nml', '&output', 'directory', 'cannot be created']),
     ('truncated checkpoint', GOOD, ['-restart', 'truncated.h5'], ['truncated.h5', 'truncated']),
     ('missing checkpoint', GOOD, ['-restart', 'nowhere.h5'], ['nowhere.h5', 'does not exist']),
+    ('unknown fluid solver', GOOD, ['-fluid_solver', 'fftt'], ['-fluid_solver', 'fftt', 'fft or krylov']),
+    ('unknown FFT planner', GOOD, ['-fluid_fft_plan', 'fast'], ['-fluid_fft_plan', 'fast', 'estimate']),
     ('checkpoint from another grid', GOOD.replace('cells_per_radius = 5', 'cells_per_radius = 2.5'),
      ['-restart', 'good_run/checkpoint.h5'], ['good_run/checkpoint.h5', 'item cells', '16x16x16', '8x8x8']),
     ('checkpoint from another box', GOOD.replace('box = 3.2, 3.2, 3.2', 'box = 3.2, 6.4, 3.2').replace('cells_per_radius = 5', 'cells_per_radius = 5'),
