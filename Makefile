@@ -2,6 +2,7 @@
 #   make            build bin/fdsusp, bin/fdsusp-pack, bin/pairtraj and the unit-test programs (optimised)
 #   make debug      the same in bin/debug/ with bounds checks and floating-point traps
 #   make check      build and run the whole test suite; last line "N passed, N failed"
+#   make install    programs, lubrication tables, decks and docs under PREFIX (default /usr/local)
 #   make run        run input/demo.nml on 2 ranks
 #   make bench      timings recorded in doc/BENCHMARKS.md
 #   make extremes   the extreme scenes of input/extremes in full (doc/VALIDATION.md §6)
@@ -82,7 +83,7 @@ UNIT_CHECKS_OBJ := $(call obj,$(UNIT_CHECKS_F90))
 
 PROGRAMS := $(BIN)/fdsusp $(BIN)/fdsusp-pack $(BIN)/fdsusp-resistance $(if $(REF_F90),$(BIN)/pairtraj)
 
-.PHONY: all debug check run bench extremes tradeoff pair-dns calibrate clean tests-build
+.PHONY: all debug check run bench extremes tradeoff pair-dns calibrate clean tests-build install
 all: $(PROGRAMS) $(UNIT_BIN)
 
 debug:
@@ -123,6 +124,19 @@ MPIRUN := mpiexec --oversubscribe
 run: all
 	$(MPIRUN) -n $(NP) $(BIN)/fdsusp input/demo.nml
 	$(PYTHON) scripts/rheology.py out/demo --compare --plots out/demo/plots
+
+# make install PREFIX=/path (default /usr/local): the programs in PREFIX/bin, the lubrication
+# tables in PREFIX/share/fdsusp/lubrication (found there by the installed fdsusp, beside its bin/),
+# the shipped decks in PREFIX/share/fdsusp/input and the documentation in PREFIX/share/doc/fdsusp.
+# FDSUSP_BIN=PREFIX/bin make check tests the installed programs.
+PREFIX ?= /usr/local
+install: all
+	install -d $(PREFIX)/bin $(PREFIX)/share/fdsusp/lubrication $(PREFIX)/share/fdsusp/input \
+	    $(PREFIX)/share/doc/fdsusp
+	install -m 755 $(PROGRAMS) $(PREFIX)/bin
+	install -m 644 input/lubrication/*.h5 $(PREFIX)/share/fdsusp/lubrication
+	install -m 644 input/*.nml $(PREFIX)/share/fdsusp/input
+	install -m 644 README.md doc/*.md $(PREFIX)/share/doc/fdsusp
 
 # TESTS=pattern runs only the tests whose path contains pattern.
 check: all

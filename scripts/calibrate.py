@@ -174,7 +174,7 @@ class Runner:
         self.binary = os.path.join(work, 'fdsusp')
         if os.path.exists(self.binary):
             os.remove(self.binary)
-        shutil.copy2(os.path.join(ROOT, 'bin', 'fdsusp'), self.binary)
+        shutil.copy2(os.path.join(os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin')), 'fdsusp'), self.binary)
 
     def add(self, name, **kw):
         out = os.path.join(self.work, name)

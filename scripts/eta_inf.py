@@ -54,7 +54,7 @@ def main():
             f.write(DECK.format(box=', '.join('%g' % b for b in args.box), cells=args.cells, phi=case[0],
                                 seed=case[1], discard=discard))
         log = open(os.path.join(d, 'log'), 'w')
-        return subprocess.Popen([os.path.join(ROOT, 'bin', 'fdsusp'), 'deck.nml'], cwd=d, env=ENV, stdout=log,
+        return subprocess.Popen([os.path.join(os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin')), 'fdsusp'), 'deck.nml'], cwd=d, env=ENV, stdout=log,
                                 stderr=subprocess.STDOUT)
 
     if not args.table_only:

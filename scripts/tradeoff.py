@@ -185,7 +185,7 @@ def main():
         params.setdefault(r['name'], r['parameters'])
     if not args.table_only:
         os.makedirs(args.work, exist_ok=True)
-        shutil.copy2(os.path.join(ROOT, 'bin', 'fdsusp'), os.path.join(args.work, 'fdsusp'))
+        shutil.copy2(os.path.join(os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin')), 'fdsusp'), os.path.join(args.work, 'fdsusp'))
 
         def report(name, status, seconds):
             cpu[name] = seconds

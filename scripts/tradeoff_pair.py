@@ -174,7 +174,7 @@ def main():
             cpu = json.load(f)
     if not args.table_only:
         os.makedirs(args.work, exist_ok=True)
-        shutil.copy2(os.path.join(ROOT, 'bin', 'fdsusp'), os.path.join(args.work, 'fdsusp'))
+        shutil.copy2(os.path.join(os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin')), 'fdsusp'), os.path.join(args.work, 'fdsusp'))
         status = {}
 
         def report(run, st, seconds):

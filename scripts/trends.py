@@ -52,7 +52,7 @@ def start(d, args, phi, mu):
     os.makedirs(d, exist_ok=True)
     binary = os.path.join(d, 'fdsusp')
     if not os.path.exists(binary):
-        shutil.copy2(os.path.join(ROOT, 'bin', 'fdsusp'), binary)
+        shutil.copy2(os.path.join(os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin')), 'fdsusp'), binary)
     with open(os.path.join(d, 'deck.nml'), 'w') as f:
         f.write(DECK.format(box=', '.join('%g' % b for b in args.box), cells=args.cells, dt=args.dt,
                             phi=phi, mu=mu, eps_bar=args.eps_bar, discard=args.discard,

@@ -1,7 +1,7 @@
 ! Reading the lubrication model of a run (doc/LUBRICATION.md): the &lubrication choice and, for
 ! the 'full' model, the table of the resolved resistance that scripts/calibrate.py measured at
-! this resolution (input/lubrication/resolved_a<N>.h5, found through the path compiled in as
-! FDSUSP_TABLE_DIR, or &lubrication table). Everything is checked before any work: a resolution
+! this resolution (resolved_a<N>.h5: in $FDSUSP_TABLE_DIR, beside an installed program in
+! PREFIX/share/fdsusp/lubrication, in the build tree's input/lubrication; or &lubrication table). Everything is checked before any work: a resolution
 ! with no table, a table calibrated with another fictitious-domain set-up (radius_offset,
 ! slip_kappa) or an unreadable file stops the run with one message. Collective.
 #include <petsc/finclude/petscsys.h>
@@ -13,7 +13,8 @@ module mod_lubrication_io
   use mod_lubrication, only: lubrication_t, lub_setup, model_code, LUB_FULL, LUB_NONE, n_wall_scalars
   use mod_resistance, only: n_pair_scalars
   use mod_h5util, only: read_attribute, read_dataset, dataset_dims, has_attribute
-  use mod_errors, only: is_root, input_error, file_error
+  use mod_errors, only: is_root, input_error, file_error, log_line
+  use mod_system, only: executable_dir
   implicit none
   private
   public :: lubrication_load, default_table_path
@@ -25,13 +26,37 @@ module mod_lubrication_io
 
 contains
 
-  !> The shipped table for a/Delta = n.
+  !> The shipped table for a/Delta = n, looked for in $FDSUSP_TABLE_DIR when it is set (then only
+  !> there), else in PREFIX/share/fdsusp/lubrication beside an installed program (its bin/../share),
+  !> in bin/../input/lubrication of a build tree, and last in the build tree compiled in
+  !> (FDSUSP_TABLE_DIR): the first that holds it (the last place when none does: the message names it).
   function default_table_path(cells_per_radius) result(path)
     real(dp), intent(in) :: cells_per_radius
-    character(len=:), allocatable :: path
+    character(len=:), allocatable :: path, bin
     character(len=16) :: tag
+    character(len=1024) :: env
+    integer :: length, status, k
+    logical :: exists
     write(tag, '(i0)') nint(cells_per_radius)
-    path = table_dir//'/resolved_a'//trim(tag)//'.h5'
+    call get_environment_variable('FDSUSP_TABLE_DIR', env, length, status)
+    if (status == 0 .and. length > 0) then
+      path = trim(env)//'/resolved_a'//trim(tag)//'.h5'
+      return
+    end if
+    bin = executable_dir()
+    do k = 1, 3
+      select case (k)
+      case (1)
+        path = bin//'/../share/fdsusp/lubrication/resolved_a'//trim(tag)//'.h5'
+      case (2)
+        path = bin//'/../input/lubrication/resolved_a'//trim(tag)//'.h5'
+      case default
+        path = table_dir//'/resolved_a'//trim(tag)//'.h5'
+      end select
+      if (len(bin) == 0 .and. k < 3) cycle
+      inquire(file=path, exist=exists)
+      if (exists) return
+    end do
   end function default_table_path
 
   !> lub configured from cfg. needed: the run has pairs or walls to lubricate (else 'none' is
@@ -64,6 +89,7 @@ contains
       end if
       message = ''
       dims = 0
+      call log_line('lubrication table: '//path)
       if (is_root()) call read_table(path, cfg, pair, wall, message)
       call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
       if (len_trim(message) > 0) call file_error(path, 'lubrication table', trim(message))

@@ -4,7 +4,7 @@ module mod_system
   implicit none
   private
   public :: install_signal_handlers, stop_signal, publish_file, make_directory, probe_directory, &
-            lock_directory, release_directory
+            lock_directory, release_directory, executable_dir
 
   interface
     subroutine fdsusp_install_signal_handlers() bind(C, name='fdsusp_install_signal_handlers')
@@ -30,11 +30,28 @@ module mod_system
       character(kind=c_char), intent(out) :: previous(*)
       integer(c_int), value :: length
     end function fdsusp_lock_directory
+    integer(c_int) function fdsusp_executable_dir(buf, len) bind(C, name='fdsusp_executable_dir')
+      import :: c_int, c_char
+      character(kind=c_char), intent(out) :: buf(*)
+      integer(c_int), value :: len
+    end function fdsusp_executable_dir
     subroutine fdsusp_release_directory() bind(C, name='fdsusp_release_directory')
     end subroutine fdsusp_release_directory
   end interface
 
 contains
+
+  ! The directory of the running program ('' where it cannot be known).
+  function executable_dir() result(dir)
+    character(len=:), allocatable :: dir
+    character(kind=c_char) :: buf(4096)
+    integer :: n, k
+    n = int(fdsusp_executable_dir(buf, size(buf)))
+    allocate(character(len=max(n, 0)) :: dir)
+    do k = 1, n
+      dir(k:k) = buf(k)
+    end do
+  end function executable_dir
 
   subroutine install_signal_handlers()
     call fdsusp_install_signal_handlers()

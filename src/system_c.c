@@ -150,3 +150,21 @@ void fdsusp_release_directory(void)
   close(lock_fd);
   lock_fd = -1;
 }
+
+/* The directory of the running executable (/proc/self/exe, Linux), so that data installed beside
+ * it (PREFIX/share/fdsusp) is found wherever the program lives. Returns its length, or -1 (the
+ * buffer holds "" then). */
+int fdsusp_executable_dir(char *buf, int len)
+{
+  char path[4096];
+  ssize_t n = readlink("/proc/self/exe", path, sizeof(path) - 1);
+  if (len <= 0) return -1;
+  buf[0] = '\0';
+  if (n <= 0) return -1;
+  path[n] = '\0';
+  char *dir = dirname(path);
+  size_t m = strlen(dir);
+  if ((int)m >= len) return -1;
+  memcpy(buf, dir, m + 1);
+  return (int)m;
+}

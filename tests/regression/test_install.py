@@ -1,0 +1,59 @@
+"""Invariant: an installed copy stands alone. `make install PREFIX=...` puts the programs, the
+lubrication tables, the decks and the docs under PREFIX, and the installed fdsusp finds its table
+beside itself (PREFIX/share/fdsusp/lubrication), not in the build tree; FDSUSP_TABLE_DIR, when set,
+is where it looks instead. Checked by the path the run log names and by a run that completes:
+  1. the installed tree holds bin/fdsusp, bin/fdsusp-pack, bin/pairtraj, the four shipped tables,
+     input/demo.nml and share/doc/fdsusp/README.md;
+  2. a two-sphere deck with full lubrication (a/Delta = 4), run by the installed program from a
+     scratch directory, logs 'lubrication table: PREFIX/bin/../share/fdsusp/lubrication/...' and
+     finishes;
+  3. with FDSUSP_TABLE_DIR pointing at an empty directory the same run is refused, naming that
+     directory (the variable wins), before any step.
+"""
+import os
+import subprocess
+import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
+import fdsusp_testlib as T  # noqa: E402
+
+prefix = T.scratch('install_prefix')
+p = subprocess.run(['make', '-s', '-C', T.ROOT, 'install', 'PREFIX=' + prefix], capture_output=True, text=True,
+                   env=T.ENV)
+T.check(p.returncode == 0, 'make install PREFIX=%s (status %d) %s' % (prefix, p.returncode, p.stderr[-300:]))
+wanted = ['bin/fdsusp', 'bin/fdsusp-pack', 'bin/pairtraj'] + \
+         ['share/fdsusp/lubrication/resolved_a%d.h5' % n for n in (4, 5, 6, 8)] + \
+         ['share/fdsusp/input/demo.nml', 'share/doc/fdsusp/README.md']
+missing = [w for w in wanted if not os.path.exists(os.path.join(prefix, w))]
+T.check(not missing, 'the installed tree holds %d files (missing: %s)' % (len(wanted), missing))
+
+DECK = """&domain box = 8, 8, 8, cells_per_radius = 4 /
+&fluid reynolds = 0.01 /
+&time dt = 1e-3, steps = 2 /
+&output directory = 'out' /
+&lubrication model = 'full' /
+&particles number = 2, position(:,1) = 2.9, 4, 4, position(:,2) = 5.1, 4, 4 /
+"""
+d = T.scratch('install_run')
+deck = T.write_deck(d, 'd.nml', DECK)
+fdsusp = os.path.join(prefix, 'bin', 'fdsusp')
+env = dict(T.ENV)
+env.pop('FDSUSP_TABLE_DIR', None)
+p = subprocess.run([fdsusp, deck], cwd=d, env=env, capture_output=True, text=True, timeout=300)
+table = [l for l in p.stdout.splitlines() if l.startswith('lubrication table:')]
+expected = os.path.join(prefix, 'bin', '..', 'share', 'fdsusp', 'lubrication', 'resolved_a4.h5')
+T.check(p.returncode == 0 and 'finished at step 2' in p.stdout,
+        'the installed fdsusp runs the deck (status %d)' % p.returncode)
+T.check(len(table) == 1 and table[0].split(':', 1)[1].strip() == expected,
+        'it reads the installed table: %s' % (table[0] if table else 'no table line'))
+
+empty = T.scratch('install_no_tables')
+env['FDSUSP_TABLE_DIR'] = empty
+d2 = T.scratch('install_run_env')
+deck = T.write_deck(d2, 'd.nml', DECK)
+p = subprocess.run([fdsusp, deck], cwd=d2, env=env, capture_output=True, text=True, timeout=300)
+messages = [l for l in p.stderr.splitlines() if l.startswith('fdsusp:')]
+T.check(p.returncode != 0 and len(messages) == 1 and empty in messages[0] and 'step ' not in p.stdout,
+        'FDSUSP_TABLE_DIR wins: an empty one is refused by name before any step (status %d, %s)'
+        % (p.returncode, messages[:1]))
+T.finish()
