@@ -39,7 +39,7 @@ module mod_fictitious_domain
   use mod_particle_lubrication, only: particle_lubrication_t, plub_corrections
   use mod_particle_contacts, only: particle_contacts_t, pcontacts_add_stiffness, pcontacts_implicit_update
   use mod_particle_solver, only: particle_solver_t, psolver_create, psolver_solve, psolver_destroy
-  use mod_solid_fraction, only: cube_fraction, relaxation_gamma
+  use mod_solid_fraction, only: cube_fraction
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates, min_image
   use mod_errors, only: fatal_error
   use mod_timers, only: event_begin, event_end, EVENT_GEOMETRY, EVENT_CARRY, EVENT_MOMENTS, EVENT_MOTION, &
@@ -362,13 +362,10 @@ contains
     if (fd%use_reach_list .and. n > 1) then
       call nlist_candidates(fd%reach_list, parts%position, fd%reach_pairs, fd%nreach_pairs, fd%reach_walls, &
                             fd%nreach_walls)
-    else
-      ! every pair, in the same canonical order
+    else if (.not. allocated(fd%reach_pairs)) then
+      ! every pair, in the same canonical order (the list never changes: made once)
       fd%nreach_pairs = n * (n - 1) / 2
-      if (allocated(fd%reach_pairs)) then
-        if (size(fd%reach_pairs, 2) < fd%nreach_pairs) deallocate(fd%reach_pairs)
-      end if
-      if (.not. allocated(fd%reach_pairs)) allocate(fd%reach_pairs(2, max(1, fd%nreach_pairs)))
+      allocate(fd%reach_pairs(2, max(1, fd%nreach_pairs)))
       l = 0
       do i = 1, n - 1
         do j = i + 1, n

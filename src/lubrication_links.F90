@@ -23,7 +23,7 @@ contains
     PetscErrorCode, intent(out) :: ierr
     PetscMPIInt :: rank, ranks
     integer, allocatable :: counts(:), displs(:)
-    integer :: mine, total
+    integer :: mine, total, r
 
     PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, ranks, ierr))
     PetscCallMPI(MPI_Comm_rank(PETSC_COMM_WORLD, rank, ierr))
@@ -36,12 +36,11 @@ contains
     allocate(counts(0:ranks - 1), displs(0:ranks - 1))
     PetscCallMPI(MPI_Allgather(mine, 1, MPI_INTEGER, counts, 1, MPI_INTEGER, PETSC_COMM_WORLD, ierr))
     displs(0) = 0
-    do rank = 1, ranks - 1
-      displs(rank) = displs(rank - 1) + counts(rank - 1)
+    do r = 1, ranks - 1
+      displs(r) = displs(r - 1) + counts(r - 1)
     end do
     total = sum(counts)
     call plub_reserve_pairs(pl, max(total, 1))
-    PetscCallMPI(MPI_Comm_rank(PETSC_COMM_WORLD, rank, ierr))
     ! each share at its place in the whole, then gathered in place
     if (displs(rank) > 0 .and. mine > 0) then
       pl%pair(:, displs(rank) + 1:displs(rank) + mine) = pl%pair(:, 1:mine)
