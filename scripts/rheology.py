@@ -2,6 +2,8 @@
 """Rheology of fdsusp runs from their series.h5 (doc/RHEOLOGY.md).
 
     scripts/rheology.py OUTDIR [OUTDIR ...] [--plots DIR] [--compare]
+    scripts/rheology.py --records SUMMARY.json [...] --plots DIR
+
 
 For each output directory, recomputes the summary of the core region from series.h5 alone, by
 the rules of src/rheology.F90 (records on the series_every grid after discard_step, `blocks`
@@ -12,6 +14,14 @@ differs by more than 1e-10 (relative). --plots DIR: PNG figures: per run the cor
 series, phi(y) and u_x(y), g(theta) and g_c(theta) (paper figs. 6 and 15); over all runs given,
 eta_r, N1/tau and N2/tau against phi_core, one series per friction coefficient (paper figs. 9,
 11).
+
+--records: the figures of the paper's comparisons from recorded summaries (summary.json with the
+"run" object that scripts/friction_study.py adds, e.g. doc/data/friction_phi04/*/summary.json),
+no series needed: paper_fig9.png (eta_r, eta_h against phi_core with the Zarraga et al. 2000 fit
+and the paper's eta_inf), paper_fig11.png (N1/tau, N2/tau with the Dai et al. 2013 fits),
+paper_fig16.png (eta_r, N1/tau, N2/tau against mu_d for each set-up with three or more
+frictions), paper_fig20_22.png (normal viscosity with Morris & Boulay 1999; phi and mu against
+I_v with Boyer, Guazzelli & Pouliquen 2011).
 """
 import argparse
 import json
@@ -250,12 +260,170 @@ def plots(runs, directory):
         plt.close(fig)
 
 
+# Published fits the paper compares with (Gallier et al. 2014 §4.2-4.8), the constants as published:
+# Zarraga, Hill & Leighton 2000 (J. Rheol. 44, 185): eta_r = exp(-2.34 phi) / (1 - phi/0.62)^3.
+# Dai, Bertevas, Qi & Tanner 2013 (J. Rheol. 57, 493), 0.1 <= phi <= 0.45: N1/tau = -0.8 phi^3,
+#   N2/tau = -4.4 phi^3.
+# Morris & Boulay 1999 (J. Rheol. 43, 1213): eta_n = K_n (phi/phi_m)^2 / (1 - phi/phi_m)^2,
+#   K_n = 0.75, phi_m = 0.68.
+# Boyer, Guazzelli & Pouliquen 2011 (PRL 107, 188301): mu(I_v) = mu_1 + (mu_2 - mu_1)/(1 + I_0/I_v)
+#   + I_v + 5/2 phi_m I_v^(1/2), phi(I_v) = phi_m / (1 + I_v^(1/2)); mu_1 = 0.32, mu_2 = 0.7,
+#   I_0 = 0.005, phi_m = 0.585. The paper's eta_inf: Krieger-Dougherty, [eta] = 2.4, phi_m' = 0.68.
+def zarraga_eta(phi):
+    return np.exp(-2.34 * phi) / (1 - phi / 0.62) ** 3
+
+
+def dai_normal(phi):
+    return -0.8 * phi ** 3, -4.4 * phi ** 3
+
+
+def morris_boulay_eta_n(phi, k_n=0.75, phi_m=0.68):
+    return k_n * (phi / phi_m) ** 2 / (1 - phi / phi_m) ** 2
+
+
+def boyer_mu(i_v, mu_1=0.32, mu_2=0.7, i_0=0.005, phi_m=0.585):
+    return mu_1 + (mu_2 - mu_1) / (1 + i_0 / i_v) + i_v + 2.5 * phi_m * np.sqrt(i_v)
+
+
+def boyer_phi(i_v, phi_m=0.585):
+    return phi_m / (1 + np.sqrt(i_v))
+
+
+def eta_inf(phi):
+    return (1 - phi / 0.68) ** (-2.4 * 0.68)
+
+
+def load_records(paths):
+    """Recorded summaries: (label, run settings, quantities); only complete ones."""
+    out = []
+    for path in paths:
+        with open(path) as f:
+            s = json.load(f)
+        if not s.get('complete') or 'run' not in s:
+            print(f'{path}: not a complete recorded summary (no "run" object), skipped')
+            continue
+        out.append((os.path.basename(os.path.dirname(os.path.abspath(path))), s['run'], s['quantities']))
+    return out
+
+
+def setup_key(run):
+    """What a run's set-up is apart from its friction: runs with the same key form a sweep."""
+    return (tuple(run['box']), run['cells_per_radius'], run['solid_fraction_bulk'], run['seed'],
+            run['eps_bar'], run['dt'], run['roughness'])
+
+
+def record_figures(records, directory):
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    os.makedirs(directory, exist_ok=True)
+    frictions = sorted({r['friction'] for _, r, _ in records})
+    colour = {mu: plt.cm.viridis(k / max(1, len(frictions) - 1)) for k, mu in enumerate(frictions)}
+
+    def points(ax, name, scale=1.0, marker='o', filled=True, labelled=True):
+        for mu in frictions:
+            sel = [(r, q) for _, r, q in records if r['friction'] == mu]
+            ax.errorbar([q['phi_core']['value'] for _, q in sel], [scale * q[name]['value'] for _, q in sel],
+                        yerr=[abs(scale) * q[name]['error'] for _, q in sel], ls='none', marker=marker,
+                        color=colour[mu], mfc=colour[mu] if filled else 'none', capsize=3,
+                        label=rf'$\mu_d$ = {mu:g}' if labelled else None)
+
+    phis = np.linspace(0.05, 0.5, 100)
+    # figure 9 (and 10): eta_r, with eta_h as open symbols
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    points(ax, 'eta_r')
+    points(ax, 'eta_h', marker='s', filled=False, labelled=False)
+    ax.plot(phis, zarraga_eta(phis), 'k-', lw=0.8, label='Zarraga et al. (2000) fit')
+    ax.plot(phis, eta_inf(phis), 'k--', lw=0.8, label=r'$\eta_\infty$ (paper eq. 4.19)')
+    ax.set_yscale('log')
+    ax.set_xlabel(r'$\phi_{core}$')
+    ax.set_ylabel(r'$\eta_r$ (filled), $\eta^h$ (open squares)')
+    ax.legend(fontsize=8)
+    ax.set_title('relative viscosity (paper fig. 9, 10)', fontsize=10)
+    fig.tight_layout()
+    fig.savefig(os.path.join(directory, 'paper_fig9.png'), dpi=110)
+    plt.close(fig)
+    # figure 11: N1/tau, N2/tau
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
+    n1, n2 = dai_normal(phis)
+    for k, (name, fit) in enumerate((('N1/tau', n1), ('N2/tau', n2))):
+        points(ax[k], name)
+        ax[k].plot(phis, fit, 'k-', lw=0.8, label='Dai et al. (2013) fit')
+        ax[k].set_xlabel(r'$\phi_{core}$')
+        ax[k].set_ylabel(name)
+        ax[k].legend(fontsize=8)
+    fig.suptitle('normal stress differences (paper fig. 11)', fontsize=10)
+    fig.tight_layout()
+    fig.savefig(os.path.join(directory, 'paper_fig11.png'), dpi=110)
+    plt.close(fig)
+    # figure 16: against mu_d, one line per set-up with three or more frictions
+    sweeps = {}
+    for label, r, q in records:
+        sweeps.setdefault(setup_key(r), []).append((r['friction'], q, label))
+    sweeps = {k: sorted(v, key=lambda z: z[0]) for k, v in sweeps.items() if len({z[0] for z in v}) >= 3}
+    if sweeps:
+        fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
+        for key, v in sweeps.items():
+            mu = [z[0] for z in v]
+            tag = '%gx%gx%g, a/D %d, bulk %.3g' % (key[0] + key[1:3])
+            ax[0].errorbar(mu, [z[1]['eta_r']['value'] for z in v], yerr=[z[1]['eta_r']['error'] for z in v],
+                           marker='o', capsize=3, label=tag)
+            for name, m in (('N1/tau', 'o'), ('N2/tau', 's')):
+                ax[1].errorbar(mu, [z[1][name]['value'] for z in v], yerr=[z[1][name]['error'] for z in v],
+                               marker=m, capsize=3, label=f'{name}, {tag}')
+        ax[0].set_ylabel(r'$\eta_r$')
+        ax[1].set_ylabel(r'$N_1/\tau$ (circles), $N_2/\tau$ (squares)')
+        for a_ in ax:
+            a_.set_xlabel(r'$\mu_d$')
+            a_.legend(fontsize=7)
+        fig.suptitle(r'friction sweep at $\phi_{bulk}$ = 0.4 (paper fig. 16)', fontsize=10)
+        fig.tight_layout()
+        fig.savefig(os.path.join(directory, 'paper_fig16.png'), dpi=110)
+        plt.close(fig)
+    # figures 20-22: normal viscosity; phi and mu against I_v = eta gamma_dot / Sigma_yy^c
+    fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
+    points(ax[0], 'eta_n')
+    ax[0].plot(phis, morris_boulay_eta_n(phis), 'k-', lw=0.8, label='Morris & Boulay (1999)')
+    ax[0].set_xlabel(r'$\phi_{core}$')
+    ax[0].set_ylabel(r'$\eta_n^p = -\Sigma^p_{xx}/\eta\dot\gamma$')
+    iv = np.logspace(-2, 2, 100)
+    for mu in frictions:
+        sel = [q for _, r, q in records if r['friction'] == mu]
+        ax[1].plot([q['I_v']['value'] for q in sel], [q['phi_core']['value'] for q in sel], 'o',
+                   color=colour[mu], label=rf'$\mu_d$ = {mu:g}')
+        ax[2].errorbar([q['I_v']['value'] for q in sel], [q['mu']['value'] for q in sel],
+                       yerr=[q['mu']['error'] for q in sel], ls='none', marker='o', color=colour[mu],
+                       capsize=3, label=rf'$\mu_d$ = {mu:g}')
+    ax[1].plot(iv, boyer_phi(iv), 'k-', lw=0.8, label='Boyer et al. (2011)')
+    ax[2].plot(iv, boyer_mu(iv), 'k-', lw=0.8, label='Boyer et al. (2011)')
+    for a_ in ax[1:]:
+        a_.set_xscale('log')
+        a_.set_xlabel(r'$I_v = \eta\dot\gamma/\Sigma^c_{yy}$')
+    ax[1].set_ylabel(r'$\phi_{core}$')
+    ax[2].set_ylabel(r'$\mu = \tau/\Sigma^c_{yy}$')
+    ax[2].set_yscale('log')
+    for a_ in ax:
+        a_.legend(fontsize=8)
+    fig.suptitle('normal viscosity and the mu(I_v) rheology (paper figs. 20-22)', fontsize=10)
+    fig.tight_layout()
+    fig.savefig(os.path.join(directory, 'paper_fig20_22.png'), dpi=110)
+    plt.close(fig)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument('outdirs', nargs='+')
+    ap.add_argument('outdirs', nargs='*')
     ap.add_argument('--plots', metavar='DIR')
     ap.add_argument('--compare', action='store_true')
+    ap.add_argument('--records', nargs='+', metavar='SUMMARY', help='recorded summary.json files')
     args = ap.parse_args()
+    if args.records:
+        if not args.plots:
+            ap.error('--records needs --plots DIR')
+        record_figures(load_records(args.records), args.plots)
+        return 0
+    if not args.outdirs:
+        ap.error('give run output directories or --records')
     runs = []
     status = 0
     for outdir in args.outdirs:
