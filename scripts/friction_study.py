@@ -102,6 +102,12 @@ def finished(d):
 
 
 def commit_of_binary():
+    """The commit the copied program was built from: the file VERSION beside it when the study runs
+    a pinned build ($FDSUSP_BIN, so that work in the checkout cannot reach a study half-way),
+    else the checkout's."""
+    pinned = os.path.join(os.environ.get('FDSUSP_BIN', ''), 'VERSION')
+    if os.environ.get('FDSUSP_BIN') and os.path.exists(pinned):
+        return open(pinned).read().strip()
     try:
         return subprocess.run(['git', 'describe', '--always', '--dirty'], cwd=ROOT, capture_output=True,
                               text=True, check=True).stdout.strip()
