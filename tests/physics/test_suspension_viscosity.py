@@ -15,8 +15,16 @@ Invariants:
     uncertain by ~1 % (k_H). Sum: 7.4 %, hence 8 %. (The issue's 5 % is met at a/Delta = 5:
     -3.9 % +- 2.0 %, and missed at a/Delta = 4: -5.6 % +- 1.5 %; bench, VALIDATION.md §5.)
  2. the high-frequency viscosity eta_inf of a frozen random configuration at phi = 0.3 is within
-    10 % of the paper's Krieger fit (1 - phi_core/0.68)^(-2.4 x 0.68) (Gallier et al. 2014 §4.3,
-    [eta] = 2.4, phi_m' = 0.68), evaluated at the measured phi_core.
+    8 % of the paper's Krieger fit (1 - phi_core/0.68)^(-2.4 x 0.68) (Gallier et al. 2014 §4.3,
+    [eta] = 2.4, phi_m' = 0.68), evaluated at the measured phi_core (~0.34, eta ~3.1).
+    Tolerance budget (parts of eta, added linearly): the discrete sphere's stresslet is 3.0 %
+    low at a/Delta = 4 in this cell (doc/VALIDATION.md §5.2), which lowers eta - 1, i.e.
+    3.0 % x (eta - 1)/eta = 2.0 % of eta; one configuration with ~52 core spheres: the dilute
+    configurations (~8 core spheres) scatter by 3.3 % in eta - 1, so 3.3 % x sqrt(8/52) x
+    (eta - 1)/eta = 0.9 % (SD), 1.8 % at 2 SD; 150 frozen steps: 0.5 %; the calibration table
+    (recalibrating it moved this eta by 0.5 %): 1 %; the fit itself, two parameters fitted by
+    the paper to its own eta_inf at phi 0.1-0.45 (its fig. 10): 3 % allowed. Sum 8.3 %, hence 8 %
+    (it was 10 % without a budget; measured -2.2 %).
 Frozen mode: the spheres are force- and torque-free but do not move; the flow relaxes to the
 Stokes flow of the configuration (Re = 0.01, dt = 5e-3, backward Euler); the last 50 steps are
 averaged. The block errors measure only the residual drift: one configuration per run. Solver
@@ -81,7 +89,7 @@ T.check(abs(mean - 1) < 0.08, 'dilute: mean over six configurations of (eta - 1)
 eta, err = value('phi0.3', 'eta_r')
 phi, _ = value('phi0.3', 'phi_core')
 krieger = (1 - phi / 0.68) ** (-2.4 * 0.68)
-T.check(abs(eta / krieger - 1) < 0.10, 'eta_inf at phi_core = %.4f: %.4f +- %.1e vs Krieger fit %.4f: %+.2f %% '
-        '(within 10 %%)' % (phi, eta, err, krieger, 100 * (eta / krieger - 1)))
+T.check(abs(eta / krieger - 1) < 0.08, 'eta_inf at phi_core = %.4f: %.4f +- %.1e vs Krieger fit %.4f: %+.2f %% '
+        '(within 8 %%, the budget of the header)' % (phi, eta, err, krieger, 100 * (eta / krieger - 1)))
 T.check(summary['phi0.3']['eta_c']['value'] == 0, 'no contact stress in a frozen hard-sphere configuration')
 T.finish()
