@@ -265,7 +265,7 @@ def plots(runs, directory):
 # Dai, Bertevas, Qi & Tanner 2013 (J. Rheol. 57, 493), 0.1 <= phi <= 0.45: N1/tau = -0.8 phi^3,
 #   N2/tau = -4.4 phi^3.
 # Morris & Boulay 1999 (J. Rheol. 43, 1213): eta_n = K_n (phi/phi_m)^2 / (1 - phi/phi_m)^2,
-#   K_n = 0.75, phi_m = 0.68.
+#   K_n = 0.75, phi_m = 0.68; the paper's fit of that form to its mu_d = 0.5 runs: 1.13, 0.58 (§4.7).
 # Boyer, Guazzelli & Pouliquen 2011 (PRL 107, 188301): mu(I_v) = mu_1 + (mu_2 - mu_1)/(1 + I_0/I_v)
 #   + I_v + 5/2 phi_m I_v^(1/2), phi(I_v) = phi_m / (1 + I_v^(1/2)); mu_1 = 0.32, mu_2 = 0.7,
 #   I_0 = 0.005, phi_m = 0.585. The paper's eta_inf: Krieger-Dougherty, [eta] = 2.4, phi_m' = 0.68.
@@ -384,6 +384,8 @@ def record_figures(records, directory):
     fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
     points(ax[0], 'eta_n')
     ax[0].plot(phis, morris_boulay_eta_n(phis), 'k-', lw=0.8, label='Morris & Boulay (1999)')
+    ax[0].plot(phis[phis < 0.5], morris_boulay_eta_n(phis[phis < 0.5], 1.13, 0.58), 'k--', lw=0.8,
+               label=r'its form fitted by the paper to $\mu_d$ = 0.5 (1.13, 0.58)')
     ax[0].set_xlabel(r'$\phi_{core}$')
     ax[0].set_ylabel(r'$\eta_n^p = -\Sigma^p_{xx}/\eta\dot\gamma$')
     iv = np.logspace(-2, 2, 100)
