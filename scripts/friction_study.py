@@ -40,7 +40,7 @@ ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
 # paper's eps_bar 0.05 instead of 0.1: with implicit contacts the §5.4 choice 0.1 stops at mu_d 0.5
 # (row eb01: the overlap guard, |delta'| > h_r, at strain 7.5).
 BASE = dict(box=(8, 20, 8), cells=4, phi=0.40, seed=1, eps_r=5e-3, eps_bar=0.05, dt=2e-3,
-            discard=2.0, average=20.0, blocks=5, min_gap=None)
+            discard=2.0, average=20.0, blocks=5, min_gap=None, implicit=True)
 
 # One choice changed at a time (issue 28, item 1). The bulk 0.375 puts the core near 0.40: at bulk
 # 0.40 the §5.4 cores were 0.4265 (mu_d 0) and 0.4323 (mu_d 0.5), i.e. 1.07-1.08 times the bulk.
@@ -48,6 +48,9 @@ ROWS = {
     'base':    ('the §5.4 set-up with eps_bar 0.05', {}),
     'eb01':    ('eps_bar 0.1 (the §5.4 set-up)', dict(eps_bar=0.1)),
     'eb002':   ('eps_bar 0.02', dict(eps_bar=0.02)),
+    'explicit': ('explicit contacts, eps_bar 0.1: the §5.4 set-up as run then',
+                 dict(eps_bar=0.1, implicit=False)),
+    'eb001':   ('eps_bar 0.01, dt 1e-3 (chatter number 0.1)', dict(eps_bar=0.01, dt=1e-3)),
     'core040': ('bulk phi 0.375 (core ~0.40)', dict(phi=0.375)),
     'a5':      ('a/Delta 5', dict(cells=5)),
     'dt5e-4':  ('dt 5e-4 (the paper\'s frictional step)', dict(dt=5e-4)),
@@ -63,7 +66,7 @@ DECK = """! issue 28 friction study, row '{row}': {what}; mu_d = {mu} (scripts/f
 &time dt = {dt} /
 &output directory = 'out', progress_every = 500, series_every = 5, checkpoint_every = 2500 /
 &particles solid_fraction = {phi}, seed = {seed}{packing} /
-&contact roughness = {eps_r}, eps_bar = {eps_bar}, friction = {mu} /
+&contact roughness = {eps_r}, eps_bar = {eps_bar}, friction = {mu}{implicit} /
 &lubrication model = 'full' /
 &rheology discard_strain = {discard}, average_strain = {average}, blocks = {blocks} /
 &run title = 'friction study {row}: mu_d = {mu}', max_wall_hours = {hours} /
@@ -86,7 +89,8 @@ def deck_text(row, mu, hours):
     return DECK.format(row=row, what=ROWS[row][0], mu=mu, box=', '.join('%g' % b for b in s['box']),
                        cells=s['cells'], dt=s['dt'], phi=s['phi'], seed=s['seed'], packing=packing,
                        eps_r=s['eps_r'], eps_bar=s['eps_bar'], discard=s['discard'],
-                       average=s['average'], blocks=s['blocks'], hours=hours)
+                       average=s['average'], blocks=s['blocks'], hours=hours,
+                       implicit='' if s['implicit'] else ', implicit = .false.')
 
 
 def load(path):
@@ -148,7 +152,8 @@ def record(d, row, mu, target):
         'spheres': int(spheres[-1]) if spheres else None,
         'box': list(st['box']), 'cells_per_radius': st['cells'], 'y_boundary': 'walls',
         'solid_fraction_bulk': st['phi'], 'seed': st['seed'], 'friction': mu,
-        'roughness': st['eps_r'], 'eps_bar': st['eps_bar'], 'dt': st['dt'], 'reynolds': 0.01,
+        'roughness': st['eps_r'], 'eps_bar': st['eps_bar'], 'implicit_contacts': st['implicit'],
+        'dt': st['dt'], 'reynolds': 0.01,
         'lubrication': 'full', 'strain_discarded': st['discard'], 'strain_averaged': st['average'],
         'blocks': st['blocks'], 'fdsusp_version': version,
         'wall_time_per_step_s': float(walls[-1]) if walls else None,
