@@ -7,7 +7,8 @@ the paper's own set-up (Gallier et al. 2014 §4).
                               [--work out/friction_phi04] [--record doc/data/friction_phi04]
                               [--table] [--list]
 
-CASE names a row of ROWS (default: every row of the sensitivity study, in the order of ROWS).
+CASE names a row of ROWS (default: every row of the sensitivity study, in the order of ROWS), run
+at every --mu, or ROW:MU for that one run (e.g. dt5e-4:0.5).
 Each (row, mu_d) run is a directory <work>/<row>_mu<mu> with its deck, log, out/ and a copy of
 bin/fdsusp taken at its first start, so a rebuild cannot change a run half-way. Resumable: a run
 whose out/summary.json is complete is done; one with out/checkpoint.h5 continues from it
@@ -51,6 +52,7 @@ ROWS = {
     'explicit': ('explicit contacts, eps_bar 0.1: the §5.4 set-up as run then',
                  dict(eps_bar=0.1, implicit=False)),
     'eb001':   ('eps_bar 0.01, dt 1e-3 (chatter number 0.1)', dict(eps_bar=0.01, dt=1e-3)),
+    'eb002dt': ('eps_bar 0.02, dt 5e-4', dict(eps_bar=0.02, dt=5e-4)),
     'core040': ('bulk phi 0.375 (core ~0.40)', dict(phi=0.375)),
     'a5':      ('a/Delta 5', dict(cells=5)),
     'dt5e-4':  ('dt 5e-4 (the paper\'s frictional step)', dict(dt=5e-4)),
@@ -213,10 +215,13 @@ def main():
     ap.add_argument('--table', action='store_true', help='print the table from the records, run nothing')
     ap.add_argument('--list', action='store_true', help='print each run\'s deck, run nothing')
     args = ap.parse_args()
-    for row in args.rows:
+    runs = []
+    for spec in args.rows:      # ROW (every --mu) or ROW:MU (that run alone)
+        row, _, mu = spec.partition(':')
         if row not in ROWS:
             ap.error('unknown row %r (rows: %s)' % (row, ', '.join(ROWS)))
-    runs = [(row, mu) for row in args.rows for mu in args.mu]
+        runs += [(row, float(mu))] if mu else [(row, m) for m in args.mu]
+    args.rows = list(dict.fromkeys(r for r, _ in runs))
     if args.list:
         for row, mu in runs:
             print(deck_text(row, mu, args.hours))
