@@ -13,7 +13,12 @@ Third guard: a linear solver that does not converge stops the run (status 3) wit
 naming the solver, its KSP reason and iterations, and the last good checkpoint survives: the
 run of the first guard is restarted from its step-14 checkpoint with the pressure solver capped
 at one iteration (-fluid_solver krylov -p_ksp_max_it 1, a stand-in for a diverging or stagnating solve).
-Fourth guard: a contact overlap beyond h_r (see the last case)."""
+Fourth guard: a contact overlap beyond h_r (see the fourth case).
+Fifth guard: the default path, whose fluid solves are direct (nothing to fail to converge), still
+has one iterative solve, the particles' 6N system: a pair of spheres 0.1a apart couples it through
+lubrication, and with that solve capped at one iteration (-particles_ksp_max_it 1, a stand-in for a
+solve that fails) the run stops (status 4) with one message naming the solve and its KSP reason,
+and no checkpoint is written over the good one."""
 import os
 import sys
 import numpy as np
@@ -86,4 +91,26 @@ T.check(os.path.exists(os.path.join(d, 'out', 'failed_state.h5')), 'failed_state
 ck = os.path.join(d, 'out', 'checkpoint.h5')
 T.check(os.path.exists(ck) and int(T.h5_attr(ck, 'step')) % 5 == 0 and np.isfinite(T.read_h5(ck, ['u'])['u']).all(),
         'the last good checkpoint is kept (step %s)' % (T.h5_attr(ck, 'step') if os.path.exists(ck) else None))
+
+d = T.scratch('runtime_guard_particle_solve')
+PAIR = """&domain box = 6.4, 6.4, 6.4, cells_per_radius = 5, y_boundary = 'walls', shear_rate = 1 /
+&fluid reynolds = 0.01, initial_flow = 'shear' /
+&time dt = 1e-3, steps = {steps} /
+&output directory = 'out', progress_every = 1, checkpoint_every = 5 /
+&particles number = 2, position(:,1) = 2.15, 3.2, 3.2, position(:,2) = 4.25, 3.2, 3.2 /
+&lubrication model = 'full' /
+"""
+deck = T.write_deck(d, 'p.nml', PAIR.format(steps=5))
+status, out, err = T.run(deck, d, np_ranks=2)
+ck = os.path.join(d, 'out', 'checkpoint.h5')
+os.replace(ck, os.path.join(d, 'good.h5'))
+deck = T.write_deck(d, 'p.nml', PAIR.format(steps=10))
+status, out, err = T.run(deck, d, np_ranks=2, args=['-restart', 'good.h5', '-particles_ksp_max_it', '1'],
+                         expect_ok=False)
+messages = [l for l in err.splitlines() if l.startswith('fdsusp:')]
+T.check(status == 4 and len(messages) == 1 and 'particle system solve failed' in messages[0]
+        and 'reason -3' in messages[0],
+        'a particle solve that does not converge stops the run: status %d, %s' % (status, messages[:1]))
+T.check(not os.path.exists(ck) and int(T.h5_attr(os.path.join(d, 'good.h5'), 'step')) == 5,
+        'no checkpoint was written over the good one (good.h5 still at step 5)')
 T.finish()
