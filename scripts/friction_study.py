@@ -141,6 +141,23 @@ def start(d, row, mu, args):
     return subprocess.Popen(command, cwd=d, env=ENV, stdout=log, stderr=subprocess.STDOUT)
 
 
+def contact_statistics(series_path, discard_strain):
+    """Means over the averaged records (strain > discard) of the contact columns of series.h5:
+    contacts between spheres and with the walls, the fraction of them sliding (at the Coulomb
+    limit), and the largest overlap of each record in units of h_r."""
+    import h5py
+    import numpy as np
+    with h5py.File(series_path, 'r') as f:
+        strain = f['time'][()] * abs(float(np.ravel(f.attrs['shear_rate'])[0]))
+        keep = strain > discard_strain
+        pair, wall, sliding = (f[k][()][keep] for k in ('contacts_pair', 'contacts_wall', 'contacts_sliding'))
+        overlap = f['contact_overlap_over_roughness'][()][keep]
+    total = pair + wall
+    return {'records': int(keep.sum()), 'pair_contacts': float(pair.mean()), 'wall_contacts': float(wall.mean()),
+            'sliding_fraction': float(sliding.sum() / total.sum()) if total.sum() > 0 else 0.0,
+            'largest_overlap_over_h_r_mean': float(overlap.mean()), 'largest_overlap_over_h_r_max': float(overlap.max())}
+
+
 def record(d, row, mu, target):
     """Copy a finished run's deck and summary (with the "run" object) into the record."""
     s = load(os.path.join(d, 'out', 'summary.json'))
@@ -161,6 +178,7 @@ def record(d, row, mu, target):
         'wall_time_per_step_s': float(walls[-1]) if walls else None,
         'ranks': 1,
     }
+    s['contacts'] = contact_statistics(os.path.join(d, 'out', 'series.h5'), st['discard'])
     os.makedirs(target, exist_ok=True)
     shutil.copy2(os.path.join(d, 'deck.nml'), os.path.join(target, 'deck.nml'))
     with open(os.path.join(target, 'summary.json'), 'w') as f:
@@ -177,8 +195,9 @@ def ratio(a, b):
 def table(rows, record_dir):
     """The sensitivity table from the records: one line per row with both frictions recorded."""
     print('| row | spheres | phi_core (0 / 0.5) | eta_r (0 -> 0.5) | eta_r ratio | eta_h (0 -> 0.5) '
-          '| eta_c (0 -> 0.5) | \\|N1\\|/tau change | \\|N2\\|/tau change | N2/N1 (0 -> 0.5) |')
-    print('|---|---|---|---|---|---|---|---|---|---|')
+          '| eta_c (0 -> 0.5) | \\|N1\\|/tau change | \\|N2\\|/tau change | N2/N1 (0 -> 0.5) '
+          '| sliding at 0.5 | overlap/h_r (0 / 0.5) |')
+    print('|---|---|---|---|---|---|---|---|---|---|---|---|')
 
     def pm(q):
         return '%.2f +- %.2f' % (q['value'], q['error'])
@@ -186,6 +205,11 @@ def table(rows, record_dir):
     for row in rows:
         s0 = load(os.path.join(record_dir, run_name(row, 0), 'summary.json'))
         s1 = load(os.path.join(record_dir, run_name(row, 0.5), 'summary.json'))
+        note = ''
+        if s0 is None and s1 is not None and row != 'base':
+            # a row run at mu_d 0.5 only: the frictionless reference is the base's (marked)
+            s0 = load(os.path.join(record_dir, run_name('base', 0), 'summary.json'))
+            note = ' (mu_d 0: the base run)'
         if s0 is None or s1 is None:
             print('| %s: %s | (not finished) |' % (row, ROWS[row][0]))
             continue
@@ -196,11 +220,12 @@ def table(rows, record_dir):
         n0, en0 = ratio(q0['N1/tau'], q0['N2/tau'])
         n1, en1 = ratio(q1['N1/tau'], q1['N2/tau'])
         print('| %s: %s | %s | %.4f / %.4f | %s -> %s | **%.3f +- %.3f** | %s -> %s | %s -> %s '
-              '| %+.0f +- %.0f %% | %+.0f +- %.0f %% | %.2f +- %.2f -> %.2f +- %.2f |'
-              % (row, ROWS[row][0], s1['run']['spheres'], q0['phi_core']['value'], q1['phi_core']['value'],
+              '| %+.0f +- %.0f %% | %+.0f +- %.0f %% | %.2f +- %.2f -> %.2f +- %.2f | %.0f %% | %.2f / %.2f |'
+              % (row, ROWS[row][0] + note, s1['run']['spheres'], q0['phi_core']['value'], q1['phi_core']['value'],
                  pm(q0['eta_r']), pm(q1['eta_r']), r, re_, pm(q0['eta_h']), pm(q1['eta_h']),
                  pm(q0['eta_c']), pm(q1['eta_c']), 100 * (c1 - 1), 100 * e1, 100 * (c2 - 1), 100 * e2,
-                 n0, en0, n1, en1))
+                 n0, en0, n1, en1, 100 * s1['contacts']['sliding_fraction'],
+                 s0['contacts']['largest_overlap_over_h_r_mean'], s1['contacts']['largest_overlap_over_h_r_mean']))
 
 
 def main():
