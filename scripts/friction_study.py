@@ -239,6 +239,8 @@ def main():
     ap.add_argument('--record', default=os.path.join(ROOT, 'doc', 'data', 'friction_phi04'))
     ap.add_argument('--table', action='store_true', help='print the table from the records, run nothing')
     ap.add_argument('--list', action='store_true', help='print each run\'s deck, run nothing')
+    ap.add_argument('--rerecord', action='store_true',
+                    help='record every finished run of --work again (after a change of the record), run nothing')
     args = ap.parse_args()
     runs = []
     for spec in args.rows:      # ROW (every --mu) or ROW:MU (that run alone)
@@ -247,6 +249,14 @@ def main():
             ap.error('unknown row %r (rows: %s)' % (row, ', '.join(ROWS)))
         runs += [(row, float(mu))] if mu else [(row, m) for m in args.mu]
     args.rows = list(dict.fromkeys(r for r, _ in runs))
+    if args.rerecord:
+        for name in sorted(os.listdir(args.work)):
+            row, _, mu = name.rpartition('_mu')
+            d = os.path.join(args.work, name)
+            if row in ROWS and finished(d):
+                record(d, row, float(mu), os.path.join(args.record, name))
+                print('recorded', name)
+        return 0
     if args.list:
         for row, mu in runs:
             print(deck_text(row, mu, args.hours))
