@@ -11,7 +11,9 @@
 !             (mod_particles_io: positions with attribute box, velocities, Adams-Bashforth history)
 !             with contacts also the group /contacts (mod_contacts_io: the tangential springs)
 !             with statistics (&rheology) also /rheology/accumulators (mod_rheology::rheo_state)
-!   attributes format_version, step, time, cells, box, walls, reynolds, dt, shear_rate, star_history
+!   attributes format_version, step, time, cells, box, walls, reynolds, dt, shear_rate, star_history,
+!             fluid_resolved (1, or 0 for lubrication dynamics, which writes no fields: no fl), and
+!             with Lees-Edwards boundaries lees_edwards_offset (the boundary offset delta, exactly)
 ! Written in parallel to NAME.tmp by PETSc's HDF5 viewer, completed by rank 0, flushed to disk
 ! and renamed over NAME: the previous checkpoint survives until the new one is whole.
 #include <petsc/finclude/petscdmda.h>
@@ -23,7 +25,7 @@ module mod_checkpoint
   use mod_grid, only: grid_t, FIELD_U, FIELD_V, FIELD_W
   use mod_fluid, only: fluid_t
   use mod_h5util, only: write_attribute, read_attribute, write_string_attribute, has_object, dataset_dims, &
-                        write_dataset, read_dataset
+                        write_dataset, read_dataset, has_attribute
   use mod_system, only: publish_file
   use mod_errors, only: is_root, abort_run, file_error
   use mod_particles, only: particles_t
@@ -39,12 +41,13 @@ module mod_checkpoint
 
 contains
 
-  ! lambda and parts: present when the run has particles; history: when it has contacts;
-  ! statistics: the accumulators of &rheology.
-  subroutine checkpoint_write(path, cfg, fl, step, time, ierr, lambda, parts, history, statistics)
+  ! fl: the fluid, absent in lubrication dynamics (&fluid model = 'none'); lambda and parts: present
+  ! when the run has particles; history: when it has contacts; statistics: the accumulators of
+  ! &rheology; offset: the Lees-Edwards offset (y_boundary = 'lees-edwards').
+  subroutine checkpoint_write(path, cfg, fl, step, time, ierr, lambda, parts, history, statistics, offset)
     character(len=*), intent(in) :: path
     type(config_t), intent(in) :: cfg
-    type(fluid_t), intent(inout) :: fl
+    type(fluid_t), intent(inout), optional :: fl
     integer, intent(in) :: step
     real(dp), intent(in) :: time
     PetscErrorCode, intent(out) :: ierr
@@ -52,29 +55,39 @@ contains
     type(particles_t), intent(in), optional :: parts
     type(contact_history_t), intent(in), optional :: history
     real(dp), intent(in), optional :: statistics(:)
+    real(dp), intent(in), optional :: offset
     PetscViewer :: viewer
     integer(HID_T) :: file, group
-    integer :: err, e(11), c, walls
+    integer :: err, e(13), c, walls, stars
     character(len=1100) :: tmp
     character(len=16) :: code
 
     tmp = trim(path)//'.tmp'
-    PetscCall(PetscViewerHDF5Open(PETSC_COMM_WORLD, trim(tmp), FILE_MODE_WRITE, viewer, ierr))
-    do c = FIELD_U, FIELD_W
-      PetscCall(VecView(fl%vel(c), viewer, ierr))
-    end do
-    PetscCall(VecView(fl%pressure, viewer, ierr))
-    PetscCall(VecView(fl%phi, viewer, ierr))
-    do c = FIELD_U, FIELD_W
-      PetscCall(VecView(fl%vel_star(c), viewer, ierr))
-      PetscCall(VecView(fl%vel_star_old(c), viewer, ierr))
-    end do
-    if (present(lambda)) then
-      do c = 1, 3
-        PetscCall(VecView(lambda(c), viewer, ierr))
+    stars = 0
+    if (present(fl)) then
+      PetscCall(PetscViewerHDF5Open(PETSC_COMM_WORLD, trim(tmp), FILE_MODE_WRITE, viewer, ierr))
+      do c = FIELD_U, FIELD_W
+        PetscCall(VecView(fl%vel(c), viewer, ierr))
       end do
+      PetscCall(VecView(fl%pressure, viewer, ierr))
+      PetscCall(VecView(fl%phi, viewer, ierr))
+      do c = FIELD_U, FIELD_W
+        PetscCall(VecView(fl%vel_star(c), viewer, ierr))
+        PetscCall(VecView(fl%vel_star_old(c), viewer, ierr))
+      end do
+      if (present(lambda)) then
+        do c = 1, 3
+          PetscCall(VecView(lambda(c), viewer, ierr))
+        end do
+      end if
+      PetscCall(PetscViewerDestroy(viewer, ierr))
+      stars = fl%star_history
+    else if (is_root()) then
+      ! no fields: rank 0 makes the file alone
+      call h5fcreate_f(trim(tmp), H5F_ACC_TRUNC_F, file, err)
+      if (err /= 0) call abort_run('cannot create '//trim(tmp))
+      call h5fclose_f(file, err)
     end if
-    PetscCall(PetscViewerDestroy(viewer, ierr))
 
     if (is_root()) then
       call h5fopen_f(trim(tmp), H5F_ACC_RDWR_F, file, err)
@@ -91,7 +104,9 @@ contains
       call write_attribute(file, 'dt', [cfg%dt], e(8))
       call write_attribute(file, 'shear_rate', [cfg%shear_rate], e(9))
       call write_string_attribute(file, 'program', 'fdsusp', e(10))
-      call write_attribute(file, 'star_history', [fl%star_history], e(11))
+      call write_attribute(file, 'star_history', [stars], e(11))
+      call write_attribute(file, 'fluid_resolved', [merge(1, 0, present(fl))], e(12))
+      if (present(offset)) call write_attribute(file, 'lees_edwards_offset', [offset], e(13))
       if (present(parts)) call particles_write(file, parts, cfg%box, .true.)
       if (present(history) .and. present(parts)) call contacts_write(file, history, parts%n)
       if (present(statistics)) then
@@ -144,7 +159,7 @@ contains
     real(dp), intent(out) :: values(2)
     integer(HID_T) :: file, dset, space
     integer(HSIZE_T) :: dims(3), maxdims(3), pdims(2)
-    integer :: err, version(1), cells(3), walls(1), istep(1), rank, d, n_saved
+    integer :: err, version(1), cells(3), walls(1), istep(1), rank, d, n_saved, resolved(1)
     real(dp) :: box(3), t(1)
     logical :: exists
 
@@ -171,6 +186,17 @@ contains
            ', the file has format ', version(1)
     end if
     if (len_trim(message) == 0) then
+      resolved = 1
+      if (has_attribute(file, 'fluid_resolved')) call read_attribute(file, 'fluid_resolved', resolved, err)
+      if ((resolved(1) == 1) .neqv. cfg%resolved) then
+        item = 'fluid_resolved'
+        message = 'the checkpoint and the deck disagree on &fluid model (resolved or none)'
+      else if (has_attribute(file, 'lees_edwards_offset') .neqv. cfg%lees_edwards) then
+        item = 'lees_edwards_offset'
+        message = 'the checkpoint and the deck disagree on &domain y_boundary = ''lees-edwards'''
+      end if
+    end if
+    if (len_trim(message) == 0 .and. cfg%resolved) then
       call read_attribute(file, 'cells', cells, err)
       if (err /= 0) then
         item = 'cells'; message = 'missing'
@@ -207,7 +233,7 @@ contains
       end if
     end if
     do d = 1, size(field_datasets)
-      if (len_trim(message) > 0) exit
+      if (len_trim(message) > 0 .or. .not. cfg%resolved) exit
       if (.not. has_object(file, trim(field_datasets(d)))) then
         item = '/'//trim(field_datasets(d)); message = 'dataset missing'
         exit
@@ -238,51 +264,65 @@ contains
     call h5fclose_f(file, err)
   end subroutine inspect
 
-  ! history (with parts): the contact history, when the run has contacts; statistics: the
-  ! accumulators of &rheology (its size is the run's; a checkpoint without them, or with another
-  ! size, stops the run).
-  subroutine checkpoint_read(path, fl, ierr, lambda, parts, history, statistics)
+  ! fl: the fluid (absent in lubrication dynamics); history (with parts): the contact history,
+  ! when the run has contacts; statistics: the accumulators of &rheology (its size is the run's; a
+  ! checkpoint without them, or with another size, stops the run); offset: the Lees-Edwards offset.
+  subroutine checkpoint_read(path, fl, ierr, lambda, parts, history, statistics, offset)
     character(len=*), intent(in) :: path
-    type(fluid_t), intent(inout) :: fl
+    type(fluid_t), intent(inout), optional :: fl
     PetscErrorCode, intent(out) :: ierr
     Vec, intent(inout), optional :: lambda(3)
     type(particles_t), intent(inout), optional :: parts
     type(contact_history_t), intent(inout), optional :: history
     real(dp), intent(inout), optional :: statistics(:)
+    real(dp), intent(out), optional :: offset
     PetscViewer :: viewer
     integer :: c, rank, err, stars(1)
+    real(dp) :: delta(1)
     integer(HID_T) :: file
     integer(HSIZE_T) :: dims(2)
     character(len=200) :: message
     real(dp), allocatable :: buffer(:, :)
-    ! how many provisional velocities the file holds (none in a checkpoint older than them)
-    stars = 0
-    if (is_root()) then
-      call h5fopen_f(trim(path), H5F_ACC_RDONLY_F, file, err)
-      if (has_object(file, 'u_star_old')) call read_attribute(file, 'star_history', stars, err)
-      if (err /= 0) stars = 0
-      call h5fclose_f(file, err)
+    if (present(offset)) then
+      delta = 0.0_dp
+      if (is_root()) then
+        call h5fopen_f(trim(path), H5F_ACC_RDONLY_F, file, err)
+        call read_attribute(file, 'lees_edwards_offset', delta, err)
+        call h5fclose_f(file, err)
+      end if
+      call MPI_Bcast(delta, 1, MPI_DOUBLE_PRECISION, 0, PETSC_COMM_WORLD, ierr)
+      offset = delta(1)
     end if
-    call MPI_Bcast(stars, 1, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
-    fl%star_history = stars(1)
-    PetscCall(PetscViewerHDF5Open(PETSC_COMM_WORLD, trim(path), FILE_MODE_READ, viewer, ierr))
-    do c = FIELD_U, FIELD_W
-      PetscCall(VecLoad(fl%vel(c), viewer, ierr))
-    end do
-    PetscCall(VecLoad(fl%pressure, viewer, ierr))
-    PetscCall(VecLoad(fl%phi, viewer, ierr))
-    if (fl%star_history > 0) then
+    if (present(fl)) then
+      ! how many provisional velocities the file holds (none in a checkpoint older than them)
+      stars = 0
+      if (is_root()) then
+        call h5fopen_f(trim(path), H5F_ACC_RDONLY_F, file, err)
+        if (has_object(file, 'u_star_old')) call read_attribute(file, 'star_history', stars, err)
+        if (err /= 0) stars = 0
+        call h5fclose_f(file, err)
+      end if
+      call MPI_Bcast(stars, 1, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
+      fl%star_history = stars(1)
+      PetscCall(PetscViewerHDF5Open(PETSC_COMM_WORLD, trim(path), FILE_MODE_READ, viewer, ierr))
       do c = FIELD_U, FIELD_W
-        PetscCall(VecLoad(fl%vel_star(c), viewer, ierr))
-        PetscCall(VecLoad(fl%vel_star_old(c), viewer, ierr))
+        PetscCall(VecLoad(fl%vel(c), viewer, ierr))
       end do
+      PetscCall(VecLoad(fl%pressure, viewer, ierr))
+      PetscCall(VecLoad(fl%phi, viewer, ierr))
+      if (fl%star_history > 0) then
+        do c = FIELD_U, FIELD_W
+          PetscCall(VecLoad(fl%vel_star(c), viewer, ierr))
+          PetscCall(VecLoad(fl%vel_star_old(c), viewer, ierr))
+        end do
+      end if
+      if (present(lambda)) then
+        do c = 1, 3
+          PetscCall(VecLoad(lambda(c), viewer, ierr))
+        end do
+      end if
+      PetscCall(PetscViewerDestroy(viewer, ierr))
     end if
-    if (present(lambda)) then
-      do c = 1, 3
-        PetscCall(VecLoad(lambda(c), viewer, ierr))
-      end do
-    end if
-    PetscCall(PetscViewerDestroy(viewer, ierr))
     if (present(parts)) call particles_read_state(path, parts)
     if (present(history) .and. present(parts)) call contacts_read(path, history, parts%n)
     if (present(statistics)) then

@@ -21,9 +21,12 @@
 ! The image shift is deliberately not part of the key: the neighbour search requires every
 ! periodic length >= 2 x cutoff, so at most one image of j can touch i, and the shift of a pair
 ! changes when a particle is wrapped into the box during a contact.
+! Lees-Edwards boundaries (contact_forces' le): the pair separation is le_separation's and the
+! partner's velocity that of its sliding image, U_j + s gamma_dot Ly e_x (kept per link, image_velocity).
 module mod_contact
   use mod_kinds, only: dp, pi
   use mod_vector, only: cross
+  use mod_lees_edwards, only: lees_edwards_t, le_separation
   implicit none
   private
   public :: contact_params_t, contact_setup, contact_stats_t
@@ -64,6 +67,9 @@ module mod_contact
     real(dp), allocatable :: normal(:,:), lever(:,:), spring(:,:)   ! (3, n)
     real(dp), allocatable :: overlap(:)
     logical, allocatable :: sliding(:)
+    ! what the partner's velocity gains as seen from i: its Lees-Edwards image's s gamma_dot Ly e_x
+    ! (0 without sliding boundaries, and for walls)
+    real(dp), allocatable :: image_velocity(:,:)   ! (3, n)
   end type contact_links_t
 
   !> Tangential springs of the open contacts, in compressed-row form over the owner particle:
@@ -289,9 +295,10 @@ contains
   !> wall 1 = lower | 2 = upper). Outputs per particle: force, torque (3, np), symmetric contact
   !> stresslet (3, 3, np); stats. The history h advances by one step (not touched if mu_d = 0).
   !> info: 0 ok; 1 the history was built for another particle count. links, optional: the open
-  !> contacts of this step (for their implicit stiffness, contact_stiffness).
+  !> contacts of this step (for their implicit stiffness, contact_stiffness). le, optional:
+  !> Lees-Edwards boundaries in y (mod_lees_edwards), when active.
   subroutine contact_forces(p, h, x, u, om, box, periodic, vw, pairs, npairs, walls, nwalls, dt, &
-                            force, torque, stresslet, stats, info, links)
+                            force, torque, stresslet, stats, info, links, le)
     type(contact_params_t), intent(in) :: p
     type(contact_history_t), intent(inout) :: h
     real(dp), intent(in) :: x(:,:), u(:,:), om(:,:), box(3), vw(3, 2), dt
@@ -301,11 +308,12 @@ contains
     type(contact_stats_t), intent(out) :: stats
     integer, intent(out) :: info
     type(contact_links_t), intent(inout), optional :: links
+    type(lees_edwards_t), intent(in), optional :: le
     integer :: m, i, j, k, w, np, nnew
     integer, allocatable :: new_owner(:), new_partner(:)
     real(dp), allocatable :: new_ups(:,:)
-    real(dp) :: r(3), d, n(3), dlt, ups(3), f(3), tq(3), fn, scale, s(3, 3)
-    logical :: tangential, sliding
+    real(dp) :: r(3), d, n(3), dlt, ups(3), f(3), tq(3), fn, scale, s(3, 3), vshift(3)
+    logical :: tangential, sliding, sliding_boundaries
 
     info = 0
     np = size(x, 2)
@@ -323,21 +331,28 @@ contains
     scale = p%h_r
     if (scale <= 0) scale = p%a
     if (present(links)) call links_reserve(links, npairs + nwalls)
+    sliding_boundaries = .false.
+    if (present(le)) sliding_boundaries = le%active
+    vshift = 0
 
     do m = 1, npairs
       i = min(pairs(1, m), pairs(2, m))
       j = max(pairs(1, m), pairs(2, m))
       r = x(:, j) - x(:, i)
-      do k = 1, 3
-        if (periodic(k)) r(k) = r(k) - box(k) * anint(r(k) / box(k))
-      end do
+      if (sliding_boundaries) then
+        call le_separation(le, x(:, j) - x(:, i), r, vshift)
+      else
+        do k = 1, 3
+          if (periodic(k)) r(k) = r(k) - box(k) * anint(r(k) / box(k))
+        end do
+      end if
       d = norm2(r)
       dlt = d - 2 * p%a - p%h_r
       if (dlt > 0) cycle
       n = r / d
       ups = 0
       if (tangential) ups = history_lookup(h, i, j)
-      call contact_pair(p, n, dlt, u(:, i) - u(:, j), om(:, i) + om(:, j), dt, ups, f, tq, fn, &
+      call contact_pair(p, n, dlt, u(:, i) - (u(:, j) + vshift), om(:, i) + om(:, j), dt, ups, f, tq, fn, &
                         sliding)
       if (tangential) call append(i, j)
       force(:, i) = force(:, i) + f
@@ -347,7 +362,7 @@ contains
       s = contact_stresslet(f, 0.5_dp * r)
       stresslet(:, :, i) = stresslet(:, :, i) + s
       stresslet(:, :, j) = stresslet(:, :, j) + s
-      if (present(links)) call add_link(j, 0.5_dp * r)
+      if (present(links)) call add_link(j, 0.5_dp * r, vshift)
       call tally(.false., j)
     end do
 
@@ -370,7 +385,7 @@ contains
       force(:, i) = force(:, i) + f
       torque(:, i) = torque(:, i) + tq
       stresslet(:, :, i) = stresslet(:, :, i) + contact_stresslet(f, 0.5_dp * (p%a + d) * n)
-      if (present(links)) call add_link(-w, 0.5_dp * (p%a + d) * n)
+      if (present(links)) call add_link(-w, 0.5_dp * (p%a + d) * n, [0.0_dp, 0.0_dp, 0.0_dp])
       call tally(.true., -w)
     end do
 
@@ -386,9 +401,9 @@ contains
       new_ups(:, nnew) = ups
     end subroutine append
 
-    subroutine add_link(other, lever)
+    subroutine add_link(other, lever, image_velocity)
       integer, intent(in) :: other
-      real(dp), intent(in) :: lever(3)
+      real(dp), intent(in) :: lever(3), image_velocity(3)
       links%n = links%n + 1
       links%i(links%n) = i
       links%partner(links%n) = other
@@ -397,6 +412,7 @@ contains
       links%overlap(links%n) = dlt
       links%spring(:, links%n) = ups
       links%sliding(links%n) = sliding
+      links%image_velocity(:, links%n) = image_velocity
     end subroutine add_link
 
     subroutine tally(wall, partner)
@@ -424,11 +440,12 @@ contains
     links%n = 0
     if (allocated(links%i)) then
       if (size(links%i) >= m) return
-      deallocate(links%i, links%partner, links%normal, links%lever, links%spring, links%overlap, links%sliding)
+      deallocate(links%i, links%partner, links%normal, links%lever, links%spring, links%overlap, links%sliding, &
+                 links%image_velocity)
     end if
     allocate(links%i(max(m, 16)), links%partner(max(m, 16)), links%normal(3, max(m, 16)), &
              links%lever(3, max(m, 16)), links%spring(3, max(m, 16)), links%overlap(max(m, 16)), &
-             links%sliding(max(m, 16)))
+             links%sliding(max(m, 16)), links%image_velocity(3, max(m, 16)))
   end subroutine links_reserve
 
   ! ---- the history -------------------------------------------------------------------------

@@ -35,8 +35,8 @@ module mod_fictitious_domain
   use mod_grid, only: grid_t, FIELD_U, FIELD_V, FIELD_W, FIELD_P
   use mod_particles, only: particles_t, MOTION_FREE, MOTION_PRESCRIBED, MOTION_FROZEN, MOTION_RESISTANCE, &
                            MOTION_FIXED
-  use mod_particle_system, only: particle_system_t, psys_reset, psys_add_diagonal, psys_add_pair, psys_solve
-  use mod_particle_lubrication, only: particle_lubrication_t, plub_corrections
+  use mod_particle_system, only: particle_system_t, psys_reset, psys_add_diagonal, psys_solve
+  use mod_particle_lubrication, only: particle_lubrication_t, plub_corrections, plub_add_to_system
   use mod_particle_contacts, only: particle_contacts_t, pcontacts_add_stiffness, pcontacts_implicit_update
   use mod_particle_solver, only: particle_solver_t, psolver_create, psolver_solve, psolver_destroy
   use mod_solid_fraction, only: cube_fraction
@@ -571,7 +571,7 @@ contains
         if (present(extra_torque)) rhs(4:6, q) = rhs(4:6, q) + extra_torque(:, q)
         if (present(contacts)) rhs(:, q) = rhs(:, q) + [contacts%force(:, q), contacts%torque(:, q)]
       end do
-      if (present(lubrication)) call add_lubrication(fd, lubrication, rhs)
+      if (present(lubrication)) call plub_add_to_system(lubrication, fd%system, rhs)
       if (present(contacts) .and. parts%motion == MOTION_FREE) &
         call pcontacts_add_stiffness(contacts, fd%system, rhs, parts%velocity, parts%omega, parts%have_prev)
       if (fd%system%npairs == 0) then
@@ -705,29 +705,6 @@ contains
     PetscCall(event_end(EVENT_UPDATE, ierr))
   end subroutine fd_update
 
-  ! The lubrication links into the 6N system: each pair's 12x12 R_sub_FU as two diagonal blocks and
-  ! one coupling block, each wall link's 6x6 on its particle's diagonal; their velocity-independent
-  ! parts (R.U_inf + R_FE:E_inf) on the right-hand side.
-  subroutine add_lubrication(fd, pl, rhs)
-    type(fd_t), intent(inout) :: fd
-    type(particle_lubrication_t), intent(in) :: pl
-    real(dp), intent(inout) :: rhs(:, :)
-    integer :: l, i, j
-    do l = 1, pl%npairs
-      i = pl%pair(1, l)
-      j = pl%pair(2, l)
-      call psys_add_diagonal(fd%system, i, pl%pair_r(1:6, 1:6, l))
-      call psys_add_diagonal(fd%system, j, pl%pair_r(7:12, 7:12, l))
-      call psys_add_pair(fd%system, i, j, pl%pair_r(1:6, 7:12, l))
-      rhs(:, i) = rhs(:, i) + pl%pair_drive(1:6, l)
-      rhs(:, j) = rhs(:, j) + pl%pair_drive(7:12, l)
-    end do
-    do l = 1, pl%nwalls
-      i = pl%wall_part(l)
-      call psys_add_diagonal(fd%system, i, pl%wall_r(:, :, l))
-      rhs(:, i) = rhs(:, i) + pl%wall_drive(:, l)
-    end do
-  end subroutine add_lubrication
 
   ! The kernels below take one run (one sphere, one velocity component c) on plain arrays with the
   ! bounds of the rank's part of the grid, so that the compiler sees fixed strides (issue 31).

@@ -17,6 +17,11 @@
 !           itself at this resolution (scripts/calibrate.py, tables in input/lubrication),
 !           interpolated linearly in ln(gap); below the smallest calibrated gap the resolved part
 !           is held (it saturates once the gap is below the grid spacing).
+!   exact   the exact functions of mod_resistance minus the one-body part, nothing resolved to
+!           subtract: the pair and wall hydrodynamics of the lubrication dynamics mode (&fluid
+!           model = 'none', mod_lubrication_dynamics), where no grid resolves anything. Its blocks
+!           are not clipped at 0 but at a floor per link set by the caller (lub_pair_link's floor),
+!           since R_2B - R_1B has negative eigenvalues at every gap (XA11 - 1 + XA12 < 0 far apart).
 ! Safeguards (§2.5): gaps below inner_cutoff are evaluated at inner_cutoff; a C1 taper takes the
 ! correction to zero at outer_cutoff over its last 30 %; every pair block of R_sub_FU is made
 ! positive semi-definite by clipping its negative eigenvalues (LAPACK dsyev), so the implicit
@@ -30,14 +35,16 @@ module mod_lubrication
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use mod_resistance, only: n_pair_scalars, resistance_scalars, leading_singular_part, &
        pair_resistance_fu, pair_force_torque_from_strain, pair_stresslets, wall_resistance_block, &
-       wall_normal_resistance, wall_tangential_resistance, &
+       wall_normal_resistance, wall_tangential_resistance, wall_twist_resistance, &
        i_xa11, i_ya11, i_xc11, i_yc11, i_xm11, i_ym11, i_zm11, i_xm12, i_ym12, i_zm12, &
        i_xa12, i_xg11, i_xg12, i_yh11, i_yh12, i_xc12, i_yc12
   implicit none
   private
   public :: lubrication_t, lub_setup, lub_pair_scalars, lub_wall_scalars, lub_pair_link, lub_wall_link, &
             lub_pair_stresslets, lub_wall_stresslet, clip_to_psd, lub_taper, model_code, grains3d_cutoff
-  integer, parameter, public :: LUB_NONE = 0, LUB_SIMPLE = 1, LUB_FULL = 2
+  integer, parameter, public :: LUB_NONE = 0, LUB_SIMPLE = 1, LUB_FULL = 2, LUB_EXACT = 3
+  ! outer cut-off of the exact model when the deck gives none [a]
+  real(dp), parameter, public :: exact_default_cutoff = 1.0_dp
   integer, parameter, public :: n_wall_scalars = 5    ! lambda_perp, f_tt, f_tr, f_rr, x_w
 
   type :: lubrication_t
@@ -68,6 +75,7 @@ contains
     select case (name)
     case ('simple'); model_code = LUB_SIMPLE
     case ('full');   model_code = LUB_FULL
+    case ('exact');  model_code = LUB_EXACT
     case default;    model_code = LUB_NONE
     end select
   end function model_code
@@ -94,6 +102,8 @@ contains
       lub%outer_cutoff = lub%simple_cutoff
     case (LUB_FULL)
       lub%outer_cutoff = lub%pair_gap(size(lub%pair_gap))
+    case (LUB_EXACT)
+      lub%outer_cutoff = exact_default_cutoff
     case default
       lub%outer_cutoff = 0.0_dp
     end select
@@ -156,6 +166,12 @@ contains
       f([i_xm11, i_ym11, i_zm11]) = f([i_xm11, i_ym11, i_zm11]) + f([i_xm12, i_ym12, i_zm12])
       f([i_xm12, i_ym12, i_zm12]) = 0.0_dp
       f = f - interpolate(lub%pair_gap, lub%pair_resolved, xi)
+    case (LUB_EXACT)
+      ! R_2B - R_1B (method.md §2.4 item 4, nothing resolved)
+      f = resistance_scalars(xi)
+      f(one_body_scalars) = f(one_body_scalars) - 1.0_dp
+      f([i_xm11, i_ym11, i_zm11]) = f([i_xm11, i_ym11, i_zm11]) + f([i_xm12, i_ym12, i_zm12])
+      f([i_xm12, i_ym12, i_zm12]) = 0.0_dp
     end select
     f = taper * f
   end function lub_pair_scalars
@@ -195,6 +211,15 @@ contains
       w(2) = w(2) - 1.0_dp
       w(4) = w(4) - 1.0_dp
       w(1:4) = w(1:4) - interpolate(lub%wall_gap, lub%wall_resolved(:, 1:4), eps)
+    case (LUB_EXACT)
+      w(1) = wall_normal_resistance(eps) - 1.0_dp
+      call wall_tangential_resistance(eps, w(2), w(3), w(4))
+      w(2) = w(2) - 1.0_dp
+      w(4) = w(4) - 1.0_dp
+      ! the twist, which no grid resolves here
+      w(5) = wall_twist_resistance(eps) - 1.0_dp
+      w = lub_taper(gap, lub%outer_cutoff) * w
+      return
     end select
     w(5) = 0.0_dp
     w = lub_taper(gap, lub%outer_cutoff) * w
@@ -207,26 +232,32 @@ contains
   !> (F_1, T_1, F_2, T_2)_lub = drive - r . (U_1, Om_1, U_2, Om_2).
   !> info (optional): 0, or LAPACK's code when the block could not be decomposed (non-finite input);
   !> the caller reports it with the pair (the kernel does not stop the run).
-  subroutine lub_pair_link(lub, f, d, u_inf, om_inf, e_inf, r, drive, info)
+  !> floor (optional, <= 0): the lowest eigenvalue the block may keep (default 0: made PSD).
+  subroutine lub_pair_link(lub, f, d, u_inf, om_inf, e_inf, r, drive, info, floor)
     type(lubrication_t), intent(in) :: lub
     real(dp), intent(in) :: f(n_pair_scalars), d(3), u_inf(3, 2), om_inf(3), e_inf(3, 3)
     real(dp), intent(out) :: r(12, 12), drive(12)
     integer, intent(out), optional :: info
-    r = clip_to_psd(pair_resistance_fu(f, d, lub%radius, lub%viscosity), info=info)
+    real(dp), intent(in), optional :: floor
+    r = clip_to_psd(pair_resistance_fu(f, d, lub%radius, lub%viscosity), floor, info)
     drive = matmul(r, [u_inf(:, 1), om_inf, u_inf(:, 2), om_inf]) &
           + pair_force_torque_from_strain(f, d, e_inf, lub%radius, lub%viscosity)
   end subroutine lub_pair_link
 
   !> One sphere-wall link: normal n from the wall into the fluid, w the subgrid wall scalars,
   !> u_wall the wall velocity. (F, T)_lub = drive - r . (U, Om), drive = r . (u_wall, 0).
-  !> info (optional): as for lub_pair_link.
-  subroutine lub_wall_link(lub, w, normal, u_wall, r, drive, info)
+  !> info (optional): as for lub_pair_link. floor (optional): replaces lub%wall_floor.
+  subroutine lub_wall_link(lub, w, normal, u_wall, r, drive, info, floor)
     type(lubrication_t), intent(in) :: lub
     real(dp), intent(in) :: w(n_wall_scalars), normal(3), u_wall(3)
     real(dp), intent(out) :: r(6, 6), drive(6)
     integer, intent(out), optional :: info
+    real(dp), intent(in), optional :: floor
+    real(dp) :: lowest
+    lowest = lub%wall_floor
+    if (present(floor)) lowest = floor
     r = clip_to_psd(wall_resistance_block(w(1), w(2), w(3), w(4), w(5), normal, lub%radius, lub%viscosity), &
-                    lub%wall_floor, info)
+                    lowest, info)
     drive = matmul(r(:, 1:3), u_wall)
   end subroutine lub_wall_link
 

@@ -10,7 +10,7 @@ module mod_lubrication_io
   use petscsys
   use mod_kinds, only: dp, pi
   use mod_params, only: config_t
-  use mod_lubrication, only: lubrication_t, lub_setup, model_code, LUB_FULL, LUB_NONE, n_wall_scalars
+  use mod_lubrication, only: lubrication_t, lub_setup, model_code, LUB_FULL, LUB_NONE, LUB_EXACT, n_wall_scalars
   use mod_resistance, only: n_pair_scalars
   use mod_h5util, only: read_attribute, read_dataset, dataset_dims, has_attribute
   use mod_errors, only: is_root, input_error, file_error, log_line
@@ -73,6 +73,13 @@ contains
 
     model = model_code(trim(cfg%lubrication_model))
     if (.not. needed) model = LUB_NONE
+    ! lubrication dynamics (&fluid model = 'none'): nothing is resolved, so 'full' is the exact
+    ! two-body functions themselves and needs no table (mod_lubrication_dynamics)
+    if (.not. cfg%resolved .and. model == LUB_FULL) then
+      model = LUB_EXACT
+      if (len_trim(cfg%lubrication_table) > 0) &
+        call log_line('lubrication: &lubrication table is not used with &fluid model = ''none'' (exact functions)')
+    end if
     if (model == LUB_FULL) then
       path = trim(cfg%lubrication_table)
       if (len(path) == 0) then

@@ -16,11 +16,13 @@ module mod_lubrication_links
 
 contains
 
-  !> The links at positions x (3, np) on every rank. Collective.
-  subroutine lubrication_links(pl, x, ierr)
+  !> The links at positions x (3, np) on every rank. Collective. offset (optional): the
+  !> Lees-Edwards offset of this configuration (lubrication dynamics with sliding boundaries).
+  subroutine lubrication_links(pl, x, ierr, offset)
     type(particle_lubrication_t), intent(inout) :: pl
     real(dp), intent(in) :: x(:, :)
     PetscErrorCode, intent(out) :: ierr
+    real(dp), intent(in), optional :: offset
     PetscMPIInt :: rank, ranks
     integer, allocatable :: counts(:), displs(:)
     integer :: mine, total, r
@@ -28,10 +30,10 @@ contains
     PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, ranks, ierr))
     PetscCallMPI(MPI_Comm_rank(PETSC_COMM_WORLD, rank, ierr))
     if (ranks == 1) then
-      call plub_links(pl, x)
+      call plub_links(pl, x, offset=offset)
       return
     end if
-    call plub_links(pl, x, rank, ranks)
+    call plub_links(pl, x, rank, ranks, offset)
     mine = pl%npairs
     allocate(counts(0:ranks - 1), displs(0:ranks - 1))
     PetscCallMPI(MPI_Allgather(mine, 1, MPI_INTEGER, counts, 1, MPI_INTEGER, PETSC_COMM_WORLD, ierr))

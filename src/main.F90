@@ -1,4 +1,6 @@
-! fdsusp: fictitious-domain simulation of sheared suspensions (design.md).
+! fdsusp: fictitious-domain simulation of sheared suspensions (design.md), or with &fluid model =
+! 'none' their lubrication dynamics: the spheres alone, one-body Stokes drag plus exact pair and wall
+! resistance and contacts, between walls or across Lees-Edwards boundaries (issue 30).
 !   bin/fdsusp DECK [-restart CHECKPOINT | -continue] [PETSc options]
 ! Reads and checks everything before any work, then steps the flow in time, writing the series,
 ! field snapshots and checkpoints the deck asks for. SIGTERM or SIGUSR1 (what batch schedulers
@@ -28,13 +30,17 @@ program fdsusp
                                    fd_destroy
   use mod_particle_contacts, only: particle_contacts_t, pcontacts_create, pcontacts_step
   use mod_contact, only: chatter_number, flattening_estimate, wall_lower, wall_upper
-  use mod_lubrication, only: lubrication_t, LUB_NONE, LUB_SIMPLE
+  use mod_lubrication, only: lubrication_t, LUB_NONE, LUB_SIMPLE, LUB_EXACT
   use mod_lubrication_io, only: lubrication_load
   use mod_particle_lubrication, only: particle_lubrication_t, plub_create
   use mod_lubrication_links, only: lubrication_links
   use mod_h5util, only: h5util_init
   use mod_solvers, only: solver_t, solver_create, solver_cold_solve, solver_destroy, fft_planner_flags
   use mod_grid, only: FIELD_P
+  use mod_lees_edwards, only: lees_edwards_t, le_create, le_wrap, le_advance
+  use mod_lubrication_dynamics, only: lubrication_dynamics_t, ld_create
+  use mod_ld_motion, only: ld_solve_motion
+  use mod_particle_solver, only: particle_solver_t, psolver_create, psolver_destroy
   implicit none
 
   PetscErrorCode :: ierr
@@ -49,6 +55,9 @@ program fdsusp
   type(lubrication_t) :: lub
   type(particle_lubrication_t), allocatable :: pl   ! allocated when lubrication is on
   type(rheology_t), allocatable :: rh               ! allocated when the deck has &rheology
+  type(lees_edwards_t) :: le                        ! y_boundary = 'lees-edwards' (le%active), its offset
+  type(lubrication_dynamics_t) :: ld                ! &fluid model = 'none': the spheres alone
+  type(particle_solver_t) :: ld_solver              ! its sparse 6N solve
   real(dp), allocatable :: statistics(:)            ! rh's accumulators, for checkpoints
   real(dp), allocatable :: mean_flow(:)             ! x-z plane means of u, per cell row
   real(dp) :: largest_overlap = 0.0_dp              ! of this run (since the start or restart) [a]
@@ -89,12 +98,15 @@ program fdsusp
   if (continuing) call continue_from_directory()
   call particles_load(cfg, parts)
   has_particles = parts%n > 0
+  ! sliding periodic boundaries in y (lubrication dynamics): the offset starts at 0, a restart
+  ! reads it from the checkpoint
+  if (cfg%lees_edwards) le = le_create(cfg%box, cfg%shear_rate, 0.0_dp)
   ! contacts: the deck has &contact and the run has particles (doc/CONTACT.md)
   has_contacts = has_particles .and. cfg%contact_group
   if (has_contacts) then
     call pcontacts_create(pc, parts%n, parts%radius, cfg%roughness, cfg%friction, cfg%eps_bar, &
          cfg%normal_stiffness, cfg%neighbour_skin, 1.0_dp, cfg%shear_rate, cfg%box, cfg%walls, cfg%dt, &
-         info, text, cfg%contact_implicit)
+         info, text, cfg%contact_implicit, le)
     if (info /= 0) call input_error(cfg%deck_file, 'contact', '', trim(text))
   end if
   ! lubrication: pairs or walls to lubricate (doc/LUBRICATION.md); the table is read and checked now
@@ -102,16 +114,16 @@ program fdsusp
   has_lubrication = lub%model /= LUB_NONE
   if (has_lubrication) then
     allocate(pl)
-    call plub_create(pl, lub, parts%n, cfg%box, cfg%walls, cfg%shear_rate, cfg%lubrication_skin, info, text)
+    call plub_create(pl, lub, parts%n, cfg%box, cfg%walls, cfg%shear_rate, cfg%lubrication_skin, info, text, le)
     if (info /= 0) call input_error(cfg%deck_file, 'lubrication', 'skin', trim(text))
   end if
   ! rough contacts: the limits of doc/CONTACT.md and doc/VALIDATION.md §6, before any work
-  if (has_contacts .and. has_lubrication) call check_contact_limits()
+  if (has_contacts .and. (has_lubrication .or. .not. cfg%resolved)) call check_contact_limits()
   ! statistics of the core region (doc/RHEOLOGY.md)
   if (cfg%rheology_group) then
     allocate(rh)
     call rheo_create(rh, parts%n, cfg%box, parts%radius, cfg%shear_rate, cfg%core, cfg%profile_bins, &
-         cfg%angle_bins, cfg%pair_shell, cfg%contact_shell, cfg%blocks, cfg%discard_step, cfg%block_steps, info)
+         cfg%angle_bins, cfg%pair_shell, cfg%contact_shell, cfg%blocks, cfg%discard_step, cfg%block_steps, info, le)
     if (info /= 0) call input_error(cfg%deck_file, 'domain', 'box', &
          'with &rheology every periodic length must be >= 2 (pair_shell + 0.3) a')
     allocate(mean_flow(0:cfg%cells(2) - 1))
@@ -121,7 +133,7 @@ program fdsusp
     call log_line(text)
     ! spheres crossing more than ~0.02 cells per step lose stresslet (doc/VALIDATION.md §5.3)
     core_edge_speed = abs(cfg%shear_rate) * max(rh%core(2) - 0.5_dp * cfg%box(2), 0.5_dp * cfg%box(2) - rh%core(1))
-    if (core_edge_speed * cfg%dt > 0.02_dp * cfg%h) then
+    if (cfg%resolved .and. core_edge_speed * cfg%dt > 0.02_dp * cfg%h) then
       write(text, '(a,f6.3,a,es9.2,a)') 'spheres at the edge of the core cross ', core_edge_speed * cfg%dt / cfg%h, &
            ' cells per step, and their stresslets lag (doc/VALIDATION.md 5.3): dt <= ', &
            0.02_dp * cfg%h / core_edge_speed, ' keeps them within 1 %'
@@ -145,12 +157,30 @@ program fdsusp
   ! ---- set-up ----
   PetscCallA(timers_register(ierr))
   PetscCallA(stage_push(STAGE_SETUP, ierr))
-  PetscCallA(grid_create(cfg, grid, ierr))
-  PetscCallA(fluid_create(cfg, grid, fl, ierr))
-  if (has_particles) then
-    PetscCallA(fd_create(grid, cfg%reynolds, cfg%dt, cfg%slip_kappa, cfg%radius_offset, fd, ierr))
+  if (cfg%resolved) then
+    PetscCallA(grid_create(cfg, grid, ierr))
+    PetscCallA(fluid_create(cfg, grid, fl, ierr))
+    if (has_particles) then
+      PetscCallA(fd_create(grid, cfg%reynolds, cfg%dt, cfg%slip_kappa, cfg%radius_offset, fd, ierr))
+    end if
+  else
+    ! lubrication dynamics: no grid, no fluid; the imposed shear comes from the walls or the
+    ! sliding boundaries (mod_lubrication_dynamics)
+    call ld_create(ld, parts%radius, 1.0_dp, cfg%shear_rate, cfg%box, cfg%walls .or. cfg%lees_edwards)
+    PetscCallA(psolver_create(ld_solver, ierr))
   end if
-  if (restarting) then
+  if (restarting .and. .not. cfg%resolved) then
+    ! (statistics: absent when unallocated, i.e. without &rheology; history: without contacts)
+    if (has_contacts) then
+      PetscCallA(checkpoint_read(restart, ierr=ierr, parts=parts, history=pc%history, statistics=statistics))
+    else
+      PetscCallA(checkpoint_read(restart, ierr=ierr, parts=parts, statistics=statistics))
+    end if
+    if (cfg%lees_edwards) then
+      PetscCallA(checkpoint_read(restart, ierr=ierr, offset=le%offset))
+    end if
+    if (allocated(rh)) call rheo_restore(rh, statistics, info)
+  else if (restarting) then
     ! (statistics: absent when unallocated, i.e. without &rheology)
     if (has_contacts) then
       PetscCallA(checkpoint_read(restart, fl, ierr, fd%lambda, parts, pc%history, statistics=statistics))
@@ -163,6 +193,9 @@ program fdsusp
   end if
   columns = [character(len=32) :: 'step', 'time', 'wall_time', 'tau_wall_bottom', 'tau_wall_top', &
              'divergence', 'rate_of_change', 'iterations_u', 'iterations_v', 'iterations_w', 'iterations_p']
+  ! without a fluid the columns of the fluid solve are not written
+  if (.not. cfg%resolved) columns = columns(1:3)
+  if (cfg%lees_edwards) columns = [character(len=32) :: columns, 'lees_edwards_offset']
   if (cfg%manufactured_solution) columns = [character(len=32) :: columns, 'mms_error_velocity_max', &
              'mms_error_pressure_max', 'mms_error_pressure_rms']
   allocate(shapes(3, size(columns)))
@@ -207,8 +240,13 @@ program fdsusp
          merge(cfg%friction, 0.0_dp, has_contacts), merge(cfg%roughness, 0.0_dp, has_contacts)])
   end if
   PetscCallA(stage_pop(ierr))
-  if (has_particles .and. has_lubrication .and. parts%motion == MOTION_FREE) call check_pair_lag()
-  if (has_particles) then
+  if (cfg%resolved .and. has_particles .and. has_lubrication .and. parts%motion == MOTION_FREE) call check_pair_lag()
+  if (.not. cfg%resolved) then
+    write(text, '(a,i0,a)') 'models: lubrication dynamics, no fluid (one-body Stokes drag in the imposed flow, '// &
+         trim(merge('Lees-Edwards boundaries', 'walls in y             ', cfg%lees_edwards))//'); ', parts%n, &
+         ' rigid spheres (motion '''//trim(cfg%motion)//'''); '//trim(contact_models())//'; '//trim(lubrication_models())
+    call log_line(text)
+  else if (has_particles) then
     write(text, '(a,i0,a)') 'models: fluid (unsteady Stokes, projection); ', parts%n, &
          ' rigid spheres (fictitious domain, motion '''//trim(cfg%motion)//'''); '//trim(contact_models())// &
          '; '//trim(lubrication_models())
@@ -218,7 +256,7 @@ program fdsusp
   end if
   ! -bench_cold_poisson: time one pressure solve from a zero guess to 1e-8 (doc/BENCHMARKS.md)
   PetscCallA(PetscOptionsHasName(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-bench_cold_poisson', bench_cold, ierr))
-  if (bench_cold) then
+  if (bench_cold .and. cfg%resolved) then
     ! the yardstick is the multigrid solve whatever solves the steps (-fluid_solver fft needs no KSP)
     if (fl%solver(FIELD_P)%direct) then
       PetscCallA(solver_create(grid, FIELD_P, 1.0e-8_dp, 0.0_dp, yardstick, ierr, krylov=.true.))
@@ -248,7 +286,7 @@ program fdsusp
   first_step = step
   stop_reason = RUNNING
   if (step >= cfg%steps) stop_reason = DONE
-  if (has_particles) then
+  if (has_particles .and. cfg%resolved) then
     ! the geometry at X^n; each step then moves it, and Lambda with it, to X^{n+1} (fd_follow)
     PetscCallA(stage_push(STAGE_PARTICLES, ierr))
     call fd_geometry(grid, fd, parts)
@@ -263,7 +301,7 @@ program fdsusp
       if (has_contacts) then
         ! contacts at X^n with the latest velocities (those of the previous step)
         PetscCallA(stage_push(STAGE_CONTACTS, ierr))
-        call pcontacts_step(pc, parts%position, parts%velocity, parts%omega, info)
+        call pcontacts_step(pc, parts%position, parts%velocity, parts%omega, info, le%offset)
         if (info /= 0) call contact_failure(info)
         if (pc%max_overlap > largest_overlap) call note_overlap()
         PetscCallA(stage_pop(ierr))
@@ -271,38 +309,59 @@ program fdsusp
       if (has_lubrication) then
         ! the lubrication links at X^n, taken implicitly in the particle problem below
         PetscCallA(stage_push(STAGE_LUBRICATION, ierr))
-        PetscCallA(lubrication_links(pl, parts%position, ierr))
+        PetscCallA(lubrication_links(pl, parts%position, ierr, le%offset))
         if (pl%failed_link(1) /= 0) call lubrication_failure(pl%failed_link)
         PetscCallA(stage_pop(ierr))
       end if
-      PetscCallA(stage_push(STAGE_FLUID, ierr))
-      PetscCallA(fluid_step(grid, fl, ierr, fd%lambda))
-      PetscCallA(stage_pop(ierr))
-      PetscCallA(stage_push(STAGE_PARTICLES, ierr))
-      ! the particle sub-problem (method.md §1.5 eq. (1)): moments of u~ and Lambda^n, the 6N
-      ! system for U, Omega (contact forces and lubrication links, each absent when not
-      ! allocated), then Lambda^{n+1}, u^{n+1} and the hydrodynamic force, torque, stresslet
-      PetscCallA(fd_moments(grid, fd, fl%vel, parts%n, ierr))
-      if (has_contacts) then
-        PetscCallA(fd_solve_motion(fd, parts, ierr, lubrication=pl, contacts=pc))
+      if (cfg%resolved) then
+        PetscCallA(stage_push(STAGE_FLUID, ierr))
+        PetscCallA(fluid_step(grid, fl, ierr, fd%lambda))
+        PetscCallA(stage_pop(ierr))
+        PetscCallA(stage_push(STAGE_PARTICLES, ierr))
+        ! the particle sub-problem (method.md §1.5 eq. (1)): moments of u~ and Lambda^n, the 6N
+        ! system for U, Omega (contact forces and lubrication links, each absent when not
+        ! allocated), then Lambda^{n+1}, u^{n+1} and the hydrodynamic force, torque, stresslet
+        PetscCallA(fd_moments(grid, fd, fl%vel, parts%n, ierr))
+        if (has_contacts) then
+          PetscCallA(fd_solve_motion(fd, parts, ierr, lubrication=pl, contacts=pc))
+        else
+          PetscCallA(fd_solve_motion(fd, parts, ierr, lubrication=pl))
+        end if
+        PetscCallA(fd_update(grid, fd, fl%vel, fl%pressure, parts, ierr, pl))
       else
-        PetscCallA(fd_solve_motion(fd, parts, ierr, lubrication=pl))
+        PetscCallA(stage_push(STAGE_PARTICLES, ierr))
+        ! lubrication dynamics: the 6N Stokes balance of the spheres alone (one-body drag in the
+        ! imposed flow, the pair and wall links, the contacts), then their hydrodynamic force,
+        ! torque and stresslet (mod_lubrication_dynamics)
+        if (has_contacts) then
+          PetscCallA(ld_solve_motion(ld, ld_solver, parts, ierr, lubrication=pl, contacts=pc))
+        else
+          PetscCallA(ld_solve_motion(ld, ld_solver, parts, ierr, lubrication=pl))
+        end if
       end if
-      PetscCallA(fd_update(grid, fd, fl%vel, fl%pressure, parts, ierr, pl))
       ! the core statistics of this configuration, before it moves on
       ! (pc%stresslet is absent, as unallocated, when there are no contacts)
       if (allocated(rh)) then
-        call rheo_sample(rh, parts%position, parts%velocity, parts%stresslet_hydro, pc%stresslet)
-        PetscCallA(fluid_mean_profile(grid, fl, mean_flow, ierr))
-        call rheo_sample_flow(rh, mean_flow, grid%h)
+        call rheo_sample(rh, parts%position, parts%velocity, parts%stresslet_hydro, pc%stresslet, le%offset)
+        if (cfg%resolved) then
+          PetscCallA(fluid_mean_profile(grid, fl, mean_flow, ierr))
+          call rheo_sample_flow(rh, mean_flow, grid%h)
+        end if
       end if
       position_before = parts%position
-      call advance_positions(parts, cfg%dt, cfg%box, [.true., .not. cfg%walls, .true.])
-      if (carry_lambda) then
-        position_before = displacements(parts%position, position_before, cfg%box, [.true., .not. cfg%walls, .true.])
-        PetscCallA(fd_follow(grid, fd, parts, position_before, ierr))
-      else
-        call fd_geometry(grid, fd, parts)
+      call advance_positions(parts, cfg%dt, cfg%box, [.true., .not. (cfg%walls .or. cfg%lees_edwards), .true.])
+      if (cfg%lees_edwards) then
+        ! the boundary slides on; spheres that left through y = 0 or Ly re-enter from the image
+        call le_advance(le, cfg%dt)
+        call le_wrap(le, parts%position, parts%velocity, parts%velocity_prev)
+      end if
+      if (cfg%resolved) then
+        if (carry_lambda) then
+          position_before = displacements(parts%position, position_before, cfg%box, [.true., .not. cfg%walls, .true.])
+          PetscCallA(fd_follow(grid, fd, parts, position_before, ierr))
+        else
+          call fd_geometry(grid, fd, parts)
+        end if
       end if
       PetscCallA(stage_pop(ierr))
     else
@@ -310,8 +369,8 @@ program fdsusp
       PetscCallA(fluid_step(grid, fl, ierr))
       PetscCallA(stage_pop(ierr))
     end if
-    iterations_sum = iterations_sum + [fl%solver(1)%iterations, fl%solver(2)%iterations, &
-                                       fl%solver(3)%iterations, fl%solver(4)%iterations]
+    if (cfg%resolved) iterations_sum = iterations_sum + [fl%solver(1)%iterations, fl%solver(2)%iterations, &
+                                                         fl%solver(3)%iterations, fl%solver(4)%iterations]
     step = step + 1
     time = time + cfg%dt
 
@@ -320,10 +379,14 @@ program fdsusp
     if (mod(step, cfg%series_every) == 0) call record()
     if (mod(step, cfg%progress_every) == 0) then
       wall_per_step = wall_now / (step - first_step)
-      call progress_line(step, cfg%steps, time, wall_now, wall_per_step, fl)
+      if (cfg%resolved) then
+        call progress_line(step, cfg%steps, time, wall_now, wall_per_step, fl)
+      else
+        call progress_line(step, cfg%steps, time, wall_now, wall_per_step)
+      end if
       call series_flush(series)
     end if
-    if (cfg%fields_every > 0) then
+    if (cfg%fields_every > 0 .and. cfg%resolved) then
       if (mod(step, cfg%fields_every) == 0) then
         PetscCallA(write_fields(cfg%output_directory, grid, fl, step, time, ierr))
       end if
@@ -337,7 +400,11 @@ program fdsusp
     PetscCallA(stage_pop(ierr))
 
     if (step == fault_nan_step) then
-      PetscCallA(VecScale(fl%vel(1), ieee_value(1.0_dp, ieee_quiet_nan), ierr))
+      if (cfg%resolved) then
+        PetscCallA(VecScale(fl%vel(1), ieee_value(1.0_dp, ieee_quiet_nan), ierr))
+      else
+        parts%velocity(1, 1) = ieee_value(1.0_dp, ieee_quiet_nan)
+      end if
     end if
     call check_health()
 
@@ -349,6 +416,8 @@ program fdsusp
     wall_loop = (MPI_Wtime() - wall_loop) / (step - first_step)
     write(text, '(a,i0,a,f10.5,a,4(f6.1))') 'steps run: ', step - first_step, '  wall time per step:', wall_loop, &
          ' s  mean iterations u v w p:', real(iterations_sum, dp) / (step - first_step)
+    if (.not. cfg%resolved) write(text, '(a,i0,a,f10.5,a)') 'steps run: ', step - first_step, &
+         '  wall time per step:', wall_loop, ' s'
     call log_line(text)
     if (has_particles) then
       if (has_contacts .and. pc%params%h_r > 0) then
@@ -357,9 +426,15 @@ program fdsusp
              largest_overlap / pc%params%h_r, ' h_r (step ', largest_overlap_step, ')'
         call log_line(text)
       end if
-      if (fd%solver%solves > 0) then
-        write(text, '(a,i0,a,f10.3,a)') 'particle system with lubrication pairs: ', fd%solver%solves, &
-             ' sparse solves, mean ', 1.0e3_dp * fd%solver%seconds / fd%solver%solves, ' ms (assembly + solve)'
+      if (cfg%resolved) then
+        if (fd%solver%solves > 0) then
+          write(text, '(a,i0,a,f10.3,a)') 'particle system with lubrication pairs: ', fd%solver%solves, &
+               ' sparse solves, mean ', 1.0e3_dp * fd%solver%seconds / fd%solver%solves, ' ms (assembly + solve)'
+          call log_line(text)
+        end if
+      else if (ld_solver%solves > 0) then
+        write(text, '(a,i0,a,f10.3,a)') 'particle system with lubrication pairs: ', ld_solver%solves, &
+             ' sparse solves, mean ', 1.0e3_dp * ld_solver%seconds / ld_solver%solves, ' ms (assembly + solve)'
         call log_line(text)
       end if
     end if
@@ -368,7 +443,9 @@ program fdsusp
   if (step > first_step .and. mod(step, cfg%series_every) /= 0) call record()
   call series_flush(series)
   if (step > first_step) then
-    PetscCallA(write_fields(cfg%output_directory, grid, fl, step, time, ierr))
+    if (cfg%resolved) then
+      PetscCallA(write_fields(cfg%output_directory, grid, fl, step, time, ierr))
+    end if
     if (has_particles) call particles_snapshot(cfg%output_directory, parts, cfg%box, step, time)
     call checkpoint()
   end if
@@ -387,7 +464,7 @@ program fdsusp
     write(text, '(a,i0)') 'finished at step ', step
   end select
   call log_line(text)
-  if (cfg%manufactured_solution) then
+  if (cfg%manufactured_solution .and. cfg%resolved) then
     PetscCallA(fluid_errors_vs_manufactured(grid, fl, cfg%shear_rate, err_vel, err_p_max, err_p_rms, ierr))
     write(text, '(a,3es14.6)') 'manufactured solution errors (velocity max, pressure max, pressure rms):', &
          err_vel, err_p_max, err_p_rms
@@ -396,11 +473,15 @@ program fdsusp
   write(text, '(a,f10.2,a)') 'wall time ', MPI_Wtime() - wall_start, ' s'
   call log_line(text)
 
-  if (has_particles) then
-    PetscCallA(fd_destroy(fd, ierr))
+  if (cfg%resolved) then
+    if (has_particles) then
+      PetscCallA(fd_destroy(fd, ierr))
+    end if
+    PetscCallA(fluid_destroy(fl, ierr))
+    PetscCallA(grid_destroy(grid, ierr))
+  else
+    PetscCallA(psolver_destroy(ld_solver, ierr))
   end if
-  PetscCallA(fluid_destroy(fl, ierr))
-  PetscCallA(grid_destroy(grid, ierr))
   call release_directory()
   PetscCallA(PetscFinalize(ierr))
 
@@ -513,11 +594,18 @@ contains
     real(dp) :: values(14)
     integer :: n
     real(dp), allocatable :: row(:)
-    values(1:11) = [real(step, dp), time, MPI_Wtime() - wall_start, fl%tau_bottom, fl%tau_top, &
-                    fl%divergence, fl%max_rate, real(fl%solver(1)%iterations, dp), &
-                    real(fl%solver(2)%iterations, dp), real(fl%solver(3)%iterations, dp), &
-                    real(fl%solver(4)%iterations, dp)]
-    n = 11
+    values(1:3) = [real(step, dp), time, MPI_Wtime() - wall_start]
+    n = 3
+    if (cfg%lees_edwards) then
+      values(4) = le%offset
+      n = 4
+    end if
+    if (cfg%resolved) then
+      values(4:11) = [fl%tau_bottom, fl%tau_top, fl%divergence, fl%max_rate, real(fl%solver(1)%iterations, dp), &
+                      real(fl%solver(2)%iterations, dp), real(fl%solver(3)%iterations, dp), &
+                      real(fl%solver(4)%iterations, dp)]
+      n = 11
+    end if
     if (cfg%manufactured_solution) then
       PetscCallA(fluid_errors_vs_manufactured(grid, fl, cfg%shear_rate, err_vel, err_p_max, err_p_rms, ierr))
       values(12:14) = [err_vel, err_p_max, err_p_rms]
@@ -549,7 +637,9 @@ contains
   subroutine checkpoint()
     call series_flush(series)
     if (allocated(rh)) statistics = rheo_state(rh)
-    if (has_contacts) then
+    if (.not. cfg%resolved) then
+      call checkpoint_particles(checkpoint_path)
+    else if (has_contacts) then
       PetscCallA(checkpoint_write(checkpoint_path, cfg, fl, step, time, ierr, fd%lambda, parts, pc%history, statistics))
     else if (has_particles) then
       PetscCallA(checkpoint_write(checkpoint_path, cfg, fl, step, time, ierr, fd%lambda, parts, statistics=statistics))
@@ -557,6 +647,20 @@ contains
       PetscCallA(checkpoint_write(checkpoint_path, cfg, fl, step, time, ierr))
     end if
   end subroutine checkpoint
+
+  ! Lubrication dynamics: no fluid; the particles, contacts, statistics and the Lees-Edwards offset.
+  subroutine checkpoint_particles(path)
+    character(len=*), intent(in) :: path
+    if (cfg%lees_edwards .and. has_contacts) then
+      PetscCallA(checkpoint_write(path, cfg, step=step, time=time, ierr=ierr, parts=parts, history=pc%history, statistics=statistics, offset=le%offset))
+    else if (cfg%lees_edwards) then
+      PetscCallA(checkpoint_write(path, cfg, step=step, time=time, ierr=ierr, parts=parts, statistics=statistics, offset=le%offset))
+    else if (has_contacts) then
+      PetscCallA(checkpoint_write(path, cfg, step=step, time=time, ierr=ierr, parts=parts, history=pc%history, statistics=statistics))
+    else
+      PetscCallA(checkpoint_write(path, cfg, step=step, time=time, ierr=ierr, parts=parts, statistics=statistics))
+    end if
+  end subroutine checkpoint_particles
 
   ! summary.json (rank 0) and the rheology in the run log: value +- standard error over the blocks.
   subroutine summary()
@@ -602,6 +706,10 @@ contains
     select case (lub%model)
     case (LUB_NONE)
       line = 'no lubrication correction'
+      if (.not. cfg%resolved) line = 'no pair hydrodynamics (one-body drag only)'
+    case (LUB_EXACT)
+      write(line, '(a,f7.3,a)') 'exact two-body pair and wall resistance minus one-body (outer cut-off ', &
+           lub%outer_cutoff, ' a)'
     case (LUB_SIMPLE)
       write(line, '(a,f6.3,a)') 'lubrication simple (singular terms, outer cut-off ', lub%outer_cutoff, ' a)'
     case default
@@ -646,7 +754,7 @@ contains
       call input_error(cfg%deck_file, 'time', 'dt', trim(text))
     end if
     ! the roughness of a dense suspension flattens under its force chains (doc/VALIDATION.md §6)
-    if (cfg%walls) then
+    if (cfg%walls .or. cfg%lees_edwards) then
       solid_fraction = parts%n * (4.0_dp / 3.0_dp) * pi * parts%radius**3 / product(cfg%box)
       expected_overlap = flattening_estimate(pc%params, solid_fraction)
       if (expected_overlap > 1.0_dp) then
@@ -726,11 +834,13 @@ contains
     integer :: c, q
     character(len=400) :: what
     what = ''
-    do c = 1, 3
-      PetscCallA(VecNorm(fl%vel(c), NORM_INFINITY, norms(c), ierr))
-    end do
-    PetscCallA(VecNorm(fl%pressure, NORM_INFINITY, norms(4), ierr))
-    norms(5) = 0.0_dp
+    norms = 0.0_dp
+    if (cfg%resolved) then
+      do c = 1, 3
+        PetscCallA(VecNorm(fl%vel(c), NORM_INFINITY, norms(c), ierr))
+      end do
+      PetscCallA(VecNorm(fl%pressure, NORM_INFINITY, norms(4), ierr))
+    end if
     do c = 1, 4
       if (.not. ieee_is_finite(norms(c))) then
         write(what, '(a,a,a,es10.3)') 'the fluid ', trim(merge('velocity', 'pressure', c <= 3)), &
@@ -767,7 +877,9 @@ contains
     integer, intent(in) :: at_step
     character(len=*), intent(in) :: what
     call series_flush(series)
-    if (has_particles) then
+    if (.not. cfg%resolved) then
+      call checkpoint_particles(trim(cfg%output_directory)//'/failed_state.h5')
+    else if (has_particles) then
       PetscCallA(checkpoint_write(trim(cfg%output_directory)//'/failed_state.h5', cfg, fl, step, time, ierr, fd%lambda, parts))
     else
       PetscCallA(checkpoint_write(trim(cfg%output_directory)//'/failed_state.h5', cfg, fl, step, time, ierr))
@@ -789,7 +901,9 @@ contains
       ! leave room for two more steps and the final output
       if (elapsed + 3.0_dp * per_step > 3600.0_dp * cfg%max_wall_hours) flags(2) = 1
     end if
-    if (cfg%steady_tolerance > 0.0_dp .and. fl%max_rate < cfg%steady_tolerance) flags(3) = 1
+    if (cfg%resolved .and. cfg%steady_tolerance > 0.0_dp) then
+      if (fl%max_rate < cfg%steady_tolerance) flags(3) = 1
+    end if
     call MPI_Allreduce(flags, all_flags, 3, MPI_INTEGER, MPI_MAX, PETSC_COMM_WORLD, ierr)
     why_stop = RUNNING
     if (step >= cfg%steps) why_stop = DONE

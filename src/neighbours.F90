@@ -8,8 +8,14 @@
 ! wall_cutoff = wall contact range + skin: the lists then hold every contact as long as no
 ! particle has moved more than skin/2 since the build (nlist_needs_rebuild).
 ! Every periodic length must be >= 2 cutoff, so that at most one image of a particle is in range.
+! Lees-Edwards boundaries (mod_lees_edwards; nlist_init's le): y is periodic with images sliding
+! by the offset delta in x; a cell row reached across y = 0 or Ly is searched over all its x cells
+! (the sliding images are not aligned with the cells), distances are le_separation's, the image
+! shift is not set (0), and the list is rebuilt once 2 x (largest move) + (change of delta since the
+! build) exceeds the skin, the bound on the change of any pair distance across the boundary.
 module mod_neighbours
   use mod_kinds, only: dp, i8
+  use mod_lees_edwards, only: lees_edwards_t, le_separation
   implicit none
   private
   public :: nlist_t, nlist_init, nlist_build, nlist_needs_rebuild, nlist_candidates, min_image
@@ -29,6 +35,8 @@ module mod_neighbours
     integer, allocatable :: cell_of(:)       ! (np)
     real(dp), allocatable :: x_ref(:,:)      ! (3, np) positions at the last build
     logical :: built = .false.               ! x_ref and the lists hold a build
+    type(lees_edwards_t) :: le               ! sliding boundaries in y (le%active), with delta now
+    real(dp) :: offset_ref = 0               ! delta at the last build
     integer(i8) :: n_dist = 0                ! distance evaluations of the last build
   end type nlist_t
 
@@ -48,14 +56,18 @@ contains
 
   !> Set up for np particles. info: 0 ok; 1 a periodic length < 2 cutoff; 2 cutoff, wall_cutoff
   !> or a box length not > 0, or skin < 0 or skin >= cutoff.
-  subroutine nlist_init(nl, np, box, periodic, cutoff, wall_cutoff, skin, info)
+  !> le, optional: Lees-Edwards boundaries in y (then periodic(2) must be .true.).
+  subroutine nlist_init(nl, np, box, periodic, cutoff, wall_cutoff, skin, info, le)
     type(nlist_t), intent(inout) :: nl
     integer, intent(in) :: np
     real(dp), intent(in) :: box(3), cutoff, wall_cutoff, skin
     logical, intent(in) :: periodic(3)
     integer, intent(out) :: info
+    type(lees_edwards_t), intent(in), optional :: le
     integer :: k
     info = 0
+    nl%le%active = .false.
+    if (present(le)) nl%le = le
     if (.not. (cutoff > 0) .or. .not. (wall_cutoff > 0) .or. .not. all(box > 0) .or. &
         .not. (skin >= 0) .or. skin >= cutoff) then
       info = 2
@@ -140,13 +152,45 @@ contains
     end do
   end subroutine cells_around
 
+  !> Lees-Edwards: the distinct cells around cell c (all directions periodic); a row reached
+  !> across y = 0 or Ly contributes all its x cells, since the sliding images are not aligned with
+  !> them. cells must hold 9 ncell(1) entries.
+  pure subroutine le_cells_around(c, ncell, cells, nc)
+    integer, intent(in) :: c(3), ncell(3)
+    integer, intent(out) :: cells(:), nc
+    integer :: o1, o2, o3, cn(3), idx, x_lo, x_hi
+    logical :: across
+    nc = 0
+    do o3 = -1, 1
+      do o2 = -1, 1
+        cn(2) = c(2) + o2
+        across = cn(2) < 0 .or. cn(2) >= ncell(2)
+        cn(2) = modulo(cn(2), ncell(2))
+        cn(3) = modulo(c(3) + o3, ncell(3))
+        x_lo = c(1) - 1
+        x_hi = c(1) + 1
+        if (across) then
+          x_lo = 0
+          x_hi = ncell(1) - 1
+        end if
+        do o1 = x_lo, x_hi
+          cn(1) = modulo(o1, ncell(1))
+          idx = cell_index(cn, ncell)
+          if (any(cells(1:nc) == idx)) cycle
+          nc = nc + 1
+          cells(nc) = idx
+        end do
+      end do
+    end do
+  end subroutine le_cells_around
+
   !> Build the pair and wall lists from positions x(3, np). The arrays grow as needed.
   subroutine nlist_build(nl, x)
     type(nlist_t), intent(inout) :: nl
     real(dp), intent(in) :: x(:,:)
     integer :: i, j, k, m, c, q, ncl, cells(27), ncells
-    integer, allocatable :: fill(:)
-    real(dp) :: d(3), r(3), rc2
+    integer, allocatable :: fill(:), le_cells(:)
+    real(dp) :: d(3), r(3), rc2, vshift(3)
     integer(i8) :: nd
 
     ! counting sort of the particles by cell
@@ -172,22 +216,36 @@ contains
     rc2 = nl%cutoff**2
     nl%npairs = 0
     nd = 0
+    if (nl%le%active) allocate(le_cells(9 * nl%ncell(1)))
     do i = 1, nl%np
-      call cells_around(cell_coord(x(:, i), nl%box, nl%periodic, nl%ncell), nl%ncell, nl%periodic, cells, ncl)
+      if (nl%le%active) then
+        call le_cells_around(cell_coord(x(:, i), nl%box, nl%periodic, nl%ncell), nl%ncell, le_cells, ncl)
+      else
+        call cells_around(cell_coord(x(:, i), nl%box, nl%periodic, nl%ncell), nl%ncell, nl%periodic, cells, ncl)
+      end if
       do m = 1, ncl
-        do q = nl%cell_start(cells(m)), nl%cell_start(cells(m) + 1) - 1
+        if (nl%le%active) then
+          c = le_cells(m)
+        else
+          c = cells(m)
+        end if
+        do q = nl%cell_start(c), nl%cell_start(c + 1) - 1
           j = nl%order(q)
           if (j <= i) cycle
           nd = nd + 1
           d = x(:, j) - x(:, i)
-          r = min_image(d, nl%box, nl%periodic)
+          if (nl%le%active) then
+            call le_separation(nl%le, d, r, vshift)
+          else
+            r = min_image(d, nl%box, nl%periodic)
+          end if
           if (sum(r**2) < rc2) then
             if (nl%npairs == size(nl%pair, 2)) call grow_pairs(nl)
             nl%npairs = nl%npairs + 1
             nl%pair(:, nl%npairs) = [i, j]
             do k = 1, 3
               nl%shift(k, nl%npairs) = 0
-              if (nl%periodic(k)) nl%shift(k, nl%npairs) = nint((r(k) - d(k)) / nl%box(k))
+              if (nl%periodic(k) .and. .not. nl%le%active) nl%shift(k, nl%npairs) = nint((r(k) - d(k)) / nl%box(k))
             end do
           end if
         end do
@@ -203,6 +261,7 @@ contains
       end do
     end if
     nl%x_ref(:, 1:nl%np) = x(:, 1:nl%np)
+    nl%offset_ref = nl%le%offset
     nl%built = .true.
 
   contains
@@ -236,9 +295,19 @@ contains
     type(nlist_t), intent(in) :: nl
     real(dp), intent(in) :: x(:,:)
     integer :: i
-    real(dp) :: lim2
+    real(dp) :: lim2, drift
     lim2 = (0.5_dp * nl%skin)**2
     yes = .false.
+    if (nl%le%active) then
+      ! pairs across the sliding boundary also move apart by the change of delta
+      drift = abs(nl%le%offset - nl%offset_ref)
+      drift = min(drift, nl%box(1) - drift)
+      if (drift >= nl%skin) then
+        yes = .true.
+        return
+      end if
+      lim2 = (0.5_dp * (nl%skin - drift))**2
+    end if
     do i = 1, nl%np
       if (sum(min_image(x(:, i) - nl%x_ref(:, i), nl%box, nl%periodic)**2) > lim2) then
         yes = .true.
@@ -252,11 +321,14 @@ contains
   !> restarted from a checkpoint (fresh list) repeats the arithmetic of an uninterrupted one
   !> bitwise. The list is rebuilt (and pairs, walls rewritten) only when it has never been built
   !> or some particle has moved more than skin/2 since; otherwise pairs and walls are left as they are.
-  subroutine nlist_candidates(nl, x, pairs, npairs, walls, nwalls)
+  !> offset, optional: the Lees-Edwards offset delta now (lists made with nlist_init's le).
+  subroutine nlist_candidates(nl, x, pairs, npairs, walls, nwalls, offset)
     type(nlist_t), intent(inout) :: nl
     real(dp), intent(in) :: x(:,:)
     integer, allocatable, intent(inout) :: pairs(:,:), walls(:,:)
     integer, intent(inout) :: npairs, nwalls
+    real(dp), intent(in), optional :: offset
+    if (present(offset)) nl%le%offset = offset
     if (nl%built) then
       if (.not. nlist_needs_rebuild(nl, x)) return
     end if

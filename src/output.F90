@@ -112,12 +112,19 @@ contains
     close(unit)
   end subroutine write_xdmf
 
-  ! step, strain, wall time, estimated time left, iterations of each solver, divergence.
+  ! step, strain, wall time, estimated time left, iterations of each solver, divergence (fl
+  ! absent, lubrication dynamics: the first four).
   subroutine progress_line(step, last_step, strain, wall, wall_per_step, fl)
     integer, intent(in) :: step, last_step
     real(dp), intent(in) :: strain, wall, wall_per_step
-    type(fluid_t), intent(in) :: fl
+    type(fluid_t), intent(in), optional :: fl
     if (.not. is_root()) return
+    if (.not. present(fl)) then
+      write(*, '(a,i9,a,f10.4,a,f9.1,a,f9.1,a)') 'step', step, '  strain', strain, &
+           '  wall', wall, ' s  left', wall_per_step * (last_step - step), ' s'
+      flush(6)
+      return
+    end if
     write(*, '(a,i9,a,f10.4,a,f9.1,a,f9.1,a,3(i0,"/"),i0,a,es8.1)') 'step', step, '  strain', strain, &
          '  wall', wall, ' s  left', wall_per_step * (last_step - step), ' s  its u/v/w/p ', &
          fl%solver(FIELD_U)%iterations, fl%solver(FIELD_V)%iterations, fl%solver(FIELD_W)%iterations, &

@@ -38,6 +38,7 @@ module mod_params
     real(dp) :: pressure_tolerance = 1.0e-6_dp          ! KSP rtol of the pressure Poisson solve [-]
     real(dp) :: viscous_theta = 0.5_dp                  ! 0.5 Crank-Nicolson, 1 backward Euler [-]
     character(len=16) :: initial_flow = 'rest'          ! 'rest' or 'shear' (the linear Couette profile)
+    character(len=16) :: fluid_model = 'resolved'       ! 'resolved' (the DNS) or 'none' (lubrication dynamics)
     ! &time
     real(dp) :: dt = 1.0e-3_dp                          ! time step [1/gamma_dot]
     integer :: steps = -1                               ! last step [-] (-1: 1000, or what &rheology needs)
@@ -98,6 +99,8 @@ module mod_params
     ! derived, not read
     integer :: cells(3) = 0
     logical :: walls = .true.
+    logical :: lees_edwards = .false.                   ! y_boundary = 'lees-edwards'
+    logical :: resolved = .true.                        ! fluid_model = 'resolved'
     real(dp) :: h = 0.0_dp                              ! grid spacing Delta [a]
     real(dp) :: wall_speed = 0.0_dp                     ! top wall +U, bottom wall -U [a*gamma_dot]
   end type config_t
@@ -192,9 +195,6 @@ contains
     ! &domain
     real(dp) :: box(3), cells_per_radius, shear_rate
     character(len=16) :: y_boundary
-    ! &fluid
-    real(dp) :: reynolds, body_force(3), velocity_tolerance, pressure_tolerance, viscous_theta
-    character(len=16) :: initial_flow
     ! &time
     real(dp) :: dt, steady_tolerance
     integer :: steps
@@ -232,7 +232,6 @@ contains
     real(dp) :: outer_cutoff, inner_cutoff, skin
     namelist /lubrication/ model, table, outer_cutoff, inner_cutoff, skin
     namelist /domain/ box, cells_per_radius, y_boundary, shear_rate
-    namelist /fluid/ reynolds, body_force, velocity_tolerance, pressure_tolerance, viscous_theta, initial_flow
     namelist /time/ dt, steps, steady_tolerance
     namelist /output/ directory, progress_every, series_every, fields_every, checkpoint_every, particles_every
     namelist /run/ title, max_wall_hours
@@ -241,9 +240,6 @@ contains
 
     box = cfg%box; cells_per_radius = cfg%cells_per_radius
     y_boundary = cfg%y_boundary; shear_rate = cfg%shear_rate
-    reynolds = cfg%reynolds; body_force = cfg%body_force
-    velocity_tolerance = cfg%velocity_tolerance; pressure_tolerance = cfg%pressure_tolerance
-    viscous_theta = cfg%viscous_theta; initial_flow = cfg%initial_flow
     dt = cfg%dt; steps = cfg%steps; steady_tolerance = cfg%steady_tolerance
     directory = cfg%output_directory; progress_every = cfg%progress_every
     series_every = cfg%series_every; fields_every = cfg%fields_every
@@ -267,10 +263,14 @@ contains
     inner_cutoff = cfg%inner_cutoff; skin = cfg%lubrication_skin
 
     stat = 0
+    ! &fluid has its own reader: its 'model' is not &lubrication's
+    if (group == 'fluid') then
+      call fluid_io(cfg, src, ios, msg, echo_unit)
+      return
+    end if
     if (present(src)) then
       select case (group)
       case ('domain');       read(src, nml=domain, iostat=stat, iomsg=msg)
-      case ('fluid');        read(src, nml=fluid, iostat=stat, iomsg=msg)
       case ('time');         read(src, nml=time, iostat=stat, iomsg=msg)
       case ('output');       read(src, nml=output, iostat=stat, iomsg=msg)
       case ('run');          read(src, nml=run, iostat=stat, iomsg=msg)
@@ -284,9 +284,6 @@ contains
       if (stat /= 0) return
       cfg%box = box; cfg%cells_per_radius = cells_per_radius
       cfg%y_boundary = to_lower(y_boundary); cfg%shear_rate = shear_rate
-      cfg%reynolds = reynolds; cfg%body_force = body_force
-      cfg%velocity_tolerance = velocity_tolerance; cfg%pressure_tolerance = pressure_tolerance
-      cfg%viscous_theta = viscous_theta; cfg%initial_flow = to_lower(initial_flow)
       cfg%dt = dt; cfg%steps = steps; cfg%steady_tolerance = steady_tolerance
       cfg%output_directory = directory; cfg%progress_every = progress_every
       cfg%series_every = series_every; cfg%fields_every = fields_every
@@ -314,7 +311,6 @@ contains
     if (present(echo_unit)) then
       select case (group)
       case ('domain');       write(echo_unit, nml=domain)
-      case ('fluid');        write(echo_unit, nml=fluid)
       case ('time');         write(echo_unit, nml=time)
       case ('output');       write(echo_unit, nml=output)
       case ('run');          write(echo_unit, nml=run)
@@ -337,6 +333,34 @@ contains
       end select
     end if
   end subroutine group_io
+
+  ! &fluid (read from src when present, echoed to echo_unit when present), like group_io.
+  subroutine fluid_io(cfg, src, ios, msg, echo_unit)
+    type(config_t), intent(inout) :: cfg
+    character(len=*), intent(in), optional :: src(:)
+    integer, intent(out), optional :: ios
+    character(len=*), intent(inout), optional :: msg
+    integer, intent(in), optional :: echo_unit
+    real(dp) :: reynolds, body_force(3), velocity_tolerance, pressure_tolerance, viscous_theta
+    character(len=16) :: initial_flow, model
+    namelist /fluid/ model, reynolds, body_force, velocity_tolerance, pressure_tolerance, viscous_theta, initial_flow
+    integer :: stat
+    model = cfg%fluid_model
+    reynolds = cfg%reynolds; body_force = cfg%body_force
+    velocity_tolerance = cfg%velocity_tolerance; pressure_tolerance = cfg%pressure_tolerance
+    viscous_theta = cfg%viscous_theta; initial_flow = cfg%initial_flow
+    stat = 0
+    if (present(src)) then
+      read(src, nml=fluid, iostat=stat, iomsg=msg)
+      if (present(ios)) ios = stat
+      if (stat /= 0) return
+      cfg%fluid_model = to_lower(model)
+      cfg%reynolds = reynolds; cfg%body_force = body_force
+      cfg%velocity_tolerance = velocity_tolerance; cfg%pressure_tolerance = pressure_tolerance
+      cfg%viscous_theta = viscous_theta; cfg%initial_flow = to_lower(initial_flow)
+    end if
+    if (present(echo_unit)) write(echo_unit, nml=fluid)
+  end subroutine fluid_io
 
   ! &particles echoed with its inline arrays cut to the particles given (not 64 x 3 zeros each).
   subroutine echo_particles(unit, cfg)
@@ -438,17 +462,30 @@ contains
       call check_real(cfg, 'domain', 'box('//xyz(d:d)//')', cfg%box(d), 0.0_dp, 1.0e4_dp, .true.)
     end do
     call check_real(cfg, 'domain', 'cells_per_radius', cfg%cells_per_radius, 1.0_dp, 64.0_dp)
-    if (cfg%y_boundary /= 'walls' .and. cfg%y_boundary /= 'periodic') &
-      call input_error(cfg%deck_file, 'domain', 'y_boundary', 'must be ''walls'' or ''periodic'', not '''// &
+    if (cfg%fluid_model /= 'resolved' .and. cfg%fluid_model /= 'none') &
+      call input_error(cfg%deck_file, 'fluid', 'model', 'must be ''resolved'' or ''none'', not '''// &
+           trim(cfg%fluid_model)//'''')
+    cfg%resolved = (cfg%fluid_model == 'resolved')
+    if (all(cfg%y_boundary /= [character(len=16) :: 'walls', 'periodic', 'lees-edwards'])) &
+      call input_error(cfg%deck_file, 'domain', 'y_boundary', 'must be ''walls'', ''periodic'' or ''lees-edwards'', not '''// &
            trim(cfg%y_boundary)//'''')
+    cfg%lees_edwards = (cfg%y_boundary == 'lees-edwards')
+    if (cfg%lees_edwards .and. cfg%resolved) &
+      call input_error(cfg%deck_file, 'domain', 'y_boundary', &
+           '''lees-edwards'' needs &fluid model = ''none'' (lubrication dynamics): the resolved fluid has walls or a periodic box')
     call check_real(cfg, 'domain', 'shear_rate', cfg%shear_rate, -1.0e3_dp, 1.0e3_dp)
     cfg%walls = (cfg%y_boundary == 'walls')
-    if (.not. cfg%walls .and. cfg%shear_rate /= 0.0_dp) &
+    if (.not. cfg%walls .and. .not. cfg%lees_edwards .and. cfg%shear_rate /= 0.0_dp) &
       call input_error(cfg%deck_file, 'domain', 'shear_rate', &
            'a periodic box in y cannot be sheared by walls: set shear_rate = 0 or y_boundary = ''walls''')
     cfg%h = 1.0_dp / cfg%cells_per_radius
     do d = 1, 3
       n = cfg%box(d) * cfg%cells_per_radius
+      if (.not. cfg%resolved) then
+        ! no grid: the cell count is only recorded
+        cfg%cells(d) = max(4, nint(n))
+        cycle
+      end if
       if (abs(n - nint(n)) > 1.0e-9_dp * n) then
         write(text, '(a,f0.6,a)') 'box length times cells_per_radius must be a whole number of cells (it is ', n, ')'
         call input_error(cfg%deck_file, 'domain', 'box('//xyz(d:d)//')', trim(text))
@@ -474,6 +511,8 @@ contains
     call check_real(cfg, 'time', 'dt', cfg%dt, 0.0_dp, 10.0_dp, .true.)
     if (cfg%steps /= -1) call check_int(cfg, 'time', 'steps', cfg%steps, 0, 1000000000)
     call check_real(cfg, 'time', 'steady_tolerance', cfg%steady_tolerance, 0.0_dp, 1.0_dp)
+    if (.not. cfg%resolved .and. cfg%steady_tolerance > 0.0_dp) &
+      call input_error(cfg%deck_file, 'time', 'steady_tolerance', 'measures the fluid: needs &fluid model = ''resolved''')
 
     if (len_trim(cfg%output_directory) == 0) &
       call input_error(cfg%deck_file, 'output', 'directory', 'must not be empty')
@@ -543,7 +582,11 @@ contains
         call input_error(cfg%deck_file, 'particles', 'motion', &
            'prescribed velocities are given inline: use number and position, not solid_fraction')
     end if
-    if (cfg%radius + cfg%radius_offset * cfg%h < 1.5_dp * cfg%h) &
+    if (.not. cfg%resolved .and. cfg%particle_number == 0 .and. len_trim(cfg%position_file) == 0 .and. &
+        cfg%solid_fraction == 0.0_dp) &
+      call input_error(cfg%deck_file, 'fluid', 'model', '''none'' (lubrication dynamics) moves spheres and nothing '// &
+           'else: give &particles (number/position, position_file or solid_fraction)')
+    if (cfg%resolved .and. cfg%radius + cfg%radius_offset * cfg%h < 1.5_dp * cfg%h) &
       call input_error(cfg%deck_file, 'particles', 'radius', &
            'the sphere must span at least 1.5 grid cells in radius (raise &domain cells_per_radius)')
   end subroutine validate_particles
@@ -555,9 +598,10 @@ contains
     real(dp) :: strain_per_step
     integer :: needed
     if (.not. cfg%rheology_group) return
-    if (.not. cfg%walls .or. cfg%shear_rate == 0.0_dp) &
+    if (.not. (cfg%walls .or. cfg%lees_edwards) .or. cfg%shear_rate == 0.0_dp) &
       call input_error(cfg%deck_file, 'rheology', '', &
-           'statistics are taken in the core of the sheared Couette cell: needs y_boundary = ''walls'' and shear_rate /= 0')
+           'statistics are taken in the core of the sheared Couette cell (or the whole Lees-Edwards box): '// &
+           'needs y_boundary = ''walls'' or ''lees-edwards'' and shear_rate /= 0')
     if (cfg%particle_number == 0 .and. len_trim(cfg%position_file) == 0 .and. cfg%solid_fraction == 0.0_dp) &
       call input_error(cfg%deck_file, 'rheology', '', 'needs particles (&particles solid_fraction, number or position_file)')
     call check_real(cfg, 'rheology', 'discard_strain', cfg%discard_strain, 0.0_dp, 1.0e6_dp)
@@ -594,7 +638,16 @@ contains
     if (all(cfg%lubrication_model /= [character(len=16) :: 'none', 'simple', 'full'])) &
       call input_error(cfg%deck_file, 'lubrication', 'model', &
            'must be ''none'', ''simple'' or ''full'', not '''//trim(cfg%lubrication_model)//'''')
-    call check_real(cfg, 'lubrication', 'outer_cutoff', cfg%outer_cutoff, 0.0_dp, 2.0_dp)
+    if (cfg%resolved) then
+      call check_real(cfg, 'lubrication', 'outer_cutoff', cfg%outer_cutoff, 0.0_dp, 2.0_dp)
+    else
+      ! lubrication dynamics: the exact functions hold at every gap (the pair test covers 10a)
+      call check_real(cfg, 'lubrication', 'outer_cutoff', cfg%outer_cutoff, 0.0_dp, 20.0_dp)
+      if (cfg%lubrication_model == 'simple') &
+        call input_error(cfg%deck_file, 'lubrication', 'model', &
+             '''simple'' corrects a resolved fluid: with &fluid model = ''none'' use ''full'' (the exact '// &
+             'two-body functions, the default) or ''none'' (one-body drag only)')
+    end if
     call check_real(cfg, 'lubrication', 'inner_cutoff', cfg%inner_cutoff, 1.0e-8_dp, 0.1_dp)
     call check_real(cfg, 'lubrication', 'skin', cfg%lubrication_skin, 0.0_dp, 2.0_dp, .true.)
     if (cfg%outer_cutoff > 0.0_dp .and. cfg%outer_cutoff <= cfg%inner_cutoff) &

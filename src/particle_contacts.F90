@@ -22,6 +22,7 @@ module mod_particle_contacts
   use mod_contact, only: contact_params_t, contact_setup, contact_stats_t, contact_history_t, &
                          contact_forces, contact_links_t, contact_stiffness, contact_stresslet
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates
+  use mod_lees_edwards, only: lees_edwards_t
   use mod_particle_system, only: particle_system_t, psys_add_diagonal, psys_add_pair
   implicit none
   private
@@ -49,6 +50,7 @@ module mod_particle_contacts
     logical :: stiffness_added = .false.
     real(dp) :: c_now = 0, c_before = 0      ! X^{n+1} - X^n = c_now U^n + c_before U^{n-1}
     real(dp), allocatable :: u_before(:,:), om_before(:,:)   ! U^{n-1}, Omega^{n-1}
+    type(lees_edwards_t) :: le               ! sliding boundaries in y (le%active), delta of the step
   end type particle_contacts_t
 
 contains
@@ -58,8 +60,9 @@ contains
   !> shear rate (walls at -+ shear_rate Ly/2 when walls); box, walls: the domain; dt: time step.
   !> info: 0 ok, else msg says what is wrong (contact_setup or nlist_init refused).
   !> implicit, optional: the contact stiffness enters the particle solve (default .true.).
+  !> le, optional: Lees-Edwards boundaries in y (walls must then be .false.).
   subroutine pcontacts_create(pc, np, a, eps_r, mu_d, eps_bar, k_n_prescribed, skin, eta, &
-                              shear_rate, box, walls, dt, info, msg, implicit)
+                              shear_rate, box, walls, dt, info, msg, implicit, le)
     type(particle_contacts_t), intent(out) :: pc
     integer, intent(in) :: np
     real(dp), intent(in) :: a, eps_r, mu_d, eps_bar, k_n_prescribed, skin, eta, shear_rate, box(3), dt
@@ -67,6 +70,7 @@ contains
     integer, intent(out) :: info
     character(len=*), intent(out) :: msg
     logical, intent(in), optional :: implicit
+    type(lees_edwards_t), intent(in), optional :: le
     call contact_setup(pc%params, a, eps_r, mu_d, eps_bar, k_n_prescribed, eta, shear_rate, info, msg)
     if (info /= 0) return
     if (present(implicit)) pc%implicit = implicit
@@ -82,8 +86,9 @@ contains
     ! far beyond the roughness: the true surfaces overlap (smooth spheres: 5 % of the radius)
     pc%overlap_limit = pc%params%h_r
     if (pc%overlap_limit <= 0) pc%overlap_limit = 0.05_dp * a
+    if (present(le)) pc%le = le
     call nlist_init(pc%nlist, np, box, pc%periodic, 2 * a + pc%params%h_r + skin, &
-                    a + pc%params%h_r + skin, skin, info)
+                    a + pc%params%h_r + skin, skin, info, pc%le)
     if (info /= 0) then
       msg = 'contacts: the neighbour search refuses this box (a periodic length below 2 x cutoff)'
       return
@@ -97,21 +102,24 @@ contains
   !> One step: contacts at positions x (3, np) with velocities u, om (3, np). Results in
   !> pc%force, pc%torque, pc%stresslet (3, 3, np) and pc%stats; the history advances by one step.
   !> info: 0 ok; 1 the history belongs to another particle count; 2 an overlap beyond
-  !> pc%overlap_limit (pc%max_overlap says how far).
-  subroutine pcontacts_step(pc, x, u, om, info)
+  !> pc%overlap_limit (pc%max_overlap says how far). offset, optional: the Lees-Edwards offset
+  !> delta of this configuration (runs created with le).
+  subroutine pcontacts_step(pc, x, u, om, info, offset)
     type(particle_contacts_t), intent(inout) :: pc
     real(dp), intent(in) :: x(:,:), u(:,:), om(:,:)
     integer, intent(out) :: info
-    call nlist_candidates(pc%nlist, x, pc%pairs, pc%npairs, pc%walls, pc%nwalls)
+    real(dp), intent(in), optional :: offset
+    if (present(offset)) pc%le%offset = offset
+    call nlist_candidates(pc%nlist, x, pc%pairs, pc%npairs, pc%walls, pc%nwalls, pc%le%offset)
     pc%stiffness_added = .false.
     if (pc%implicit) then
       call contact_forces(pc%params, pc%history, x, u, om, pc%box, pc%periodic, pc%wall_velocity, &
                           pc%pairs, pc%npairs, pc%walls, pc%nwalls, pc%dt, pc%force, pc%torque, &
-                          pc%stresslet, pc%stats, info, pc%links)
+                          pc%stresslet, pc%stats, info, pc%links, pc%le)
     else
       call contact_forces(pc%params, pc%history, x, u, om, pc%box, pc%periodic, pc%wall_velocity, &
                           pc%pairs, pc%npairs, pc%walls, pc%nwalls, pc%dt, pc%force, pc%torque, &
-                          pc%stresslet, pc%stats, info)
+                          pc%stresslet, pc%stats, info, le=pc%le)
     end if
     if (info /= 0) return
     pc%max_overlap = pc%stats%max_overlap * pc%params%h_r
@@ -159,8 +167,14 @@ contains
       if (j > 0) then
         call psys_add_diagonal(sys, j, a(7:12, 7:12))
         call psys_add_pair(sys, i, j, a(1:6, 7:12))
-        q = [u(:, i), om(:, i), u(:, j), om(:, j)]
+        q = [u(:, i), om(:, i), u(:, j) + pc%links%image_velocity(:, m), om(:, j)]
         g = -pc%c_before * matmul(kn, q)
+        if (pc%le%active) then
+          ! the partner's Lees-Edwards image moves with U_j + image_velocity: the known part of
+          ! its velocity this step goes to the right-hand side with the matrix block
+          qw = [pc%links%image_velocity(:, m), 0.0_dp, 0.0_dp, 0.0_dp]
+          g = g - matmul(a(:, 7:12), qw)
+        end if
         rhs(:, i) = rhs(:, i) + g(1:6)
         rhs(:, j) = rhs(:, j) + g(7:12)
       else
@@ -188,8 +202,9 @@ contains
       i = pc%links%i(m)
       j = pc%links%partner(m)
       if (j > 0) then
-        q = [u(:, i), om(:, i), u(:, j), om(:, j)]
-        q0 = [pc%u_before(:, i), pc%om_before(:, i), pc%u_before(:, j), pc%om_before(:, j)]
+        q = [u(:, i), om(:, i), u(:, j) + pc%links%image_velocity(:, m), om(:, j)]
+        q0 = [pc%u_before(:, i), pc%om_before(:, i), pc%u_before(:, j) + pc%links%image_velocity(:, m), &
+              pc%om_before(:, j)]
       else
         q = [u(:, i), om(:, i), pc%wall_velocity(:, -j), 0.0_dp, 0.0_dp, 0.0_dp]
         q0 = [pc%u_before(:, i), pc%om_before(:, i), pc%wall_velocity(:, -j), 0.0_dp, 0.0_dp, 0.0_dp]

@@ -6,15 +6,27 @@
 !
 ! The undisturbed flow is the imposed shear of the Couette cell: U_inf = shear_rate (y - Ly/2) e_x,
 ! Om_inf = -shear_rate/2 e_z, E_inf = shear_rate/2 (e_x e_y + e_y e_x); at rest in a periodic box.
+! The same shear with Lees-Edwards boundaries (mod_lees_edwards, lubrication dynamics only): a pair
+! across the sliding boundary is taken with le_separation's image of j, and U_inf of j at its own
+! centre, since the image's velocity and its undisturbed velocity differ by the same
+! s gamma_dot Ly e_x (the block acts on U - U_inf, method.md §2.1).
+! Model 'exact' (lubrication dynamics): the blocks R_2B - R_1B are clipped at a floor per link,
+! -(1/2) min(6 pi eta a, 8 pi eta a^3) / max(z_i, z_j), z the links (pairs and walls) of each sphere
+! this step: the links of a sphere then lower the spectrum of its one-body block by at most half,
+! so the 6N system of mod_lubrication_dynamics stays positive definite, and an isolated pair,
+! whose R_2B is positive definite, keeps its exact block (its lowest eigenvalue, ~-0.36 x 6 pi
+! eta a at contact, is above the floor -3 pi eta a).
 module mod_particle_lubrication
-  use mod_kinds, only: dp, i8
+  use mod_kinds, only: dp, i8, pi
   use mod_resistance, only: n_pair_scalars
   use mod_lubrication, only: lubrication_t, lub_pair_scalars, lub_wall_scalars, lub_pair_link, &
-       lub_wall_link, lub_pair_stresslets, lub_wall_stresslet, n_wall_scalars, LUB_NONE
+       lub_wall_link, lub_pair_stresslets, lub_wall_stresslet, n_wall_scalars, LUB_NONE, LUB_EXACT
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates
+  use mod_lees_edwards, only: lees_edwards_t, le_separation
+  use mod_particle_system, only: particle_system_t, psys_add_diagonal, psys_add_pair
   implicit none
   private
-  public :: particle_lubrication_t, plub_create, plub_links, plub_corrections, plub_reserve_pairs
+  public :: particle_lubrication_t, plub_create, plub_links, plub_corrections, plub_reserve_pairs, plub_add_to_system
 
   type :: particle_lubrication_t
     type(lubrication_t) :: lub
@@ -22,6 +34,8 @@ module mod_particle_lubrication
     integer :: np = 0
     real(dp) :: box(3) = 0, shear_rate = 0
     logical :: walls = .false., periodic(3) = .true.
+    type(lees_edwards_t) :: le                                 ! sliding boundaries in y (le%active)
+    integer, allocatable :: links_of(:)                        ! (np) links per sphere (model 'exact')
     integer :: ncand = 0, ncand_walls = 0
     integer, allocatable :: cand(:, :), cand_walls(:, :)        ! canonical candidate lists
     ! links of the current configuration
@@ -43,7 +57,8 @@ module mod_particle_lubrication
 contains
 
   !> lub: the configured model (mod_lubrication lub_setup); skin: neighbour-list skin [a].
-  subroutine plub_create(pl, lub, np, box, walls, shear_rate, skin, info, msg)
+  !> le, optional: Lees-Edwards boundaries in y (walls .false.).
+  subroutine plub_create(pl, lub, np, box, walls, shear_rate, skin, info, msg, le)
     type(particle_lubrication_t), intent(out) :: pl
     type(lubrication_t), intent(in) :: lub
     integer, intent(in) :: np
@@ -51,8 +66,11 @@ contains
     logical, intent(in) :: walls
     integer, intent(out) :: info
     character(len=*), intent(out) :: msg
+    type(lees_edwards_t), intent(in), optional :: le
     real(dp) :: reach
     pl%lub = lub
+    if (present(le)) pl%le = le
+    allocate(pl%links_of(np))
     pl%np = np
     pl%box = box
     pl%walls = walls
@@ -81,7 +99,7 @@ contains
     end if
     reach = lub%outer_cutoff * lub%radius
     call nlist_init(pl%nlist, np, box, pl%periodic, 2 * lub%radius + reach + skin, lub%radius + reach + skin, &
-                    skin, info)
+                    skin, info, pl%le)
     if (info /= 0) msg = 'lubrication: the neighbour search refuses this box (a periodic length below '// &
                          '2 x (2a + outer_cutoff + skin))'
   end subroutine plub_create
@@ -91,7 +109,7 @@ contains
     real(dp), intent(in) :: x(3)
     real(dp) :: u(3)
     u = 0
-    if (pl%walls) u(1) = pl%shear_rate * (x(2) - 0.5_dp * pl%box(2))
+    if (pl%walls .or. pl%le%active) u(1) = pl%shear_rate * (x(2) - 0.5_dp * pl%box(2))
   end function ambient_velocity
 
   subroutine ambient_gradients(pl, om, e)
@@ -99,7 +117,7 @@ contains
     real(dp), intent(out) :: om(3), e(3, 3)
     real(dp) :: g
     g = 0
-    if (pl%walls) g = pl%shear_rate
+    if (pl%walls .or. pl%le%active) g = pl%shear_rate
     om = [0.0_dp, 0.0_dp, -0.5_dp * g]
     e = 0
     e(1, 2) = 0.5_dp * g
@@ -111,20 +129,29 @@ contains
   !> cannot be decomposed is named in pl%failed_link for the caller to report.
   !> part, parts (optional): only the part-th of parts contiguous shares of the pair candidates
   !> (0-based; mod_lubrication_links gathers the shares of all ranks in order); walls always all.
-  subroutine plub_links(pl, x, part, parts)
+  !> offset (optional): the Lees-Edwards offset delta of this configuration (runs created with le).
+  subroutine plub_links(pl, x, part, parts, offset)
     type(particle_lubrication_t), intent(inout) :: pl
     real(dp), intent(in) :: x(:, :)
     integer, intent(in), optional :: part, parts
+    real(dp), intent(in), optional :: offset
     integer :: c, i, j, side, first, last, status
     real(dp) :: r(3), dist, gap, d(3), om_inf(3), e_inf(3, 3), u_inf(3, 2), normal(3), u_wall(3), w(n_wall_scalars)
+    real(dp) :: vshift(3), floor_scale
     pl%npairs = 0
     pl%nwalls = 0
     pl%min_gap = huge(1.0_dp)
     pl%failed_link = 0
     if (pl%lub%model == LUB_NONE) return
+    if (present(offset)) pl%le%offset = offset
     ! one sphere: its wall candidates were set once by plub_create
-    if (pl%np > 1) call nlist_candidates(pl%nlist, x, pl%cand, pl%ncand, pl%cand_walls, pl%ncand_walls)
+    if (pl%np > 1) call nlist_candidates(pl%nlist, x, pl%cand, pl%ncand, pl%cand_walls, pl%ncand_walls, pl%le%offset)
     call ambient_gradients(pl, om_inf, e_inf)
+    if (pl%lub%model == LUB_EXACT) then
+      call count_links()
+      floor_scale = -0.5_dp * min(6.0_dp * pi * pl%lub%viscosity * pl%lub%radius, &
+                                  8.0_dp * pi * pl%lub%viscosity * pl%lub%radius**3)
+    end if
     first = 1
     last = pl%ncand
     if (present(part) .and. present(parts)) then
@@ -134,8 +161,7 @@ contains
     do c = first, last
       i = pl%cand(1, c)
       j = pl%cand(2, c)
-      r = x(:, j) - x(:, i)
-      where (pl%periodic) r = r - pl%box * anint(r / pl%box)
+      r = separation(i, j)
       dist = norm2(r)
       gap = dist / pl%lub%radius - 2.0_dp
       pl%min_gap = min(pl%min_gap, gap)
@@ -143,15 +169,26 @@ contains
       call grow_pairs()
       pl%npairs = pl%npairs + 1
       d = r / dist
-      ! the undisturbed velocity at sphere 2 as seen from sphere 1 (same image)
+      ! the undisturbed velocity at sphere 2 as seen from sphere 1 (same image); across a sliding
+      ! boundary at j's own centre, where j's velocity is
       u_inf(:, 1) = ambient_velocity(pl, x(:, i))
-      u_inf(:, 2) = ambient_velocity(pl, x(:, i) + r)
+      if (pl%le%active) then
+        u_inf(:, 2) = ambient_velocity(pl, x(:, j))
+      else
+        u_inf(:, 2) = ambient_velocity(pl, x(:, i) + r)
+      end if
       pl%pair(:, pl%npairs) = [i, j]
       pl%pair_d(:, pl%npairs) = d
       pl%pair_uinf(:, pl%npairs) = [u_inf(:, 1), u_inf(:, 2)]
       pl%pair_f(:, pl%npairs) = lub_pair_scalars(pl%lub, gap)
-      call lub_pair_link(pl%lub, pl%pair_f(:, pl%npairs), d, u_inf, om_inf, e_inf, &
-                         pl%pair_r(:, :, pl%npairs), pl%pair_drive(:, pl%npairs), status)
+      if (pl%lub%model == LUB_EXACT) then
+        call lub_pair_link(pl%lub, pl%pair_f(:, pl%npairs), d, u_inf, om_inf, e_inf, &
+                           pl%pair_r(:, :, pl%npairs), pl%pair_drive(:, pl%npairs), status, &
+                           floor_scale / max(pl%links_of(i), pl%links_of(j)))
+      else
+        call lub_pair_link(pl%lub, pl%pair_f(:, pl%npairs), d, u_inf, om_inf, e_inf, &
+                           pl%pair_r(:, :, pl%npairs), pl%pair_drive(:, pl%npairs), status)
+      end if
       if (status /= 0 .and. pl%failed_link(1) == 0) pl%failed_link = [i, j]
     end do
     do c = 1, pl%ncand_walls
@@ -173,11 +210,53 @@ contains
       w = lub_wall_scalars(pl%lub, gap)
       pl%wall_part(pl%nwalls) = i
       pl%wall_n(:, pl%nwalls) = normal
-      call lub_wall_link(pl%lub, w, normal, u_wall, pl%wall_r(:, :, pl%nwalls), pl%wall_drive(:, pl%nwalls), status)
+      if (pl%lub%model == LUB_EXACT) then
+        call lub_wall_link(pl%lub, w, normal, u_wall, pl%wall_r(:, :, pl%nwalls), pl%wall_drive(:, pl%nwalls), status, &
+                           floor_scale / pl%links_of(i))
+      else
+        call lub_wall_link(pl%lub, w, normal, u_wall, pl%wall_r(:, :, pl%nwalls), pl%wall_drive(:, pl%nwalls), status)
+      end if
       if (status /= 0 .and. pl%failed_link(1) == 0) pl%failed_link = [i, 0]
     end do
 
   contains
+
+    ! r = x_j - x_i, minimum image (across sliding boundaries: le_separation's)
+    function separation(i, j) result(r)
+      integer, intent(in) :: i, j
+      real(dp) :: r(3)
+      r = x(:, j) - x(:, i)
+      if (pl%le%active) then
+        call le_separation(pl%le, x(:, j) - x(:, i), r, vshift)
+      else
+        where (pl%periodic) r = r - pl%box * anint(r / pl%box)
+      end if
+    end function separation
+
+    ! links_of: the pair and wall links of every sphere within the outer cut-off (all candidates,
+    ! whatever share this rank evaluates, so that every rank sets the same floors)
+    subroutine count_links()
+      integer :: k, a, b
+      real(dp) :: g
+      pl%links_of = 0
+      do k = 1, pl%ncand
+        a = pl%cand(1, k)
+        b = pl%cand(2, k)
+        g = norm2(separation(a, b)) / pl%lub%radius - 2.0_dp
+        if (g >= pl%lub%outer_cutoff) cycle
+        pl%links_of(a) = pl%links_of(a) + 1
+        pl%links_of(b) = pl%links_of(b) + 1
+      end do
+      do k = 1, pl%ncand_walls
+        a = pl%cand_walls(1, k)
+        if (pl%cand_walls(2, k) == 1) then
+          g = x(2, a) / pl%lub%radius - 1.0_dp
+        else
+          g = (pl%box(2) - x(2, a)) / pl%lub%radius - 1.0_dp
+        end if
+        if (g < pl%lub%outer_cutoff) pl%links_of(a) = pl%links_of(a) + 1
+      end do
+    end subroutine count_links
 
     subroutine grow_pairs()
       if (pl%npairs < size(pl%pair, 2)) return
@@ -214,6 +293,30 @@ contains
     allocate(t3(12, 12, m)); t3(:, :, 1:pl%npairs) = pl%pair_r(:, :, 1:pl%npairs); call move_alloc(t3, pl%pair_r)
     allocate(t2(12, m)); t2(:, 1:pl%npairs) = pl%pair_drive(:, 1:pl%npairs); call move_alloc(t2, pl%pair_drive)
   end subroutine plub_reserve_pairs
+
+  !> The links into a 6N system (method.md §1.5 eq. (1)): each pair's 12x12 block as two diagonal
+  !> blocks and one coupling block, each wall link's 6x6 on its particle's diagonal; their
+  !> velocity-independent parts (R.U_inf + R_FE:E_inf) onto rhs (6, np).
+  subroutine plub_add_to_system(pl, sys, rhs)
+    type(particle_lubrication_t), intent(in) :: pl
+    type(particle_system_t), intent(inout) :: sys
+    real(dp), intent(inout) :: rhs(:, :)
+    integer :: l, i, j
+    do l = 1, pl%npairs
+      i = pl%pair(1, l)
+      j = pl%pair(2, l)
+      call psys_add_diagonal(sys, i, pl%pair_r(1:6, 1:6, l))
+      call psys_add_diagonal(sys, j, pl%pair_r(7:12, 7:12, l))
+      call psys_add_pair(sys, i, j, pl%pair_r(1:6, 7:12, l))
+      rhs(:, i) = rhs(:, i) + pl%pair_drive(1:6, l)
+      rhs(:, j) = rhs(:, j) + pl%pair_drive(7:12, l)
+    end do
+    do l = 1, pl%nwalls
+      i = pl%wall_part(l)
+      call psys_add_diagonal(sys, i, pl%wall_r(:, :, l))
+      rhs(:, i) = rhs(:, i) + pl%wall_drive(:, l)
+    end do
+  end subroutine plub_add_to_system
 
   !> The corrections with the velocities of this step, u and om (3, np): force, torque and
   !> stresslet on each particle (pl%force, pl%torque, pl%stresslet).

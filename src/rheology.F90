@@ -15,6 +15,11 @@
 ! phi u_x (y) in bins (exact sphere-slab volumes); pair counts in the shear plane for the pair
 ! distribution g(theta) at r < r_outer and at contact (r < 2a + h_c).
 !
+! Lees-Edwards boundaries (lubrication dynamics, rheo_create's le): the shear is homogeneous, there
+! are no wall layers, and the core is the whole box: every sphere counts whole (w_i = 1, so
+! phi_core = N (4/3) pi a^3 / V), its centre is a reference of g(theta), and pairs are taken across
+! the sliding boundary (le_separation).
+!
 ! Statistics (paper §4, "five statistically independent time-segments"): the records after
 ! discard_step are split into `blocks` blocks of block_steps steps; a block's mean is taken over
 ! its records, every summary quantity is evaluated on each complete block's means (the error: the
@@ -24,6 +29,7 @@ module mod_rheology
   use mod_kinds, only: dp, pi
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates, min_image
+  use mod_lees_edwards, only: lees_edwards_t, le_separation
   implicit none
   private
   public :: rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, rheo_quantities, rheo_block_of, &
@@ -50,6 +56,7 @@ module mod_rheology
     integer :: nbins = 0, nangles = 0       ! profile bins across y, angle bins of g over [0, 2 pi)
     integer :: blocks = 5, discard_step = 0, block_steps = 1
     type(nlist_t) :: nl
+    type(lees_edwards_t) :: le              ! sliding boundaries (le%active): the whole box is the core
     ! the pair candidates of nl: kept here between samples, because nlist_candidates refreshes them
     ! only when it rebuilds the list (a list local to rheo_sample was empty between rebuilds)
     integer :: npairs = 0, nwalls = 0
@@ -73,18 +80,22 @@ contains
 
   !> Set up. contact_shell: h_c of the contact shell [a]; steps are counted from the start of the
   !> simulation. info: 0 ok; 1 a periodic length below twice the pair search range.
+  !> le, optional: Lees-Edwards boundaries in y (core_fraction is then [0, 1]: the whole box).
   subroutine rheo_create(r, n, box, radius, shear_rate, core_fraction, nbins, nangles, r_outer, contact_shell, &
-                         blocks, discard_step, block_steps, info)
+                         blocks, discard_step, block_steps, info, le)
     type(rheology_t), intent(out) :: r
     integer, intent(in) :: n                ! number of spheres
     real(dp), intent(in) :: box(3), radius, shear_rate, core_fraction(2), r_outer, contact_shell
     integer, intent(in) :: nbins, nangles, blocks, discard_step, block_steps
     integer, intent(out) :: info
+    type(lees_edwards_t), intent(in), optional :: le
     real(dp), parameter :: skin = 0.3_dp
+    if (present(le)) r%le = le
     r%box = box
     r%radius = radius
     r%shear_rate = shear_rate
     r%core = core_fraction * box(2)
+    if (r%le%active) r%core = [0.0_dp, box(2)]
     r%nbins = nbins
     r%nangles = nangles
     r%r_outer = r_outer * radius
@@ -97,8 +108,8 @@ contains
              r%block_references(blocks), r%block_records(blocks))
     r%profile = 0; r%angles = 0
     r%block_sums = 0; r%block_profile = 0; r%block_angles = 0; r%block_references = 0; r%block_records = 0
-    call nlist_init(r%nl, n, box, [.true., .false., .true.], max(r%r_outer, r%r_contact) + skin, &
-                    radius + skin, skin, info)
+    call nlist_init(r%nl, n, box, [.true., r%le%active, .true.], max(r%r_outer, r%r_contact) + skin, &
+                    radius + skin, skin, info, r%le)
   end subroutine rheo_create
 
   !> The block of a record at step (0-based), or -1 outside the averaging window.
@@ -123,12 +134,14 @@ contains
 
   !> One record: core stresses, volume fraction, velocity-fit sums, profiles, pair counts.
   !> position, velocity (3, N); stresslet_hydro, stresslet_contact (3, 3, N) [eta gamma_dot a^3];
-  !> stresslet_contact absent: no contacts (zero contact stress).
-  subroutine rheo_sample(r, position, velocity, stresslet_hydro, stresslet_contact)
+  !> stresslet_contact absent: no contacts (zero contact stress). offset (optional): the
+  !> Lees-Edwards offset of this configuration (rheo_create's le).
+  subroutine rheo_sample(r, position, velocity, stresslet_hydro, stresslet_contact, offset)
     type(rheology_t), intent(inout) :: r
     real(dp), intent(in) :: position(:, :), velocity(:, :), stresslet_hydro(:, :, :)
     real(dp), intent(in), optional :: stresslet_contact(:, :, :)
-    real(dp) :: a, vp, v_core, w, y, u, dbin, d(3), dist, theta, sin_half, gap
+    real(dp), intent(in), optional :: offset
+    real(dp) :: a, vp, v_core, w, y, u, dbin, d(3), dist, theta, sin_half, gap, vshift(3)
     integer :: n, i, b, b1, b2, k, p, i1, i2
     logical :: ref_i, ref_j
 
@@ -145,6 +158,7 @@ contains
       y = position(2, i)
       u = velocity(1, i)
       w = slab_volume(y, a, r%core(1), r%core(2)) / vp
+      if (r%le%active) w = 1.0_dp
       if (w > 0) then
         r%values(1:5) = r%values(1:5) + w * components(stresslet_hydro(:, :, i))
         if (present(stresslet_contact)) r%values(6:10) = r%values(6:10) + w * components(stresslet_contact(:, :, i))
@@ -168,11 +182,16 @@ contains
     ! pairs in the shear plane: polar angle from the vorticity axis within pi/2 -+ half an angle bin
     sin_half = sin(pi / r%nangles)
     r%min_pair_gap = max(r%r_outer, r%r_contact) - 2 * a
-    call nlist_candidates(r%nl, position, r%pairs, r%npairs, r%walls, r%nwalls)
+    if (present(offset)) r%le%offset = offset
+    call nlist_candidates(r%nl, position, r%pairs, r%npairs, r%walls, r%nwalls, r%le%offset)
     do p = 1, r%npairs
       i1 = r%pairs(1, p)
       i2 = r%pairs(2, p)
-      d = min_image(position(:, i2) - position(:, i1), r%box, [.true., .false., .true.])
+      if (r%le%active) then
+        call le_separation(r%le, position(:, i2) - position(:, i1), d, vshift)
+      else
+        d = min_image(position(:, i2) - position(:, i1), r%box, [.true., .false., .true.])
+      end if
       dist = norm2(d)
       gap = dist - 2 * a
       r%min_pair_gap = min(r%min_pair_gap, gap)

@@ -23,6 +23,11 @@ with open(os.path.join(d, 'truncated.h5'), 'wb') as f:
 with open(os.path.join(d, 'not_a_directory'), 'w') as f:
     f.write('a file')
 os.rename(os.path.join(d, 'out'), os.path.join(d, 'good_run'))
+# a lubrication-dynamics checkpoint (&fluid model = 'none', Lees-Edwards), for the DNS to refuse
+LD = GOOD.replace('cells_per_radius = 5', "cells_per_radius = 5, y_boundary = 'lees-edwards', shear_rate = 1") \
+    .replace('reynolds = 0.01', "model = 'none'") + '&particles number = 1, position(:,1) = 1.6, 1.6, 1.6 /\n'
+T.run(T.write_deck(d, 'ld.nml', LD), d)
+os.rename(os.path.join(d, 'out'), os.path.join(d, 'ld_run'))
 
 cases = [
     # name, deck text (None: do not write), extra args, words the message must contain
@@ -106,6 +111,27 @@ cases = [
      [], ['bad.nml', '&particles', 'solid_fraction', 'one way']),
     ('packing beyond the supported fraction', GOOD + '&particles solid_fraction = 0.6 /\n', [],
      ['bad.nml', '&particles', 'solid_fraction', 'out of range']),
+    # lubrication dynamics (issue 30)
+    ('unknown fluid model', GOOD.replace('reynolds = 0.01', "reynolds = 0.01, model = 'stokes'"), [],
+     ['bad.nml', '&fluid', 'model', 'stokes']),
+    ('sliding boundaries with the resolved fluid', GOOD.replace('cells_per_radius = 5',
+     "cells_per_radius = 5, y_boundary = 'lees-edwards'"), [], ['bad.nml', '&domain', 'y_boundary', 'lees-edwards',
+                                                                "model = 'none'"]),
+    ('lubrication dynamics without particles', GOOD.replace('reynolds = 0.01', "model = 'none'"), [],
+     ['bad.nml', '&fluid', 'model', 'particles']),
+    ('simple lubrication without a fluid', LD + "&lubrication model = 'simple' /\n", [],
+     ['bad.nml', '&lubrication', 'model', 'simple']),
+    ('pair cut-off beyond 20a', LD + "&lubrication outer_cutoff = 25 /\n", [],
+     ['bad.nml', '&lubrication', 'outer_cutoff', 'out of range']),
+    ('lubrication-dynamics step beyond the contact limit', LD.replace('dt = 0.005', 'dt = 0.05')
+     .replace('3.2, 3.2, 3.2', '6.4, 6.4, 6.4').replace('1.6, 1.6, 1.6', '3.2, 3.2, 3.2') +
+     '&contact roughness = 0.01 /\n', [], ['bad.nml', '&time', 'dt', 'largest dt measured stable here is  1.00E-02']),
+    ('steady state without a fluid', LD.replace('steps = 4', 'steps = 4, steady_tolerance = 1e-3'), [],
+     ['bad.nml', '&time', 'steady_tolerance', "model = 'resolved'"]),
+    ('DNS restart from a lubrication-dynamics checkpoint', GOOD, ['-restart', 'ld_run/checkpoint.h5'],
+     ['ld_run/checkpoint.h5', 'fluid_resolved', '&fluid model']),
+    ('walls restart from a Lees-Edwards checkpoint', LD.replace("y_boundary = 'lees-edwards'", "y_boundary = 'walls'"),
+     ['-restart', 'ld_run/checkpoint.h5'], ['ld_run/checkpoint.h5', 'lees_edwards_offset', 'y_boundary']),
     ('averaging blocks without records', GOOD + '&particles solid_fraction = 0.1 /\n'
      '&rheology average_strain = 0.01, blocks = 5 /\n', [],
      ['bad.nml', '&rheology', 'average_strain', 'series_every']),
