@@ -21,7 +21,8 @@ run() {
     "$(grep -o 'sparse solves, mean *[0-9.]* ms' "$log")"
 }
 run cg-pbjacobi
-run cholesky-cholmod-metis -particles_ksp_type preonly -particles_pc_type cholesky \
+# the factorisations need an AIJ matrix (PETSc's CHOLMOD takes aij, or sbaij of block size 1)
+run cholesky-cholmod-metis -particles_mat_type aij -particles_ksp_type preonly -particles_pc_type cholesky \
     -particles_pc_factor_mat_solver_type cholmod
-run cholesky-mumps-amd -particles_ksp_type preonly -particles_pc_type cholesky \
+run cholesky-mumps-amd -particles_mat_type aij -particles_ksp_type preonly -particles_pc_type cholesky \
     -particles_pc_factor_mat_solver_type mumps

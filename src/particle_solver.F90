@@ -4,11 +4,15 @@
 ! inverse of each 6x6 diagonal block (PCPBJACOBI), relative tolerance 1e-12, started from the
 ! velocities of the last step (issue 31: 44 -> 26 iterations per step on the paper scene), on a
 ! block-AIJ matrix (BAIJ, 6x6 blocks: one index per block, assembly and products ~2x faster than
-! AIJ; -particles_mat_type is not read, the format is fixed here). A sparse Cholesky
-! ordered by METIS (SuiteSparse CHOLMOD's nested dissection) is one option away:
-!   -particles_ksp_type preonly -particles_pc_type cholesky -particles_pc_factor_mat_solver_type cholmod
+! AIJ; -particles_mat_type aij or sbaij changes it). A sparse Cholesky ordered by METIS
+! (SuiteSparse CHOLMOD's nested dissection) is one option away (PETSc's CHOLMOD factors aij, and
+! sbaij of block size 1 only):
+!   -particles_mat_type aij -particles_ksp_type preonly -particles_pc_type cholesky
+!   -particles_pc_factor_mat_solver_type cholmod
 ! At 1000 spheres (phi = 0.4, ~2900 lubricating pairs) CG takes ~46 iterations and is ~20 times
-! faster than the factorisation (doc/BENCHMARKS.md, scripts/bench_particle_solver.sh). Particle data is replicated, so every
+! faster than the factorisation (doc/BENCHMARKS.md, scripts/bench_particle_solver.sh); in
+! lubrication dynamics (no fluid mass on the diagonal) CG takes 64-97 iterations at 1000 spheres and
+! is still the faster, ~7x at 500 spheres (doc/BENCHMARKS.md §11). Particle data is replicated, so every
 ! rank assembles and solves the same sequential system and gets the same answer.
 ! Without pair blocks the system is block diagonal and mod_particle_system solves it directly.
 #include <petsc/finclude/petscksp.h>
@@ -57,7 +61,9 @@ contains
     Vec :: vx, vb
     PetscInt :: n6, row(1), col(1), its
     PetscInt, parameter :: zero = 0, one = 1, six = 6
-    PetscInt, allocatable :: nnz(:)
+    PetscInt, allocatable :: nnz(:), upper(:)
+    PetscBool :: sbaij
+    KSPType :: ksp_type
     PetscScalar, pointer :: p(:)
     integer :: q, i, j
     real(dp) :: t0
@@ -76,8 +82,28 @@ contains
     ! a pair may come more than once (lubrication and contact stiffness): its blocks add up in
     ! one, and a row never holds more blocks than there are particles
     nnz = min(nnz, sys%n)
-    PetscCall(MatCreateSeqBAIJ(PETSC_COMM_SELF, six, n6, n6, zero, nnz, a, ierr))
+    ! the upper triangle alone (sbaij): the diagonal block and the pairs whose other particle is later
+    allocate(upper(sys%n))
+    upper = 1
+    do q = 1, sys%npairs
+      i = min(sys%pair(1, q), sys%pair(2, q))
+      upper(i) = upper(i) + 1
+    end do
+    upper = min(upper, sys%n)
+    ! BAIJ unless -particles_mat_type says otherwise (sbaij or aij for a sparse Cholesky:
+    ! PETSc's CHOLMOD factors only those; sbaij keeps the upper triangle, the lower is ignored)
+    PetscCall(MatCreate(PETSC_COMM_SELF, a, ierr))
+    PetscCall(MatSetSizes(a, n6, n6, n6, n6, ierr))
+    PetscCall(MatSetBlockSize(a, six, ierr))
+    PetscCall(MatSetType(a, MATSEQBAIJ, ierr))
+    PetscCall(MatSetOptionsPrefix(a, 'particles_', ierr))
+    PetscCall(MatSetFromOptions(a, ierr))
+    PetscCall(MatXAIJSetPreallocation(a, six, nnz, PETSC_NULL_INTEGER, upper, PETSC_NULL_INTEGER, ierr))
     PetscCall(MatSetOption(a, MAT_SYMMETRIC, PETSC_TRUE, ierr))
+    PetscCall(PetscObjectTypeCompare(a, MATSEQSBAIJ, sbaij, ierr))
+    if (sbaij) then
+      PetscCall(MatSetOption(a, MAT_IGNORE_LOWER_TRIANGULAR, PETSC_TRUE, ierr))
+    end if
     do q = 1, sys%n
       row(1) = q - 1
       PetscCall(MatSetValuesBlocked(a, one, row, one, row, row_major(sys%diag(:, :, q)), ADD_VALUES, ierr))
@@ -98,7 +124,13 @@ contains
     PetscCall(VecGetArrayF90(vx, p, ierr))
     p = reshape(x(:, 1:sys%n), [6 * sys%n])
     PetscCall(VecRestoreArrayF90(vx, p, ierr))
-    PetscCall(KSPSetInitialGuessNonzero(ps%ksp, PETSC_TRUE, ierr))
+    ! a direct solve (preonly) takes no guess
+    PetscCall(KSPGetType(ps%ksp, ksp_type, ierr))
+    if (trim(ksp_type) == trim(KSPPREONLY)) then
+      PetscCall(KSPSetInitialGuessNonzero(ps%ksp, PETSC_FALSE, ierr))
+    else
+      PetscCall(KSPSetInitialGuessNonzero(ps%ksp, PETSC_TRUE, ierr))
+    end if
     PetscCall(KSPSetOperators(ps%ksp, a, a, ierr))
     PetscCall(KSPSolve(ps%ksp, vb, vx, ierr))
     PetscCall(KSPGetConvergedReason(ps%ksp, reason, ierr))
