@@ -32,7 +32,7 @@ module mod_contact
   public :: contact_params_t, contact_setup, contact_stats_t
   public :: contact_history_t, history_size, history_pack, history_unpack, history_clear
   public :: history_lookup, contact_pair, contact_forces, contact_stresslet
-  public :: wall_lower, wall_upper, chatter_number, flattening_estimate
+  public :: wall_lower, wall_upper, chatter_number, stick_number, flattening_estimate
   public :: contact_links_t, contact_stiffness
 
   integer, parameter :: wall_lower = -1, wall_upper = -2   ! history partner ids of the walls
@@ -125,6 +125,19 @@ contains
     if (p%h_r <= 0 .or. p%gamma_dot == 0 .or. p%k_n <= 0) return
     q = dt * abs(p%gamma_dot) * p%h_r / reference_overlap(p)
   end function chatter_number
+
+  !> The slip of one step at the shear velocity, gamma_dot a dt, against the length over which a
+  !> contact's spring sticks at the reference overlap, mu_d |F_n|/k_t = mu_d delta_0/kt_coeff
+  !> ((2.19)-(2.22); (7/2) mu_d delta_0). Above ~5 a step turns contacts that should stick into
+  !> sliding ones (doc/CONTACT.md "Time-step considerations", the friction study of
+  !> doc/VALIDATION.md §5.4). 0 without friction, roughness or shear.
+  pure real(dp) function stick_number(p, dt) result(q)
+    type(contact_params_t), intent(in) :: p
+    real(dp), intent(in) :: dt
+    q = 0
+    if (p%mu_d <= 0 .or. p%h_r <= 0 .or. p%gamma_dot == 0 .or. p%k_n <= 0) return
+    q = dt * abs(p%gamma_dot) * p%a * p%kt_coeff / (p%mu_d * reference_overlap(p))
+  end function stick_number
 
   !> delta_0 = (6 pi eta gamma_dot a^2 / k_n)^(2/3): the Hertz overlap under the force scale
   !> (eps_bar h_r when k_n comes from eps_bar); needs k_n > 0 and gamma_dot /= 0.

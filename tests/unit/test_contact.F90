@@ -33,7 +33,7 @@
 program test_contact
   use mod_kinds, only: dp, pi
   use mod_vector, only: cross
-  use mod_contact, only: contact_params_t, contact_setup, chatter_number, flattening_estimate, contact_history_t, history_size, &
+  use mod_contact, only: contact_params_t, contact_setup, chatter_number, stick_number, flattening_estimate, contact_history_t, history_size, &
                          contact_pair, contact_forces, contact_stats_t, history_lookup
   use mod_unit_checks, only: check, finish
   implicit none
@@ -228,6 +228,13 @@ program test_contact
   call check(err < 1e-13_dp, 'chatter number scales as k_n^(2/3)')
   call contact_setup(p0, 1.0_dp, 0.0_dp, 0.5_dp, 0.05_dp, 1.0e6_dp, 1.0_dp, 1.0_dp, info, msg)
   call check(chatter_number(p0, 2.0e-3_dp) == 0, 'no chatter number for smooth spheres')
+  ! the stick number: slip of a step gamma_dot a dt over the stick length (7/2) mu_d eps_bar h_r
+  ! (p: eps_r = 5e-3, eps_bar = 0.05, mu_d = 0.5): 2e-3/(3.5 x 0.5 x 2.5e-4) = 4.5714...
+  err = abs(stick_number(p, 2.0e-3_dp) / (2.0e-3_dp / (3.5_dp * 0.5_dp * 0.05_dp * 5.0e-3_dp)) - 1)
+  print '(a,es12.5,a,es9.2)', '12b. stick number at dt = 2e-3: ', stick_number(p, 2.0e-3_dp), ' rel. error ', err
+  call check(err < 1e-13_dp, 'stick number = gamma_dot a dt / ((7/2) mu_d eps_bar h_r)')
+  call contact_setup(p0, 1.0_dp, 5.0e-3_dp, 0.0_dp, 0.05_dp, 0.0_dp, 1.0_dp, 1.0_dp, info, msg)
+  call check(stick_number(p0, 2.0e-3_dp) == 0, 'no stick number without friction')
 
   ! 13. flattening estimate (p: eps_bar = 0.05)
   call check(abs(flattening_estimate(p, 0.4_dp) / (6.9_dp * 0.05_dp) - 1) < 1e-13_dp, 'flattening at phi = 0.4 is 6.9 eps_bar')
