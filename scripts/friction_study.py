@@ -5,12 +5,13 @@ the paper's own set-up (Gallier et al. 2014 §4).
 
     scripts/friction_study.py [CASE ...] [--mu 0 0.5] [--jobs 2] [--ranks 1] [--hours 0]
                               [--work out/friction_phi04] [--record doc/data/friction_phi04]
-                              [--table] [--list]
+                              [--table] [--list] [--rerecord]
 
 CASE names a row of ROWS (default: every row of the sensitivity study, in the order of ROWS), run
 at every --mu, or ROW:MU for that one run (e.g. dt5e-4:0.5).
 Each (row, mu_d) run is a directory <work>/<row>_mu<mu> with its deck, log, out/ and a copy of
-bin/fdsusp taken at its first start, so a rebuild cannot change a run half-way. Resumable: a run
+bin/fdsusp ($FDSUSP_BIN/fdsusp: point it at a pinned build with a VERSION file beside it) taken at
+its first start, so a rebuild cannot change a run half-way. Resumable: a run
 whose out/summary.json is complete is done; one with out/checkpoint.h5 continues from it
 (`-restart`); otherwise it starts. --hours sets &run max_wall_hours, so a run stops with a
 checkpoint in time and the next call continues it (on the same machine: out/ is not in git).
@@ -18,7 +19,8 @@ checkpoint in time and the next call continues it (on the same machine: out/ is 
 Each finished run is recorded in <record>/<row>_mu<mu>/ as deck.nml and summary.json: fdsusp's
 summary with a "run" object added that says what was run without the deck beside it (spheres,
 box, a/Delta, bulk phi, mu_d, eps_r, eps_bar, dt, strains discarded and averaged, the fdsusp
-commit). --table prints, from the records, the rows of the sensitivity table: the friction
+commit) and a "contacts" object from series.h5 (contacts, the fraction sliding, overlaps);
+--rerecord writes the records of every finished run again. --table prints, from the records, the rows of the sensitivity table: the friction
 ratio eta_r(0.5)/eta_r(0), the relative change of |N1|/tau and |N2|/tau, N2/N1 at both mu_d,
 each with its error propagated from the block errors.
 """
@@ -59,8 +61,12 @@ ROWS = {
     'w12':     ('x, z periods 12a', dict(box=(12, 20, 12))),
     'w20':     ('x, z periods 20a', dict(box=(20, 20, 20))),
     'w20s2':   ('x, z periods 20a, seed 2', dict(box=(20, 20, 20), seed=2)),
+    # issue 28 item 2, the paper's set-up: 20a cube at a/Delta 5 (~760 spheres); dt 1e-3 keeps the
+    # stick number at 2.3 (converged) and eta_h within the 5 % that dt 2e-3 costs; 2.4 h per run
+    # on 2 ranks (--ranks 2 --jobs 1)
+    'paper':   ('the paper\'s set-up: 20a cube, a/Delta 5, dt 1e-3', dict(box=(20, 20, 20), cells=5, dt=1e-3)),
 }
-SENSITIVITY = list(ROWS)
+SENSITIVITY = [r for r in ROWS if r != 'paper']   # item 1; 'paper' is item 2
 
 DECK = """! issue 28 friction study, row '{row}': {what}; mu_d = {mu} (scripts/friction_study.py)
 &domain box = {box}, cells_per_radius = {cells}, y_boundary = 'walls', shear_rate = 1 /
@@ -158,7 +164,7 @@ def contact_statistics(series_path, discard_strain):
             'largest_overlap_over_h_r_mean': float(overlap.mean()), 'largest_overlap_over_h_r_max': float(overlap.max())}
 
 
-def record(d, row, mu, target):
+def record(d, row, mu, target, ranks=1):
     """Copy a finished run's deck and summary (with the "run" object) into the record."""
     s = load(os.path.join(d, 'out', 'summary.json'))
     st = settings(row)
@@ -176,7 +182,7 @@ def record(d, row, mu, target):
         'lubrication': 'full', 'strain_discarded': st['discard'], 'strain_averaged': st['average'],
         'blocks': st['blocks'], 'fdsusp_version': version,
         'wall_time_per_step_s': float(walls[-1]) if walls else None,
-        'ranks': 1,
+        'ranks': ranks,
     }
     s['contacts'] = contact_statistics(os.path.join(d, 'out', 'series.h5'), st['discard'])
     os.makedirs(target, exist_ok=True)
@@ -270,7 +276,7 @@ def main():
             if status != 0:
                 print('%s stopped with status %d (see %s/log)' % (run_name(*run), status, d), flush=True)
             elif finished(d):
-                record(d, run[0], run[1], os.path.join(args.record, run_name(*run)))
+                record(d, run[0], run[1], os.path.join(args.record, run_name(*run)), args.ranks)
                 print('%s finished (%.0f CPU s), recorded' % (run_name(*run), cpu), flush=True)
             else:
                 print('%s stopped at its wall-time limit (%.0f CPU s): call again to continue'
@@ -279,7 +285,7 @@ def main():
         for run in runs:    # finished before, but not yet recorded (e.g. the record was lost)
             target = os.path.join(args.record, run_name(*run))
             if finished(where(run)) and not os.path.exists(os.path.join(target, 'summary.json')):
-                record(where(run), run[0], run[1], target)
+                record(where(run), run[0], run[1], target, args.ranks)
         waiting = [r for r in runs if not finished(where(r))]
         run_all(waiting, lambda r: start(where(r), r[0], r[1], args), args.jobs, report)
     table([r for r in args.rows], args.record)
