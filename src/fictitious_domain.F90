@@ -33,12 +33,11 @@ module mod_fictitious_domain
   use petscksp
   use mod_kinds, only: dp
   use mod_grid, only: grid_t, FIELD_U, FIELD_V, FIELD_W, FIELD_P
-  use mod_particles, only: particles_t, MOTION_FREE, MOTION_PRESCRIBED, MOTION_FROZEN, MOTION_RESISTANCE, &
-                           MOTION_FIXED
-  use mod_particle_system, only: particle_system_t, psys_reset, psys_add_diagonal, psys_solve
-  use mod_particle_lubrication, only: particle_lubrication_t, plub_corrections, plub_add_to_system
+  use mod_particles, only: particles_t, MOTION_FREE, MOTION_FROZEN, impose_motion
+  use mod_particle_system, only: particle_system_t, psys_reset, psys_add_diagonal
+  use mod_particle_lubrication, only: particle_lubrication_t, plub_corrections, plub_add_to_system, plub_add_corrections
   use mod_particle_contacts, only: particle_contacts_t, pcontacts_add_stiffness, pcontacts_implicit_update
-  use mod_particle_solver, only: particle_solver_t, psolver_create, psolver_solve, psolver_destroy
+  use mod_particle_solver, only: particle_solver_t, psolver_create, psolver_solve_checked, psolver_destroy
   use mod_solid_fraction, only: cube_fraction
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates, min_image
   use mod_errors, only: fatal_error
@@ -549,9 +548,6 @@ contains
     type(particle_contacts_t), intent(inout), optional :: contacts
     real(dp), allocatable :: rhs(:, :), x(:, :)
     integer :: q, n
-    logical :: ok
-    character(len=200) :: text
-    KSPConvergedReason :: reason
 
     PetscCall(event_begin(EVENT_MOTION, ierr))
     n = parts%n
@@ -574,31 +570,14 @@ contains
       if (present(lubrication)) call plub_add_to_system(lubrication, fd%system, rhs)
       if (present(contacts) .and. parts%motion == MOTION_FREE) &
         call pcontacts_add_stiffness(contacts, fd%system, rhs, parts%velocity, parts%omega, parts%have_prev)
-      if (fd%system%npairs == 0) then
-        ! block diagonal: a direct solve, block by block
-        call psys_solve(fd%system, rhs, x, 1.0e-12_dp, fd%solver_iterations, ok)
-        if (.not. ok) then
-          write(text, '(a,i0,a)') 'fdsusp: fatal: the particle system is not positive definite or did not '// &
-               'converge (', fd%solver_iterations, ' iterations): a particle covers no grid face?'
-          call fatal_error(text, 4)
-        end if
-      else
-        PetscCall(psolver_solve(fd%solver, fd%system, rhs, x, fd%solver_iterations, reason, ierr))
-        if (reason < 0) then
-          write(text, '(a,i0,a,i0,a)') 'fdsusp: fatal: the particle system solve failed (KSP converged reason ', &
-               reason, ' after ', fd%solver_iterations, ' iterations; see -particles_ksp_converged_reason)'
-          call fatal_error(text, 4)
-        end if
-      end if
+      call psolver_solve_checked(fd%solver, fd%system, rhs, x, fd%solver_iterations, ierr, &
+                                 ': a particle covers no grid face?')
+      CHKERRQ(ierr)
       parts%velocity = x(1:3, :)
       parts%omega = x(4:6, :)
       if (present(contacts)) call pcontacts_implicit_update(contacts, parts%velocity, parts%omega)
-    case (MOTION_PRESCRIBED, MOTION_RESISTANCE)
-      parts%velocity = parts%prescribed_velocity
-      parts%omega = parts%prescribed_omega
-    case (MOTION_FIXED)
-      parts%velocity = 0.0_dp
-      parts%omega = 0.0_dp
+    case default                    ! prescribed, resistance, fixed
+      call impose_motion(parts)
     end select
     PetscCall(event_end(EVENT_MOTION, ierr))
   end subroutine fd_solve_motion
@@ -697,11 +676,8 @@ contains
         parts%stresslet_hydro(c, c, q) = parts%stresslet_hydro(c, c, q) - integral
       end do
     end do
-    if (present(lubrication)) then
-      parts%force_hydro = parts%force_hydro + lubrication%force
-      parts%torque_hydro = parts%torque_hydro + lubrication%torque
-      parts%stresslet_hydro = parts%stresslet_hydro + lubrication%stresslet
-    end if
+    if (present(lubrication)) &
+      call plub_add_corrections(lubrication, parts%force_hydro, parts%torque_hydro, parts%stresslet_hydro)
     PetscCall(event_end(EVENT_UPDATE, ierr))
   end subroutine fd_update
 

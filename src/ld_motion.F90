@@ -7,11 +7,8 @@
 module mod_ld_motion
   use petscksp
   use mod_kinds, only: dp
-  use mod_errors, only: fatal_error
-  use mod_particles, only: particles_t, MOTION_FREE, MOTION_PRESCRIBED, MOTION_FROZEN, MOTION_RESISTANCE, &
-                           MOTION_FIXED
-  use mod_particle_system, only: psys_solve
-  use mod_particle_solver, only: particle_solver_t, psolver_solve
+  use mod_particles, only: particles_t, MOTION_FREE, MOTION_FROZEN, impose_motion
+  use mod_particle_solver, only: particle_solver_t, psolver_solve_checked
   use mod_particle_lubrication, only: particle_lubrication_t, plub_corrections
   use mod_particle_contacts, only: particle_contacts_t, pcontacts_implicit_update
   use mod_lubrication_dynamics, only: lubrication_dynamics_t, ld_assemble, ld_hydrodynamics
@@ -33,9 +30,6 @@ contains
     type(particle_contacts_t), intent(inout), optional :: contacts
     real(dp), allocatable :: rhs(:, :), x(:, :)
     integer :: iterations
-    logical :: ok
-    character(len=200) :: text
-    KSPConvergedReason :: reason
 
     ierr = 0
     select case (parts%motion)
@@ -45,26 +39,12 @@ contains
       x(1:3, :) = parts%velocity
       x(4:6, :) = parts%omega
       call ld_assemble(ld, parts, rhs, lubrication, contacts)
-      if (ld%system%npairs == 0) then
-        call psys_solve(ld%system, rhs, x, 1.0e-12_dp, iterations, ok)
-        if (.not. ok) call fatal_error('fdsusp: fatal: the lubrication-dynamics system is not positive definite', 4)
-      else
-        PetscCall(psolver_solve(solver, ld%system, rhs, x, iterations, reason, ierr))
-        if (reason < 0) then
-          write(text, '(a,i0,a,i0,a)') 'fdsusp: fatal: the particle system solve failed (KSP converged reason ', &
-               reason, ' after ', iterations, ' iterations; see -particles_ksp_converged_reason)'
-          call fatal_error(text, 4)
-        end if
-      end if
+      PetscCall(psolver_solve_checked(solver, ld%system, rhs, x, iterations, ierr, ''))
       parts%velocity = x(1:3, :)
       parts%omega = x(4:6, :)
       if (present(contacts)) call pcontacts_implicit_update(contacts, parts%velocity, parts%omega)
-    case (MOTION_PRESCRIBED, MOTION_RESISTANCE)
-      parts%velocity = parts%prescribed_velocity
-      parts%omega = parts%prescribed_omega
-    case (MOTION_FIXED)
-      parts%velocity = 0.0_dp
-      parts%omega = 0.0_dp
+    case default                    ! prescribed, resistance, fixed
+      call impose_motion(parts)
     end select
     if (present(lubrication)) call plub_corrections(lubrication, parts%velocity, parts%omega)
     call ld_hydrodynamics(ld, parts, lubrication)

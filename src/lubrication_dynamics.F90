@@ -21,7 +21,7 @@ module mod_lubrication_dynamics
   use mod_kinds, only: dp, pi
   use mod_particles, only: particles_t, MOTION_FREE
   use mod_particle_system, only: particle_system_t, psys_reset, psys_add_diagonal
-  use mod_particle_lubrication, only: particle_lubrication_t, plub_add_to_system
+  use mod_particle_lubrication, only: particle_lubrication_t, plub_add_to_system, plub_add_corrections
   use mod_particle_contacts, only: particle_contacts_t, pcontacts_add_stiffness
   implicit none
   private
@@ -125,11 +125,8 @@ contains
       parts%torque_hydro(:, q) = 8.0_dp * pi * ld%viscosity * ld%radius**3 * (om - parts%omega(:, q))
       parts%stresslet_hydro(:, :, q) = 20.0_dp / 3.0_dp * pi * ld%viscosity * ld%radius**3 * e
     end do
-    if (present(lubrication)) then
-      parts%force_hydro = parts%force_hydro + lubrication%force
-      parts%torque_hydro = parts%torque_hydro + lubrication%torque
-      parts%stresslet_hydro = parts%stresslet_hydro + lubrication%stresslet
-    end if
+    if (present(lubrication)) &
+      call plub_add_corrections(lubrication, parts%force_hydro, parts%torque_hydro, parts%stresslet_hydro)
   end subroutine ld_hydrodynamics
 
 end module mod_lubrication_dynamics

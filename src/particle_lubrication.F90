@@ -26,7 +26,8 @@ module mod_particle_lubrication
   use mod_particle_system, only: particle_system_t, psys_add_diagonal, psys_add_pair
   implicit none
   private
-  public :: particle_lubrication_t, plub_create, plub_links, plub_corrections, plub_reserve_pairs, plub_add_to_system
+  public :: particle_lubrication_t, plub_create, plub_links, plub_corrections, plub_reserve_pairs, plub_add_to_system, &
+            plub_add_corrections
 
   type :: particle_lubrication_t
     type(lubrication_t) :: lub
@@ -352,5 +353,15 @@ contains
       pl%stresslet(:, :, i) = pl%stresslet(:, :, i) + lub_wall_stresslet(pl%lub, pl%wall_n(:, l), ft6(1:3))
     end do
   end subroutine plub_corrections
+
+  !> Add the links' corrections of plub_corrections to a sphere's hydrodynamic force, torque
+  !> (3, np) and stresslet (3, 3, np).
+  subroutine plub_add_corrections(pl, force, torque, stresslet)
+    type(particle_lubrication_t), intent(in) :: pl
+    real(dp), intent(inout) :: force(:, :), torque(:, :), stresslet(:, :, :)
+    force = force + pl%force
+    torque = torque + pl%torque
+    stresslet = stresslet + pl%stresslet
+  end subroutine plub_add_corrections
 
 end module mod_particle_lubrication

@@ -19,11 +19,12 @@
 module mod_particle_solver
   use petscksp
   use mod_kinds, only: dp
-  use mod_particle_system, only: particle_system_t
+  use mod_particle_system, only: particle_system_t, psys_solve
   use mod_solvers, only: set_default_option
+  use mod_errors, only: fatal_error
   implicit none
   private
-  public :: particle_solver_t, psolver_create, psolver_solve, psolver_destroy
+  public :: particle_solver_t, psolver_create, psolver_solve, psolver_solve_checked, psolver_destroy
 
   type :: particle_solver_t
     KSP :: ksp
@@ -46,6 +47,38 @@ contains
     PetscCall(KSPSetFromOptions(ps%ksp, ierr))
     ps%created = .true.
   end subroutine psolver_create
+
+  !> Solve sys x = rhs (both 6 x n) from the guess in x: block by block when no pair couples the
+  !> system (mod_particle_system), else by the KSP. A failure stops the run (status 4) with one
+  !> message; hint, appended to the message of a failed block solve, says what may have caused it.
+  subroutine psolver_solve_checked(ps, sys, rhs, x, iterations, ierr, hint)
+    type(particle_solver_t), intent(inout) :: ps
+    type(particle_system_t), intent(in) :: sys
+    real(dp), intent(in) :: rhs(:, :)
+    real(dp), intent(inout) :: x(:, :)
+    integer, intent(out) :: iterations
+    PetscErrorCode, intent(out) :: ierr
+    character(len=*), intent(in) :: hint
+    KSPConvergedReason :: reason
+    logical :: ok
+    character(len=300) :: text
+    ierr = 0
+    if (sys%npairs == 0) then
+      call psys_solve(sys, rhs, x, 1.0e-12_dp, iterations, ok)
+      if (.not. ok) then
+        write(text, '(a,i0,2a)') 'fdsusp: fatal: the particle system is not positive definite or did not '// &
+             'converge (', iterations, ' iterations)', hint
+        call fatal_error(text, 4)
+      end if
+    else
+      PetscCall(psolver_solve(ps, sys, rhs, x, iterations, reason, ierr))
+      if (reason < 0) then
+        write(text, '(a,i0,a,i0,a)') 'fdsusp: fatal: the particle system solve failed (KSP converged reason ', &
+             reason, ' after ', iterations, ' iterations; see -particles_ksp_converged_reason)'
+        call fatal_error(text, 4)
+      end if
+    end if
+  end subroutine psolver_solve_checked
 
   !> Solve sys x = rhs (both 6 x n), from the guess in x. The converged reason is returned in
   !> reason (negative: not converged); iterations as KSP counts them.

@@ -6,7 +6,7 @@ module mod_particles
   use mod_neighbours, only: min_image
   implicit none
   private
-  public :: particles_t, particles_init, advance_positions, displacements, configuration_fault
+  public :: particles_t, particles_init, advance_positions, displacements, configuration_fault, impose_motion
   public :: MOTION_FREE, MOTION_PRESCRIBED, MOTION_FROZEN, MOTION_RESISTANCE, MOTION_FIXED, motion_code
 
   ! resistance: velocities imposed as for prescribed, but the configuration is held where it is
@@ -74,6 +74,20 @@ contains
 
   ! X^{n+1} = X^n + dt (3/2 U^n - 1/2 U^{n-1}), forward Euler on the first step; wrap the
   ! periodic directions into [0, L).
+  !> The velocities of the motions that are not solved for: prescribed and resistance take the
+  !> prescribed ones, fixed spheres are at rest. Free and frozen spheres are left as they are.
+  subroutine impose_motion(p)
+    type(particles_t), intent(inout) :: p
+    select case (p%motion)
+    case (MOTION_PRESCRIBED, MOTION_RESISTANCE)
+      p%velocity = p%prescribed_velocity
+      p%omega = p%prescribed_omega
+    case (MOTION_FIXED)
+      p%velocity = 0.0_dp
+      p%omega = 0.0_dp
+    end select
+  end subroutine impose_motion
+
   subroutine advance_positions(p, dt, box, periodic)
     type(particles_t), intent(inout) :: p
     real(dp), intent(in) :: dt, box(3)
