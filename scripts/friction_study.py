@@ -34,7 +34,7 @@ import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from jobpool import ENV, run_all  # noqa: E402
+from jobpool import run_all, start_resumable  # noqa: E402
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
 
@@ -128,23 +128,11 @@ def commit_of_binary():
 
 
 def start(d, row, mu, args):
-    os.makedirs(d, exist_ok=True)
-    binary = os.path.join(d, 'fdsusp')
-    if not os.path.exists(binary):
-        shutil.copy2(os.path.join(os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin')), 'fdsusp'), binary)
+    proc, fresh = start_resumable(d, deck_text(row, mu, args.hours), args.ranks)
+    if fresh:
         with open(os.path.join(d, 'version'), 'w') as f:
             f.write(commit_of_binary() + '\n')
-    with open(os.path.join(d, 'deck.nml'), 'w') as f:
-        f.write(deck_text(row, mu, args.hours))
-    command = [binary, 'deck.nml']
-    if args.ranks > 1:
-        command = ['mpirun', '--oversubscribe', '-n', str(args.ranks)] + command
-    if os.path.exists(os.path.join(d, 'out', 'checkpoint.h5')):
-        command += ['-restart', 'out/checkpoint.h5']
-    log = open(os.path.join(d, 'log'), 'a')
-    log.write('\n# %s\n' % ' '.join(command))
-    log.flush()
-    return subprocess.Popen(command, cwd=d, env=ENV, stdout=log, stderr=subprocess.STDOUT)
+    return proc
 
 
 def contact_statistics(series_path, discard_strain):

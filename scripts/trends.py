@@ -22,12 +22,10 @@ seen at this step with 0.05, and the paper found the rheology independent of eps
 import argparse
 import json
 import os
-import shutil
-import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from jobpool import ENV, run_all  # noqa: E402
+from jobpool import run_all, start_resumable  # noqa: E402
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
 DECK = """&domain box = {box}, cells_per_radius = {cells}, y_boundary = 'walls', shear_rate = 1 /
@@ -49,21 +47,9 @@ def case_dir(work, phi, mu):
 
 
 def start(d, args, phi, mu):
-    os.makedirs(d, exist_ok=True)
-    binary = os.path.join(d, 'fdsusp')
-    if not os.path.exists(binary):
-        shutil.copy2(os.path.join(os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin')), 'fdsusp'), binary)
-    with open(os.path.join(d, 'deck.nml'), 'w') as f:
-        f.write(DECK.format(box=', '.join('%g' % b for b in args.box), cells=args.cells, dt=args.dt,
-                            phi=phi, mu=mu, eps_bar=args.eps_bar, discard=args.discard,
-                            average=args.average, hours=args.hours))
-    command = [binary, 'deck.nml']
-    if os.path.exists(os.path.join(d, 'out', 'checkpoint.h5')):
-        command += ['-restart', 'out/checkpoint.h5']
-    log = open(os.path.join(d, 'log'), 'a')
-    log.write('\n# %s\n' % ' '.join(command))
-    log.flush()
-    return subprocess.Popen(command, cwd=d, env=ENV, stdout=log, stderr=subprocess.STDOUT)
+    deck = DECK.format(box=', '.join('%g' % b for b in args.box), cells=args.cells, dt=args.dt, phi=phi, mu=mu,
+                       eps_bar=args.eps_bar, discard=args.discard, average=args.average, hours=args.hours)
+    return start_resumable(d, deck)[0]
 
 
 def summary(d):
