@@ -1,0 +1,230 @@
+"""A resumable study of sheared suspensions in a Couette cell (or a Lees-Edwards box): the machinery
+shared by scripts/friction_study.py (issue 28) and scripts/model_trade.py (issue 30).
+
+A study is a base set-up (BASE below, overridden per study) and rows, each a name, a sentence and
+the settings it changes; each row runs at one or more mu_d. Each (row, mu_d) run is a directory
+<work>/<row>_mu<mu> with its deck, log, out/ and a copy of bin/fdsusp ($FDSUSP_BIN/fdsusp: point
+it at a pinned build with a VERSION file beside it) taken at its first start, so a rebuild cannot
+change a run half-way. A run whose out/summary.json is complete is done; one with out/checkpoint.h5
+continues from it (`-restart`); otherwise it starts. --hours sets &run max_wall_hours, so a run
+stops with a checkpoint in time and the next call continues it (on the same machine: out/ is not
+in git). The CPU seconds of every call are added up in <run>/cpu_seconds.
+
+Each finished run is recorded in <record>/<row>_mu<mu>/ as deck.nml and summary.json: fdsusp's
+summary with a "run" object added that says what was run without the deck beside it (model,
+spheres, box, boundaries, a/Delta, bulk phi, mu_d, eps_r, eps_bar, dt, strains discarded and
+averaged, the fdsusp commit, the cost) and a "contacts" object from series.h5 (contacts, the
+fraction sliding, overlaps).
+"""
+import argparse
+import json
+import math
+import os
+import re
+import shutil
+import subprocess
+
+from jobpool import run_all, start_resumable
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
+
+# The doc/VALIDATION.md §5.4 set-up with the paper's eps_bar 0.05: 8a x 20a x 8a Couette cell,
+# a/Delta = 4, bulk phi 0.40 (seed 1), eps_r 5e-3, implicit contacts, full lubrication, dt 2e-3,
+# 2 strains discarded and 20 averaged in 5 blocks, the resolved fluid.
+BASE = dict(box=(8, 20, 8), cells=4, phi=0.40, seed=1, eps_r=5e-3, eps_bar=0.05, dt=2e-3,
+            discard=2.0, average=20.0, blocks=5, min_gap=None, implicit=True,
+            model='resolved', boundary='walls')
+
+DECK = """! {study}, row '{row}': {what}; mu_d = {mu}
+&domain box = {box}, cells_per_radius = {cells}, y_boundary = '{boundary}', shear_rate = 1 /
+&fluid {model}reynolds = 0.01, initial_flow = 'shear' /
+&time dt = {dt} /
+&output directory = 'out', progress_every = 500, series_every = 5, checkpoint_every = 2500 /
+&particles solid_fraction = {phi}, seed = {seed}{packing} /
+&contact roughness = {eps_r}, eps_bar = {eps_bar}, friction = {mu}{implicit} /
+&lubrication model = 'full' /
+&rheology discard_strain = {discard}, average_strain = {average}, blocks = {blocks} /
+&run title = '{title} {row}: mu_d = {mu}', max_wall_hours = {hours} /
+"""
+
+
+def run_name(row, mu):
+    return '%s_mu%g' % (row, mu)
+
+
+def load(path):
+    if not os.path.exists(path):
+        return None
+    with open(path) as f:
+        return json.load(f)
+
+
+def finished(d):
+    s = load(os.path.join(d, 'out', 'summary.json'))
+    return s is not None and s.get('complete')
+
+
+def ratio(a, b):
+    """b/a with its error from the two relative errors."""
+    r = b['value'] / a['value']
+    return r, abs(r) * math.hypot(a['error'] / a['value'], b['error'] / b['value'])
+
+
+def commit_of_binary():
+    """The commit the copied program was built from: the file VERSION beside it when the study runs
+    a pinned build ($FDSUSP_BIN, so that work in the checkout cannot reach a study half-way),
+    else the checkout's."""
+    pinned = os.path.join(os.environ.get('FDSUSP_BIN', ''), 'VERSION')
+    if os.environ.get('FDSUSP_BIN') and os.path.exists(pinned):
+        return open(pinned).read().strip()
+    try:
+        return subprocess.run(['git', 'describe', '--always', '--dirty'], cwd=ROOT, capture_output=True,
+                              text=True, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return 'unknown'
+
+
+def contact_statistics(series_path, discard_strain):
+    """Means over the averaged records (strain > discard) of the contact columns of series.h5:
+    contacts between spheres and with the walls, the fraction of them sliding (at the Coulomb
+    limit), and the largest overlap of each record in units of h_r."""
+    import h5py
+    import numpy as np
+    with h5py.File(series_path, 'r') as f:
+        strain = f['time'][()] * abs(float(np.ravel(f.attrs['shear_rate'])[0]))
+        keep = strain > discard_strain
+        pair, wall, sliding = (f[k][()][keep] for k in ('contacts_pair', 'contacts_wall', 'contacts_sliding'))
+        overlap = f['contact_overlap_over_roughness'][()][keep]
+    total = pair + wall
+    return {'records': int(keep.sum()), 'pair_contacts': float(pair.mean()), 'wall_contacts': float(wall.mean()),
+            'sliding_fraction': float(sliding.sum() / total.sum()) if total.sum() > 0 else 0.0,
+            'largest_overlap_over_h_r_mean': float(overlap.mean()), 'largest_overlap_over_h_r_max': float(overlap.max())}
+
+
+class Study:
+    """rows: {name: (sentence, {setting: value})} over base; title names the study in decks and
+    records; default_rows are run when none are named; table(study, rows) prints the result."""
+
+    def __init__(self, title, rows, base, default_rows, work, record, table, doc):
+        self.title, self.rows, self.base = title, rows, base
+        self.default_rows, self.work, self.record_dir = default_rows, work, record
+        self.table, self.doc = table, doc
+
+    def settings(self, row):
+        s = dict(self.base)
+        s.update(self.rows[row][1])
+        return s
+
+    def deck_text(self, row, mu, hours):
+        s = self.settings(row)
+        packing = '' if s['min_gap'] is None else ', packing_min_gap = %g' % s['min_gap']
+        return DECK.format(study=self.title, title=self.title, row=row, what=self.rows[row][0], mu=mu,
+                           box=', '.join('%g' % b for b in s['box']), cells=s['cells'],
+                           boundary=s['boundary'],
+                           model='' if s['model'] == 'resolved' else "model = '%s', " % s['model'],
+                           dt=s['dt'], phi=s['phi'], seed=s['seed'], packing=packing,
+                           eps_r=s['eps_r'], eps_bar=s['eps_bar'], discard=s['discard'],
+                           average=s['average'], blocks=s['blocks'], hours=hours,
+                           implicit='' if s['implicit'] else ', implicit = .false.')
+
+    def load_record(self, row, mu):
+        return load(os.path.join(self.record_dir, run_name(row, mu), 'summary.json'))
+
+    def start(self, d, row, mu, args):
+        proc, fresh = start_resumable(d, self.deck_text(row, mu, args.hours), args.ranks)
+        if fresh:
+            with open(os.path.join(d, 'version'), 'w') as f:
+                f.write(commit_of_binary() + '\n')
+        return proc
+
+    def record(self, d, row, mu, target, ranks=1):
+        """Copy a finished run's deck and summary (with the "run" object) into the record."""
+        s = load(os.path.join(d, 'out', 'summary.json'))
+        st = self.settings(row)
+        log = open(os.path.join(d, 'log')).read()
+        spheres = [int(n) for n in re.findall(r'(\d+) rigid spheres', log)]
+        walls = re.findall(r'wall time per step:\s+([0-9.eE+-]+)', log)
+        version = open(os.path.join(d, 'version')).read().strip() if os.path.exists(os.path.join(d, 'version')) else 'unknown'
+        cpu_file = os.path.join(d, 'cpu_seconds')
+        cpu = sum(float(x) for x in open(cpu_file).read().split()) if os.path.exists(cpu_file) else None
+        strain = st['discard'] + st['average']
+        s['run'] = {
+            'study': '%s, row %s: %s' % (self.title, row, self.rows[row][0]),
+            'fluid_model': st['model'], 'spheres': spheres[-1] if spheres else None,
+            'box': list(st['box']), 'cells_per_radius': st['cells'], 'y_boundary': st['boundary'],
+            'solid_fraction_bulk': st['phi'], 'seed': st['seed'], 'friction': mu,
+            'roughness': st['eps_r'], 'eps_bar': st['eps_bar'], 'implicit_contacts': st['implicit'],
+            'dt': st['dt'], 'reynolds': 0.01,
+            'lubrication': 'full', 'strain_discarded': st['discard'], 'strain_averaged': st['average'],
+            'blocks': st['blocks'], 'fdsusp_version': version,
+            'wall_time_per_step_s': float(walls[-1]) if walls else None,
+            'ranks': ranks,
+            # CPU seconds over every call (the runs' own rusage, whatever ran beside them)
+            'cpu_seconds': cpu, 'cpu_seconds_per_strain': cpu / strain if cpu else None,
+        }
+        s['contacts'] = contact_statistics(os.path.join(d, 'out', 'series.h5'), st['discard'])
+        os.makedirs(target, exist_ok=True)
+        shutil.copy2(os.path.join(d, 'deck.nml'), os.path.join(target, 'deck.nml'))
+        with open(os.path.join(target, 'summary.json'), 'w') as f:
+            json.dump(s, f, indent=1)
+            f.write('\n')
+
+    def main(self, argv=None):
+        ap = argparse.ArgumentParser(description=self.doc, formatter_class=argparse.RawDescriptionHelpFormatter)
+        ap.add_argument('rows', nargs='*', default=self.default_rows, help='rows (default: %(default)s)')
+        ap.add_argument('--mu', type=float, nargs='+', default=[0.0, 0.5])
+        ap.add_argument('--jobs', type=int, default=2)
+        ap.add_argument('--ranks', type=int, default=1)
+        ap.add_argument('--hours', type=float, default=0.0)
+        ap.add_argument('--work', default=self.work)
+        ap.add_argument('--record', default=self.record_dir)
+        ap.add_argument('--table', action='store_true', help='print the table from the records, run nothing')
+        ap.add_argument('--list', action='store_true', help='print each run\'s deck, run nothing')
+        ap.add_argument('--rerecord', action='store_true',
+                        help='record every finished run of --work again (after a change of the record), run nothing')
+        args = ap.parse_args(argv)
+        self.record_dir = args.record
+        runs = []
+        for spec in args.rows:      # ROW (every --mu) or ROW:MU (that run alone)
+            row, _, mu = spec.partition(':')
+            if row not in self.rows:
+                ap.error('unknown row %r (rows: %s)' % (row, ', '.join(self.rows)))
+            runs += [(row, float(mu))] if mu else [(row, m) for m in args.mu]
+        rows = list(dict.fromkeys(r for r, _ in runs))
+        if args.rerecord:
+            for name in sorted(os.listdir(args.work)):
+                row, _, mu = name.rpartition('_mu')
+                d = os.path.join(args.work, name)
+                if row in self.rows and finished(d):
+                    self.record(d, row, float(mu), os.path.join(args.record, name))
+                    print('recorded', name)
+            return 0
+        if args.list:
+            for row, mu in runs:
+                print(self.deck_text(row, mu, args.hours))
+            return 0
+        if not args.table:
+            def where(run):
+                return os.path.join(args.work, run_name(*run))
+
+            def report(run, status, cpu):
+                d = where(run)
+                with open(os.path.join(d, 'cpu_seconds'), 'a') as f:
+                    f.write('%.1f\n' % cpu)
+                if status != 0:
+                    print('%s stopped with status %d (see %s/log)' % (run_name(*run), status, d), flush=True)
+                elif finished(d):
+                    self.record(d, run[0], run[1], os.path.join(args.record, run_name(*run)), args.ranks)
+                    print('%s finished (%.0f CPU s), recorded' % (run_name(*run), cpu), flush=True)
+                else:
+                    print('%s stopped at its wall-time limit (%.0f CPU s): call again to continue'
+                          % (run_name(*run), cpu), flush=True)
+
+            for run in runs:    # finished before, but not yet recorded (e.g. the record was lost)
+                target = os.path.join(args.record, run_name(*run))
+                if finished(where(run)) and not os.path.exists(os.path.join(target, 'summary.json')):
+                    self.record(where(run), run[0], run[1], target, args.ranks)
+            waiting = [r for r in runs if not finished(where(r))]
+            run_all(waiting, lambda r: self.start(where(r), r[0], r[1], args), args.jobs, report)
+        self.table(self, rows)
+        return 0
