@@ -6,6 +6,7 @@ the same packings (the in-run packing of the same seed in the same box), run wit
     scripts/model_trade.py [CASE ...] [--mu 0 0.5] [--jobs 2] [--ranks 1] [--hours 0]
                            [--work out/model_trade] [--record doc/data/model_trade]
                            [--table] [--list] [--rerecord]
+    scripts/model_trade.py --figure doc/figures/model_trade.png
 
 CASE names a row of ROWS (default: every row but the paper-scale ones), run at every --mu, or
 ROW:MU for one run. Runs are made, resumed and recorded as by scripts/study.py
@@ -26,24 +27,36 @@ from study import BASE, ROOT, Study, load, run_name  # noqa: E402
 LD = dict(model='none')
 ROWS = {
     'ld':          ('lubrication dynamics, the §5.4 set-up (its DNS: friction study row base)', dict(LD)),
+    # stiffer contacts: ld at mu_d 0.5 stops on the overlap guard at strain 21.6 (largest overlap of
+    # a record 0.47 h_r on average, 0.98 at the 99.9th percentile; the DNS: 0.37); eps_bar 0.02
+    # with dt 8e-4 keeps the stick number at 4.6, where the DNS showed eps_bar not to matter
+    'ld_eb002':    ('lubrication dynamics, eps_bar 0.02, dt 8e-4', dict(LD, eps_bar=0.02, dt=8e-4)),
     'ld_le':       ('lubrication dynamics, Lees-Edwards in y instead of walls, 8a x 20a x 8a',
                     dict(LD, boundary='lees-edwards')),
     'dns_phi0.3':  ('DNS, the §5.4 set-up at bulk phi 0.3', dict(phi=0.3)),
     'ld_phi0.3':   ('lubrication dynamics, the §5.4 set-up at bulk phi 0.3', dict(LD, phi=0.3)),
     'dns_phi0.45': ('DNS, the §5.4 set-up at bulk phi 0.45', dict(phi=0.45)),
     'ld_phi0.45':  ('lubrication dynamics, the §5.4 set-up at bulk phi 0.45', dict(LD, phi=0.45)),
+    # the knobs of lubrication dynamics at phi 0.4 (the &lubrication outer_cutoff default is 1a)
+    'ld_cut0.5':   ('lubrication dynamics, pair and wall resistance cut at a gap of 0.5a', dict(LD, cutoff=0.5)),
+    # (a cut-off of 2a needs periods of at least 2 (2a + 2a + skin): the 8a box refuses it)
+    'ld_cut1.5':   ('lubrication dynamics, pair and wall resistance cut at a gap of 1.5a', dict(LD, cutoff=1.5)),
+    'ld_dt5e-3':   ('lubrication dynamics, dt 5e-3 (stick number 11.4 at mu_d 0.5)', dict(LD, dt=5e-3)),
+    # at phi 0.45 and mu_d 0.5 eps_bar 0.05 reaches the overlap guard within a strain (step 409)
+    'ld_phi0.45_eb002': ('lubrication dynamics at bulk phi 0.45, eps_bar 0.02, dt 8e-4',
+                         dict(LD, phi=0.45, eps_bar=0.02, dt=8e-4)),
     'ld_paper':    ('lubrication dynamics, the paper\'s set-up at dt 2e-3 (its DNS: friction study row paperdt2)',
                     dict(LD, box=(20, 20, 20), cells=5)),
 }
 DEFAULT = [r for r in ROWS if r != 'ld_paper']
 
 FRICTION_RECORD = os.path.join(ROOT, 'doc', 'data', 'friction_phi04')
-# (case, where the DNS record is: (record directory or None for this study's, row), LD row)
+# (case, where the DNS record is: (record directory or None for this study's, row), LD rows)
 PAIRS = [
-    ('phi 0.3, §5.4 set-up', (None, 'dns_phi0.3'), 'ld_phi0.3'),
-    ('phi 0.4, §5.4 set-up', (FRICTION_RECORD, 'base'), 'ld'),
-    ('phi 0.45, §5.4 set-up', (None, 'dns_phi0.45'), 'ld_phi0.45'),
-    ('phi 0.4, paper set-up', (FRICTION_RECORD, 'paperdt2'), 'ld_paper'),
+    ('phi 0.3, §5.4 set-up', (None, 'dns_phi0.3'), ['ld_phi0.3']),
+    ('phi 0.4, §5.4 set-up', (FRICTION_RECORD, 'base'), ['ld', 'ld_eb002']),
+    ('phi 0.45, §5.4 set-up', (None, 'dns_phi0.45'), ['ld_phi0.45', 'ld_phi0.45_eb002']),
+    ('phi 0.4, paper set-up', (FRICTION_RECORD, 'paperdt2'), ['ld_paper']),
 ]
 QUANTITIES = ('eta_r', 'eta_h', 'eta_c', 'N1/tau', 'N2/tau', 'Pi/tau', 'phi_core')
 
@@ -68,23 +81,32 @@ def table(study, rows):
     print('| case | mu_d | model | spheres | ' + ' | '.join(QUANTITIES) +
           ' | eta_r LD/DNS (sigmas) | CPU s per strain |')
     print('|---' * (len(QUANTITIES) + 6) + '|')
-    for case, (where, dns_row), ld_row in PAIRS:
+    for case, (where, dns_row), ld_rows in PAIRS:
         for mu in (0.0, 0.5):
             dns = load(os.path.join(where or study.record_dir, run_name(dns_row, mu), 'summary.json'))
-            ld = study.load_record(ld_row, mu)
-            for model, s in (('DNS', dns), ('LD', ld)):
+            for model, s in [('DNS', dns)] + [('LD ' + r, study.load_record(r, mu)) for r in ld_rows]:
                 if s is None:
                     print('| %s | %g | %s | (not run) |' % (case, mu, model))
                     continue
                 q = s['quantities']
                 extra = ''
-                if model == 'LD' and dns is not None:
+                if model != 'DNS' and dns is not None:
                     a, b = dns['quantities']['eta_r'], q['eta_r']
                     extra = '%.3f (%+.1f)' % (b['value'] / a['value'],
                                               (b['value'] - a['value']) / math.hypot(a['error'], b['error']))
                 print('| %s | %g | %s | %s | %s | %s | %.3g |' % (
                     case, mu, model, s['run']['spheres'], ' | '.join(pm(q[k]) for k in QUANTITIES), extra,
                     cpu_per_strain(s)))
+    print()
+    print('The knobs of lubrication dynamics at phi 0.4 (rows ld, ld_cut0.5, ld_cut1.5, ld_dt5e-3, ld_eb002)')
+    print('| mu_d | row | ' + ' | '.join(QUANTITIES) + ' | CPU s per strain |')
+    print('|---' * (len(QUANTITIES) + 3) + '|')
+    for mu in (0.0, 0.5):
+        for row in ('ld', 'ld_cut0.5', 'ld_cut1.5', 'ld_dt5e-3', 'ld_eb002'):
+            s = study.load_record(row, mu)
+            if s is not None:
+                print('| %g | %s | %s | %.3g |' % (mu, row, ' | '.join(pm(s['quantities'][k]) for k in QUANTITIES),
+                                                 cpu_per_strain(s)))
     print()
     print('Lees-Edwards against walls in lubrication dynamics (walls: the core; Lees-Edwards: the whole box)')
     print('| mu_d | boundaries | ' + ' | '.join(QUANTITIES) + ' |')
@@ -96,9 +118,55 @@ def table(study, rows):
                 print('| %g | %s | %s |' % (mu, label, ' | '.join(pm(s['quantities'][k]) for k in QUANTITIES)))
 
 
+def figure(study, path):
+    """eta_r, eta_h, eta_c, N1/tau, N2/tau and Pi/tau against phi_core, DNS (filled) and lubrication
+    dynamics (open), mu_d 0 (blue) and 0.5 (red), with the Zarraga et al. (2000) viscosity and the
+    Dai et al. (2013) normal-stress fits (scripts/rheology.py)."""
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    import numpy as np
+    from rheology import dai_normal, zarraga_eta
+    names = ('eta_r', 'eta_h', 'eta_c', 'N1/tau', 'N2/tau', 'Pi/tau')
+    fig, axes = plt.subplots(2, 3, figsize=(12, 7))
+    phi = np.linspace(0.28, 0.47, 50)
+    axes[0, 0].plot(phi, zarraga_eta(phi), 'k--', lw=1, label='Zarraga et al. 2000')
+    axes[1, 0].plot(phi, dai_normal(phi)[0], 'k--', lw=1, label='Dai et al. 2013')
+    axes[1, 1].plot(phi, dai_normal(phi)[1], 'k--', lw=1, label='Dai et al. 2013')
+    seen = set()
+    for case, (where, dns_row), ld_rows in PAIRS:
+        for mu, colour in ((0.0, 'C0'), (0.5, 'C3')):
+            dns = load(os.path.join(where or study.record_dir, run_name(dns_row, mu), 'summary.json'))
+            runs = [('DNS', dns, 'o', colour)] + [('LD', study.load_record(r, mu), 's', 'none') for r in ld_rows]
+            for model, s, marker, face in runs:
+                if s is None:
+                    continue
+                label = '%s, mu_d %g' % (model, mu)
+                for ax, name in zip(axes.flat, names):
+                    q, x = s['quantities'][name], s['quantities']['phi_core']
+                    ax.errorbar(x['value'], q['value'], xerr=x['error'], yerr=q['error'], fmt=marker,
+                                mfc=face, mec=colour, ecolor=colour, ms=7 if 'paper' in case else 5,
+                                label=None if label in seen else label)
+                seen.add(label)
+    for ax, name in zip(axes.flat, names):
+        ax.set_xlabel('phi_core')
+        ax.set_title(name)
+    axes[0, 0].set_yscale('log')
+    axes[0, 0].legend(fontsize=7)
+    axes[1, 0].legend(fontsize=7)
+    fig.suptitle('The DNS against lubrication dynamics (LD): the same decks and packings, '
+                 'Couette walls, core values (large symbols: the paper\'s 20a cube)', fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    print('wrote', path)
+
+
 STUDY = Study('issue 30 model trade', ROWS, BASE, DEFAULT,
               work=os.path.join(ROOT, 'out', 'model_trade'),
               record=os.path.join(ROOT, 'doc', 'data', 'model_trade'), table=table, doc=__doc__)
 
 if __name__ == '__main__':
+    if '--figure' in sys.argv:      # --figure PATH: draw the records, run nothing
+        figure(STUDY, sys.argv[sys.argv.index('--figure') + 1])
+        sys.exit(0)
     sys.exit(STUDY.main())

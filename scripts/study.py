@@ -30,10 +30,11 @@ ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
 
 # The doc/VALIDATION.md §5.4 set-up with the paper's eps_bar 0.05: 8a x 20a x 8a Couette cell,
 # a/Delta = 4, bulk phi 0.40 (seed 1), eps_r 5e-3, implicit contacts, full lubrication, dt 2e-3,
-# 2 strains discarded and 20 averaged in 5 blocks, the resolved fluid.
+# 2 strains discarded and 20 averaged in 5 blocks, the resolved fluid, the model's own lubrication
+# cut-off (&lubrication outer_cutoff).
 BASE = dict(box=(8, 20, 8), cells=4, phi=0.40, seed=1, eps_r=5e-3, eps_bar=0.05, dt=2e-3,
             discard=2.0, average=20.0, blocks=5, min_gap=None, implicit=True,
-            model='resolved', boundary='walls')
+            model='resolved', boundary='walls', cutoff=None)
 
 DECK = """! {study}, row '{row}': {what}; mu_d = {mu}
 &domain box = {box}, cells_per_radius = {cells}, y_boundary = '{boundary}', shear_rate = 1 /
@@ -42,7 +43,7 @@ DECK = """! {study}, row '{row}': {what}; mu_d = {mu}
 &output directory = 'out', progress_every = 500, series_every = 5, checkpoint_every = 2500 /
 &particles solid_fraction = {phi}, seed = {seed}{packing} /
 &contact roughness = {eps_r}, eps_bar = {eps_bar}, friction = {mu}{implicit} /
-&lubrication model = 'full' /
+&lubrication model = 'full'{cutoff} /
 &rheology discard_strain = {discard}, average_strain = {average}, blocks = {blocks} /
 &run title = '{title} {row}: mu_d = {mu}', max_wall_hours = {hours} /
 """
@@ -121,6 +122,7 @@ class Study:
         return DECK.format(study=self.title, title=self.title, row=row, what=self.rows[row][0], mu=mu,
                            box=', '.join('%g' % b for b in s['box']), cells=s['cells'],
                            boundary=s['boundary'],
+                           cutoff='' if s['cutoff'] is None else ', outer_cutoff = %g' % s['cutoff'],
                            model='' if s['model'] == 'resolved' else "model = '%s', " % s['model'],
                            dt=s['dt'], phi=s['phi'], seed=s['seed'], packing=packing,
                            eps_r=s['eps_r'], eps_bar=s['eps_bar'], discard=s['discard'],
@@ -155,7 +157,7 @@ class Study:
             'solid_fraction_bulk': st['phi'], 'seed': st['seed'], 'friction': mu,
             'roughness': st['eps_r'], 'eps_bar': st['eps_bar'], 'implicit_contacts': st['implicit'],
             'dt': st['dt'], 'reynolds': 0.01,
-            'lubrication': 'full', 'strain_discarded': st['discard'], 'strain_averaged': st['average'],
+            'lubrication': 'full', 'lubrication_outer_cutoff': st['cutoff'], 'strain_discarded': st['discard'], 'strain_averaged': st['average'],
             'blocks': st['blocks'], 'fdsusp_version': version,
             'wall_time_per_step_s': float(walls[-1]) if walls else None,
             'ranks': ranks,
