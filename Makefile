@@ -73,8 +73,9 @@ LIB_OBJ := $(call obj,$(SRC_F90) $(SRC_C))
 # so they run without PETSc.
 PURE_F90 := $(shell python3 scripts/pure-modules $(SRC_F90))
 PURE_OBJ := $(call obj,$(PURE_F90))
-# pairtraj shares only kinds, vector algebra and the resistance module with the solver (design.md).
-RESISTANCE_F90 := src/kinds.F90 src/vector.F90 src/resistance.F90 src/resistance_table.F90
+# pairtraj shares only kinds, vector algebra and the resistance modules with the solver (design.md).
+RESISTANCE_F90 := src/kinds.F90 src/vector.F90 src/resistance_table.F90 src/pair_resistance.F90 \
+                  src/wall_resistance.F90 src/resistance_blocks.F90 src/pair_mobility.F90
 PAIRTRAJ_OBJ := $(call obj,$(REF_F90) $(RESISTANCE_F90))
 UNIT_BIN := $(patsubst tests/unit/%.F90,$(BUILD)/tests/%,$(UNIT_F90))
 # pass/fail bookkeeping every unit test links (mod_unit_checks)

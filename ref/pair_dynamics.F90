@@ -1,7 +1,7 @@
 ! Relative motion of two equal, inertialess, force- and torque-free spheres in unbounded simple
-! shear u = (gamma_dot y, 0, 0), with the exact two-sphere hydrodynamics (mod_resistance) and the
-! contact law of the reference paper (Gallier et al. 2014 JFM section 2.4, eqs 2.16-2.24;
-! method.md sections 1.7 and 4). Units: a = eta = gamma_dot = 1.
+! shear u = (gamma_dot y, 0, 0), with the exact two-sphere hydrodynamics (mod_pair_resistance,
+! mod_resistance_blocks) and the contact law of the reference paper (Gallier et al. 2014 JFM
+! section 2.4, eqs 2.16-2.24; method.md sections 1.7 and 4). Units: a = eta = gamma_dot = 1.
 !
 ! State y = (r, Upsilon): r = x_2 - x_1 (units of a) and the tangential spring elongation
 ! Upsilon (JFM 2.20), integrated only while the rough surfaces touch. The spheres sit at
@@ -25,15 +25,15 @@
 !     (Upsilon rescaled so that k_t |Upsilon| = mu_d |F_n|, i.e. |Upsilon| <= (7/2) mu_d |delta'|),
 !     Upsilon kept in the tangent plane, and reset to 0 when the contact opens (method.md 1.7);
 !   torques T^c_1 = T^c_2 = a n x F^c (JFM 2.23); sphere 2 receives -F^c.
-! Stresslets: S^h from R_SU . w + R_SE : E (JFM 2.13, mod_resistance pair_stresslets), and
+! Stresslets: S^h from R_SU . w + R_SE : E (JFM 2.13, mod_resistance_blocks pair_stresslets), and
 ! S^c = (1/2)(F^c r/2 + r/2 F^c) per sphere (JFM 2.24, sphere 1: F^c_1 and r = x_2 - x_1; sphere 2
 ! gives the same). N1* = 2 (S_xx - S_yy) / S_inf, N2* = 2 (S_yy - S_zz) / S_inf with S = S^h + S^c
 ! of one sphere and S_inf = (20/3) pi eta a^3 gamma_dot (JFM 3.1, 3.2).
 module mod_pair_dynamics
   use mod_kinds, only: dp, pi
   use mod_vector, only: cross, outer
-  use mod_resistance, only: n_pair_scalars, resistance_scalars, pair_resistance_fu, &
-                            pair_resistance_fe, pair_stresslets
+  use mod_pair_resistance, only: n_pair_scalars, resistance_scalars
+  use mod_resistance_blocks, only: pair_resistance_fu, pair_resistance_fe, pair_stresslets
   implicit none
   private
   public :: pair_model, pair_diagnostics, pair_state_size, make_pair_model, pair_rates, &

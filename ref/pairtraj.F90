@@ -1,7 +1,7 @@
 ! pairtraj: reference trajectory of two rough, frictional, force- and torque-free equal spheres in
 ! unbounded simple shear (the "theory" curves of Gallier et al. 2014 JFM section 3, figures 3-5;
-! DaCunha & Hinch 1996). Independent of the DNS solver: it shares only mod_kinds and
-! mod_resistance (+ its table) with src/.
+! DaCunha & Hinch 1996). Independent of the DNS solver: it shares only mod_kinds, mod_vector and
+! the resistance kernels (mod_pair_resistance + its table, mod_resistance_blocks) with src/.
 !
 !   usage: pairtraj DECK.nml
 !

@@ -20,7 +20,7 @@ f_k(lambda) = 2^k sum_q P_{n0, k-q, q} lambda^q follow from recurrences for P, V
 implements those recurrences (in the form corrected and completed by Townsend 2018,
 arXiv:1802.08226, eqs 5-8 and 18, whose corrections matter for YH, YM and ZM) at lambda = 1 and
 writes G_m = 4^-m f_m(1), so that a scalar is  sigma * sum_m G_m t^m  over the even or the odd m,
-with t = 2/s = 1/(1 + xi/2) (mod_resistance documents sigma and the parity of each scalar).
+with t = 2/s = 1/(1 + xi/2) (mod_pair_resistance documents sigma and the parity of each scalar).
 Checked: the first ten coefficients of every family equal method.md section 3.2 (libstokes), and
 the ZM coefficients equal libstokes' independently generated ZM.c to all printed digits.
 """
@@ -34,7 +34,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CSV_PATH = os.path.join(ROOT, "input", "tables", "two_sphere_resistance_equal_spheres.csv")
 OUT_PATH = os.path.join(ROOT, "src", "resistance_table.F90")
 
-# Column order of the scalar block; must match the index parameters of mod_resistance.
+# Column order of the scalar block; must match the index parameters of mod_pair_resistance.
 SCALARS = ["XA11", "YA11", "YB11", "XC11", "YC11", "XG11", "YG11", "YH11", "XM11", "YM11", "ZM11",
            "XA12", "YA12", "YB12", "XC12", "YC12", "XG12", "YG12", "YH12", "XM12", "YM12", "ZM12"]
 
@@ -195,7 +195,7 @@ def main():
     L.append("! normalised as in Kim & Karrila (1991) section 11.3: A x 6 pi eta a, B and G x 4 pi eta a^2,")
     L.append("! C and H x 8 pi eta a^3, M x (20/3) pi eta a^3. Column j of resistance_table_values is")
     L.append("! scalar j in the order " + ", ".join(SCALARS[:11]) + ",")
-    L.append("! " + ", ".join(SCALARS[11:]) + " (the index parameters of mod_resistance).")
+    L.append("! " + ", ".join(SCALARS[11:]) + " (the index parameters of mod_pair_resistance).")
     L.append("! resistance_table_a_bg holds Batchelor & Green's (1972) A(r) as given in the same CSV.")
     L.append("! Pure data: no PETSc, no MPI.")
     L.append("module mod_resistance_table")

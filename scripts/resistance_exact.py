@@ -1,4 +1,4 @@
-"""The exact resistance functions of mod_resistance, from bin/fdsusp-resistance (doc/RESISTANCE.md)."""
+"""The exact resistance functions of mod_pair_resistance, mod_wall_resistance and mod_pair_mobility, from bin/fdsusp-resistance (doc/RESISTANCE.md)."""
 import os
 import subprocess
 import numpy as np
@@ -21,7 +21,7 @@ def pair_scalars(gap):
 
 def shear_functions(gaps):
     """Rows [A, B, C, K, L, M] of a force- and torque-free equal pair in a linear flow at these gaps
-    (Batchelor & Green; mod_resistance::pair_shear_functions): the relative velocity is
+    (Batchelor & Green; mod_pair_mobility::pair_shear_functions): the relative velocity is
     dr/dt = Om x r + E.r - [A dd + B (I - dd)].E.r."""
     return _table('shear', list(gaps))[:, 1:]
 

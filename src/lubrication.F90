@@ -13,11 +13,11 @@
 !           g2 ln(1/xi) part of each scalar, xi_c from Grains3D's rule (0.185 at a/Delta = 5) for
 !           translation, 0.05 for rotation, and a saturation gap xi_sat = 0.02 below which the
 !           singular terms are held.
-!   full    the exact functions of mod_resistance minus the resolved part measured by fdsusp
+!   full    the exact functions (mod_pair_resistance, mod_wall_resistance) minus the resolved part measured by fdsusp
 !           itself at this resolution (scripts/calibrate.py, tables in input/lubrication),
 !           interpolated linearly in ln(gap); below the smallest calibrated gap the resolved part
 !           is held (it saturates once the gap is below the grid spacing).
-!   exact   the exact functions of mod_resistance minus the one-body part, nothing resolved to
+!   exact   the same exact functions minus the one-body part, nothing resolved to
 !           subtract: the pair and wall hydrodynamics of the lubrication dynamics mode (&fluid
 !           model = 'none', mod_lubrication_dynamics), where no grid resolves anything. Its blocks
 !           are not clipped at 0 but at a floor per link set by the caller (lub_pair_link's floor),
@@ -33,11 +33,13 @@
 module mod_lubrication
   use mod_kinds, only: dp, pi
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
-  use mod_resistance, only: n_pair_scalars, resistance_scalars, leading_singular_part, &
-       pair_resistance_fu, pair_force_torque_from_strain, pair_stresslets, wall_resistance_block, &
-       wall_normal_resistance, wall_tangential_resistance, wall_twist_resistance, &
-       i_xa11, i_ya11, i_xc11, i_yc11, i_xm11, i_ym11, i_zm11, i_xm12, i_ym12, i_zm12, &
-       i_xa12, i_xg11, i_xg12, i_yh11, i_yh12, i_xc12, i_yc12
+  use mod_pair_resistance, only: n_pair_scalars, resistance_scalars, leading_singular_part, i_xa11, &
+       i_ya11, i_xc11, i_yc11, i_xm11, i_ym11, i_zm11, i_xm12, i_ym12, i_zm12, i_xa12, i_xg11, &
+       i_xg12, i_yh11, i_yh12, i_xc12, i_yc12
+  use mod_wall_resistance, only: wall_normal_resistance, wall_tangential_resistance, &
+       wall_twist_resistance
+  use mod_resistance_blocks, only: pair_resistance_fu, pair_force_torque_from_strain, &
+       pair_stresslets, wall_resistance_block
   implicit none
   private
   public :: lubrication_t, lub_setup, lub_pair_scalars, lub_wall_scalars, lub_pair_link, lub_wall_link, &

@@ -1,9 +1,9 @@
 ! Lubrication dynamics (&fluid model = 'none'; issue 30): the spheres without a resolved fluid.
 ! Each sphere feels the one-body Stokes resistance relative to the imposed linear flow, each close
 ! pair and each sphere near a wall the exact two-body resistance minus the one-body part
-! (mod_lubrication's model 'exact', the functions of mod_resistance that bin/pairtraj uses), and
-! the DEM contacts as in the DNS, all in one implicit 6N system (Ball & Melrose 1997; Mari, Seto,
-! Morris & Denn 2014 without the far-field mobility):
+! (mod_lubrication's model 'exact': the exact functions of mod_pair_resistance, which bin/pairtraj
+! uses, and mod_wall_resistance), and the DEM contacts as in the DNS, all in one implicit 6N
+! system (Ball & Melrose 1997; Mari, Seto, Morris & Denn 2014 without the far-field mobility):
 !
 !   [R_1B + sum_links R_link + K_contact] U = R_1B . U_inf + sum_links drive + F_c + F_ext + K-part
 !

@@ -11,7 +11,7 @@ module mod_lubrication_io
   use mod_kinds, only: dp, pi
   use mod_params, only: config_t
   use mod_lubrication, only: lubrication_t, lub_setup, model_code, LUB_FULL, LUB_NONE, LUB_EXACT, n_wall_scalars
-  use mod_resistance, only: n_pair_scalars
+  use mod_pair_resistance, only: n_pair_scalars
   use mod_h5util, only: read_attribute, read_dataset, dataset_dims, has_attribute
   use mod_errors, only: is_root, input_error, file_error, log_line
   use mod_system, only: executable_dir

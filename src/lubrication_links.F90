@@ -8,7 +8,7 @@
 module mod_lubrication_links
   use petscsys
   use mod_kinds, only: dp
-  use mod_resistance, only: n_pair_scalars
+  use mod_pair_resistance, only: n_pair_scalars
   use mod_particle_lubrication, only: particle_lubrication_t, plub_links, plub_reserve_pairs
   implicit none
   private

@@ -18,7 +18,7 @@
 ! eta a at contact, is above the floor -3 pi eta a).
 module mod_particle_lubrication
   use mod_kinds, only: dp, i8, pi
-  use mod_resistance, only: n_pair_scalars
+  use mod_pair_resistance, only: n_pair_scalars
   use mod_lubrication, only: lubrication_t, lub_pair_scalars, lub_wall_scalars, lub_pair_link, &
        lub_wall_link, lub_pair_stresslets, lub_wall_stresslet, n_wall_scalars, LUB_NONE, LUB_EXACT
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates

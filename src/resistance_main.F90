@@ -1,6 +1,6 @@
-! fdsusp-resistance: the exact two-sphere and sphere-wall resistance functions of mod_resistance
-! (the ones the lubrication correction and bin/pairtraj use) at the gaps given, for scripts and
-! tests that compare fdsusp with theory (doc/RESISTANCE.md).
+! fdsusp-resistance: the exact two-sphere and sphere-wall resistance functions (mod_pair_resistance,
+! mod_wall_resistance, mod_pair_mobility; the ones the lubrication correction and bin/pairtraj use)
+! at the gaps given, for scripts and tests that compare fdsusp with theory (doc/RESISTANCE.md).
 !   bin/fdsusp-resistance pair GAP [GAP ...]   one line per gap: gap XA11 YA11 ... ZM12 (22 scalars,
 !                                              Kim & Karrila normalisation, order of the header)
 !   bin/fdsusp-resistance wall GAP [GAP ...]   one line per gap: gap lambda_perp f_tt f_tr f_rr x_w
@@ -9,8 +9,10 @@
 !                                              (pair_shear_functions, the ones bin/pairtraj integrates)
 program fdsusp_resistance
   use mod_kinds, only: dp
-  use mod_resistance, only: resistance_scalars, pair_scalar_names, n_pair_scalars, wall_normal_resistance, &
-       wall_tangential_resistance, wall_twist_resistance, pair_shear_functions
+  use mod_pair_resistance, only: resistance_scalars, pair_scalar_names, n_pair_scalars
+  use mod_wall_resistance, only: wall_normal_resistance, wall_tangential_resistance, &
+       wall_twist_resistance
+  use mod_pair_mobility, only: pair_shear_functions
   implicit none
   character(len=64) :: kind, arg
   real(dp) :: gap, f_tt, f_tr, f_rr, bg(6)

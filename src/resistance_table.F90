@@ -7,7 +7,7 @@
 ! normalised as in Kim & Karrila (1991) section 11.3: A x 6 pi eta a, B and G x 4 pi eta a^2,
 ! C and H x 8 pi eta a^3, M x (20/3) pi eta a^3. Column j of resistance_table_values is
 ! scalar j in the order XA11, YA11, YB11, XC11, YC11, XG11, YG11, YH11, XM11, YM11, ZM11,
-! XA12, YA12, YB12, XC12, YC12, XG12, YG12, YH12, XM12, YM12, ZM12 (the index parameters of mod_resistance).
+! XA12, YA12, YB12, XC12, YC12, XG12, YG12, YH12, XM12, YM12, ZM12 (the index parameters of mod_pair_resistance).
 ! resistance_table_a_bg holds Batchelor & Green's (1972) A(r) as given in the same CSV.
 ! Pure data: no PETSc, no MPI.
 module mod_resistance_table

@@ -1,9 +1,9 @@
 """Invariant: with the full lubrication correction, the hydrodynamic resistance of two spheres and of
 a sphere near a wall, as fdsusp computes it at a/Delta = 5 (resolved by the grid + subgrid
-correction), equals the exact two-sphere and sphere-wall resistance (mod_resistance: Jeffrey &
-Onishi / Townsend tables for pairs, Brenner 1961 and the O'Neill bispherical solutions for the
-wall, each validated against published values by its own unit tests) within 5 % (issue 5) at
-gaps 1e-3, 1e-2, 1e-1 and 0.5. The uncorrected DNS (total minus the correction, from the same run)
+correction), equals the exact two-sphere and sphere-wall resistance (mod_pair_resistance,
+mod_wall_resistance: Jeffrey & Onishi / Townsend tables for pairs, Brenner 1961 and the O'Neill
+bispherical solutions for the wall, each validated against published values by its own unit
+tests) within 5 % (issue 5) at gaps 1e-3, 1e-2, 1e-1 and 0.5. The uncorrected DNS (total minus the correction, from the same run)
 is printed beside it: it falls short below a gap of about Delta = 0.2a.
 
 Resistance mode (velocities imposed, configuration held), steady state by Aitken extrapolation

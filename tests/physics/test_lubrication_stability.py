@@ -8,7 +8,7 @@ Asserted:
   1. every step is finite and the gap decreases monotonically to below 2e-4 (no overshoot, no
      oscillation: the implicit 6N solve damps the stiff 1/gap mode exactly);
   2. the approach speed equals the exact two-sphere value V = 2F / (6 pi (XA11 - XA12)) (sphere 1
-     force balance with U_1 = -U_2 = V/2; mod_resistance) within 5 % at every gap between 1e-2 and
+     force balance with U_1 = -U_2 = V/2; mod_pair_resistance) within 5 % at every gap between 1e-2 and
      2e-4: the correction is right dynamically, not only in resistance mode. The 5 % covers the
      calibration (doc/VALIDATION.md) and the O((a/L)^3) periodic images of this pair (a force dipole).
 Recorded, not asserted (doc/VALIDATION.md): the same drive without the correction reaches contact

@@ -1,5 +1,5 @@
 ! Invariants of the subgrid lubrication kernels (mod_lubrication), checked against the exact
-! forms of mod_resistance and against symmetries, without the DNS:
+! forms of mod_pair_resistance and against symmetries, without the DNS:
 !  1. simple model: the squeeze combination XA11 - XA12 equals the singular difference
 !     [1/(2 xi) + (9/20) ln(1/xi)] - [same at xi_c] inside the cut-off (1e-12: the same formula
 !     evaluated two ways), is held below the saturation gap, and is zero beyond xi_c;
@@ -21,8 +21,8 @@
 !  8. pair stresslet: symmetric, and its trace is a d.F_1 for a squeeze (method.md §2.7).
 program test_lubrication
   use mod_kinds, only: dp
-  use mod_resistance, only: n_pair_scalars, resistance_scalars, i_xa11, i_xa12, i_ya11, i_xc11, i_yc11, &
-       i_xm11, i_ym11, i_zm11, i_xm12, i_ym12, i_zm12
+  use mod_pair_resistance, only: n_pair_scalars, resistance_scalars, i_xa11, i_xa12, i_ya11, i_xc11, &
+       i_yc11, i_xm11, i_ym11, i_zm11, i_xm12, i_ym12, i_zm12
   use mod_lubrication, only: lubrication_t, lub_setup, lub_pair_scalars, lub_wall_scalars, lub_pair_link, &
        lub_wall_link, lub_pair_stresslets, clip_to_psd, LUB_SIMPLE, LUB_FULL
   use mod_unit_checks, only: check, finish

@@ -8,7 +8,7 @@
 !     above -6 pi eta a; measured -0.355 x 6 pi, near contact), so a lone pair keeps its exact block;
 !  3. a free pair in shear: solving [R_1B + (R_2B - R_1B)] U = drive gives the relative velocity
 !     of the exact two-sphere mobility, U_rel = E.r - (A d d + B (I - d d)).E.r (Batchelor & Green
-!     1972) with A, B from mod_resistance's pair_shear_functions, the functions bin/pairtraj
+!     1972) with A, B from mod_pair_mobility's pair_shear_functions, the functions bin/pairtraj
 !     integrates: to 1e-12 relative (A, B come from the same resistance scalars; the difference is
 !     the round-off of two 12x12 eliminations at condition numbers up to ~1e4 at gap 1e-3);
 !  4. Lees-Edwards: le_separation of a pair straddling y = Ly equals the separation of the same
@@ -17,11 +17,11 @@
 !     velocity by the image's.
 program test_lubrication_dynamics
   use mod_kinds, only: dp, pi
-  use mod_resistance, only: pair_shear_functions
+  use mod_pair_mobility, only: pair_shear_functions
   use mod_particles, only: particles_t, particles_init, MOTION_FREE
   use mod_particle_system, only: psys_solve
   use mod_lubrication, only: lubrication_t, lub_setup, LUB_EXACT, lub_pair_scalars
-  use mod_resistance, only: pair_resistance_fu
+  use mod_resistance_blocks, only: pair_resistance_fu
   use mod_particle_lubrication, only: particle_lubrication_t, plub_create, plub_links, plub_corrections
   use mod_lubrication_dynamics, only: lubrication_dynamics_t, ld_create, ld_assemble, ld_hydrodynamics, &
        ld_one_body_block

@@ -1,4 +1,4 @@
-! Unit test: axisymmetric two-sphere motions of mod_resistance against the exact bispherical-
+! Unit test: axisymmetric two-sphere motions of mod_pair_resistance against the exact bispherical-
 ! coordinate solutions, implemented here independently of the module (issue 3 acceptance).
 ! With cosh(alpha) = s/2 (s = r/a) and m = 2n + 1:
 !   * co-translation along the line of centres, XA11 + XA12 (Stimson & Jeffery 1926):
@@ -27,7 +27,7 @@
 ! series' limit, 3e-5 as above.
 program test_resistance_bispherical
   use mod_kinds, only: dp
-  use mod_resistance, only: n_pair_scalars, resistance_scalars, i_xa11, i_xa12, i_xc11, i_xc12
+  use mod_pair_resistance, only: n_pair_scalars, resistance_scalars, i_xa11, i_xa12, i_xc11, i_xc12
   use mod_unit_checks, only: check_below, finish
   implicit none
   real(dp), parameter :: gaps(16) = [1.0e-5_dp, 1.0e-4_dp, 1.0e-3_dp, 5.0e-3_dp, 0.01_dp, 0.02_dp, &

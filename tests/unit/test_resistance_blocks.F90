@@ -1,4 +1,4 @@
-! Unit test: the pair resistance blocks FU, FE, SU, SE of mod_resistance (method.md 2.1, 2.6).
+! Unit test: the pair resistance blocks FU, FE, SU, SE of mod_resistance_blocks (method.md 2.1, 2.6).
 ! Invariants (none of them is produced by the code itself: each is a theorem of Stokes flow or an
 ! identity of the tensor algebra):
 !   1. R_FU (12x12) is symmetric (Lorentz reciprocity) and positive definite (dissipation is
@@ -19,10 +19,10 @@
 ! Random directions and strains use a fixed seed (reproducible).
 program test_resistance_blocks
   use mod_kinds, only: dp, pi
-  use mod_resistance, only: n_pair_scalars, resistance_scalars, pair_resistance_fu, &
-                            pair_resistance_fe, pair_resistance_su, pair_resistance_se, &
-                            pair_force_torque_from_strain, pair_stresslets, strain_d0, &
-                            strain_d1, strain_d2, i_xa11, i_xa12, i_ya11, i_ya12
+  use mod_pair_resistance, only: n_pair_scalars, resistance_scalars, i_xa11, i_xa12, i_ya11, i_ya12
+  use mod_resistance_blocks, only: pair_resistance_fu, pair_resistance_fe, pair_resistance_su, &
+       pair_resistance_se, pair_force_torque_from_strain, pair_stresslets, strain_d0, strain_d1, &
+       strain_d2
   use mod_unit_checks, only: failures, check_below, finish
   implicit none
   integer :: k, l, alpha, ntrial, nseed

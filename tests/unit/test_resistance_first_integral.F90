@@ -19,7 +19,7 @@
 ! trajectory through (2 + xi, pi/2) is negative, i.e. the closed orbits B&G found near contact.
 program test_resistance_first_integral
   use mod_kinds, only: dp
-  use mod_resistance, only: pair_shear_functions
+  use mod_pair_mobility, only: pair_shear_functions
   use mod_unit_checks, only: check_below, finish
   implicit none
   integer, parameter :: n = 40001

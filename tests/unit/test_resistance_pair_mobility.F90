@@ -1,5 +1,5 @@
 ! Unit test: Batchelor & Green's (1972) pair functions computed from the module's scalars
-! (mod_resistance pair_shear_functions, the reduction of method.md 4.1-4.2) against published
+! (mod_pair_mobility pair_shear_functions, the reduction of method.md 4.1-4.2) against published
 ! numbers (issue 3 acceptance):
 !   1. A(s) at the 26 Lamb-method separations (s >= 2.025, where the module interpolates the
 !      table) against the A_BatchelorGreen column of the reference table (6 decimals):
@@ -19,7 +19,7 @@
 !      error must also fall faster than s^-7 between s = 6 and 20 (it is a truncation effect).
 program test_resistance_pair_mobility
   use mod_kinds, only: dp
-  use mod_resistance, only: pair_shear_functions
+  use mod_pair_mobility, only: pair_shear_functions
   use mod_resistance_table, only: resistance_table_size, resistance_table_sep, resistance_table_a_bg
   use mod_unit_checks, only: failures, check_below, finish
   implicit none

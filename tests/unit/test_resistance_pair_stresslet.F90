@@ -1,6 +1,6 @@
 ! Unit test: stresslet of a force- and torque-free pair in simple shear, two routes.
 !   Route 1 (general blocks): solve R_FU . w = -R_FE : E for w = U^inf - U (12 unknowns, force-
-!     and torque-free), then S_1 = R_SU . w + R_SE : E with mod_resistance's pair_stresslets.
+!     and torque-free), then S_1 = R_SU . w + R_SE : E with mod_resistance_blocks' pair_stresslets.
 !   Route 2 (Batchelor & Green closed forms, method.md 4.2 and 4.4): in the shear plane,
 !     d = (cos t, sin t, 0):  N1* = M sin(2t) cos(2t),  N2* = sin(2t) [L + M sin^2 t],
 !     with L, M from pair_shear_functions (which reduces the same scalars to the 6-unknown
@@ -16,8 +16,9 @@
 !      1.025097 - 0.072311 - 1): evaluated at xi = 1e-10, within 1e-5.
 program test_resistance_pair_stresslet
   use mod_kinds, only: dp, pi
-  use mod_resistance, only: n_pair_scalars, resistance_scalars, pair_resistance_fu, &
-                            pair_resistance_fe, pair_stresslets, pair_shear_functions
+  use mod_pair_resistance, only: n_pair_scalars, resistance_scalars
+  use mod_resistance_blocks, only: pair_resistance_fu, pair_resistance_fe, pair_stresslets
+  use mod_pair_mobility, only: pair_shear_functions
   use mod_unit_checks, only: check_below, finish
   implicit none
   real(dp), parameter :: gaps(7) = [1.0e-4_dp, 1.0e-3_dp, 0.01_dp, 0.1_dp, 0.5_dp, 1.5_dp, 5.0_dp]

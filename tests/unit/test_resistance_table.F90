@@ -1,4 +1,4 @@
-! Unit test: the 22 equal-sphere resistance scalars of mod_resistance against the reference table
+! Unit test: the 22 equal-sphere resistance scalars of mod_pair_resistance against the reference table
 ! (input/tables/two_sphere_resistance_equal_spheres.csv, Jeffrey-Onishi / Lamb-method values,
 ! compiled in as mod_resistance_table), at every tabulated separation and at the joins with the
 ! near- and far-field pieces (issue 3 acceptance; method.md sections 2.3, 3.1, 3.2;
@@ -38,10 +38,9 @@
 !      (the next terms are O(s^-2) = 1e-8).
 program test_resistance_table
   use mod_kinds, only: dp
-  use mod_resistance, only: n_pair_scalars, pair_scalar_names, resistance_scalars, &
-                            near_field_scalars, far_field_scalars, series_scalars, &
-                            contact_constants, i_xa12, i_ya12, i_zm11, i_zm12, &
-                            near_join_gap, far_join_gap, zm_join_gap
+  use mod_pair_resistance, only: n_pair_scalars, pair_scalar_names, resistance_scalars, &
+       near_field_scalars, far_field_scalars, series_scalars, contact_constants, i_xa12, i_ya12, &
+       i_zm11, i_zm12, near_join_gap, far_join_gap, zm_join_gap
   use mod_resistance_table, only: resistance_table_size, resistance_table_sep, &
                                   resistance_table_values
   use mod_unit_checks, only: failures, check_below, finish

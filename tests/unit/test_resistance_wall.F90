@@ -1,4 +1,4 @@
-! Unit test: sphere-wall resistance functions of mod_resistance (method.md 2.8) against published
+! Unit test: sphere-wall resistance functions of mod_wall_resistance (method.md 2.8) against published
 ! exact values and exact identities (issue 3 acceptance).
 !   1. Normal approach against Brenner's (1961) published table, lambda = F/(6 pi eta a U) at
 !      l/a = cosh(alpha), alpha = 0.5, 1, 1.5, 2, 2.5, 3: 9.2518, 3.0361, 1.8375, 1.4129,
@@ -23,9 +23,10 @@
 !      contact limit f_tr/((4/3) f_rr) -> (2/15)/(4/3 * 2/5)), at eps = 1e-3, 1e-2, 0.1, 1.
 program test_resistance_wall
   use mod_kinds, only: dp
-  use mod_resistance, only: wall_normal_resistance, wall_normal_near_field, wall_normal_far_field, &
-                            wall_tangential_resistance, wall_twist_resistance, wall_resistance_fu, &
-                            i_xc11, i_xc12
+  use mod_pair_resistance, only: i_xc11, i_xc12
+  use mod_wall_resistance, only: wall_normal_resistance, wall_normal_near_field, &
+       wall_normal_far_field, wall_tangential_resistance, wall_twist_resistance
+  use mod_resistance_blocks, only: wall_resistance_fu
   use mod_resistance_table, only: resistance_table_size, resistance_table_sep, resistance_table_values
   use mod_unit_checks, only: failures, check_below, finish
   implicit none

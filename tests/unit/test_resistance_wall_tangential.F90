@@ -1,4 +1,4 @@
-! Unit test: tangential sphere-wall functions of mod_resistance (f_tt translation, f_tr coupling,
+! Unit test: tangential sphere-wall functions of mod_wall_resistance (f_tt translation, f_tr coupling,
 ! f_rr rotation; method.md 2.8) against published values and exact identities (issue 3).
 ! The module evaluates the exact bispherical solutions (O'Neill 1964 translation, Dean & O'Neill
 ! 1963 rotation) for 1e-3 <= eps <= 10, the inner forms below and the reflection forms above.
@@ -44,8 +44,8 @@
 !      former inner/far blend, to record how far off the blend was (doc/RESISTANCE.md).
 program test_resistance_wall_tangential
   use mod_kinds, only: dp
-  use mod_resistance, only: wall_tangential_resistance, wall_tangential_exact, &
-                            wall_tangential_inner, wall_tangential_far
+  use mod_wall_resistance, only: wall_tangential_resistance, wall_tangential_exact, &
+       wall_tangential_inner, wall_tangential_far
   use mod_unit_checks, only: check_below, finish
   implicit none
   real(dp), parameter :: gaps(6) = [1.0e-3_dp, 0.1_dp, 0.5_dp, 1.0_dp, 2.0_dp, 5.0_dp]
