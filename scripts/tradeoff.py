@@ -2,7 +2,7 @@
 """Speed against accuracy (issue 7): one knob at a time around a base setting, for a small
 sheared suspension, with the error of each setting against the finest one and its cost per strain.
 
-    scripts/tradeoff.py [--knobs grid dt tolerance lubrication] [--strain 0.5] [--jobs 2]
+    scripts/tradeoff.py [--knobs grid dt tolerance lubrication model] [--strain 0.5] [--jobs 2]
                         [--work out/tradeoff] [--table-only] [--plot FILE]
 
 The scene (the same packing at every setting: seed 1, positions in units of a): phi = 0.3 in a
@@ -21,10 +21,14 @@ lubrication 'full'); the last of each knob is its finest:
   tolerance      velocity = pressure relative tolerance 1e-3, 1e-4, 1e-6 (the code's default),
                  then the base's 1e-8 / 1e-10 (the default before this study)
   lubrication    none, simple, full
+  model          lubrication dynamics (`&fluid model = 'none'`: no grid, exact pair resistance
+                 within 1a), then the resolved fluid (the DNS)
 Two errors per setting: against its knob's finest setting (the error that knob causes), and
 against the reference, the finest affordable configuration (the largest a/Delta with a table,
-dt = 5e-4, tolerances 1e-8 / 1e-10, 'full'), which is the total error that the plot and its Pareto
-front use. Cost = CPU seconds per unit strain of the single-rank run (its own rusage, start-up
+dt = 5e-4, tolerances 1e-8 / 1e-10, 'full'), the total error. The figure has one panel of each:
+left, every knob against its own finest setting (so a knob's points do not carry another knob's
+error, e.g. the grid's in the dt series); right, the total error with the Pareto front over the
+distinct configurations. The code's defaults are ringed. Cost = CPU seconds per unit strain of the single-rank run (its own rusage, start-up
 included), so runs side by side do not bias it.
 
 Writes a markdown table (doc/BENCHMARKS.md §9), out/tradeoff/tradeoff.json and the error-cost
@@ -43,9 +47,11 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from jobpool import ENV, run_all  # noqa: E402
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
-BASE = {'cells': 4, 'dt': 1e-3, 'vtol': 1e-8, 'ptol': 1e-10, 'lub': 'full'}
+BASE = {'cells': 4, 'dt': 1e-3, 'vtol': 1e-8, 'ptol': 1e-10, 'lub': 'full', 'model': 'resolved'}
+# the settings that are the code's defaults (doc/INPUT.md): ringed in the figure
+DEFAULTS = {'tol 1e-06 (default)', 'full', 'DNS (resolved fluid)'}
 DECK = """&domain box = 7, 10, 7, cells_per_radius = {cells}, y_boundary = 'walls', shear_rate = 1 /
-&fluid reynolds = 0.01, initial_flow = 'shear', velocity_tolerance = {vtol:g}, pressure_tolerance = {ptol:g} /
+&fluid model = '{model}', reynolds = 0.01, initial_flow = 'shear', velocity_tolerance = {vtol:g}, pressure_tolerance = {ptol:g} /
 &time dt = {dt:g} /
 &output directory = 'out', progress_every = 250, series_every = 1 /
 &particles solid_fraction = 0.3, seed = 1 /
@@ -83,10 +89,14 @@ def settings(knobs):
         # the full model is the finest; how short a step 'none' needs is doc/VALIDATION.md §4.3
         series['lubrication'] = [('none', dict(BASE, lub='none')), ('simple', dict(BASE, lub='simple')),
                                  ('full', dict(BASE))]
+    if 'model' in knobs:
+        # lubrication dynamics: the same deck without the grid (doc/VALIDATION.md §8.7)
+        series['model'] = [('LD (no fluid)', dict(BASE, model='none')), ('DNS (resolved fluid)', dict(BASE))]
     out = []
     for knob, members in series.items():
         for label, p in members:
-            out.append({'name': 'a%(cells)d_dt%(dt)g_tol%(vtol)g-%(ptol)g_%(lub)s' % p, 'knob': knob, 'label': label, 'parameters': p,
+            name = 'a%(cells)d_dt%(dt)g_tol%(vtol)g-%(ptol)g_%(lub)s' % p + ('_ld' if p['model'] == 'none' else '')
+            out.append({'name': name, 'knob': knob, 'label': label, 'parameters': p,
                         'finest': members[-1][0]})
     return out
 
@@ -133,30 +143,50 @@ def pareto(points):
     return sorted(front, key=lambda i: points[i][0])
 
 
-def plot_front(rows, path, cost, markers, xlabel, ylabel, title, floor=1e-5):
-    """Error against cost, one marker per knob, each setting labelled, and the Pareto front over
-    the distinct configurations (the base appears under several knobs). Errors below floor are
-    drawn at floor (log axis)."""
+def plot_front(rows, path, cost, markers, xlabel, title, floor=1e-5):
+    """Two panels of error against cost, one marker and colour per knob. Left: each knob's settings
+    against that knob's finest (error_knob), each labelled, the finest itself left out (its error is
+    0 by construction). Right: every setting against the reference (error), the Pareto front over
+    the distinct configurations, and only the front's points labelled. Defaults are ringed; errors
+    below floor are drawn at floor (log axis)."""
     import matplotlib
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(7, 5))
-    err = lambda r: max(r['error'], floor)  # noqa: E731
-    for knob, marker in markers.items():
-        pts = [r for r in rows if r['knob'] == knob and r['error'] is not None]
-        if pts:
-            ax.scatter([r[cost] for r in pts], [err(r) for r in pts], marker=marker, label=knob, s=40)
-            for r in pts:
-                ax.annotate(r['label'], (r[cost], err(r)), fontsize=6, xytext=(3, 3), textcoords='offset points')
+    fig, axes = plt.subplots(1, 2, figsize=(14.5, 5.5), sharey=True)
+    colours = dict(zip(markers, ['C%d' % i for i in range(len(markers))]))
+
+    def draw(ax, key, labelled):
+        for knob, marker in markers.items():
+            pts = [r for r in rows if r['knob'] == knob and r[key] is not None
+                   and not (key == 'error_knob' and r['label'] == r['finest'])]
+            for i, r in enumerate(pts):
+                x, y = r[cost], max(r[key], floor)
+                ax.scatter([x], [y], marker=marker, color=colours[knob], s=45,
+                           label=knob if i == 0 else None, zorder=3)
+                if r['label'] in DEFAULTS:
+                    ax.scatter([x], [y], marker='o', s=220, facecolors='none', edgecolors='k', lw=1, zorder=2)
+                if labelled(r):
+                    # alternate the label above and below its point, so that neighbours do not overlap
+                    ax.annotate(r['label'], (x, y), fontsize=7, color=colours[knob],
+                                xytext=(5, 6 if i % 2 == 0 else -11), textcoords='offset points')
+        ax.set_xscale('log')
+        ax.set_yscale('log')
+        ax.set_xlabel(xlabel)
+        ax.grid(True, which='major', lw=0.3)
+
+    draw(axes[0], 'error_knob', lambda r: True)
+    axes[0].set_ylabel('|eta_r - eta_r(finest)| / eta_r(finest)')
+    axes[0].set_title("each knob against its own finest setting", fontsize=10)
     pts = list({r['name']: r for r in rows if r['knob'] in markers and r['error'] is not None}.values())
-    front = pareto([(r[cost], err(r)) for r in pts])
-    ax.plot([pts[i][cost] for i in front], [err(pts[i]) for i in front], 'k--', lw=1, label='Pareto front')
-    ax.set_xscale('log')
-    ax.set_yscale('log')
-    ax.set_xlabel(xlabel)
-    ax.set_ylabel(ylabel)
-    ax.set_title(title)
-    ax.legend(fontsize=8)
+    front = pareto([(r[cost], max(r['error'], floor)) for r in pts])
+    on_front = {pts[i]['name'] for i in front}
+    draw(axes[1], 'error', lambda r: r['name'] in on_front)
+    axes[1].plot([pts[i][cost] for i in front], [max(pts[i]['error'], floor) for i in front], 'k--', lw=1,
+                 label='Pareto front')
+    axes[1].set_title('total error against the reference (finest grid, dt, tolerance)', fontsize=10)
+    axes[1].scatter([], [], marker='o', s=220, facecolors='none', edgecolors='k', label="the code's default")
+    axes[1].legend(fontsize=8, loc='center left', bbox_to_anchor=(1.01, 0.5))
+    fig.suptitle(title, fontsize=11)
     fig.tight_layout()
     os.makedirs(os.path.dirname(path), exist_ok=True)
     fig.savefig(path, dpi=120)
@@ -164,8 +194,8 @@ def plot_front(rows, path, cost, markers, xlabel, ylabel, title, floor=1e-5):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument('--knobs', nargs='+', default=['grid', 'dt', 'tolerance', 'lubrication'],
-                    choices=['grid', 'dt', 'tolerance', 'lubrication'])
+    ap.add_argument('--knobs', nargs='+', default=['grid', 'dt', 'tolerance', 'lubrication', 'model'],
+                    choices=['grid', 'dt', 'tolerance', 'lubrication', 'model'])
     ap.add_argument('--strain', type=float, default=0.5, help='strain run (the first 0.2 discarded)')
     ap.add_argument('--jobs', type=int, default=2)
     ap.add_argument('--work', default=os.path.join(ROOT, 'out', 'tradeoff'))
@@ -225,9 +255,10 @@ def main():
                                                            e(r['error_knob']), e(r['error']), r['cpu_per_strain']))
     if any(r['error'] is not None and r['knob'] != 'reference' for r in rows):
         plot_front(rows, args.plot, 'cpu_per_strain',
-                   {'grid (full)': 'o', 'grid (simple)': 'v', 'dt': 's', 'tolerance': '^', 'lubrication': 'D'},
-                   'cost: CPU seconds per unit strain (1 rank)', '|eta_r - eta_r(reference)| / eta_r(reference)',
-                   'fdsusp speed against accuracy (phi = 0.3, 7a x 10a x 7a)')
+                   {'grid (full)': 'o', 'grid (simple)': 'v', 'dt': 's', 'tolerance': '^', 'lubrication': 'D',
+                    'model': 'P'},
+                   'cost: CPU seconds per unit strain (1 rank)',
+                   'fdsusp speed against accuracy (phi = 0.3, 7a x 10a x 7a, mu_d = 0.5)')
         print('plot: %s' % os.path.relpath(args.plot, ROOT))
     return 0
 
