@@ -5,7 +5,8 @@ with one message that names the limit. Short version for make check: each runnin
 results in doc/VALIDATION.md §6), through scripts/extremes.py, which applies the criteria:
 'stable' needs exit status 0, every step run, overlap < h_r/2 (the bound of the issue) and finite
 stresslets and velocities; 'refused' needs status 2 with an input error and no time step taken.
-The refusals are checked for the words that state their limit."""
+The refusals are checked for the words that state their limit. The ld_* scenes are the same limits
+in lubrication dynamics (&fluid model = 'none', issue 30)."""
 import json
 import os
 import subprocess
@@ -20,6 +21,9 @@ EXPECTED = {
     'gamma1e-3': ('stable', []), 'dt5x': ('stable', []),
     'wall_touch': ('refused', ['&particles', 'position(:,1)', 'wall gap', 'h_r/2']),
     'pair_overlap': ('refused', ['&particles', 'position(:,1)', 'start at a gap of', 'h_r/2']),
+    # lubrication dynamics (issue 30): the same limits without the fluid
+    'ld_phi055_mu1': ('stable', []), 'ld_epsr1e-4': ('stable', []),
+    'ld_dt_too_large': ('refused', ['&time', 'dt', 'the largest dt measured stable here is  2.00E-03']),
 }
 d = T.scratch('extremes')
 report = os.path.join(d, 'extremes.json')
