@@ -34,7 +34,7 @@ include $(PETSC_DIR)/lib/petsc/conf/variables
 # HDF5's Fortran API (series files); PETSc's link line already holds the C library and its path.
 HDF5_FC_LIB ?= -lhdf5_fortran
 # FFTW's Fortran 2003 interface (fftw3-mpi.f03, Debian's libfftw3-dev / libfftw3-mpi-dev): the direct
-# fluid solves (src/fft_solver.F90); PETSc's link line already holds -lfftw3_mpi -lfftw3.
+# fluid solves (src/fluid/fft_solver.F90); PETSc's link line already holds -lfftw3_mpi -lfftw3.
 FFTW_FC_INCLUDE ?= -I/usr/include
 FDSUSP_FFTW_LIB := -lfftw3_mpi -lfftw3
 
@@ -60,22 +60,25 @@ FCFLAGS_ALL := $(FC_FLAGS) $(OPTFLAGS) $(WARN) -fimplicit-none -std=f2018 -fall-
 CFLAGS_ALL := $(CC_FLAGS) $(COPTFLAGS) -Wall -Wextra $(PETSC_CC_INCLUDES)
 LIBS := $(HDF5_FC_LIB) $(FDSUSP_FFTW_LIB) $(PETSC_LIB)
 
-# Program sources: everything else in src/ is a module linked into every program.
-PROGRAM_SRC := src/main.F90 src/pack_main.F90 src/resistance_main.F90
-SRC_F90 := $(filter-out $(PROGRAM_SRC),$(wildcard src/*.F90))
-SRC_C := $(wildcard src/*.c)
+# Sources (doc/DESIGN.md "Source layout"): src/kernels (pure physics), src/runtime (decks, errors,
+# system, timers), src/fluid, src/bodies (the particle step on the grid and in parallel), src/io
+# (HDF5 files), src/programs (one file per program). Every module is linked into every program.
+PROGRAM_SRC := $(wildcard src/programs/*.F90)
+SRC_F90 := $(filter-out $(PROGRAM_SRC),$(wildcard src/*/*.F90))
+SRC_C := $(wildcard src/*/*.c)
 REF_F90 := $(wildcard ref/*.F90)
 UNIT_F90 := $(wildcard tests/unit/test_*.F90)
 
-obj = $(addprefix $(BUILD)/,$(subst /,_,$(patsubst %.F90,%.o,$(patsubst %.c,%.o,$(1)))))
+# Objects mirror the sources: src/kernels/contact.F90 -> $(BUILD)/src/kernels/contact.o.
+obj = $(addprefix $(BUILD)/,$(patsubst %.F90,%.o,$(patsubst %.c,%.o,$(1))))
 LIB_OBJ := $(call obj,$(SRC_F90) $(SRC_C))
-# Pure modules use neither PETSc, MPI nor HDF5: the physics kernels. Unit tests link only these,
-# so they run without PETSc.
-PURE_F90 := $(shell python3 scripts/pure-modules $(SRC_F90))
+# The kernels use neither PETSc, MPI, HDF5 nor C (scripts/pure-modules --check enforces it). Unit
+# tests link only these, so they run without PETSc.
+PURE_F90 := $(wildcard src/kernels/*.F90)
 PURE_OBJ := $(call obj,$(PURE_F90))
 # pairtraj shares only kinds, vector algebra and the resistance modules with the solver (design.md).
-RESISTANCE_F90 := src/kinds.F90 src/vector.F90 src/resistance_table.F90 src/pair_resistance.F90 \
-                  src/wall_resistance.F90 src/resistance_blocks.F90 src/pair_mobility.F90
+RESISTANCE_F90 := $(addprefix src/kernels/,kinds.F90 vector.F90 resistance_table.F90 pair_resistance.F90 \
+                  wall_resistance.F90 resistance_blocks.F90 pair_mobility.F90)
 PAIRTRAJ_OBJ := $(call obj,$(REF_F90) $(RESISTANCE_F90))
 UNIT_BIN := $(patsubst tests/unit/%.F90,$(BUILD)/tests/%,$(UNIT_F90))
 # pass/fail bookkeeping every unit test links (mod_unit_checks)
@@ -84,37 +87,41 @@ UNIT_CHECKS_OBJ := $(call obj,$(UNIT_CHECKS_F90))
 
 PROGRAMS := $(BIN)/fdsusp $(BIN)/fdsusp-pack $(BIN)/fdsusp-resistance $(if $(REF_F90),$(BIN)/pairtraj)
 
-.PHONY: all debug check run bench extremes tradeoff pair-dns calibrate clean tests-build install
+.PHONY: all debug check run bench extremes tradeoff pair-dns calibrate clean tests-build install layout-check
 all: $(PROGRAMS) $(UNIT_BIN)
 
 debug:
 	$(MAKE) MODE=debug all
 
-$(BUILD) $(BIN) $(BUILD)/tests:
+$(BIN) $(BUILD)/tests:
 	@mkdir -p $@
 
-$(BUILD)/src_%.o: src/%.F90 | $(BUILD)
-	$(FC) $(FCFLAGS_ALL) -c $< -o $@
-$(BUILD)/ref_%.o: ref/%.F90 | $(BUILD)
-	$(FC) $(FCFLAGS_ALL) -c $< -o $@
-$(BUILD)/src_%.o: src/%.c | $(BUILD)
-	$(CC) $(CFLAGS_ALL) -c $< -o $@
-$(BUILD)/tests_unit_%.o: tests/unit/%.F90 | $(BUILD)
-	$(FC) $(FCFLAGS_ALL) -c $< -o $@
+# The layout's rules (pure kernels, which folder may import which) are checked once per make,
+# before anything is compiled; a violation stops the build naming the file, line and import.
+layout-check:
+	@python3 scripts/pure-modules --check
 
-$(BIN)/fdsusp: $(call obj,src/main.F90) $(LIB_OBJ) | $(BIN)
+$(BUILD)/%.o: %.F90 | layout-check
+	@mkdir -p $(@D)
+	$(FC) $(FCFLAGS_ALL) -c $< -o $@
+$(BUILD)/%.o: %.c | layout-check
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS_ALL) -c $< -o $@
+
+$(BIN)/fdsusp: $(call obj,src/programs/main.F90) $(LIB_OBJ) | $(BIN)
 	$(FC_LINKER) $(OPTFLAGS) -o $@ $^ $(LIBS)
-$(BIN)/fdsusp-pack: $(call obj,src/pack_main.F90) $(LIB_OBJ) | $(BIN)
+$(BIN)/fdsusp-pack: $(call obj,src/programs/pack_main.F90) $(LIB_OBJ) | $(BIN)
 	$(FC_LINKER) $(OPTFLAGS) -o $@ $^ $(LIBS)
-$(BIN)/fdsusp-resistance: $(call obj,src/resistance_main.F90 $(RESISTANCE_F90)) | $(BIN)
+$(BIN)/fdsusp-resistance: $(call obj,src/programs/resistance_main.F90 $(RESISTANCE_F90)) | $(BIN)
 	$(FC_LINKER) $(OPTFLAGS) -o $@ $^
 $(BIN)/pairtraj: $(PAIRTRAJ_OBJ) | $(BIN)
 	$(FC_LINKER) $(OPTFLAGS) -o $@ $^
-$(BUILD)/tests/%: $(BUILD)/tests_unit_%.o $(UNIT_CHECKS_OBJ) $(PURE_OBJ) | $(BUILD)/tests
+$(UNIT_BIN): $(BUILD)/tests/%: $(BUILD)/tests/unit/%.o $(UNIT_CHECKS_OBJ) $(PURE_OBJ) | $(BUILD)/tests
 	$(FC_LINKER) $(OPTFLAGS) -o $@ $^ -llapack -lblas
 
 # Module dependencies, regenerated whenever a source changes.
-$(BUILD)/deps.mk: $(SRC_F90) $(PROGRAM_SRC) $(REF_F90) $(UNIT_F90) $(UNIT_CHECKS_F90) scripts/f90deps | $(BUILD)
+$(BUILD)/deps.mk: $(SRC_F90) $(PROGRAM_SRC) $(REF_F90) $(UNIT_F90) $(UNIT_CHECKS_F90) scripts/f90deps
+	@mkdir -p $(@D)
 	@scripts/f90deps $(BUILD) $(SRC_F90) $(PROGRAM_SRC) $(REF_F90) $(UNIT_F90) $(UNIT_CHECKS_F90) > $@
 -include $(BUILD)/deps.mk
 

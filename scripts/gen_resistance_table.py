@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Generate src/resistance_table.F90 (module mod_resistance_table) from
+"""Generate src/kernels/resistance_table.F90 (module mod_resistance_table) from
 input/tables/two_sphere_resistance_equal_spheres.csv, and the twin-multipole series coefficients
 of the equal-sphere resistance functions (Jeffrey & Onishi 1984; Jeffrey 1992).
 
@@ -32,7 +32,7 @@ from math import comb
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CSV_PATH = os.path.join(ROOT, "input", "tables", "two_sphere_resistance_equal_spheres.csv")
-OUT_PATH = os.path.join(ROOT, "src", "resistance_table.F90")
+OUT_PATH = os.path.join(ROOT, "src", "kernels", "resistance_table.F90")
 
 # Column order of the scalar block; must match the index parameters of mod_pair_resistance.
 SCALARS = ["XA11", "YA11", "YB11", "XC11", "YC11", "XG11", "YG11", "YH11", "XM11", "YM11", "ZM11",

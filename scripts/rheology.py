@@ -6,7 +6,7 @@
 
 
 For each output directory, recomputes the summary of the core region from series.h5 alone, by
-the rules of src/rheology.F90 (records on the series_every grid after discard_step, `blocks`
+the rules of src/kernels/rheology.F90 (records on the series_every grid after discard_step, `blocks`
 blocks of block_steps steps, quantities evaluated on the block means; value from the mean of the
 block means, error = standard deviation over the complete blocks (ddof 1) / sqrt(blocks)), and
 prints it. --compare: also compare with the run's own summary.json and exit 1 if any number
@@ -105,7 +105,7 @@ def load(outdir):
 
 
 def summarise(a, s):
-    """The summary as src/rheology.F90 computes it (see the module header there)."""
+    """The summary as src/kernels/rheology.F90 computes it (see the module header there)."""
     step = np.rint(s['step']).astype(np.int64)
     blocks, discard, block_steps = int(a['blocks']), int(a['discard_step']), int(a['block_steps'])
     every = int(a['series_every'])

@@ -1,5 +1,5 @@
 """Invariant: the direct solves of the fluid step (-fluid_solver fft, the default: fast transforms,
-src/fft_solver.F90) and the Krylov solves (-fluid_solver krylov: CG with multigrid or Jacobi on the
+src/fluid/fft_solver.F90) and the Krylov solves (-fluid_solver krylov: CG with multigrid or Jacobi on the
 assembled operators of mod_solvers) solve the same four linear systems, so run to a relative
 tolerance of 1e-13 the Krylov path must reproduce the direct one to round-off. Checked for every
 boundary treatment the transforms must match:

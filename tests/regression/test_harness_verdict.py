@@ -63,7 +63,7 @@ shell_test('fail_exit0', 'check_result 1 "does not hold"\nexit 0', 1, 'a failed 
 # Fortran: two programs against the built mod_unit_checks (modules and objects beside the unit tests)
 unit_dir = os.environ.get('FDSUSP_UNIT_DIR') or os.path.join(T.ROOT, 'build', 'opt', 'tests')
 build = os.path.dirname(unit_dir)
-objects = [os.path.join(build, 'tests_unit_unit_checks.o'), os.path.join(build, 'src_kinds.o')]
+objects = [os.path.join(build, 'tests', 'unit', 'unit_checks.o'), os.path.join(build, 'src', 'kernels', 'kinds.o')]
 fc = shutil.which('gfortran') or shutil.which('mpif90')
 T.check(fc is not None and all(os.path.exists(o) for o in objects),
         'a Fortran compiler (%s) and the built mod_unit_checks (%s)' % (fc, build))

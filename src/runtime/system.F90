@@ -1,4 +1,4 @@
-! Fortran side of src/system_c.c: signals, atomic file publication and the output directory's lock.
+! Fortran side of src/runtime/system_c.c: signals, atomic file publication and the output directory's lock.
 module mod_system
   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
   implicit none
@@ -78,7 +78,7 @@ contains
     probe_directory = int(fdsusp_probe_directory(trim(path)//c_null_char))
   end function probe_directory
 
-  ! Lock the output directory for this process (rank 0; src/system_c.c): 0 taken, -1 another live
+  ! Lock the output directory for this process (rank 0; src/runtime/system_c.c): 0 taken, -1 another live
   ! run holds it, -2 the file system offers no locks, else the errno of creating the lock file.
   ! holder: who holds it (refused) or held it last without releasing it (taken), '' if nobody.
   integer function lock_directory(path, holder)

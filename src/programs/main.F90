@@ -538,7 +538,7 @@ contains
   end subroutine continue_from_directory
 
   ! The output directory must exist (it is created), be this run's alone (a lock, before anything
-  ! is written there) and be writable now, not hours from now. The lock (src/system_c.c) is held by
+  ! is written there) and be writable now, not hours from now. The lock (src/runtime/system_c.c) is held by
   ! rank 0's process until it ends and dies with it, so a lock file left by a killed run does not
   ! block the next start. A checkpoint.h5.tmp left by a run killed while writing is removed.
   subroutine prepare_output_directory(cfg)
