@@ -6,7 +6,7 @@ shows that the check catches what it must: on a copy of the sources it plants, o
 kernel that uses hdf5, a kernel that uses mod_errors (runtime), a fluid module that uses
 mod_fictitious_domain (bodies), a C source among the kernels and a module in a file of another
 name, and each must fail the check with one violation, named by file, line and import.
-Exact (no tolerance): exit statuses and message text. Python standard library only; < 1 s."""
+Exact (no tolerance): exit statuses and message text. Python standard library only; ~2 s of CPU."""
 import os
 import shutil
 import subprocess
