@@ -73,6 +73,11 @@ def cpu_per_strain(s):
     return float('nan')
 
 
+def dns_record(study, where, row, mu):
+    """The DNS record of a case: in the friction study's records (where) or this study's (None)."""
+    return load(os.path.join(where or study.record_dir, run_name(row, mu), 'summary.json'))
+
+
 def pm(q):
     return '%.3g +- %.2g' % (q['value'], q['error'])
 
@@ -83,7 +88,7 @@ def table(study, rows):
     print('|---' * (len(QUANTITIES) + 6) + '|')
     for case, (where, dns_row), ld_rows in PAIRS:
         for mu in (0.0, 0.5):
-            dns = load(os.path.join(where or study.record_dir, run_name(dns_row, mu), 'summary.json'))
+            dns = dns_record(study, where, dns_row, mu)
             for model, s in [('DNS', dns)] + [('LD ' + r, study.load_record(r, mu)) for r in ld_rows]:
                 if s is None:
                     print('| %s | %g | %s | (not run) |' % (case, mu, model))
@@ -97,25 +102,25 @@ def table(study, rows):
                 print('| %s | %g | %s | %s | %s | %s | %.3g |' % (
                     case, mu, model, s['run']['spheres'], ' | '.join(pm(q[k]) for k in QUANTITIES), extra,
                     cpu_per_strain(s)))
+    knobs = ('ld', 'ld_cut0.5', 'ld_cut1.5', 'ld_dt5e-3', 'ld_eb002')
+    print_ld_rows(study, 'The knobs of lubrication dynamics at phi 0.4 (rows %s)' % ', '.join(knobs),
+                  [(r, r) for r in knobs])
+    print_ld_rows(study, 'Lees-Edwards against walls in lubrication dynamics (walls: the core; Lees-Edwards: '
+                  'the whole box)', [('ld', 'walls'), ('ld_le', 'Lees-Edwards')])
+
+
+def print_ld_rows(study, title, rows):
+    """One table of recorded lubrication-dynamics rows, (row, label) each, at both mu_d."""
     print()
-    print('The knobs of lubrication dynamics at phi 0.4 (rows ld, ld_cut0.5, ld_cut1.5, ld_dt5e-3, ld_eb002)')
+    print(title)
     print('| mu_d | row | ' + ' | '.join(QUANTITIES) + ' | CPU s per strain |')
     print('|---' * (len(QUANTITIES) + 3) + '|')
     for mu in (0.0, 0.5):
-        for row in ('ld', 'ld_cut0.5', 'ld_cut1.5', 'ld_dt5e-3', 'ld_eb002'):
+        for row, label in rows:
             s = study.load_record(row, mu)
             if s is not None:
-                print('| %g | %s | %s | %.3g |' % (mu, row, ' | '.join(pm(s['quantities'][k]) for k in QUANTITIES),
+                print('| %g | %s | %s | %.3g |' % (mu, label, ' | '.join(pm(s['quantities'][k]) for k in QUANTITIES),
                                                  cpu_per_strain(s)))
-    print()
-    print('Lees-Edwards against walls in lubrication dynamics (walls: the core; Lees-Edwards: the whole box)')
-    print('| mu_d | boundaries | ' + ' | '.join(QUANTITIES) + ' |')
-    print('|---' * (len(QUANTITIES) + 2) + '|')
-    for mu in (0.0, 0.5):
-        for row, label in (('ld', 'walls'), ('ld_le', 'Lees-Edwards')):
-            s = study.load_record(row, mu)
-            if s is not None:
-                print('| %g | %s | %s |' % (mu, label, ' | '.join(pm(s['quantities'][k]) for k in QUANTITIES)))
 
 
 def figure(study, path):
@@ -136,7 +141,7 @@ def figure(study, path):
     seen = set()
     for case, (where, dns_row), ld_rows in PAIRS:
         for mu, colour in ((0.0, 'C0'), (0.5, 'C3')):
-            dns = load(os.path.join(where or study.record_dir, run_name(dns_row, mu), 'summary.json'))
+            dns = dns_record(study, where, dns_row, mu)
             runs = [('DNS', dns, 'o', colour)] + [('LD', study.load_record(r, mu), 's', 'none') for r in ld_rows]
             for model, s, marker, face in runs:
                 if s is None:
