@@ -61,8 +61,8 @@ CFLAGS_ALL := $(CC_FLAGS) $(COPTFLAGS) -Wall -Wextra $(PETSC_CC_INCLUDES)
 LIBS := $(HDF5_FC_LIB) $(FDSUSP_FFTW_LIB) $(PETSC_LIB)
 
 # Sources (doc/DESIGN.md "Source layout"): src/kernels (pure physics), src/runtime (decks, errors,
-# system, timers), src/fluid, src/bodies (the particle step on the grid and in parallel), src/io
-# (HDF5 files), src/programs (one file per program). Every module is linked into every program.
+# OS services, PETSc options, timers), src/fluid, src/bodies (the particle step on the grid and in
+# parallel), src/io (HDF5 files), src/programs (one file per program). Every module is linked into every program.
 PROGRAM_SRC := $(wildcard src/programs/*.F90)
 SRC_F90 := $(filter-out $(PROGRAM_SRC),$(wildcard src/*/*.F90))
 SRC_C := $(wildcard src/*/*.c)

@@ -20,7 +20,7 @@ module mod_particle_solver
   use petscksp
   use mod_kinds, only: dp
   use mod_particle_system, only: particle_system_t, psys_solve
-  use mod_solvers, only: set_default_option
+  use mod_petsc_options, only: set_default_option
   use mod_errors, only: fatal_error
   implicit none
   private

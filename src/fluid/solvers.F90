@@ -13,11 +13,12 @@ module mod_solvers
   use mod_kinds, only: dp
   use mod_grid, only: grid_t, FIELD_U, FIELD_V, FIELD_W, FIELD_P, field_names, direct_solves_wanted
   use mod_errors, only: fatal_error, log_line
+  use mod_petsc_options, only: set_default_option
   use mod_fft_solver, only: fft_solver_t, fft_create, fft_solve, fft_destroy
   implicit none
   private
   public :: solver_t, solvers_configure, solver_create, solver_solve, solver_destroy
-  public :: set_default_option, solver_cold_solve, fft_planner_flags
+  public :: solver_cold_solve, fft_planner_flags
 
   type :: solver_t
     KSP :: ksp
@@ -49,17 +50,6 @@ contains
     box_lengths = box
     has_walls = walls
   end subroutine solvers_configure
-
-  ! Put NAME=VALUE in the options database unless the user already set NAME.
-  subroutine set_default_option(name, value, ierr)
-    character(len=*), intent(in) :: name, value
-    PetscErrorCode, intent(out) :: ierr
-    PetscBool :: set
-    PetscCall(PetscOptionsHasName(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, name, set, ierr))
-    if (.not. set) then
-      PetscCall(PetscOptionsSetValue(PETSC_NULL_OPTIONS, name, value, ierr))
-    end if
-  end subroutine set_default_option
 
   ! rtol: relative tolerance from the deck. atol: the residual norm at which the solve stops
   ! whatever |b| is; the caller sets it at round-off level of a physically sized right-hand side,

@@ -26,7 +26,7 @@ module mod_checkpoint
   use mod_fluid, only: fluid_t
   use mod_h5util, only: write_attribute, read_attribute, write_string_attribute, has_object, dataset_dims, &
                         write_dataset, read_dataset, has_attribute
-  use mod_system, only: publish_file
+  use mod_os_services, only: publish_file
   use mod_errors, only: is_root, abort_run, file_error
   use mod_particles, only: particles_t
   use mod_particles_io, only: particles_write, particles_read_state

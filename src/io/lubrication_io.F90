@@ -14,7 +14,7 @@ module mod_lubrication_io
   use mod_pair_resistance, only: n_pair_scalars
   use mod_h5util, only: read_attribute, read_dataset, dataset_dims, has_attribute
   use mod_errors, only: is_root, input_error, file_error, log_line
-  use mod_system, only: executable_dir
+  use mod_os_services, only: executable_dir
   implicit none
   private
   public :: lubrication_load, default_table_path

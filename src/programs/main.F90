@@ -18,7 +18,7 @@ program fdsusp
   use mod_series, only: series_t, series_open, series_record, series_flush, series_attributes
   use mod_output, only: write_fields, progress_line
   use mod_checkpoint, only: checkpoint_write, checkpoint_check, checkpoint_read
-  use mod_system, only: install_signal_handlers, stop_signal, make_directory, probe_directory, lock_directory, &
+  use mod_os_services, only: install_signal_handlers, stop_signal, make_directory, probe_directory, lock_directory, &
                         release_directory
   use mod_timers, only: timers_register, stage_push, stage_pop, STAGE_SETUP, STAGE_FLUID, STAGE_OUTPUT, &
                         STAGE_PARTICLES, STAGE_CONTACTS, STAGE_LUBRICATION
@@ -538,7 +538,7 @@ contains
   end subroutine continue_from_directory
 
   ! The output directory must exist (it is created), be this run's alone (a lock, before anything
-  ! is written there) and be writable now, not hours from now. The lock (src/runtime/system_c.c) is held by
+  ! is written there) and be writable now, not hours from now. The lock (src/runtime/os_services_c.c) is held by
   ! rank 0's process until it ends and dies with it, so a lock file left by a killed run does not
   ! block the next start. A checkpoint.h5.tmp left by a run killed while writing is removed.
   subroutine prepare_output_directory(cfg)

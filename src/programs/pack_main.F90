@@ -12,7 +12,7 @@ program fdsusp_pack
   use mod_kinds, only: dp
   use mod_errors, only: input_error, fatal_error, log_line, is_root, abort_run
   use mod_h5util, only: h5util_init, write_attribute, write_string_attribute
-  use mod_system, only: make_directory, probe_directory, publish_file
+  use mod_os_services, only: make_directory, probe_directory, publish_file
   use mod_packing, only: random_packing, packing_report_t
   use mod_packing_deck, only: pack_config_t, read_pack_deck, pack_deck_lines, max_line
   implicit none

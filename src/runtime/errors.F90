@@ -5,7 +5,7 @@
 #include <petsc/finclude/petscsys.h>
 module mod_errors
   use petscsys
-  use mod_system, only: release_directory
+  use mod_os_services, only: release_directory
   implicit none
   private
   public :: input_error, file_error, fatal_error, abort_run, is_root, log_line, warn_line
@@ -56,7 +56,7 @@ contains
   end subroutine file_error
 
   ! A collective fatal error: every rank calls it. Rank 0 prints and releases the output
-  ! directory (mod_system; a no-op before it is locked); all ranks finalise and exit.
+  ! directory (mod_os_services; a no-op before it is locked); all ranks finalise and exit.
   subroutine fatal_error(message, status)
     character(len=*), intent(in) :: message
     integer, intent(in) :: status

@@ -1,7 +1,7 @@
 """Invariant: a run killed with SIGKILL (no chance to clean up) while it writes a checkpoint leaves
 the previous checkpoint whole and readable, and restarting from it reproduces the uninterrupted
 run exactly (issue 8). Why it holds: a checkpoint is written to checkpoint.h5.tmp, flushed to disk
-and only then renamed over checkpoint.h5 (mod_checkpoint, mod_system publish_file), and a restart
+and only then renamed over checkpoint.h5 (mod_checkpoint, mod_os_services publish_file), and a restart
 from step n repeats the arithmetic of steps n+1.. bitwise (test_restart, test_contact_restart).
 
 Set-up: a 64 x 32 x 64 Couette cell with two free spheres close enough for lubrication (so the

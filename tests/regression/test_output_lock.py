@@ -1,5 +1,5 @@
 """Invariant: one run per output directory. A run locks its &output directory at start (rank 0, an
-fcntl lock on DIR/.fdsusp.lock that lives as long as its process; src/runtime/system_c.c), so:
+fcntl lock on DIR/.fdsusp.lock that lives as long as its process; src/runtime/os_services_c.c), so:
  1. a second run started into a directory in use is refused before it writes anything there:
     exit status 2, one message on stderr naming the directory, the deck's &output directory and
     the holder's pid; the lock file still names the first run; and the first run's series.h5 holds

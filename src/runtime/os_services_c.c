@@ -1,7 +1,7 @@
 /* Operating-system services fdsusp needs and Fortran lacks: catching the signals batch
  * schedulers send before they kill a job, publishing a file atomically, and locking the output
  * directory against a second run.
- * Called from Fortran through mod_system (system.F90) (bind(C)). */
+ * Called from Fortran through mod_os_services (os_services.F90) (bind(C)). */
 #include <errno.h>
 #include <fcntl.h>
 #include <signal.h>

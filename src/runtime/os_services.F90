@@ -1,5 +1,6 @@
-! Fortran side of src/runtime/system_c.c: signals, atomic file publication and the output directory's lock.
-module mod_system
+! Operating-system services, the Fortran side of src/runtime/os_services_c.c: signals, atomic file
+! publication, directories, the output directory's lock and the directory of the executable.
+module mod_os_services
   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
   implicit none
   private
@@ -78,7 +79,7 @@ contains
     probe_directory = int(fdsusp_probe_directory(trim(path)//c_null_char))
   end function probe_directory
 
-  ! Lock the output directory for this process (rank 0; src/runtime/system_c.c): 0 taken, -1 another live
+  ! Lock the output directory for this process (rank 0; src/runtime/os_services_c.c): 0 taken, -1 another live
   ! run holds it, -2 the file system offers no locks, else the errno of creating the lock file.
   ! holder: who holds it (refused) or held it last without releasing it (taken), '' if nobody.
   integer function lock_directory(path, holder)
@@ -99,4 +100,4 @@ contains
     call fdsusp_release_directory()
   end subroutine release_directory
 
-end module mod_system
+end module mod_os_services
