@@ -17,7 +17,7 @@
 !   fluid      the projection step with Lambda^n as a body force (mod_fluid) -> u~.
 !   particles  beta M U = beta b(u~) - m(Lambda^n) + F_ext    (method.md eq. (1) with the weights)
 !              b = sum_f w u~_c g dV,  m = sum_f Lambda^n_f/(1+gamma) g dV; later models add their
-!              stiffness and forces through mod_particle_system.
+!              stiffness and forces to the 6N system (mod_particle_solver).
 !              Lambda^{n+1} = [Lambda^n + beta alpha (g.U - u~)]/(1 + gamma) on owned faces, 0 elsewhere;
 !              u^{n+1} = u~ + (Lambda^{n+1} - Lambda^n)/beta.
 !   moments    F = -sum Lambda e_c dV, T = -sum r x Lambda e_c dV,
@@ -34,10 +34,14 @@ module mod_fictitious_domain
   use mod_kinds, only: dp
   use mod_grid, only: grid_t, FIELD_U, FIELD_V, FIELD_W, FIELD_P
   use mod_particles, only: particles_t, MOTION_FREE, MOTION_FROZEN, impose_motion
-  use mod_particle_system, only: particle_system_t, psys_reset, psys_add_diagonal
-  use mod_particle_lubrication, only: particle_lubrication_t, plub_corrections, plub_add_to_system, plub_add_corrections
-  use mod_particle_contacts, only: particle_contacts_t, pcontacts_add_stiffness, pcontacts_implicit_update
-  use mod_particle_solver, only: particle_solver_t, psolver_create, psolver_solve_checked, psolver_destroy
+  use mod_particle_system, only: particle_system_reset, particle_system_add_diagonal
+  use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_corrections, &
+                                      particle_lubrication_add_to_system, &
+                                      particle_lubrication_add_corrections
+  use mod_particle_contacts, only: particle_contacts_t, particle_contacts_add_stiffness, &
+                                   particle_contacts_implicit_update
+  use mod_particle_solver, only: particle_solver_t, particle_solver_create, particle_solver_solve, &
+                                 particle_solver_destroy
   use mod_solid_fraction, only: cube_fraction
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates, min_image
   use mod_errors, only: fatal_error
@@ -45,9 +49,11 @@ module mod_fictitious_domain
                         EVENT_UPDATE
   implicit none
   private
-  public :: fd_t, fd_create, fd_geometry, fd_follow, fd_moments, fd_solve_motion, fd_update, fd_destroy
+  public :: fictitious_domain_t, fictitious_domain_create, fictitious_domain_geometry, &
+            fictitious_domain_follow, fictitious_domain_moments, fictitious_domain_solve_motion, &
+            fictitious_domain_update, fictitious_domain_destroy
 
-  type :: fd_t
+  type :: fictitious_domain_t
     real(dp) :: beta = 0.0_dp           ! rho/dt = Re/dt
     real(dp) :: kappa = 0.5_dp          ! relaxation constant of §1.5b
     real(dp) :: radius_offset = 0.38_dp ! in grid cells
@@ -73,12 +79,10 @@ module mod_fictitious_domain
     integer, allocatable :: rival_part(:)        ! the rival's index
     real(dp), allocatable :: rival_offset(:, :)  ! (3, :): centre of the rival minus the centre of q (minimum image)
     real(dp), allocatable :: lambda_new(:)   ! Lambda^{n+1} per listed face (kept: no allocation per step)
-    logical :: lambda_listed = .false.       ! Lambda^n is zero off the listed faces (fd_follow put it there)
-    real(dp), allocatable :: moments(:, :)   ! (12, n): b(u~) and m(Lambda^n) of the step (fd_moments)
-    type(particle_system_t) :: system
-    type(particle_solver_t) :: solver     ! the 6N system once pairs couple it
-    integer :: solver_iterations = 0
-  end type fd_t
+    logical :: lambda_listed = .false.       ! Lambda^n is zero off the listed faces (fictitious_domain_follow put it there)
+    real(dp), allocatable :: moments(:, :)   ! (12, n): b(u~) and m(Lambda^n) of the step (fictitious_domain_moments)
+    type(particle_solver_t) :: solver     ! the 6N system of the particle step and its solution
+  end type fictitious_domain_t
 
   type :: field_pointer
     PetscScalar, pointer :: ptr(:, :, :) => null()
@@ -90,10 +94,10 @@ module mod_fictitious_domain
 
 contains
 
-  subroutine fd_create(grid, reynolds, dt, kappa, radius_offset, fd, ierr)
+  subroutine fictitious_domain_create(grid, reynolds, dt, kappa, radius_offset, fd, ierr)
     type(grid_t), intent(in) :: grid
     real(dp), intent(in) :: reynolds, dt, kappa, radius_offset
-    type(fd_t), intent(inout) :: fd
+    type(fictitious_domain_t), intent(inout) :: fd
     PetscErrorCode, intent(out) :: ierr
     integer :: c
     character(len=8), parameter :: names(3) = ['lambda_u', 'lambda_v', 'lambda_w']
@@ -105,10 +109,10 @@ contains
       PetscCall(VecSet(fd%lambda(c), 0.0_dp, ierr))
       PetscCall(PetscObjectSetName(fd%lambda(c), trim(names(c)), ierr))
     end do
-    PetscCall(psolver_create(fd%solver, ierr))
+    PetscCall(particle_solver_create(fd%solver, ierr))
     allocate(fd%f_ijk(3, 1024), fd%f_r(3, 1024), fd%f_alpha(1024), fd%f_relax(1024))
     allocate(fd%run_start(1), fd%run_comp(0), fd%run_part(0))
-  end subroutine fd_create
+  end subroutine fictitious_domain_create
 
   ! The geometry at the current positions: face ownership, alpha, the face list and M_p.
   ! Collective (M_p is summed over ranks).
@@ -119,16 +123,16 @@ contains
   ! takes the same decision: the largest alpha owns the unknown (ties to the lower index) with
   ! weight alpha - the runner-up's. No grid-sized ownership arrays, no second pass (issue 31: the
   ! geometry was half of the paper scene's step).
-  subroutine fd_geometry(grid, fd, parts)
+  subroutine fictitious_domain_geometry(grid, fd, parts)
     type(grid_t), intent(in) :: grid
-    type(fd_t), intent(inout) :: fd
+    type(fictitious_domain_t), intent(inout) :: fd
     type(particles_t), intent(in) :: parts
     integer :: q, c, ierr, f0
     real(dp) :: radius
 
     PetscCallA(event_begin(EVENT_GEOMETRY, ierr))
     radius = parts%radius + fd%radius_offset * grid%h
-    fd%lambda_listed = .false.      ! Lambda^n may sit on faces of another geometry (fd_follow carries it)
+    fd%lambda_listed = .false.      ! Lambda^n may sit on faces of another geometry (fictitious_domain_follow carries it)
     call find_rivals(grid, fd, parts, radius)
     if (allocated(fd%rigid_matrix)) then
       if (size(fd%rigid_matrix, 3) /= parts%n) deallocate(fd%rigid_matrix)
@@ -157,14 +161,14 @@ contains
     call MPI_Allreduce(MPI_IN_PLACE, fd%rigid_matrix, 36 * parts%n, MPI_DOUBLE_PRECISION, MPI_SUM, &
                        PETSC_COMM_WORLD, ierr)
     PetscCallA(event_end(EVENT_GEOMETRY, ierr))
-  end subroutine fd_geometry
+  end subroutine fictitious_domain_geometry
 
   ! The unknowns of component c (1..4, 4 = cell centres) that particle q owns, listed with their
   ! owned (wrapped) index, their offset r from the centre (unwrapped, so no image logic), their
   ! weight and relaxation; M_p of q accumulated (sum_f w g g^T dV over the non-zeros of g).
   subroutine visit(grid, fd, parts, q, c, radius)
     type(grid_t), intent(in) :: grid
-    type(fd_t), intent(inout) :: fd
+    type(fictitious_domain_t), intent(inout) :: fd
     type(particles_t), intent(in) :: parts
     integer, intent(in) :: q, c
     real(dp), intent(in) :: radius
@@ -317,7 +321,7 @@ contains
 
   ! Room for n faces in the face list (its arrays grow by doubling, kept between steps).
   subroutine reserve_faces(fd, n)
-    type(fd_t), intent(inout) :: fd
+    type(fictitious_domain_t), intent(inout) :: fd
     integer, intent(in) :: n
     integer :: m
     integer, allocatable :: t3(:, :)
@@ -336,7 +340,7 @@ contains
   ! A periodic length below twice the reach would let a sphere reach its own image: refused.
   subroutine find_rivals(grid, fd, parts, radius)
     type(grid_t), intent(in) :: grid
-    type(fd_t), intent(inout) :: fd
+    type(fictitious_domain_t), intent(inout) :: fd
     type(particles_t), intent(in) :: parts
     real(dp), intent(in) :: radius
     real(dp) :: reach
@@ -419,9 +423,9 @@ contains
   ! sphere owns get zero. Only the translation is carried: the traction on a sphere that turns in
   ! a steady flow is steady in the lab frame, not in the body's. displacement (3, n): X^{n+1} - X^n,
   ! unwrapped; each component must stay below one cell (the ghost width). Collective.
-  subroutine fd_follow(grid, fd, parts, displacement, ierr)
+  subroutine fictitious_domain_follow(grid, fd, parts, displacement, ierr)
     type(grid_t), intent(in) :: grid
-    type(fd_t), intent(inout) :: fd
+    type(fictitious_domain_t), intent(inout) :: fd
     type(particles_t), intent(in) :: parts
     real(dp), intent(in) :: displacement(:, :)
     PetscErrorCode, intent(out) :: ierr
@@ -431,7 +435,7 @@ contains
     integer :: run, f0, f1, c, q, o(3), a, b, e, m, corner(3, 8)
     character(len=200) :: text
 
-    call fd_geometry(grid, fd, parts)
+    call fictitious_domain_geometry(grid, fd, parts)
     if (maxval(abs(displacement)) >= grid%h) then
       write(text, '(a,f8.3,a)') 'fdsusp: fatal: a sphere moved ', maxval(abs(displacement)) / grid%h, &
            ' cells in one step (its force density can follow at most one): reduce &time dt'
@@ -481,20 +485,20 @@ contains
       PetscCall(DMRestoreLocalVector(grid%da(c), old(c), ierr))
     end do
     PetscCall(event_end(EVENT_CARRY, ierr))
-  end subroutine fd_follow
+  end subroutine fictitious_domain_follow
 
   ! The particle sub-problem after the fluid step, in three named parts that main.F90 calls in
   ! turn (method.md §1.5 eq. (1), §1.5b):
-  !   fd_moments       b(u~) and m(Lambda^n) of every sphere, summed over ranks;
-  !   fd_solve_motion  the 6N system (rigid-body matrices, lubrication, contacts): U, Omega;
-  !   fd_update        Lambda^{n+1}, u^{n+1} = u~ + (Lambda^{n+1} - Lambda^n)/beta, and the
+  !   fictitious_domain_moments       b(u~) and m(Lambda^n) of every sphere, summed over ranks;
+  !   fictitious_domain_solve_motion  the 6N system (rigid-body matrices, lubrication, contacts): U, Omega;
+  !   fictitious_domain_update        Lambda^{n+1}, u^{n+1} = u~ + (Lambda^{n+1} - Lambda^n)/beta, and the
   !                    resolved force, torque and stresslet (plus the lubrication corrections).
 
   ! b = sum_f w u~_c g dV and m = sum_f Lambda^n_f/(1+gamma) g dV per sphere (rows 1-6, 7-12 of
   ! fd%moments). vel: the projected velocity u~. Collective.
-  subroutine fd_moments(grid, fd, vel, n, ierr)
+  subroutine fictitious_domain_moments(grid, fd, vel, n, ierr)
     type(grid_t), intent(in) :: grid
-    type(fd_t), intent(inout) :: fd
+    type(fictitious_domain_t), intent(inout) :: fd
     Vec, intent(in) :: vel(3)
     integer, intent(in) :: n
     PetscErrorCode, intent(out) :: ierr
@@ -527,7 +531,7 @@ contains
     end do
     call MPI_Allreduce(MPI_IN_PLACE, fd%moments, 12 * n, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
     PetscCall(event_end(EVENT_MOMENTS, ierr))
-  end subroutine fd_moments
+  end subroutine fictitious_domain_moments
 
   ! The velocities of the spheres: beta M U = beta b(u~) - m(Lambda^n) + F_ext (method.md eq. (1)
   ! with the weights), for free motion; prescribed, resistance and fixed motions set them.
@@ -535,12 +539,12 @@ contains
   ! the right-hand side next to external_force/external_torque (free and frozen motion).
   ! lubrication, optional: the links of this configuration (mod_particle_lubrication); their
   ! resistance enters the 6N system implicitly. contacts, optional: the contacts of this step
-  ! (pcontacts_step at X^n): their forces and torques join the right-hand side (free and frozen
+  ! (particle_contacts_step at X^n): their forces and torques join the right-hand side (free and frozen
   ! motion) and, for free motion with implicit contacts, their linearised stiffness the 6N system;
   ! after the solve their force, torque and stresslet are those the balance used
   ! (mod_particle_contacts). Identical on every rank (replicated data).
-  subroutine fd_solve_motion(fd, parts, ierr, extra_force, extra_torque, lubrication, contacts)
-    type(fd_t), intent(inout) :: fd
+  subroutine fictitious_domain_solve_motion(fd, parts, ierr, extra_force, extra_torque, lubrication, contacts)
+    type(fictitious_domain_t), intent(inout) :: fd
     type(particles_t), intent(inout) :: parts
     PetscErrorCode, intent(out) :: ierr
     real(dp), intent(in), optional :: extra_force(:, :), extra_torque(:, :)
@@ -558,38 +562,37 @@ contains
       ! repeats the same iterations)
       x(1:3, :) = parts%velocity
       x(4:6, :) = parts%omega
-      call psys_reset(fd%system, n)
+      call particle_system_reset(fd%solver%system, n)
       do q = 1, n
-        call psys_add_diagonal(fd%system, q, fd%beta * fd%rigid_matrix(:, :, q))
+        call particle_system_add_diagonal(fd%solver%system, q, fd%beta * fd%rigid_matrix(:, :, q))
         rhs(:, q) = fd%beta * fd%moments(1:6, q) - fd%moments(7:12, q) &
              + [parts%external_force(:, q), parts%external_torque(:, q)]
         if (present(extra_force)) rhs(1:3, q) = rhs(1:3, q) + extra_force(:, q)
         if (present(extra_torque)) rhs(4:6, q) = rhs(4:6, q) + extra_torque(:, q)
         if (present(contacts)) rhs(:, q) = rhs(:, q) + [contacts%force(:, q), contacts%torque(:, q)]
       end do
-      if (present(lubrication)) call plub_add_to_system(lubrication, fd%system, rhs)
+      if (present(lubrication)) call particle_lubrication_add_to_system(lubrication, fd%solver%system, rhs)
       if (present(contacts) .and. parts%motion == MOTION_FREE) &
-        call pcontacts_add_stiffness(contacts, fd%system, rhs, parts%velocity, parts%omega, parts%have_prev)
-      call psolver_solve_checked(fd%solver, fd%system, rhs, x, fd%solver_iterations, ierr, &
-                                 ': a particle covers no grid face?')
+        call particle_contacts_add_stiffness(contacts, fd%solver%system, rhs, parts%velocity, parts%omega, parts%have_prev)
+      call particle_solver_solve(fd%solver, rhs, x, ierr, ': a particle covers no grid face?')
       CHKERRQ(ierr)
       parts%velocity = x(1:3, :)
       parts%omega = x(4:6, :)
-      if (present(contacts)) call pcontacts_implicit_update(contacts, parts%velocity, parts%omega)
+      if (present(contacts)) call particle_contacts_implicit_update(contacts, parts%velocity, parts%omega)
     case default                    ! prescribed, resistance, fixed
       call impose_motion(parts)
     end select
     PetscCall(event_end(EVENT_MOTION, ierr))
-  end subroutine fd_solve_motion
+  end subroutine fictitious_domain_solve_motion
 
   ! Lambda^{n+1} = [Lambda^n + beta alpha (g.U - u~)]/(1 + gamma) on owned faces, 0 elsewhere;
   ! u^{n+1} = u~ + (Lambda^{n+1} - Lambda^n)/beta; the moments F = -sum Lambda e_c dV,
   ! T = -sum r x Lambda e_c dV, S = -1/2 sum Lambda (r e_c + e_c r) dV - (sum_cells alpha p dV) I
   ! (§1.6). vel: u~ on entry, u^{n+1} on exit. lubrication, optional: its corrections are added to
   ! the resolved force, torque and stresslet, which then hold the total hydrodynamics. Collective.
-  subroutine fd_update(grid, fd, vel, pressure, parts, ierr, lubrication)
+  subroutine fictitious_domain_update(grid, fd, vel, pressure, parts, ierr, lubrication)
     type(grid_t), intent(in) :: grid
-    type(fd_t), intent(inout) :: fd
+    type(fictitious_domain_t), intent(inout) :: fd
     Vec, intent(inout) :: vel(3)
     Vec, intent(in) :: pressure
     type(particles_t), intent(inout) :: parts
@@ -607,7 +610,7 @@ contains
     dv = grid%h**3
     allocate(sums(16, n))
     sums = 0.0_dp
-    ! Lambda^n is non-zero only on the listed faces once fd_follow has carried it there; then
+    ! Lambda^n is non-zero only on the listed faces once fictitious_domain_follow has carried it there; then
     ! removing it and adding Lambda^{n+1} is one pass over the list. Otherwise (the first step
     ! of a run, -fd_carry_lambda 0) Lambda^{n+1} is computed first and Lambda^n removed from the
     ! whole grid, as the formula says; both give the same numbers where both apply.
@@ -666,7 +669,7 @@ contains
       PetscCall(DMDAVecRestoreArrayF90(grid%da(c), vel(c), u(c)%ptr, ierr))
     end do
     call MPI_Allreduce(MPI_IN_PLACE, sums, 16 * n, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
-    if (present(lubrication)) call plub_corrections(lubrication, parts%velocity, parts%omega)
+    if (present(lubrication)) call particle_lubrication_corrections(lubrication, parts%velocity, parts%omega)
     do q = 1, n
       parts%force_hydro(:, q) = sums(1:3, q)
       parts%torque_hydro(:, q) = sums(4:6, q)
@@ -677,9 +680,9 @@ contains
       end do
     end do
     if (present(lubrication)) &
-      call plub_add_corrections(lubrication, parts%force_hydro, parts%torque_hydro, parts%stresslet_hydro)
+      call particle_lubrication_add_corrections(lubrication, parts%force_hydro, parts%torque_hydro, parts%stresslet_hydro)
     PetscCall(event_end(EVENT_UPDATE, ierr))
-  end subroutine fd_update
+  end subroutine fictitious_domain_update
 
 
   ! The kernels below take one run (one sphere, one velocity component c) on plain arrays with the
@@ -701,7 +704,7 @@ contains
     end select
   end subroutine torque_arm
 
-  ! Lambda carried by the displacement: trilinear from the eight corners of x_f - dX (fd_follow).
+  ! Lambda carried by the displacement: trilinear from the eight corners of x_f - dX (fictitious_domain_follow).
   subroutine carry_run(old, new, glo, ghi, lo, hi, nfaces, ijk, corner, weight, moved, walls, ny)
     integer, intent(in) :: glo(3), ghi(3), lo(3), hi(3), nfaces, ijk(3, nfaces), corner(3, 8), ny
     real(dp), intent(in) :: old(glo(1):ghi(1), glo(2):ghi(2), glo(3):ghi(3)), weight(8)
@@ -715,7 +718,7 @@ contains
       end do
       return
     end if
-    ! corner m = 1..8 is (o1 + a, o2 + b, o3 + e), a fastest (fd_follow)
+    ! corner m = 1..8 is (o1 + a, o2 + b, o3 + e), a fastest (fictitious_domain_follow)
     i0 = corner(1, 1); j0 = corner(2, 1); k0 = corner(3, 1)
     do f = 1, nfaces
       i = ijk(1, f) + i0; j = ijk(2, f) + j0; k = ijk(3, f) + k0
@@ -736,7 +739,7 @@ contains
     end do
   end subroutine carry_run
 
-  ! moments(1:6) += sum w u~_c g dV, moments(7:12) += sum Lambda^n/(1+gamma) g dV (fd_moments).
+  ! moments(1:6) += sum w u~_c g dV, moments(7:12) += sum Lambda^n/(1+gamma) g dV (fictitious_domain_moments).
   subroutine moments_run(c, u, lam, lo, hi, nfaces, ijk, r, alpha, relax, dv, moments)
     integer, intent(in) :: c, lo(3), hi(3), nfaces, ijk(3, nfaces)
     real(dp), intent(in) :: u(lo(1):hi(1), lo(2):hi(2), lo(3):hi(3)), lam(lo(1):hi(1), lo(2):hi(2), lo(3):hi(3))
@@ -774,7 +777,7 @@ contains
     end do
   end subroutine new_lambda_run
 
-  ! One run of fd_update: Lambda^{n+1} (from lambda_new when given, the grid then already free
+  ! One run of fictitious_domain_update: Lambda^{n+1} (from lambda_new when given, the grid then already free
   ! of Lambda^n), u^{n+1} = u~ - Lambda^n/beta + Lambda^{n+1}/beta, and the run's force, torque
   ! and stresslet added to sums(1:15) (the 3x3 block stored by columns in 7:15).
   subroutine update_run(c, u, lam, lo, hi, nfaces, ijk, r, alpha, relax, beta, dv, velocity, omega, sums, lambda_new)
@@ -828,14 +831,14 @@ contains
   end subroutine pressure_run
 
 
-  subroutine fd_destroy(fd, ierr)
-    type(fd_t), intent(inout) :: fd
+  subroutine fictitious_domain_destroy(fd, ierr)
+    type(fictitious_domain_t), intent(inout) :: fd
     PetscErrorCode, intent(out) :: ierr
     integer :: c
     do c = 1, 3
       PetscCall(VecDestroy(fd%lambda(c), ierr))
     end do
-    PetscCall(psolver_destroy(fd%solver, ierr))
-  end subroutine fd_destroy
+    PetscCall(particle_solver_destroy(fd%solver, ierr))
+  end subroutine fictitious_domain_destroy
 
 end module mod_fictitious_domain

@@ -2,23 +2,24 @@
 ! link (the 6N particle system is replicated), but evaluating them (resistance functions, the
 ! 12x12 blocks, their projection onto positive semi-definite matrices) is ~15 us per pair, and the
 ! paper scene has ~4000 pairs: each rank evaluates one contiguous share of the pair candidates
-! (mod_particle_lubrication plub_links), and the shares are gathered in rank order, so every rank
-! holds the links in the order one rank alone would have made them, bitwise the same.
+! (particle_lubrication_links), and the shares are gathered in rank order, so every rank holds the
+! links in the order one rank alone would have made them, bitwise the same.
 #include <petsc/finclude/petscsys.h>
 module mod_lubrication_links
   use petscsys
   use mod_kinds, only: dp
   use mod_pair_resistance, only: n_pair_scalars
-  use mod_particle_lubrication, only: particle_lubrication_t, plub_links, plub_reserve_pairs
+  use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_links, &
+                                      particle_lubrication_reserve_pairs
   implicit none
   private
-  public :: lubrication_links
+  public :: lubrication_links_evaluate
 
 contains
 
   !> The links at positions x (3, np) on every rank. Collective. offset (optional): the
   !> Lees-Edwards offset of this configuration (lubrication dynamics with sliding boundaries).
-  subroutine lubrication_links(pl, x, ierr, offset)
+  subroutine lubrication_links_evaluate(pl, x, ierr, offset)
     type(particle_lubrication_t), intent(inout) :: pl
     real(dp), intent(in) :: x(:, :)
     PetscErrorCode, intent(out) :: ierr
@@ -30,10 +31,10 @@ contains
     PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, ranks, ierr))
     PetscCallMPI(MPI_Comm_rank(PETSC_COMM_WORLD, rank, ierr))
     if (ranks == 1) then
-      call plub_links(pl, x, offset=offset)
+      call particle_lubrication_links(pl, x, offset=offset)
       return
     end if
-    call plub_links(pl, x, rank, ranks, offset)
+    call particle_lubrication_links(pl, x, rank, ranks, offset)
     mine = pl%npairs
     allocate(counts(0:ranks - 1), displs(0:ranks - 1))
     PetscCallMPI(MPI_Allgather(mine, 1, MPI_INTEGER, counts, 1, MPI_INTEGER, PETSC_COMM_WORLD, ierr))
@@ -42,7 +43,7 @@ contains
       displs(r) = displs(r - 1) + counts(r - 1)
     end do
     total = sum(counts)
-    call plub_reserve_pairs(pl, max(total, 1))
+    call particle_lubrication_reserve_pairs(pl, max(total, 1))
     ! each share at its place in the whole, then gathered in place
     if (displs(rank) > 0 .and. mine > 0) then
       pl%pair(:, displs(rank) + 1:displs(rank) + mine) = pl%pair(:, 1:mine)
@@ -69,6 +70,6 @@ contains
       integer, intent(in) :: per_link
       PetscCallMPI(MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, a, per_link * counts, per_link * displs, MPI_DOUBLE_PRECISION, PETSC_COMM_WORLD, ierr))
     end subroutine gather
-  end subroutine lubrication_links
+  end subroutine lubrication_links_evaluate
 
 end module mod_lubrication_links

@@ -1,6 +1,12 @@
-! The implicit 6N particle system (method.md §1.5 eq. (1)) once lubrication couples the spheres:
-! the blocks assembled by mod_particle_system go into a sparse PETSc matrix (AIJ, block size 6) and
-! are solved by a KSP with the options prefix particles_. Defaults: CG preconditioned by the exact
+! The owner of the implicit 6N particle system (method.md §1.5 eq. (1)) and of its solution. A
+! caller (mod_fictitious_domain, mod_ld_motion) resets the system it holds here (%system), lets the
+! kernels add their blocks to it in plain arrays (mod_particle_system's assembly:
+! particle_system_reset, particle_system_add_diagonal, particle_system_add_pair, which
+! mod_particle_lubrication and mod_particle_contacts call), and solves it by particle_solver_solve;
+! nothing else outside src/kernels/ solves it. Without pair blocks the system is block diagonal and
+! mod_particle_system's block solve is exact (one iteration); once lubrication or contact stiffness
+! couples the spheres the blocks go into a sparse PETSc matrix and are solved by a KSP with the
+! options prefix particles_. Defaults: CG preconditioned by the exact
 ! inverse of each 6x6 diagonal block (PCPBJACOBI), relative tolerance 1e-12, started from the
 ! velocities of the last step (issue 31: 44 -> 26 iterations per step on the paper scene), on a
 ! block-AIJ matrix (BAIJ, 6x6 blocks: one index per block, assembly and products ~2x faster than
@@ -14,28 +20,29 @@
 ! lubrication dynamics (no fluid mass on the diagonal) CG takes 64-97 iterations at 1000 spheres and
 ! is still the faster, ~7x at 500 spheres (doc/BENCHMARKS.md §11). Particle data is replicated, so every
 ! rank assembles and solves the same sequential system and gets the same answer.
-! Without pair blocks the system is block diagonal and mod_particle_system solves it directly.
 #include <petsc/finclude/petscksp.h>
 module mod_particle_solver
   use petscksp
   use mod_kinds, only: dp
-  use mod_particle_system, only: particle_system_t, psys_solve
+  use mod_particle_system, only: particle_system_t, particle_system_solve
   use mod_petsc_options, only: set_default_option
   use mod_errors, only: fatal_error
   implicit none
   private
-  public :: particle_solver_t, psolver_create, psolver_solve, psolver_solve_checked, psolver_destroy
+  public :: particle_solver_t, particle_solver_create, particle_solver_solve, particle_solver_destroy
 
   type :: particle_solver_t
+    type(particle_system_t) :: system   ! the 6N system of the step, assembled by the caller
+    integer :: iterations = 0           ! of the last solve
     KSP :: ksp
     logical :: created = .false.
-    integer :: solves = 0
-    real(dp) :: seconds = 0.0_dp        ! assembly + solve, summed over the run
+    integer :: solves = 0               ! sparse (KSP) solves
+    real(dp) :: seconds = 0.0_dp        ! their assembly + solve, summed over the run
   end type particle_solver_t
 
 contains
 
-  subroutine psolver_create(ps, ierr)
+  subroutine particle_solver_create(ps, ierr)
     type(particle_solver_t), intent(inout) :: ps
     PetscErrorCode, intent(out) :: ierr
     PetscCall(set_default_option('-particles_ksp_type', 'cg', ierr))
@@ -46,44 +53,48 @@ contains
     PetscCall(KSPSetOptionsPrefix(ps%ksp, 'particles_', ierr))
     PetscCall(KSPSetFromOptions(ps%ksp, ierr))
     ps%created = .true.
-  end subroutine psolver_create
+  end subroutine particle_solver_create
 
-  !> Solve sys x = rhs (both 6 x n) from the guess in x: block by block when no pair couples the
-  !> system (mod_particle_system), else by the KSP. A failure stops the run (status 4) with one
-  !> message; hint, appended to the message of a failed block solve, says what may have caused it.
-  subroutine psolver_solve_checked(ps, sys, rhs, x, iterations, ierr, hint)
+  !> Solve ps%system x = rhs (both 6 x n) from the guess in x: block by block when no pair couples
+  !> the system (mod_particle_system), else by the KSP; ps%iterations as the solver counts them. A
+  !> failure stops the run (status 4) with one message; hint, appended to the message of a failed
+  !> block solve, says what may have caused it.
+  subroutine particle_solver_solve(ps, rhs, x, ierr, hint)
     type(particle_solver_t), intent(inout) :: ps
-    type(particle_system_t), intent(in) :: sys
     real(dp), intent(in) :: rhs(:, :)
     real(dp), intent(inout) :: x(:, :)
-    integer, intent(out) :: iterations
     PetscErrorCode, intent(out) :: ierr
     character(len=*), intent(in) :: hint
     KSPConvergedReason :: reason
     logical :: ok
     character(len=300) :: text
+    real(dp) :: t0
     ierr = 0
-    if (sys%npairs == 0) then
-      call psys_solve(sys, rhs, x, 1.0e-12_dp, iterations, ok)
+    if (ps%system%npairs == 0) then
+      call particle_system_solve(ps%system, rhs, x, 1.0e-12_dp, ps%iterations, ok)
       if (.not. ok) then
         write(text, '(a,i0,2a)') 'fdsusp: fatal: the particle system is not positive definite or did not '// &
-             'converge (', iterations, ' iterations)', hint
+             'converge (', ps%iterations, ' iterations)', hint
         call fatal_error(text, 4)
       end if
     else
-      PetscCall(psolver_solve(ps, sys, rhs, x, iterations, reason, ierr))
+      t0 = MPI_Wtime()
+      PetscCall(ksp_solve(ps%ksp, ps%system, rhs, x, ps%iterations, reason, ierr))
+      ps%solves = ps%solves + 1
+      ps%seconds = ps%seconds + (MPI_Wtime() - t0)
       if (reason < 0) then
         write(text, '(a,i0,a,i0,a)') 'fdsusp: fatal: the particle system solve failed (KSP converged reason ', &
-             reason, ' after ', iterations, ' iterations; see -particles_ksp_converged_reason)'
+             reason, ' after ', ps%iterations, ' iterations; see -particles_ksp_converged_reason)'
         call fatal_error(text, 4)
       end if
     end if
-  end subroutine psolver_solve_checked
+  end subroutine particle_solver_solve
 
-  !> Solve sys x = rhs (both 6 x n), from the guess in x. The converged reason is returned in
-  !> reason (negative: not converged); iterations as KSP counts them.
-  subroutine psolver_solve(ps, sys, rhs, x, iterations, reason, ierr)
-    type(particle_solver_t), intent(inout) :: ps
+  !> Solve sys x = rhs (both 6 x n) by ksp, from the guess in x: assembly of the sparse matrix,
+  !> then the solve. The converged reason is returned in reason (negative: not converged);
+  !> iterations as KSP counts them.
+  subroutine ksp_solve(ksp, sys, rhs, x, iterations, reason, ierr)
+    KSP, intent(in) :: ksp
     type(particle_system_t), intent(in) :: sys
     real(dp), intent(in) :: rhs(:, :)
     real(dp), intent(inout) :: x(:, :)
@@ -93,15 +104,13 @@ contains
     Mat :: a
     Vec :: vx, vb
     PetscInt :: n6, row(1), col(1), its
-    PetscInt, parameter :: zero = 0, one = 1, six = 6
+    PetscInt, parameter :: one = 1, six = 6
     PetscInt, allocatable :: nnz(:), upper(:)
     PetscBool :: sbaij
     KSPType :: ksp_type
     PetscScalar, pointer :: p(:)
     integer :: q, i, j
-    real(dp) :: t0
 
-    t0 = MPI_Wtime()
     n6 = 6 * sys%n
     ! block row of particle i: its diagonal block and one block per pair it belongs to
     allocate(nnz(sys%n))
@@ -158,16 +167,16 @@ contains
     p = reshape(x(:, 1:sys%n), [6 * sys%n])
     PetscCall(VecRestoreArrayF90(vx, p, ierr))
     ! a direct solve (preonly) takes no guess
-    PetscCall(KSPGetType(ps%ksp, ksp_type, ierr))
+    PetscCall(KSPGetType(ksp, ksp_type, ierr))
     if (trim(ksp_type) == trim(KSPPREONLY)) then
-      PetscCall(KSPSetInitialGuessNonzero(ps%ksp, PETSC_FALSE, ierr))
+      PetscCall(KSPSetInitialGuessNonzero(ksp, PETSC_FALSE, ierr))
     else
-      PetscCall(KSPSetInitialGuessNonzero(ps%ksp, PETSC_TRUE, ierr))
+      PetscCall(KSPSetInitialGuessNonzero(ksp, PETSC_TRUE, ierr))
     end if
-    PetscCall(KSPSetOperators(ps%ksp, a, a, ierr))
-    PetscCall(KSPSolve(ps%ksp, vb, vx, ierr))
-    PetscCall(KSPGetConvergedReason(ps%ksp, reason, ierr))
-    PetscCall(KSPGetIterationNumber(ps%ksp, its, ierr))
+    PetscCall(KSPSetOperators(ksp, a, a, ierr))
+    PetscCall(KSPSolve(ksp, vb, vx, ierr))
+    PetscCall(KSPGetConvergedReason(ksp, reason, ierr))
+    PetscCall(KSPGetIterationNumber(ksp, its, ierr))
     iterations = int(its)
     PetscCall(VecGetArrayReadF90(vx, p, ierr))
     x(:, 1:sys%n) = reshape(p, [6, sys%n])
@@ -175,9 +184,7 @@ contains
     PetscCall(VecDestroy(vx, ierr))
     PetscCall(VecDestroy(vb, ierr))
     PetscCall(MatDestroy(a, ierr))
-    ps%solves = ps%solves + 1
-    ps%seconds = ps%seconds + (MPI_Wtime() - t0)
-  end subroutine psolver_solve
+  end subroutine ksp_solve
 
   ! PETSc takes a block row by row
   pure function row_major(b) result(v)
@@ -186,7 +193,7 @@ contains
     v = reshape(transpose(b), [36])
   end function row_major
 
-  subroutine psolver_destroy(ps, ierr)
+  subroutine particle_solver_destroy(ps, ierr)
     type(particle_solver_t), intent(inout) :: ps
     PetscErrorCode, intent(out) :: ierr
     ierr = 0
@@ -194,6 +201,6 @@ contains
       PetscCall(KSPDestroy(ps%ksp, ierr))
     end if
     ps%created = .false.
-  end subroutine psolver_destroy
+  end subroutine particle_solver_destroy
 
 end module mod_particle_solver

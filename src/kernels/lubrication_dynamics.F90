@@ -16,30 +16,32 @@
 ! system stays positive definite); their stresslets are lub_pair_stresslets' (the deviatoric
 ! R_SU, R_SE part and the trace of method.md §2.7, as for the DNS correction), so the rheology
 ! compares with the DNS quantity by quantity.
-! Pure: no PETSc, MPI or files (the sparse solve is mod_ld_motion's).
+! Pure: no PETSc, MPI or files (the system is solved by its owner, mod_particle_solver, in
+! mod_ld_motion).
 module mod_lubrication_dynamics
   use mod_kinds, only: dp, pi
   use mod_particles, only: particles_t, MOTION_FREE
-  use mod_particle_system, only: particle_system_t, psys_reset, psys_add_diagonal
-  use mod_particle_lubrication, only: particle_lubrication_t, plub_add_to_system, plub_add_corrections
-  use mod_particle_contacts, only: particle_contacts_t, pcontacts_add_stiffness
+  use mod_particle_system, only: particle_system_t, particle_system_reset, particle_system_add_diagonal
+  use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_add_to_system, &
+                                      particle_lubrication_add_corrections
+  use mod_particle_contacts, only: particle_contacts_t, particle_contacts_add_stiffness
   implicit none
   private
-  public :: lubrication_dynamics_t, ld_create, ld_ambient_velocity, ld_ambient_gradients, ld_one_body_block, &
-            ld_assemble, ld_hydrodynamics
+  public :: lubrication_dynamics_t, lubrication_dynamics_create, lubrication_dynamics_ambient_velocity, &
+            lubrication_dynamics_ambient_gradients, lubrication_dynamics_one_body_block, &
+            lubrication_dynamics_assemble, lubrication_dynamics_hydrodynamics
 
   type :: lubrication_dynamics_t
     real(dp) :: radius = 1.0_dp, viscosity = 1.0_dp
     real(dp) :: shear_rate = 0.0_dp
     real(dp) :: box(3) = 0.0_dp
     logical :: sheared = .false.            ! walls or Lees-Edwards boundaries carry the shear
-    type(particle_system_t) :: system       ! the 6N system of the step
   end type lubrication_dynamics_t
 
 contains
 
   !> sheared: the imposed flow is the shear (walls or Lees-Edwards), else the fluid is at rest.
-  subroutine ld_create(ld, radius, viscosity, shear_rate, box, sheared)
+  subroutine lubrication_dynamics_create(ld, radius, viscosity, shear_rate, box, sheared)
     type(lubrication_dynamics_t), intent(out) :: ld
     real(dp), intent(in) :: radius, viscosity, shear_rate, box(3)
     logical, intent(in) :: sheared
@@ -48,19 +50,19 @@ contains
     ld%shear_rate = shear_rate
     ld%box = box
     ld%sheared = sheared
-  end subroutine ld_create
+  end subroutine lubrication_dynamics_create
 
   !> U_inf at x: gamma_dot (y - Ly/2) e_x.
-  pure function ld_ambient_velocity(ld, x) result(u)
+  pure function lubrication_dynamics_ambient_velocity(ld, x) result(u)
     type(lubrication_dynamics_t), intent(in) :: ld
     real(dp), intent(in) :: x(3)
     real(dp) :: u(3)
     u = 0.0_dp
     if (ld%sheared) u(1) = ld%shear_rate * (x(2) - 0.5_dp * ld%box(2))
-  end function ld_ambient_velocity
+  end function lubrication_dynamics_ambient_velocity
 
   !> Omega_inf = -gamma_dot/2 e_z and E_inf = gamma_dot/2 (e_x e_y + e_y e_x).
-  pure subroutine ld_ambient_gradients(ld, om, e)
+  pure subroutine lubrication_dynamics_ambient_gradients(ld, om, e)
     type(lubrication_dynamics_t), intent(in) :: ld
     real(dp), intent(out) :: om(3), e(3, 3)
     real(dp) :: g
@@ -70,10 +72,10 @@ contains
     e = 0.0_dp
     e(1, 2) = 0.5_dp * g
     e(2, 1) = 0.5_dp * g
-  end subroutine ld_ambient_gradients
+  end subroutine lubrication_dynamics_ambient_gradients
 
   !> The one-body resistance R_1B = diag(6 pi eta a I, 8 pi eta a^3 I) (Stokes; Kim & Karrila §2.2).
-  pure function ld_one_body_block(ld) result(r)
+  pure function lubrication_dynamics_one_body_block(ld) result(r)
     type(lubrication_dynamics_t), intent(in) :: ld
     real(dp) :: r(6, 6)
     integer :: k
@@ -82,51 +84,53 @@ contains
       r(k, k) = 6.0_dp * pi * ld%viscosity * ld%radius
       r(3 + k, 3 + k) = 8.0_dp * pi * ld%viscosity * ld%radius**3
     end do
-  end function ld_one_body_block
+  end function lubrication_dynamics_one_body_block
 
-  !> The 6N system of free (or frozen) spheres at their positions: R_1B on every diagonal block and
-  !> R_1B (U_inf, Omega_inf) + F_ext onto rhs (6, n); the links of lubrication and the contact
-  !> forces (and, for free motion with implicit contacts, their stiffness), each when present.
-  subroutine ld_assemble(ld, parts, rhs, lubrication, contacts)
-    type(lubrication_dynamics_t), intent(inout) :: ld
+  !> The 6N system sys of free (or frozen) spheres at their positions (reset here; its owner,
+  !> mod_particle_solver, solves it): R_1B on every diagonal block and R_1B (U_inf, Omega_inf) +
+  !> F_ext onto rhs (6, n); the links of lubrication and the contact forces (and, for free motion
+  !> with implicit contacts, their stiffness), each when present.
+  subroutine lubrication_dynamics_assemble(ld, parts, sys, rhs, lubrication, contacts)
+    type(lubrication_dynamics_t), intent(in) :: ld
     type(particles_t), intent(in) :: parts
+    type(particle_system_t), intent(inout) :: sys
     real(dp), intent(out) :: rhs(:, :)
     type(particle_lubrication_t), intent(in), optional :: lubrication
     type(particle_contacts_t), intent(inout), optional :: contacts
     real(dp) :: r1(6, 6), om(3), e(3, 3)
     integer :: q
-    r1 = ld_one_body_block(ld)
-    call ld_ambient_gradients(ld, om, e)
-    call psys_reset(ld%system, parts%n)
+    r1 = lubrication_dynamics_one_body_block(ld)
+    call lubrication_dynamics_ambient_gradients(ld, om, e)
+    call particle_system_reset(sys, parts%n)
     do q = 1, parts%n
-      call psys_add_diagonal(ld%system, q, r1)
-      rhs(:, q) = matmul(r1, [ld_ambient_velocity(ld, parts%position(:, q)), om]) &
+      call particle_system_add_diagonal(sys, q, r1)
+      rhs(:, q) = matmul(r1, [lubrication_dynamics_ambient_velocity(ld, parts%position(:, q)), om]) &
                   + [parts%external_force(:, q), parts%external_torque(:, q)]
       if (present(contacts)) rhs(:, q) = rhs(:, q) + [contacts%force(:, q), contacts%torque(:, q)]
     end do
-    if (present(lubrication)) call plub_add_to_system(lubrication, ld%system, rhs)
+    if (present(lubrication)) call particle_lubrication_add_to_system(lubrication, sys, rhs)
     if (present(contacts) .and. parts%motion == MOTION_FREE) &
-      call pcontacts_add_stiffness(contacts, ld%system, rhs, parts%velocity, parts%omega, parts%have_prev)
-  end subroutine ld_assemble
+      call particle_contacts_add_stiffness(contacts, sys, rhs, parts%velocity, parts%omega, parts%have_prev)
+  end subroutine lubrication_dynamics_assemble
 
   !> With the velocities of the step: the hydrodynamic force, torque and stresslet on each sphere,
-  !> one-body plus the links' (lubrication%force etc., plub_corrections), into parts%force_hydro,
+  !> one-body plus the links' (lubrication%force etc., particle_lubrication_corrections), into parts%force_hydro,
   !> torque_hydro, stresslet_hydro.
-  subroutine ld_hydrodynamics(ld, parts, lubrication)
+  subroutine lubrication_dynamics_hydrodynamics(ld, parts, lubrication)
     type(lubrication_dynamics_t), intent(in) :: ld
     type(particles_t), intent(inout) :: parts
     type(particle_lubrication_t), intent(in), optional :: lubrication
     real(dp) :: om(3), e(3, 3)
     integer :: q
-    call ld_ambient_gradients(ld, om, e)
+    call lubrication_dynamics_ambient_gradients(ld, om, e)
     do q = 1, parts%n
       parts%force_hydro(:, q) = 6.0_dp * pi * ld%viscosity * ld%radius &
-                                * (ld_ambient_velocity(ld, parts%position(:, q)) - parts%velocity(:, q))
+                                * (lubrication_dynamics_ambient_velocity(ld, parts%position(:, q)) - parts%velocity(:, q))
       parts%torque_hydro(:, q) = 8.0_dp * pi * ld%viscosity * ld%radius**3 * (om - parts%omega(:, q))
       parts%stresslet_hydro(:, :, q) = 20.0_dp / 3.0_dp * pi * ld%viscosity * ld%radius**3 * e
     end do
     if (present(lubrication)) &
-      call plub_add_corrections(lubrication, parts%force_hydro, parts%torque_hydro, parts%stresslet_hydro)
-  end subroutine ld_hydrodynamics
+      call particle_lubrication_add_corrections(lubrication, parts%force_hydro, parts%torque_hydro, parts%stresslet_hydro)
+  end subroutine lubrication_dynamics_hydrodynamics
 
 end module mod_lubrication_dynamics

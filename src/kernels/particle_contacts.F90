@@ -14,8 +14,8 @@
 !      stresslet, the history advanced by one step.
 ! Implicit contacts (doc/CONTACT.md "Implicit contacts"; the default, pc%implicit): the particle
 ! solve then adds the linearised stiffness of every open contact to its 6N system
-! (pcontacts_add_stiffness) and, once U^n is known, the force it implied to the step's contact
-! force, torque and stresslet (pcontacts_implicit_update): the force the balance used is the
+! (particle_contacts_add_stiffness) and, once U^n is known, the force it implied to the step's contact
+! force, torque and stresslet (particle_contacts_implicit_update): the force the balance used is the
 ! contact force at the end of the step, X^{n+1}, linearised about X^n.
 module mod_particle_contacts
   use mod_kinds, only: dp
@@ -23,11 +23,11 @@ module mod_particle_contacts
                          contact_forces, contact_links_t, contact_stiffness, contact_stresslet
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates
   use mod_lees_edwards, only: lees_edwards_t
-  use mod_particle_system, only: particle_system_t, psys_add_diagonal, psys_add_pair
+  use mod_particle_system, only: particle_system_t, particle_system_add_diagonal, particle_system_add_pair
   implicit none
   private
-  public :: particle_contacts_t, pcontacts_create, pcontacts_step
-  public :: pcontacts_add_stiffness, pcontacts_implicit_update
+  public :: particle_contacts_t, particle_contacts_create, particle_contacts_step
+  public :: particle_contacts_add_stiffness, particle_contacts_implicit_update
 
   type :: particle_contacts_t
     type(contact_params_t) :: params
@@ -44,7 +44,7 @@ module mod_particle_contacts
     real(dp) :: max_overlap = 0              ! max |delta'| of the last step [a]
     real(dp), allocatable :: force(:,:), torque(:,:), stresslet(:,:,:)   ! of the last step
     ! implicit contacts: the switch, the open contacts of the step, and what
-    ! pcontacts_add_stiffness keeps for pcontacts_implicit_update
+    ! particle_contacts_add_stiffness keeps for particle_contacts_implicit_update
     logical :: implicit = .true.
     type(contact_links_t) :: links
     logical :: stiffness_added = .false.
@@ -61,7 +61,7 @@ contains
   !> info: 0 ok, else msg says what is wrong (contact_setup or nlist_init refused).
   !> implicit, optional: the contact stiffness enters the particle solve (default .true.).
   !> le, optional: Lees-Edwards boundaries in y (walls must then be .false.).
-  subroutine pcontacts_create(pc, np, a, eps_r, mu_d, eps_bar, k_n_prescribed, skin, eta, &
+  subroutine particle_contacts_create(pc, np, a, eps_r, mu_d, eps_bar, k_n_prescribed, skin, eta, &
                               shear_rate, box, walls, dt, info, msg, implicit, le)
     type(particle_contacts_t), intent(out) :: pc
     integer, intent(in) :: np
@@ -97,14 +97,14 @@ contains
     pc%force = 0
     pc%torque = 0
     pc%stresslet = 0
-  end subroutine pcontacts_create
+  end subroutine particle_contacts_create
 
   !> One step: contacts at positions x (3, np) with velocities u, om (3, np). Results in
   !> pc%force, pc%torque, pc%stresslet (3, 3, np) and pc%stats; the history advances by one step.
   !> info: 0 ok; 1 the history belongs to another particle count; 2 an overlap beyond
   !> pc%overlap_limit (pc%max_overlap says how far). offset, optional: the Lees-Edwards offset
   !> delta of this configuration (runs created with le).
-  subroutine pcontacts_step(pc, x, u, om, info, offset)
+  subroutine particle_contacts_step(pc, x, u, om, info, offset)
     type(particle_contacts_t), intent(inout) :: pc
     real(dp), intent(in) :: x(:,:), u(:,:), om(:,:)
     integer, intent(out) :: info
@@ -125,10 +125,10 @@ contains
     pc%max_overlap = pc%stats%max_overlap * pc%params%h_r
     if (pc%params%h_r <= 0) pc%max_overlap = pc%stats%max_overlap * pc%params%a
     if (pc%max_overlap > pc%overlap_limit) info = 2
-  end subroutine pcontacts_step
+  end subroutine particle_contacts_step
 
   !> The implicit part of this step's contacts into the 6N system [(rho/dt) M + R + K] U = rhs of
-  !> the particle solve (free motion; after pcontacts_step, whose forces stay on the right-hand
+  !> the particle solve (free motion; after particle_contacts_step, whose forces stay on the right-hand
   !> side). Positions advance by X^{n+1} - X^n = c_now U^n + c_before U^{n-1} (advance_positions:
   !> Adams-Bashforth 2, c_now = 3/2 dt, c_before = -1/2 dt; forward Euler on a run's first step,
   !> ab2 = .false.: dt, 0), and the next step's spring by U^s(U^n) dt. The force the solve sees is
@@ -138,7 +138,7 @@ contains
   !> c_now K_n + dt K_t goes into the matrix (two 6x6 diagonal blocks and one coupling block per
   !> pair, one diagonal block per wall contact), the rest onto rhs (6, np). u, om (3, np): the
   !> velocities of the previous step, U^{n-1}, Omega^{n-1}. Nothing when pc%implicit is off.
-  subroutine pcontacts_add_stiffness(pc, sys, rhs, u, om, ab2)
+  subroutine particle_contacts_add_stiffness(pc, sys, rhs, u, om, ab2)
     type(particle_contacts_t), intent(inout) :: pc
     type(particle_system_t), intent(inout) :: sys
     real(dp), intent(inout) :: rhs(:,:)
@@ -163,10 +163,10 @@ contains
       a = pc%c_now * kn + pc%dt * kt
       i = pc%links%i(m)
       j = pc%links%partner(m)
-      call psys_add_diagonal(sys, i, a(1:6, 1:6))
+      call particle_system_add_diagonal(sys, i, a(1:6, 1:6))
       if (j > 0) then
-        call psys_add_diagonal(sys, j, a(7:12, 7:12))
-        call psys_add_pair(sys, i, j, a(1:6, 7:12))
+        call particle_system_add_diagonal(sys, j, a(7:12, 7:12))
+        call particle_system_add_pair(sys, i, j, a(1:6, 7:12))
         q = [u(:, i), om(:, i), u(:, j) + pc%links%image_velocity(:, m), om(:, j)]
         g = -pc%c_before * matmul(kn, q)
         if (pc%le%active) then
@@ -185,12 +185,12 @@ contains
       end if
     end do
     pc%stiffness_added = .true.
-  end subroutine pcontacts_add_stiffness
+  end subroutine particle_contacts_add_stiffness
 
-  !> After the solve: u, om (3, np) = U^n, Omega^n. Adds dF of pcontacts_add_stiffness to the
+  !> After the solve: u, om (3, np) = U^n, Omega^n. Adds dF of particle_contacts_add_stiffness to the
   !> step's contact force, torque and stresslet (lever as in contact_forces), which then hold the
-  !> contact force the particle balance used. Nothing unless pcontacts_add_stiffness ran this step.
-  subroutine pcontacts_implicit_update(pc, u, om)
+  !> contact force the particle balance used. Nothing unless particle_contacts_add_stiffness ran this step.
+  subroutine particle_contacts_implicit_update(pc, u, om)
     type(particle_contacts_t), intent(inout) :: pc
     real(dp), intent(in) :: u(:,:), om(:,:)
     real(dp) :: kn(12, 12), kt(12, 12), q(12), q0(12), g(12), s(3, 3)
@@ -224,7 +224,7 @@ contains
       end if
     end do
     pc%stiffness_added = .false.
-  end subroutine pcontacts_implicit_update
+  end subroutine particle_contacts_implicit_update
 
 
 end module mod_particle_contacts

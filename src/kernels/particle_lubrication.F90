@@ -23,11 +23,12 @@ module mod_particle_lubrication
        lub_wall_link, lub_pair_stresslets, lub_wall_stresslet, n_wall_scalars, LUB_NONE, LUB_EXACT
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates
   use mod_lees_edwards, only: lees_edwards_t, le_separation
-  use mod_particle_system, only: particle_system_t, psys_add_diagonal, psys_add_pair
+  use mod_particle_system, only: particle_system_t, particle_system_add_diagonal, particle_system_add_pair
   implicit none
   private
-  public :: particle_lubrication_t, plub_create, plub_links, plub_corrections, plub_reserve_pairs, plub_add_to_system, &
-            plub_add_corrections
+  public :: particle_lubrication_t, particle_lubrication_create, particle_lubrication_links, &
+            particle_lubrication_corrections, particle_lubrication_reserve_pairs, &
+            particle_lubrication_add_to_system, particle_lubrication_add_corrections
 
   type :: particle_lubrication_t
     type(lubrication_t) :: lub
@@ -59,7 +60,7 @@ contains
 
   !> lub: the configured model (mod_lubrication lub_setup); skin: neighbour-list skin [a].
   !> le, optional: Lees-Edwards boundaries in y (walls .false.).
-  subroutine plub_create(pl, lub, np, box, walls, shear_rate, skin, info, msg, le)
+  subroutine particle_lubrication_create(pl, lub, np, box, walls, shear_rate, skin, info, msg, le)
     type(particle_lubrication_t), intent(out) :: pl
     type(lubrication_t), intent(in) :: lub
     integer, intent(in) :: np
@@ -103,7 +104,7 @@ contains
                     skin, info, pl%le)
     if (info /= 0) msg = 'lubrication: the neighbour search refuses this box (a periodic length below '// &
                          '2 x (2a + outer_cutoff + skin))'
-  end subroutine plub_create
+  end subroutine particle_lubrication_create
 
   pure function ambient_velocity(pl, x) result(u)
     type(particle_lubrication_t), intent(in) :: pl
@@ -131,7 +132,7 @@ contains
   !> part, parts (optional): only the part-th of parts contiguous shares of the pair candidates
   !> (0-based; mod_lubrication_links gathers the shares of all ranks in order); walls always all.
   !> offset (optional): the Lees-Edwards offset delta of this configuration (runs created with le).
-  subroutine plub_links(pl, x, part, parts, offset)
+  subroutine particle_lubrication_links(pl, x, part, parts, offset)
     type(particle_lubrication_t), intent(inout) :: pl
     real(dp), intent(in) :: x(:, :)
     integer, intent(in), optional :: part, parts
@@ -145,7 +146,7 @@ contains
     pl%failed_link = 0
     if (pl%lub%model == LUB_NONE) return
     if (present(offset)) pl%le%offset = offset
-    ! one sphere: its wall candidates were set once by plub_create
+    ! one sphere: its wall candidates were set once by particle_lubrication_create
     if (pl%np > 1) call nlist_candidates(pl%nlist, x, pl%cand, pl%ncand, pl%cand_walls, pl%ncand_walls, pl%le%offset)
     call ambient_gradients(pl, om_inf, e_inf)
     if (pl%lub%model == LUB_EXACT) then
@@ -261,7 +262,7 @@ contains
 
     subroutine grow_pairs()
       if (pl%npairs < size(pl%pair, 2)) return
-      call plub_reserve_pairs(pl, 2 * size(pl%pair, 2))
+      call particle_lubrication_reserve_pairs(pl, 2 * size(pl%pair, 2))
     end subroutine grow_pairs
 
     subroutine grow_walls()
@@ -276,10 +277,10 @@ contains
       allocate(t2(6, m)); t2(:, 1:pl%nwalls) = pl%wall_drive(:, 1:pl%nwalls); call move_alloc(t2, pl%wall_drive)
     end subroutine grow_walls
 
-  end subroutine plub_links
+  end subroutine particle_lubrication_links
 
   !> Room for n pair links (the first npairs kept).
-  subroutine plub_reserve_pairs(pl, n)
+  subroutine particle_lubrication_reserve_pairs(pl, n)
     type(particle_lubrication_t), intent(inout) :: pl
     integer, intent(in) :: n
     integer :: m
@@ -293,12 +294,12 @@ contains
     allocate(t2(6, m)); t2(:, 1:pl%npairs) = pl%pair_uinf(:, 1:pl%npairs); call move_alloc(t2, pl%pair_uinf)
     allocate(t3(12, 12, m)); t3(:, :, 1:pl%npairs) = pl%pair_r(:, :, 1:pl%npairs); call move_alloc(t3, pl%pair_r)
     allocate(t2(12, m)); t2(:, 1:pl%npairs) = pl%pair_drive(:, 1:pl%npairs); call move_alloc(t2, pl%pair_drive)
-  end subroutine plub_reserve_pairs
+  end subroutine particle_lubrication_reserve_pairs
 
   !> The links into a 6N system (method.md §1.5 eq. (1)): each pair's 12x12 block as two diagonal
   !> blocks and one coupling block, each wall link's 6x6 on its particle's diagonal; their
   !> velocity-independent parts (R.U_inf + R_FE:E_inf) onto rhs (6, np).
-  subroutine plub_add_to_system(pl, sys, rhs)
+  subroutine particle_lubrication_add_to_system(pl, sys, rhs)
     type(particle_lubrication_t), intent(in) :: pl
     type(particle_system_t), intent(inout) :: sys
     real(dp), intent(inout) :: rhs(:, :)
@@ -306,22 +307,22 @@ contains
     do l = 1, pl%npairs
       i = pl%pair(1, l)
       j = pl%pair(2, l)
-      call psys_add_diagonal(sys, i, pl%pair_r(1:6, 1:6, l))
-      call psys_add_diagonal(sys, j, pl%pair_r(7:12, 7:12, l))
-      call psys_add_pair(sys, i, j, pl%pair_r(1:6, 7:12, l))
+      call particle_system_add_diagonal(sys, i, pl%pair_r(1:6, 1:6, l))
+      call particle_system_add_diagonal(sys, j, pl%pair_r(7:12, 7:12, l))
+      call particle_system_add_pair(sys, i, j, pl%pair_r(1:6, 7:12, l))
       rhs(:, i) = rhs(:, i) + pl%pair_drive(1:6, l)
       rhs(:, j) = rhs(:, j) + pl%pair_drive(7:12, l)
     end do
     do l = 1, pl%nwalls
       i = pl%wall_part(l)
-      call psys_add_diagonal(sys, i, pl%wall_r(:, :, l))
+      call particle_system_add_diagonal(sys, i, pl%wall_r(:, :, l))
       rhs(:, i) = rhs(:, i) + pl%wall_drive(:, l)
     end do
-  end subroutine plub_add_to_system
+  end subroutine particle_lubrication_add_to_system
 
   !> The corrections with the velocities of this step, u and om (3, np): force, torque and
   !> stresslet on each particle (pl%force, pl%torque, pl%stresslet).
-  subroutine plub_corrections(pl, u, om)
+  subroutine particle_lubrication_corrections(pl, u, om)
     type(particle_lubrication_t), intent(inout) :: pl
     real(dp), intent(in) :: u(:, :), om(:, :)
     integer :: l, i, j
@@ -352,16 +353,16 @@ contains
       pl%torque(:, i) = pl%torque(:, i) + ft6(4:6)
       pl%stresslet(:, :, i) = pl%stresslet(:, :, i) + lub_wall_stresslet(pl%lub, pl%wall_n(:, l), ft6(1:3))
     end do
-  end subroutine plub_corrections
+  end subroutine particle_lubrication_corrections
 
-  !> Add the links' corrections of plub_corrections to a sphere's hydrodynamic force, torque
+  !> Add the links' corrections of particle_lubrication_corrections to a sphere's hydrodynamic force, torque
   !> (3, np) and stresslet (3, 3, np).
-  subroutine plub_add_corrections(pl, force, torque, stresslet)
+  subroutine particle_lubrication_add_corrections(pl, force, torque, stresslet)
     type(particle_lubrication_t), intent(in) :: pl
     real(dp), intent(inout) :: force(:, :), torque(:, :), stresslet(:, :, :)
     force = force + pl%force
     torque = torque + pl%torque
     stresslet = stresslet + pl%stresslet
-  end subroutine plub_add_corrections
+  end subroutine particle_lubrication_add_corrections
 
 end module mod_particle_lubrication

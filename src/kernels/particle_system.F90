@@ -6,12 +6,17 @@
 ! The matrix is symmetric positive definite when every added pair contribution is positive
 ! semi-definite. Solved by conjugate gradients preconditioned with the exact inverse of each 6x6
 ! diagonal block (Cholesky); with no pair blocks that is a direct solve in one iteration.
+! This module is the system's assembly in plain arrays; in a run the system belongs to
+! mod_particle_solver (bodies), which holds it, lets the kernels add their blocks and solves it
+! (this block solve when no pair couples it, else PETSc's KSP). Nothing else outside src/kernels/
+! solves it; the unit tests call the block solve directly.
 ! Pure: the same data sits on every rank, so every rank computes the same answer.
 module mod_particle_system
   use mod_kinds, only: dp
   implicit none
   private
-  public :: particle_system_t, psys_reset, psys_add_diagonal, psys_add_pair, psys_solve, psys_apply
+  public :: particle_system_t, particle_system_reset, particle_system_add_diagonal, &
+            particle_system_add_pair, particle_system_solve, particle_system_apply
 
   type :: particle_system_t
     integer :: n = 0                          ! particles
@@ -23,7 +28,7 @@ module mod_particle_system
 
 contains
 
-  subroutine psys_reset(sys, n)
+  subroutine particle_system_reset(sys, n)
     type(particle_system_t), intent(inout) :: sys
     integer, intent(in) :: n
     if (allocated(sys%diag)) then
@@ -34,17 +39,17 @@ contains
     sys%diag = 0.0_dp
     sys%npairs = 0
     if (.not. allocated(sys%pair)) allocate(sys%pair(2, 64), sys%block(6, 6, 64))
-  end subroutine psys_reset
+  end subroutine particle_system_reset
 
-  subroutine psys_add_diagonal(sys, p, a)
+  subroutine particle_system_add_diagonal(sys, p, a)
     type(particle_system_t), intent(inout) :: sys
     integer, intent(in) :: p
     real(dp), intent(in) :: a(6, 6)
     sys%diag(:, :, p) = sys%diag(:, :, p) + a
-  end subroutine psys_add_diagonal
+  end subroutine particle_system_add_diagonal
 
   ! Add A(i,j) = a_ij (and A(j,i) = transpose(a_ij)).
-  subroutine psys_add_pair(sys, i, j, a_ij)
+  subroutine particle_system_add_pair(sys, i, j, a_ij)
     type(particle_system_t), intent(inout) :: sys
     integer, intent(in) :: i, j
     real(dp), intent(in) :: a_ij(6, 6)
@@ -60,9 +65,9 @@ contains
     sys%npairs = sys%npairs + 1
     sys%pair(:, sys%npairs) = [i, j]
     sys%block(:, :, sys%npairs) = a_ij
-  end subroutine psys_add_pair
+  end subroutine particle_system_add_pair
 
-  pure subroutine psys_apply(sys, x, y)
+  pure subroutine particle_system_apply(sys, x, y)
     type(particle_system_t), intent(in) :: sys
     real(dp), intent(in) :: x(6, sys%n)
     real(dp), intent(out) :: y(6, sys%n)
@@ -76,11 +81,11 @@ contains
       y(:, i) = y(:, i) + matmul(sys%block(:, :, q), x(:, j))
       y(:, j) = y(:, j) + matmul(transpose(sys%block(:, :, q)), x(:, i))
     end do
-  end subroutine psys_apply
+  end subroutine particle_system_apply
 
   ! Solve to relative residual rtol from x = 0. ok is false when a diagonal block is not positive
   ! definite or CG did not converge in 10*6n iterations.
-  subroutine psys_solve(sys, rhs, x, rtol, iterations, ok)
+  subroutine particle_system_solve(sys, rhs, x, rtol, iterations, ok)
     type(particle_system_t), intent(in) :: sys
     real(dp), intent(in) :: rhs(6, sys%n), rtol
     real(dp), intent(out) :: x(6, sys%n)
@@ -105,7 +110,7 @@ contains
     rz = sum(r * z)
     do while (iterations < 60 * sys%n)
       iterations = iterations + 1
-      call psys_apply(sys, d, q)
+      call particle_system_apply(sys, d, q)
       step = rz / sum(d * q)
       x = x + step * d
       r = r - step * q
@@ -116,7 +121,7 @@ contains
       rz = rz_new
     end do
     ok = .false.
-  end subroutine psys_solve
+  end subroutine particle_system_solve
 
   pure subroutine precondition(chol, r, z)
     real(dp), intent(in) :: chol(:, :, :), r(:, :)

@@ -18,29 +18,32 @@ program fdsusp
   use mod_series, only: series_t, series_open, series_record, series_flush, series_attributes
   use mod_output, only: write_fields, progress_line
   use mod_checkpoint, only: checkpoint_write, checkpoint_check, checkpoint_read
-  use mod_os_services, only: install_signal_handlers, stop_signal, make_directory, probe_directory, lock_directory, &
-                        release_directory
+  use mod_os_services, only: install_signal_handlers, stop_signal, make_directory, probe_directory, &
+                             lock_directory, release_directory
   use mod_timers, only: timers_register, stage_push, stage_pop, STAGE_SETUP, STAGE_FLUID, STAGE_OUTPUT, &
                         STAGE_PARTICLES, STAGE_CONTACTS, STAGE_LUBRICATION
   use mod_particles, only: particles_t, advance_positions, displacements, MOTION_FREE
   use mod_particles_io, only: particles_load, particles_snapshot
-  use mod_rheology, only: rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, rheo_state, rheo_restore, &
-                          rheo_write_summary, rheo_summarise, summary_names, NSUMMARY
-  use mod_fictitious_domain, only: fd_t, fd_create, fd_geometry, fd_follow, fd_moments, fd_solve_motion, fd_update, &
-                                   fd_destroy
-  use mod_particle_contacts, only: particle_contacts_t, pcontacts_create, pcontacts_step
+  use mod_rheology, only: rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, &
+                          rheo_state, rheo_restore, rheo_write_summary, rheo_summarise, summary_names, &
+                          NSUMMARY
+  use mod_fictitious_domain, only: fictitious_domain_t, fictitious_domain_create, &
+                                   fictitious_domain_geometry, fictitious_domain_follow, &
+                                   fictitious_domain_moments, fictitious_domain_solve_motion, &
+                                   fictitious_domain_update, fictitious_domain_destroy
+  use mod_particle_contacts, only: particle_contacts_t, particle_contacts_create, particle_contacts_step
   use mod_contact, only: chatter_number, stick_number, flattening_estimate, wall_lower, wall_upper
   use mod_lubrication, only: lubrication_t, LUB_NONE, LUB_SIMPLE, LUB_EXACT
   use mod_lubrication_io, only: lubrication_load
-  use mod_particle_lubrication, only: particle_lubrication_t, plub_create
-  use mod_lubrication_links, only: lubrication_links
+  use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_create
+  use mod_lubrication_links, only: lubrication_links_evaluate
   use mod_h5util, only: h5util_init
   use mod_solvers, only: solver_t, solver_create, solver_cold_solve, solver_destroy, fft_planner_flags
   use mod_grid, only: FIELD_P
   use mod_lees_edwards, only: lees_edwards_t, le_create, le_wrap, le_advance
-  use mod_lubrication_dynamics, only: lubrication_dynamics_t, ld_create
-  use mod_ld_motion, only: ld_solve_motion
-  use mod_particle_solver, only: particle_solver_t, psolver_create, psolver_destroy
+  use mod_lubrication_dynamics, only: lubrication_dynamics_t, lubrication_dynamics_create
+  use mod_ld_motion, only: ld_motion_solve
+  use mod_particle_solver, only: particle_solver_t, particle_solver_create, particle_solver_destroy
   implicit none
 
   PetscErrorCode :: ierr
@@ -50,7 +53,7 @@ program fdsusp
   type(solver_t) :: yardstick                       ! -bench_cold_poisson's multigrid solve
   type(series_t) :: series
   type(particles_t) :: parts
-  type(fd_t) :: fd
+  type(fictitious_domain_t) :: fd
   type(particle_contacts_t) :: pc
   type(lubrication_t) :: lub
   type(particle_lubrication_t), allocatable :: pl   ! allocated when lubrication is on
@@ -107,7 +110,7 @@ program fdsusp
   ! contacts: the deck has &contact and the run has particles (doc/CONTACT.md)
   has_contacts = has_particles .and. cfg%contact_group
   if (has_contacts) then
-    call pcontacts_create(pc, parts%n, parts%radius, cfg%roughness, cfg%friction, cfg%eps_bar, &
+    call particle_contacts_create(pc, parts%n, parts%radius, cfg%roughness, cfg%friction, cfg%eps_bar, &
          cfg%normal_stiffness, cfg%neighbour_skin, 1.0_dp, cfg%shear_rate, cfg%box, cfg%walls, cfg%dt, &
          info, text, cfg%contact_implicit, le)
     if (info /= 0) call input_error(cfg%deck_file, 'contact', '', trim(text))
@@ -117,7 +120,7 @@ program fdsusp
   has_lubrication = lub%model /= LUB_NONE
   if (has_lubrication) then
     allocate(pl)
-    call plub_create(pl, lub, parts%n, cfg%box, cfg%walls, cfg%shear_rate, cfg%lubrication_skin, info, text, le)
+    call particle_lubrication_create(pl, lub, parts%n, cfg%box, cfg%walls, cfg%shear_rate, cfg%lubrication_skin, info, text, le)
     if (info /= 0) call input_error(cfg%deck_file, 'lubrication', 'skin', trim(text))
   end if
   ! rough contacts: the limits of doc/CONTACT.md and doc/VALIDATION.md §6, before any work
@@ -164,13 +167,13 @@ program fdsusp
     PetscCallA(grid_create(cfg, grid, ierr))
     PetscCallA(fluid_create(cfg, grid, fl, ierr))
     if (has_particles) then
-      PetscCallA(fd_create(grid, cfg%reynolds, cfg%dt, cfg%slip_kappa, cfg%radius_offset, fd, ierr))
+      PetscCallA(fictitious_domain_create(grid, cfg%reynolds, cfg%dt, cfg%slip_kappa, cfg%radius_offset, fd, ierr))
     end if
   else
     ! lubrication dynamics: no grid, no fluid; the imposed shear comes from the walls or the
     ! sliding boundaries (mod_lubrication_dynamics)
-    call ld_create(ld, parts%radius, 1.0_dp, cfg%shear_rate, cfg%box, cfg%walls .or. cfg%lees_edwards)
-    PetscCallA(psolver_create(ld_solver, ierr))
+    call lubrication_dynamics_create(ld, parts%radius, 1.0_dp, cfg%shear_rate, cfg%box, cfg%walls .or. cfg%lees_edwards)
+    PetscCallA(particle_solver_create(ld_solver, ierr))
   end if
   if (restarting .and. .not. cfg%resolved) then
     ! (statistics: absent when unallocated, i.e. without &rheology; history: without contacts)
@@ -290,9 +293,9 @@ program fdsusp
   stop_reason = RUNNING
   if (step >= cfg%steps) stop_reason = DONE
   if (has_particles .and. cfg%resolved) then
-    ! the geometry at X^n; each step then moves it, and Lambda with it, to X^{n+1} (fd_follow)
+    ! the geometry at X^n; each step then moves it, and Lambda with it, to X^{n+1} (fictitious_domain_follow)
     PetscCallA(stage_push(STAGE_PARTICLES, ierr))
-    call fd_geometry(grid, fd, parts)
+    call fictitious_domain_geometry(grid, fd, parts)
     PetscCallA(stage_pop(ierr))
     ! -fd_carry_lambda 0: leave Lambda on the faces of X^n (the scheme before 2026-11-23; for the
     ! comparison of doc/VALIDATION.md §5.3 only)
@@ -304,7 +307,7 @@ program fdsusp
       if (has_contacts) then
         ! contacts at X^n with the latest velocities (those of the previous step)
         PetscCallA(stage_push(STAGE_CONTACTS, ierr))
-        call pcontacts_step(pc, parts%position, parts%velocity, parts%omega, info, le%offset)
+        call particle_contacts_step(pc, parts%position, parts%velocity, parts%omega, info, le%offset)
         if (info /= 0) call contact_failure(info)
         if (pc%max_overlap > largest_overlap) call note_overlap()
         PetscCallA(stage_pop(ierr))
@@ -312,7 +315,7 @@ program fdsusp
       if (has_lubrication) then
         ! the lubrication links at X^n, taken implicitly in the particle problem below
         PetscCallA(stage_push(STAGE_LUBRICATION, ierr))
-        PetscCallA(lubrication_links(pl, parts%position, ierr, le%offset))
+        PetscCallA(lubrication_links_evaluate(pl, parts%position, ierr, le%offset))
         if (pl%failed_link(1) /= 0) call lubrication_failure(pl%failed_link)
         PetscCallA(stage_pop(ierr))
       end if
@@ -324,22 +327,22 @@ program fdsusp
         ! the particle sub-problem (method.md §1.5 eq. (1)): moments of u~ and Lambda^n, the 6N
         ! system for U, Omega (contact forces and lubrication links, each absent when not
         ! allocated), then Lambda^{n+1}, u^{n+1} and the hydrodynamic force, torque, stresslet
-        PetscCallA(fd_moments(grid, fd, fl%vel, parts%n, ierr))
+        PetscCallA(fictitious_domain_moments(grid, fd, fl%vel, parts%n, ierr))
         if (has_contacts) then
-          PetscCallA(fd_solve_motion(fd, parts, ierr, lubrication=pl, contacts=pc))
+          PetscCallA(fictitious_domain_solve_motion(fd, parts, ierr, lubrication=pl, contacts=pc))
         else
-          PetscCallA(fd_solve_motion(fd, parts, ierr, lubrication=pl))
+          PetscCallA(fictitious_domain_solve_motion(fd, parts, ierr, lubrication=pl))
         end if
-        PetscCallA(fd_update(grid, fd, fl%vel, fl%pressure, parts, ierr, pl))
+        PetscCallA(fictitious_domain_update(grid, fd, fl%vel, fl%pressure, parts, ierr, pl))
       else
         PetscCallA(stage_push(STAGE_PARTICLES, ierr))
         ! lubrication dynamics: the 6N Stokes balance of the spheres alone (one-body drag in the
         ! imposed flow, the pair and wall links, the contacts), then their hydrodynamic force,
         ! torque and stresslet (mod_lubrication_dynamics)
         if (has_contacts) then
-          PetscCallA(ld_solve_motion(ld, ld_solver, parts, ierr, lubrication=pl, contacts=pc))
+          PetscCallA(ld_motion_solve(ld, ld_solver, parts, ierr, lubrication=pl, contacts=pc))
         else
-          PetscCallA(ld_solve_motion(ld, ld_solver, parts, ierr, lubrication=pl))
+          PetscCallA(ld_motion_solve(ld, ld_solver, parts, ierr, lubrication=pl))
         end if
       end if
       ! the core statistics of this configuration, before it moves on
@@ -361,9 +364,9 @@ program fdsusp
       if (cfg%resolved) then
         if (carry_lambda) then
           position_before = displacements(parts%position, position_before, cfg%box, [.true., .not. cfg%walls, .true.])
-          PetscCallA(fd_follow(grid, fd, parts, position_before, ierr))
+          PetscCallA(fictitious_domain_follow(grid, fd, parts, position_before, ierr))
         else
-          call fd_geometry(grid, fd, parts)
+          call fictitious_domain_geometry(grid, fd, parts)
         end if
       end if
       PetscCallA(stage_pop(ierr))
@@ -478,12 +481,12 @@ program fdsusp
 
   if (cfg%resolved) then
     if (has_particles) then
-      PetscCallA(fd_destroy(fd, ierr))
+      PetscCallA(fictitious_domain_destroy(fd, ierr))
     end if
     PetscCallA(fluid_destroy(fl, ierr))
     PetscCallA(grid_destroy(grid, ierr))
   else
-    PetscCallA(psolver_destroy(ld_solver, ierr))
+    PetscCallA(particle_solver_destroy(ld_solver, ierr))
   end if
   call release_directory()
   PetscCallA(PetscFinalize(ierr))

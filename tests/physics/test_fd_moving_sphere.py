@@ -11,7 +11,7 @@ sphere sits at mid-height, so the walls push no lift; |F_y|, |F_z| < 1e-6 |F_x|)
 is zero to the same level.
 Second run, the same sphere at dt = 1e-2 (0.1 cells per step, 100 steps): the scheme's steady
 state does not depend on dt (method.md §1.5b), so only the lag of the incremental lambda behind
-the moving body can change the drag. Lambda is carried with the sphere (fd_follow); measured:
+the moving body can change the drag. Lambda is carried with the sphere (fictitious_domain_follow); measured:
 mean drag over the last 50 steps -3.5 % from the dt = 1e-3 value, ripple 0.84 %. Without carrying
 (-fd_carry_lambda 0): -8.0 % and 4.3 %. Asserted: within 5 % and ripple <= 2 % (issue 9's bound),
 so the uncarried scheme fails both."""

@@ -6,8 +6,12 @@ shows that the check catches what it must: on a copy of the sources it plants, o
 kernel that uses hdf5, a kernel that uses mod_errors (runtime), a fluid module that uses
 mod_fictitious_domain (bodies), a C source among the kernels and a module in a file of another
 name, and each must fail the check with one violation, named by file, line and import.
+Also the naming rule of the particle glue modules (doc/DESIGN.md "Names of the particle glue
+modules"): every public name of mod_x in src/bodies/ and in the kernels particle_system,
+particle_contacts, particle_lubrication and lubrication_dynamics is x_t or x_<verb>.
 Exact (no tolerance): exit statuses and message text. Python standard library only; ~2 s of CPU."""
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -35,6 +39,19 @@ p = subprocess.run([sys.executable, SCRIPT] + kernels, cwd=ROOT, capture_output=
 pure = p.stdout.split()
 check(p.returncode == 0 and pure == kernels, 'scripts/pure-modules lists all %d kernels as pure (%s)'
       % (len(kernels), ', '.join(sorted(set(kernels) - set(pure))) or 'none missing'))
+
+# the naming rule of the particle glue modules
+glue = sorted(os.path.join('src', 'bodies', f) for f in os.listdir(os.path.join(ROOT, 'src', 'bodies'))
+              if f.endswith('.F90')) + \
+       [os.path.join('src', 'kernels', f + '.F90') for f in ('particle_system', 'particle_contacts',
+                                                             'particle_lubrication', 'lubrication_dynamics')]
+for path in glue:
+    short = os.path.basename(path)[:-len('.F90')]
+    text = open(os.path.join(ROOT, path)).read().replace('&\n', ' ')
+    names = [n.strip() for m in re.finditer(r'^\s*public\s*::(.*)$', text, re.M) for n in m.group(1).split(',')]
+    off = [n for n in names if not n.startswith(short + '_')]
+    check(names and not off, '%s: its %d public names are %s_t or %s_<verb>%s'
+          % (path, len(names), short, short, ' (not: %s)' % ', '.join(off) if off else ''))
 
 
 def planted(what, path, edit, expect):

@@ -1,5 +1,5 @@
 ! Unit test of the implicit contact stiffness (mod_contact contact_stiffness; mod_particle_contacts
-! pcontacts_add_stiffness, pcontacts_implicit_update; doc/CONTACT.md "Implicit contacts").
+! particle_contacts_add_stiffness, particle_contacts_implicit_update; doc/CONTACT.md "Implicit contacts").
 ! a = eta = gamma_dot = 1, eps_r = 5e-3, eps_bar = 0.05 (k_n = 4.769e6), mu_d = 0.5 unless said.
 ! Generalised coordinates q = (U_i, Omega_i, U_j, Omega_j); the generalised force of a contact is
 ! G = (F, T, -F, T) (F on i, T = a n x F on both).
@@ -34,7 +34,7 @@
 !      once (0.92: the next position step still carries -dt U^{n-1}/2 of the approach velocity);
 !      from step 4 on no sign change of consecutive overlap increments (those below 1e-12 of
 !      the overlap are rounding), overlap (F/k_n)^(2/3) to 1e-9 and the contact force the
-!      balance used (pcontacts_implicit_update) equal to -F to 1e-9 after 300 steps (the linear
+!      balance used (particle_contacts_implicit_update) equal to -F to 1e-9 after 300 steps (the linear
 !      rate is (1 + z/2)/(1 + 3z/2) = 0.57 per step at z = 1.5), action = reaction bitwise.
 !   7. The same with friction for a sphere pressed on the lower wall (moving at 0.01 e_x) with
 !      resistance r I_6: k_t dt M_t = 4.3 > 2 at the Hertz overlap (the explicit spring's limit,
@@ -45,9 +45,10 @@ program test_contact_stiffness
   use mod_kinds, only: dp, pi
   use mod_vector, only: cross
   use mod_contact, only: contact_params_t, contact_setup, contact_pair, contact_stiffness
-  use mod_particle_contacts, only: particle_contacts_t, pcontacts_create, pcontacts_step, &
-                                   pcontacts_add_stiffness, pcontacts_implicit_update
-  use mod_particle_system, only: particle_system_t, psys_reset, psys_add_diagonal, psys_solve
+  use mod_particle_contacts, only: particle_contacts_t, particle_contacts_create, particle_contacts_step, &
+                                   particle_contacts_add_stiffness, particle_contacts_implicit_update
+  use mod_particle_system, only: particle_system_t, particle_system_reset, particle_system_add_diagonal, &
+                                 particle_system_solve
   use mod_unit_checks, only: check, check_below, finish
   implicit none
   type(contact_params_t) :: p, p0
@@ -266,7 +267,7 @@ contains
     integer :: step, its, c, info
     logical :: ok, have_prev
     character(len=200) :: msg
-    call pcontacts_create(pc, 2, 1.0_dp, 5.0e-3_dp, 0.0_dp, 0.05_dp, 0.0_dp, 0.2_dp, 1.0_dp, 1.0_dp, &
+    call particle_contacts_create(pc, 2, 1.0_dp, 5.0e-3_dp, 0.0_dp, 0.05_dp, 0.0_dp, 0.2_dp, 1.0_dp, 1.0_dp, &
                           [20.0_dp, 20.0_dp, 20.0_dp], .true., dt, info, msg, implicit_mode)
     d6 = 0
     do c = 1, 6
@@ -280,22 +281,22 @@ contains
     have_prev = .false.
     opened = .false.
     do step = 1, size(overlap)
-      call pcontacts_step(pc, x, u, om, info)
+      call particle_contacts_step(pc, x, u, om, info)
       if (info /= 0) then
         opened = .true.                           ! overlap beyond h_r: as bad as chatter
         overlap(step:) = overlap(max(step - 1, 1))
         exit
       end if
-      call psys_reset(sys, 2)
-      call psys_add_diagonal(sys, 1, d6)
-      call psys_add_diagonal(sys, 2, d6)
+      call particle_system_reset(sys, 2)
+      call particle_system_add_diagonal(sys, 1, d6)
+      call particle_system_add_diagonal(sys, 2, d6)
       rhs(:, 1) = [f, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp] + [pc%force(:, 1), pc%torque(:, 1)]
       rhs(:, 2) = [-f, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp] + [pc%force(:, 2), pc%torque(:, 2)]
-      call pcontacts_add_stiffness(pc, sys, rhs, u, om, have_prev)
-      call psys_solve(sys, rhs, sol, 1e-14_dp, its, ok)
+      call particle_contacts_add_stiffness(pc, sys, rhs, u, om, have_prev)
+      call particle_system_solve(sys, rhs, sol, 1e-14_dp, its, ok)
       u = sol(1:3, :)
       om = sol(4:6, :)
-      call pcontacts_implicit_update(pc, u, om)
+      call particle_contacts_implicit_update(pc, u, om)
       if (have_prev) then
         x = x + dt * (1.5_dp * u - 0.5_dp * u_prev)
       else
@@ -321,7 +322,7 @@ contains
     logical :: ok, have_prev, stuck
     character(len=200) :: msg
     ! the lower wall moves at -shear_rate Ly/2: shear_rate = -2 v_wall / Ly gives +v_wall
-    call pcontacts_create(pc, 1, 1.0_dp, 5.0e-3_dp, 0.5_dp, 0.05_dp, p%k_n, 0.2_dp, 1.0_dp, &
+    call particle_contacts_create(pc, 1, 1.0_dp, 5.0e-3_dp, 0.5_dp, 0.05_dp, p%k_n, 0.2_dp, 1.0_dp, &
                           -2 * v_wall / 20.0_dp, [20.0_dp, 20.0_dp, 20.0_dp], .true., dt, info, msg, .true.)
     call check(info == 0 .and. abs(pc%wall_velocity(1, 1) - v_wall) < 1e-15_dp, '7. wall at +0.01 e_x')
     kt_dt_m = p%kt_coeff * p%k_n * sqrt(p%eps_bar * p%h_r) * dt * (1 / r + 1 / r)
@@ -339,16 +340,16 @@ contains
     stuck = .true.
     change = 0
     do step = 1, 600
-      call pcontacts_step(pc, x, u, om, info)
-      call psys_reset(sys, 1)
-      call psys_add_diagonal(sys, 1, d6)
+      call particle_contacts_step(pc, x, u, om, info)
+      call particle_system_reset(sys, 1)
+      call particle_system_add_diagonal(sys, 1, d6)
       rhs(:, 1) = [0.0_dp, -f, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp] + [pc%force(:, 1), pc%torque(:, 1)]
-      call pcontacts_add_stiffness(pc, sys, rhs, u, om, have_prev)
-      call psys_solve(sys, rhs, sol, 1e-14_dp, its, ok)
+      call particle_contacts_add_stiffness(pc, sys, rhs, u, om, have_prev)
+      call particle_system_solve(sys, rhs, sol, 1e-14_dp, its, ok)
       change = norm2(sol(1:3, 1) - u(:, 1)) + norm2(sol(4:6, 1) - om(:, 1))
       u = sol(1:3, :)
       om = sol(4:6, :)
-      call pcontacts_implicit_update(pc, u, om)
+      call particle_contacts_implicit_update(pc, u, om)
       if (have_prev) then
         x = x + dt * (1.5_dp * u - 0.5_dp * u_prev)
       else

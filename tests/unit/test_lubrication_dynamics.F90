@@ -19,17 +19,20 @@ program test_lubrication_dynamics
   use mod_kinds, only: dp, pi
   use mod_pair_mobility, only: pair_shear_functions
   use mod_particles, only: particles_t, particles_init, MOTION_FREE
-  use mod_particle_system, only: psys_solve
+  use mod_particle_system, only: particle_system_t, particle_system_solve
   use mod_lubrication, only: lubrication_t, lub_setup, LUB_EXACT, lub_pair_scalars
   use mod_resistance_blocks, only: pair_resistance_fu
-  use mod_particle_lubrication, only: particle_lubrication_t, plub_create, plub_links, plub_corrections
-  use mod_lubrication_dynamics, only: lubrication_dynamics_t, ld_create, ld_assemble, ld_hydrodynamics, &
-       ld_one_body_block
+  use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_create, &
+                                      particle_lubrication_links, particle_lubrication_corrections
+  use mod_lubrication_dynamics, only: lubrication_dynamics_t, lubrication_dynamics_create, &
+                                      lubrication_dynamics_assemble, lubrication_dynamics_hydrodynamics, &
+                                      lubrication_dynamics_one_body_block
   use mod_lees_edwards, only: lees_edwards_t, le_create, le_separation, le_wrap
   use mod_unit_checks, only: check, check_below, finish
   implicit none
   type(particles_t) :: parts
   type(lubrication_dynamics_t) :: ld
+  type(particle_system_t) :: sys
   type(lubrication_t) :: lub
   type(particle_lubrication_t) :: pl
   type(lees_edwards_t) :: le
@@ -46,12 +49,12 @@ program test_lubrication_dynamics
   ! 1. one sphere in shear
   call particles_init(parts, 1, 1.0_dp, MOTION_FREE)
   parts%position(:, 1) = [5.0_dp, 13.0_dp, 5.0_dp]
-  call ld_create(ld, 1.0_dp, 1.0_dp, 1.0_dp, box, .true.)
-  call ld_assemble(ld, parts, rhs(:, 1:1))
-  call psys_solve(ld%system, rhs(:, 1:1), x(:, 1:1), 1.0e-14_dp, its, ok)
+  call lubrication_dynamics_create(ld, 1.0_dp, 1.0_dp, 1.0_dp, box, .true.)
+  call lubrication_dynamics_assemble(ld, parts, sys, rhs(:, 1:1))
+  call particle_system_solve(sys, rhs(:, 1:1), x(:, 1:1), 1.0e-14_dp, its, ok)
   parts%velocity(:, 1) = x(1:3, 1)
   parts%omega(:, 1) = x(4:6, 1)
-  call ld_hydrodynamics(ld, parts)
+  call lubrication_dynamics_hydrodynamics(ld, parts)
   call check(ok, 'one sphere: solved')
   call check_below('one sphere: |U - (3, 0, 0)|', norm2(parts%velocity(:, 1) - [3.0_dp, 0.0_dp, 0.0_dp]) / 3, 1.0e-14_dp)
   call check_below('one sphere: |Omega - (0, 0, -1/2)| / (1/2)', norm2(parts%omega(:, 1) - [0.0_dp, 0.0_dp, -0.5_dp]) &
@@ -79,7 +82,7 @@ program test_lubrication_dynamics
   call particles_init(parts, 2, 1.0_dp, MOTION_FREE)
   box = [30.0_dp, 30.0_dp, 30.0_dp]
   le = le_create(box, 1.0_dp, 0.0_dp)
-  call ld_create(ld, 1.0_dp, 1.0_dp, 1.0_dp, box, .true.)
+  call lubrication_dynamics_create(ld, 1.0_dp, 1.0_dp, 1.0_dp, box, .true.)
   e = 0
   e(1, 2) = 0.5_dp
   e(2, 1) = 0.5_dp
@@ -89,11 +92,11 @@ program test_lubrication_dynamics
     d = [-0.8_dp, 0.6_dp, 0.0_dp] / norm2([-0.8_dp, 0.6_dp, 0.0_dp])
     parts%position(:, 1) = [15.0_dp, 15.0_dp, 15.0_dp]
     parts%position(:, 2) = parts%position(:, 1) + (2 + gap) * d
-    call plub_create(pl, lub, 2, box, .false., 1.0_dp, 0.2_dp, info, msg, le)
-    call plub_links(pl, parts%position)
-    call ld_assemble(ld, parts, rhs, pl)
+    call particle_lubrication_create(pl, lub, 2, box, .false., 1.0_dp, 0.2_dp, info, msg, le)
+    call particle_lubrication_links(pl, parts%position)
+    call lubrication_dynamics_assemble(ld, parts, sys, rhs, pl)
     x = 0
-    call psys_solve(ld%system, rhs, x, 1.0e-14_dp, its, ok)
+    call particle_system_solve(sys, rhs, x, 1.0e-14_dp, its, ok)
     urel = x(1:3, 2) - x(1:3, 1)
     call pair_shear_functions(gap, a_bg, b_bg, c_rot, k_bg, l_bg, m_bg)
     sep = (2 + gap) * d
@@ -135,6 +138,6 @@ program test_lubrication_dynamics
   call check_below('Lees-Edwards: le_wrap keeps every separation [a]', worst, 1.0e-14_dp)
   call check(abs(vel(1, 2) - (6.3_dp - 12)) < 1.0e-14_dp .and. abs(vel(1, 3) - (-6.1_dp + 12)) < 1.0e-14_dp &
              .and. vprev(1, 2) == vel(1, 2), 'Lees-Edwards: a wrapped sphere takes the velocity of its image')
-  call check(all(ld_one_body_block(ld) >= 0), 'one-body block non-negative')
+  call check(all(lubrication_dynamics_one_body_block(ld) >= 0), 'one-body block non-negative')
   call finish('test_lubrication_dynamics')
 end program test_lubrication_dynamics

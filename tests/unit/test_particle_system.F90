@@ -5,12 +5,12 @@
 !     solution satisfies A x = b to the requested 1e-12 relative residual, checked by an
 !     independent dense Gaussian elimination on the assembled 6N x 6N matrix (agreement 1e-9,
 !     which allows for the condition number ~1e3 of the test matrix);
-!  3. psys_apply is symmetric: x1.(A x2) = x2.(A x1) to 1e-12 relative;
+!  3. particle_system_apply is symmetric: x1.(A x2) = x2.(A x1) to 1e-12 relative;
 !  4. a block that is not positive definite is reported (ok = .false.), not solved.
 program test_particle_system
   use mod_kinds, only: dp
-  use mod_particle_system, only: particle_system_t, psys_reset, psys_add_diagonal, psys_add_pair, &
-       psys_solve, psys_apply
+  use mod_particle_system, only: particle_system_t, particle_system_reset, particle_system_add_diagonal, &
+                                 particle_system_add_pair, particle_system_solve, particle_system_apply
   use mod_unit_checks, only: check, finish
   implicit none
   integer, parameter :: n = 7
@@ -19,16 +19,16 @@ program test_particle_system
   integer :: p, q, its, i, j
   logical :: ok
 
-  call psys_reset(sys, n)
+  call particle_system_reset(sys, n)
   dense = 0.0_dp
   do p = 1, n
     d = spd(p, 3.0_dp)
-    call psys_add_diagonal(sys, p, d)
+    call particle_system_add_diagonal(sys, p, d)
     dense(6*p-5:6*p, 6*p-5:6*p) = d
     b(:, p) = [(sin(1.3_dp * p + i), i = 1, 6)]
   end do
-  call psys_solve(sys, b, x, 1.0e-12_dp, its, ok)
-  call psys_apply(sys, x, y)
+  call particle_system_solve(sys, b, x, 1.0e-12_dp, its, ok)
+  call particle_system_apply(sys, x, y)
   call check(ok .and. its == 1, 'diagonal system: solved in one iteration')
   call check(norm2(y - b) < 1.0e-13_dp * norm2(b), 'diagonal system: residual at round-off')
 
@@ -41,16 +41,16 @@ program test_particle_system
     case (4); i = 7; j = 1
     end select
     k = spd(10 + q, 50.0_dp)
-    call psys_add_diagonal(sys, i, k)
-    call psys_add_diagonal(sys, j, k)
-    call psys_add_pair(sys, i, j, -k)
+    call particle_system_add_diagonal(sys, i, k)
+    call particle_system_add_diagonal(sys, j, k)
+    call particle_system_add_pair(sys, i, j, -k)
     dense(6*i-5:6*i, 6*i-5:6*i) = dense(6*i-5:6*i, 6*i-5:6*i) + k
     dense(6*j-5:6*j, 6*j-5:6*j) = dense(6*j-5:6*j, 6*j-5:6*j) + k
     dense(6*i-5:6*i, 6*j-5:6*j) = dense(6*i-5:6*i, 6*j-5:6*j) - k
     dense(6*j-5:6*j, 6*i-5:6*i) = dense(6*j-5:6*j, 6*i-5:6*i) - transpose(k)
   end do
-  call psys_solve(sys, b, x, 1.0e-12_dp, its, ok)
-  call psys_apply(sys, x, y)
+  call particle_system_solve(sys, b, x, 1.0e-12_dp, its, ok)
+  call particle_system_apply(sys, x, y)
   call check(ok, 'coupled system: CG converged')
   call check(norm2(y - b) <= 1.0e-12_dp * norm2(b), 'coupled system: relative residual <= 1e-12')
   xd = gauss(dense, reshape(b, [6 * n]))
@@ -58,14 +58,14 @@ program test_particle_system
        norm2(reshape(x, [6 * n]) - xd) / norm2(xd)
   call check(norm2(reshape(x, [6 * n]) - xd) < 1.0e-9_dp * norm2(xd), 'coupled system: equals dense elimination')
   x2 = cos(3.0_dp * b)
-  call psys_apply(sys, x2, y2)
+  call particle_system_apply(sys, x2, y2)
   call check(abs(sum(x * y2) - sum(x2 * y)) < 1.0e-12_dp * norm2(x) * norm2(y2), 'the operator is symmetric')
 
-  call psys_reset(sys, 1)
+  call particle_system_reset(sys, 1)
   d = spd(1, 1.0_dp)
   d(3, 3) = -1.0_dp
-  call psys_add_diagonal(sys, 1, d)
-  call psys_solve(sys, b(:, 1:1), x(:, 1:1), 1.0e-12_dp, its, ok)
+  call particle_system_add_diagonal(sys, 1, d)
+  call particle_system_solve(sys, b(:, 1:1), x(:, 1:1), 1.0e-12_dp, its, ok)
   call check(.not. ok, 'an indefinite block is reported')
 
   call finish('test_particle_system')
