@@ -550,18 +550,14 @@ contains
     real(dp), intent(in), optional :: extra_force(:, :), extra_torque(:, :)
     type(particle_lubrication_t), intent(in), optional :: lubrication
     type(particle_contacts_t), intent(inout), optional :: contacts
-    real(dp), allocatable :: rhs(:, :), x(:, :)
+    real(dp), allocatable :: rhs(:, :)
     integer :: q, n
 
     PetscCall(event_begin(EVENT_MOTION, ierr))
     n = parts%n
     select case (parts%motion)
     case (MOTION_FREE, MOTION_FROZEN)
-      allocate(rhs(6, n), x(6, n))
-      ! the last velocities start the iterative solve (they are in the checkpoint: a restart
-      ! repeats the same iterations)
-      x(1:3, :) = parts%velocity
-      x(4:6, :) = parts%omega
+      allocate(rhs(6, n))
       call particle_system_reset(fd%solver%system, n)
       do q = 1, n
         call particle_system_add_diagonal(fd%solver%system, q, fd%beta * fd%rigid_matrix(:, :, q))
@@ -574,10 +570,8 @@ contains
       if (present(lubrication)) call particle_lubrication_add_to_system(lubrication, fd%solver%system, rhs)
       if (present(contacts) .and. parts%motion == MOTION_FREE) &
         call particle_contacts_add_stiffness(contacts, fd%solver%system, rhs, parts%velocity, parts%omega, parts%have_prev)
-      call particle_solver_solve(fd%solver, rhs, x, ierr, ': a particle covers no grid face?')
+      call particle_solver_solve(fd%solver, rhs, parts, ierr, ': a particle covers no grid face?')
       CHKERRQ(ierr)
-      parts%velocity = x(1:3, :)
-      parts%omega = x(4:6, :)
       if (present(contacts)) call particle_contacts_implicit_update(contacts, parts%velocity, parts%omega)
     case default                    ! prescribed, resistance, fixed
       call impose_motion(parts)

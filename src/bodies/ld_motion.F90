@@ -31,19 +31,14 @@ contains
     PetscErrorCode, intent(out) :: ierr
     type(particle_lubrication_t), intent(inout), optional :: lubrication
     type(particle_contacts_t), intent(inout), optional :: contacts
-    real(dp), allocatable :: rhs(:, :), x(:, :)
+    real(dp), allocatable :: rhs(:, :)
 
     ierr = 0
     select case (parts%motion)
     case (MOTION_FREE, MOTION_FROZEN)
-      allocate(rhs(6, parts%n), x(6, parts%n))
-      ! the last velocities start an iterative solve (they are in the checkpoint)
-      x(1:3, :) = parts%velocity
-      x(4:6, :) = parts%omega
+      allocate(rhs(6, parts%n))
       call lubrication_dynamics_assemble(ld, parts, solver%system, rhs, lubrication, contacts)
-      PetscCall(particle_solver_solve(solver, rhs, x, ierr, ''))
-      parts%velocity = x(1:3, :)
-      parts%omega = x(4:6, :)
+      PetscCall(particle_solver_solve(solver, rhs, parts, ierr, ''))
       if (present(contacts)) call particle_contacts_implicit_update(contacts, parts%velocity, parts%omega)
     case default                    ! prescribed, resistance, fixed
       call impose_motion(parts)

@@ -2,8 +2,9 @@
 ! caller (mod_fictitious_domain, mod_ld_motion) resets the system it holds here (%system), lets the
 ! kernels add their blocks to it in plain arrays (mod_particle_system's assembly:
 ! particle_system_reset, particle_system_add_diagonal, particle_system_add_pair, which
-! mod_particle_lubrication and mod_particle_contacts call), and solves it by particle_solver_solve;
-! nothing else outside src/kernels/ solves it. Without pair blocks the system is block diagonal and
+! mod_particle_lubrication and mod_particle_contacts call), and solves it by particle_solver_solve,
+! which starts from the spheres' velocities and writes the solution into them; nothing else
+! outside src/kernels/ solves it. Without pair blocks the system is block diagonal and
 ! mod_particle_system's block solve is exact (one iteration); once lubrication or contact stiffness
 ! couples the spheres the blocks go into a sparse PETSc matrix and are solved by a KSP with the
 ! options prefix particles_. Defaults: CG preconditioned by the exact
@@ -24,6 +25,7 @@
 module mod_particle_solver
   use petscksp
   use mod_kinds, only: dp
+  use mod_particles, only: particles_t
   use mod_particle_system, only: particle_system_t, particle_system_solve
   use mod_petsc_options, only: set_default_option
   use mod_errors, only: fatal_error
@@ -55,21 +57,27 @@ contains
     ps%created = .true.
   end subroutine particle_solver_create
 
-  !> Solve ps%system x = rhs (both 6 x n) from the guess in x: block by block when no pair couples
-  !> the system (mod_particle_system), else by the KSP; ps%iterations as the solver counts them. A
-  !> failure stops the run (status 4) with one message; hint, appended to the message of a failed
-  !> block solve, says what may have caused it.
-  subroutine particle_solver_solve(ps, rhs, x, ierr, hint)
+  !> The velocities of the spheres from ps%system (U, Omega) = rhs (6 x n): the solution starts
+  !> from parts%velocity, parts%omega (the last step's: a restart, which reads them from the
+  !> checkpoint, repeats the same iterations) and is written back there. Block by block when no
+  !> pair couples the system (mod_particle_system), else by the KSP; ps%iterations as the solver
+  !> counts them. A failure stops the run (status 4) with one message; hint, appended to the
+  !> message of a failed block solve, says what may have caused it.
+  subroutine particle_solver_solve(ps, rhs, parts, ierr, hint)
     type(particle_solver_t), intent(inout) :: ps
     real(dp), intent(in) :: rhs(:, :)
-    real(dp), intent(inout) :: x(:, :)
+    type(particles_t), intent(inout) :: parts
     PetscErrorCode, intent(out) :: ierr
     character(len=*), intent(in) :: hint
+    real(dp), allocatable :: x(:, :)
     KSPConvergedReason :: reason
     logical :: ok
     character(len=300) :: text
     real(dp) :: t0
     ierr = 0
+    allocate(x(6, parts%n))
+    x(1:3, :) = parts%velocity
+    x(4:6, :) = parts%omega
     if (ps%system%npairs == 0) then
       call particle_system_solve(ps%system, rhs, x, 1.0e-12_dp, ps%iterations, ok)
       if (.not. ok) then
@@ -88,6 +96,8 @@ contains
         call fatal_error(text, 4)
       end if
     end if
+    parts%velocity = x(1:3, :)
+    parts%omega = x(4:6, :)
   end subroutine particle_solver_solve
 
   !> Solve sys x = rhs (both 6 x n) by ksp, from the guess in x: assembly of the sparse matrix,
