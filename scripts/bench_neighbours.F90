@@ -6,7 +6,8 @@
 program bench_neighbours
   use mod_kinds, only: dp, i8
   use mod_neighbours, only: nlist_t, nlist_init, nlist_build
-  use mod_packing, only: random_packing, packing_report_t, packing_box_for
+  use mod_packing, only: random_packing, packing_report_t
+  use mod_packing_geometry, only: packing_box_for
   use mod_contact, only: contact_params_t, contact_setup, contact_history_t, contact_forces, &
                          contact_stats_t
   implicit none

@@ -21,12 +21,12 @@ module mod_fluid
   use petscdmda
   use mod_kinds, only: dp
   use mod_params, only: config_t
-  use mod_grid, only: grid_t, grid_position, field_names, FIELD_U, FIELD_V, FIELD_W, FIELD_P
+  use mod_grid, only: grid_t, grid_position, grid_fixed_row, field_names, FIELD_U, FIELD_V, FIELD_W, FIELD_P
   use mod_solvers, only: solver_t, solvers_configure, solver_create, solver_solve, solver_destroy
-  use mod_manufactured, only: mms_forcing, mms_velocity, mms_pressure
+  use mod_manufactured, only: mms_forcing
   implicit none
   private
-  public :: fluid_t, fluid_create, fluid_step, fluid_destroy, fluid_errors_vs_manufactured, fluid_mean_profile
+  public :: fluid_t, fluid_create, fluid_step, fluid_destroy, fluid_mean_profile
   integer, parameter :: STAR_HISTORY_FULL = 2   ! u*^n and u*^{n-1} known: extrapolate
 
   type :: fluid_t
@@ -188,13 +188,6 @@ contains
     PetscCall(DMDAVecRestoreArrayF90(grid%da(c), fl%loc(c), a, ierr))
   end subroutine ghosted
 
-  ! True for the rows that are not unknowns: v on the wall face j = 0.
-  pure logical function fixed_row(grid, c, j)
-    type(grid_t), intent(in) :: grid
-    integer, intent(in) :: c, j
-    fixed_row = grid%walls .and. c == FIELD_V .and. j == 0
-  end function fixed_row
-
   ! source: an extra force density on the u, v, w faces (the fictitious-domain Lambda^n).
   subroutine fluid_step(grid, fl, ierr, source)
     type(grid_t), intent(in) :: grid
@@ -226,7 +219,7 @@ contains
       do k = grid%lo(3), grid%hi(3)
         do j = grid%lo(2), grid%hi(2)
           do i = grid%lo(1), grid%hi(1)
-            if (fixed_row(grid, c, j)) then
+            if (grid_fixed_row(grid, c, j)) then
               r(i, j, k) = 0.0_dp
               cycle
             end if
@@ -287,7 +280,7 @@ contains
       do k = grid%lo(3), grid%hi(3)
         do j = grid%lo(2), grid%hi(2)
           do i = grid%lo(1), grid%hi(1)
-            if (fixed_row(grid, c, j)) cycle
+            if (grid_fixed_row(grid, c, j)) cycle
             rate = r(i, j, k) - fl%dt / fl%reynolds * (ph(i, j, k) - ph(i - e(1), j - e(2), k - e(3))) / h
             local_max = max(local_max, abs(rate - a(i, j, k)))
             a(i, j, k) = rate
@@ -405,68 +398,6 @@ contains
     call MPI_Allreduce(sums, profile, grid%n(2), MPIU_REAL, MPI_SUM, PETSC_COMM_WORLD, mpierr)
     profile = profile / real(grid%n(1) * grid%n(3), dp)
   end subroutine fluid_mean_profile
-
-  subroutine fluid_errors_vs_manufactured(grid, fl, shear_rate, err_vel, err_p_max, err_p_rms, ierr)
-    type(grid_t), intent(in) :: grid
-    type(fluid_t), intent(inout) :: fl
-    real(dp), intent(in) :: shear_rate
-    real(dp), intent(out) :: err_vel, err_p_max, err_p_rms
-    PetscErrorCode, intent(out) :: ierr
-    PetscScalar, pointer :: a(:,:,:)
-    real(dp) :: x(3), exact, loc(3), tot(3), mean_h, mean_e, ncell
-    PetscErrorCode :: mpierr
-    integer :: c, i, j, k
-
-    loc = 0.0_dp
-    do c = 1, 3
-      PetscCall(DMDAVecGetArrayReadF90(grid%da(c), fl%vel(c), a, ierr))
-      do k = grid%lo(3), grid%hi(3)
-        do j = grid%lo(2), grid%hi(2)
-          do i = grid%lo(1), grid%hi(1)
-            if (fixed_row(grid, c, j)) cycle
-            x = grid_position(grid, c, i, j, k)
-            exact = mms_velocity(c, x, grid%box, grid%walls)
-            if (c == FIELD_U .and. grid%walls) exact = exact + shear_rate * (x(2) - 0.5_dp * grid%box(2))
-            loc(1) = max(loc(1), abs(a(i, j, k) - exact))
-          end do
-        end do
-      end do
-      PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), fl%vel(c), a, ierr))
-    end do
-    call MPI_Allreduce(loc(1), tot(1), 1, MPIU_REAL, MPI_MAX, PETSC_COMM_WORLD, mpierr)
-    err_vel = tot(1)
-
-    ! means of the computed and the exact pressure
-    ncell = real(grid%n(1), dp) * grid%n(2) * grid%n(3)
-    PetscCall(VecSum(fl%pressure, mean_h, ierr))
-    mean_h = mean_h / ncell
-    loc = 0.0_dp
-    PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_P), fl%pressure, a, ierr))
-    do k = grid%lo(3), grid%hi(3)
-      do j = grid%lo(2), grid%hi(2)
-        do i = grid%lo(1), grid%hi(1)
-          loc(1) = loc(1) + mms_pressure(grid_position(grid, FIELD_P, i, j, k), grid%box, grid%walls)
-        end do
-      end do
-    end do
-    call MPI_Allreduce(loc(1), mean_e, 1, MPIU_REAL, MPI_SUM, PETSC_COMM_WORLD, mpierr)
-    mean_e = mean_e / ncell
-    loc = 0.0_dp
-    do k = grid%lo(3), grid%hi(3)
-      do j = grid%lo(2), grid%hi(2)
-        do i = grid%lo(1), grid%hi(1)
-          exact = mms_pressure(grid_position(grid, FIELD_P, i, j, k), grid%box, grid%walls) - mean_e
-          loc(2) = max(loc(2), abs(a(i, j, k) - mean_h - exact))
-          loc(3) = loc(3) + (a(i, j, k) - mean_h - exact)**2
-        end do
-      end do
-    end do
-    PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_P), fl%pressure, a, ierr))
-    call MPI_Allreduce(loc(2), tot(2), 1, MPIU_REAL, MPI_MAX, PETSC_COMM_WORLD, mpierr)
-    call MPI_Allreduce(loc(3), tot(3), 1, MPIU_REAL, MPI_SUM, PETSC_COMM_WORLD, mpierr)
-    err_p_max = tot(2)
-    err_p_rms = sqrt(tot(3) / ncell)
-  end subroutine fluid_errors_vs_manufactured
 
   subroutine fluid_destroy(fl, ierr)
     type(fluid_t), intent(inout) :: fl

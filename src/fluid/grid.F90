@@ -22,7 +22,7 @@ module mod_grid
   use mod_errors, only: log_line, fatal_error
   implicit none
   private
-  public :: grid_t, grid_create, grid_destroy, grid_position, direct_solves_wanted
+  public :: grid_t, grid_create, grid_destroy, grid_position, grid_fixed_row, direct_solves_wanted
   public :: FIELD_U, FIELD_V, FIELD_W, FIELD_P, field_names
 
   integer, parameter :: FIELD_U = 1, FIELD_V = 2, FIELD_W = 3, FIELD_P = 4
@@ -127,6 +127,14 @@ contains
     x = ([i, j, k] + 0.5_dp) * grid%h
     if (f <= 3) x(f) = x(f) - 0.5_dp * grid%h
   end function grid_position
+
+  !> True for the rows that are not unknowns: v on the wall face j = 0 (periodic layout: the same
+  !> face as j = n2, the top wall).
+  pure logical function grid_fixed_row(grid, c, j)
+    type(grid_t), intent(in) :: grid
+    integer, intent(in) :: c, j
+    grid_fixed_row = grid%walls .and. c == FIELD_V .and. j == 0
+  end function grid_fixed_row
 
   subroutine grid_destroy(grid, ierr)
     type(grid_t), intent(inout) :: grid

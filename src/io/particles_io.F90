@@ -11,47 +11,23 @@ module mod_particles_io
   use mod_params, only: config_t
   use mod_particles, only: particles_t, particles_init, motion_code, configuration_fault
   use mod_h5util, only: write_attribute, read_attribute, has_object, write_dataset, read_dataset, dataset_dims
-  use mod_errors, only: is_root, input_error, file_error, abort_run, fatal_error, log_line
-  use mod_packing, only: random_packing, packing_count, packing_report_t
+  use mod_errors, only: is_root, input_error, file_error, abort_run
   implicit none
   private
   public :: particles_load, particles_write, particles_read_state, particles_snapshot
 
 contains
 
-  ! The particles of the deck: inline (&particles number, position, ...), from position_file, or a
-  ! random hard-sphere packing of solid_fraction made now (mod_packing, as bin/fdsusp-pack; every
-  ! rank builds the same one). Collective. Checks the configuration (inside the box, off the
-  ! walls, no overlap).
+  ! The particles of the deck: inline (&particles number, position, ...) or from position_file (a
+  ! deck with solid_fraction > 0 packs them instead: mod_initial_packing). Collective. Checks the
+  ! configuration (inside the box, off the walls, no overlap).
   subroutine particles_load(cfg, parts)
     type(config_t), intent(in) :: cfg
     type(particles_t), intent(out) :: parts
     real(dp), allocatable :: position(:, :)
     character(len=400) :: message
-    integer :: n, culprit, ierr, info
+    integer :: n, culprit, ierr
     character(len=32) :: item
-    type(packing_report_t) :: report
-
-    if (cfg%solid_fraction > 0.0_dp) then
-      n = packing_count(cfg%solid_fraction, cfg%box, cfg%radius)
-      call random_packing(n, cfg%box, [.true., .not. cfg%walls, .true.], cfg%radius, cfg%packing_min_gap, &
-                          cfg%seed, cfg%packing_sweeps, position, info, message, report)
-      select case (info)
-      case (0)
-      case (1)
-        call input_error(cfg%deck_file, 'particles', 'solid_fraction', trim(message))
-      case (2)
-        call input_error(cfg%deck_file, 'domain', 'box', trim(message))
-      case default
-        call fatal_error('fdsusp: '//trim(message), 3)
-      end select
-      write(message, '(a,i0,a,f8.5,a,i0,a,es10.3,a)') 'packing: ', n, ' spheres, phi = ', report%phi, &
-           ' (seed ', cfg%seed, '), smallest gap ', min(report%min_pair_gap, report%min_wall_gap), ' a'
-      call log_line(message)
-      call particles_init(parts, n, cfg%radius, motion_code(cfg%motion))
-      parts%position = position
-      return
-    end if
 
     if (len_trim(cfg%position_file) == 0) then
       n = cfg%particle_number

@@ -27,12 +27,11 @@
 module mod_packing
   use mod_kinds, only: dp, i8, pi
   use mod_neighbours, only: cell_coord, cell_index, cells_around, min_image
+  use mod_packing_geometry, only: phi_max
   implicit none
   private
-  public :: rng_t, rng_seed, rng_uniform, packing_count, packing_box_for
-  public :: packing_report_t, random_packing, hs_monte_carlo, min_separation, phi_max
-
-  real(dp), parameter :: phi_max = 0.55_dp     ! highest target accepted
+  public :: rng_t, rng_seed, rng_uniform
+  public :: packing_report_t, random_packing, hs_monte_carlo, min_separation
 
   type :: rng_t
     integer(i8) :: s(6) = 12345_i8             ! MRG32k3a state: s(1:3) component 1, s(4:6) 2
@@ -105,22 +104,6 @@ contains
     g%s(6) = p2
     r = real(modulo(p1 - p2, m1) + 1, dp) / real(m1 + 1, dp)
   end function rng_uniform
-
-  ! ---- sizes --------------------------------------------------------------------------------
-
-  !> Number of spheres of radius a closest to volume fraction phi in box.
-  pure integer function packing_count(phi, box, a) result(n)
-    real(dp), intent(in) :: phi, box(3), a
-    n = nint(phi * product(box) / (4.0_dp / 3 * pi * a**3))
-  end function packing_count
-
-  !> The box of the shape of box that holds n spheres of radius a at volume fraction phi exactly.
-  pure function packing_box_for(n, phi, box, a) result(b)
-    integer, intent(in) :: n
-    real(dp), intent(in) :: phi, box(3), a
-    real(dp) :: b(3)
-    b = box * (n * (4.0_dp / 3 * pi * a**3) / (phi * product(box)))**(1.0_dp / 3)
-  end function packing_box_for
 
   ! ---- cell lists ---------------------------------------------------------------------------
 

@@ -13,8 +13,8 @@ program fdsusp
   use mod_params, only: config_t, read_deck, echo_deck, max_line
   use mod_errors, only: log_line, warn_line, input_error, fatal_error, is_root
   use mod_grid, only: grid_t, grid_create, grid_destroy, direct_solves_wanted
-  use mod_fluid, only: fluid_t, fluid_create, fluid_step, fluid_destroy, fluid_errors_vs_manufactured, &
-                       fluid_mean_profile
+  use mod_fluid, only: fluid_t, fluid_create, fluid_step, fluid_destroy, fluid_mean_profile
+  use mod_fluid_verification, only: fluid_errors_vs_manufactured
   use mod_series, only: series_t, series_open, series_record, series_flush, series_attributes
   use mod_output, only: write_fields, progress_line
   use mod_checkpoint, only: checkpoint_write, checkpoint_check, checkpoint_read
@@ -24,9 +24,10 @@ program fdsusp
                         STAGE_PARTICLES, STAGE_CONTACTS, STAGE_LUBRICATION
   use mod_particles, only: particles_t, advance_positions, displacements, MOTION_FREE
   use mod_particles_io, only: particles_load, particles_snapshot
-  use mod_rheology, only: rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, &
-                          rheo_state, rheo_restore, rheo_write_summary, rheo_summarise, summary_names, &
-                          NSUMMARY
+  use mod_initial_packing, only: initial_packing_make
+  use mod_rheology, only: rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, rheo_state, rheo_restore, &
+                          rheo_summarise, summary_names, NSUMMARY
+  use mod_summary_io, only: summary_write
   use mod_fictitious_domain, only: fictitious_domain_t, fictitious_domain_create, &
                                    fictitious_domain_geometry, fictitious_domain_follow, &
                                    fictitious_domain_moments, fictitious_domain_solve_motion, &
@@ -102,7 +103,11 @@ program fdsusp
   call echo_deck(cfg)
   call prepare_output_directory(cfg)
   if (continuing) call continue_from_directory()
-  call particles_load(cfg, parts)
+  if (cfg%solid_fraction > 0.0_dp) then
+    call initial_packing_make(cfg, parts)        ! a random packing made now
+  else
+    call particles_load(cfg, parts)              ! the deck's or the position file's
+  end if
   has_particles = parts%n > 0
   ! sliding periodic boundaries in y (lubrication dynamics): the offset starts at 0, a restart
   ! reads it from the checkpoint
@@ -679,7 +684,7 @@ contains
     if (.not. is_root()) return
     path = trim(cfg%output_directory)//'/summary.json'
     call rheo_summarise(rh, step, complete, value, error, profile, angles)
-    call rheo_write_summary(rh, path, step, complete, value, error, profile, angles, err)
+    call summary_write(rh, path, step, complete, value, error, profile, angles, err)
     if (err /= 0) call warn_line('cannot write '//trim(path))
     write(text, '(a,i0,a,i0,a)') 'rheology of the core region (', complete, ' of ', cfg%blocks, &
          ' blocks complete; value +- standard error; doc/RHEOLOGY.md):'

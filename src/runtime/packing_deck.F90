@@ -9,7 +9,7 @@ module mod_packing_deck
   use mod_kinds, only: dp, pi
   use mod_errors, only: input_error
   use mod_deck_text, only: deck_line_length, load_lines, group_on_line, to_lower, diagnose_group
-  use mod_packing, only: phi_max, packing_count, packing_box_for
+  use mod_packing_geometry, only: phi_max, packing_count, packing_box_for
   implicit none
   private
   public :: pack_config_t, read_pack_deck, pack_deck_lines, max_line

@@ -11,7 +11,7 @@ module mod_params
   use mod_kinds, only: dp
   use mod_errors, only: input_error, log_line, is_root
   use mod_deck_text, only: deck_line_length, load_lines, group_on_line, to_lower, diagnose_group
-  use mod_packing, only: phi_max
+  use mod_packing_geometry, only: phi_max
   implicit none
   private
   public :: config_t, read_deck, echo_deck, max_line, max_inline_particles

@@ -28,8 +28,8 @@ program test_contact_history
   use mod_contact, only: contact_params_t, contact_setup, contact_history_t, history_size, &
                          history_pack, history_unpack, contact_forces, contact_stats_t
   use mod_neighbours, only: nlist_t, nlist_init, nlist_build, nlist_needs_rebuild
-  use mod_packing, only: rng_t, rng_seed, rng_uniform, random_packing, packing_report_t, &
-                         packing_count
+  use mod_packing, only: rng_t, rng_seed, rng_uniform, random_packing, packing_report_t
+  use mod_packing_geometry, only: packing_count
   use mod_unit_checks, only: check, fail, finish
   implicit none
   real(dp), parameter :: box(3) = [16.0_dp, 10.0_dp, 16.0_dp], dt = 1.0e-3_dp

@@ -18,8 +18,8 @@
 program test_neighbours
   use mod_kinds, only: dp, i8, pi
   use mod_neighbours, only: nlist_t, nlist_init, nlist_build, nlist_needs_rebuild, min_image
-  use mod_packing, only: rng_t, rng_seed, rng_uniform, random_packing, packing_report_t, &
-                         packing_box_for
+  use mod_packing, only: rng_t, rng_seed, rng_uniform, random_packing, packing_report_t
+  use mod_packing_geometry, only: packing_box_for
   use mod_unit_checks, only: check, fail, finish
   implicit none
   integer :: k, info

@@ -16,8 +16,8 @@
 !      acceptance asks for under a minute; not asserted, machines differ).
 program test_packing
   use mod_kinds, only: dp, i8, pi
-  use mod_packing, only: rng_t, rng_uniform, random_packing, packing_report_t, packing_count, &
-                         packing_box_for, phi_max
+  use mod_packing, only: rng_t, rng_uniform, random_packing, packing_report_t
+  use mod_packing_geometry, only: packing_count, packing_box_for, phi_max
   use mod_unit_checks, only: check, fail, finish
   implicit none
   integer, parameter :: nphi = 5

@@ -14,8 +14,8 @@
 ! printed and must agree with the quadratic within 2 %.
 program test_packing_gr
   use mod_kinds, only: dp, pi
-  use mod_packing, only: rng_t, rng_seed, random_packing, hs_monte_carlo, packing_report_t, &
-                         packing_box_for, min_separation
+  use mod_packing, only: rng_t, rng_seed, random_packing, hs_monte_carlo, packing_report_t, min_separation
+  use mod_packing_geometry, only: packing_box_for
   use mod_neighbours, only: nlist_t, nlist_init, nlist_build
   use mod_unit_checks, only: check, finish
   implicit none

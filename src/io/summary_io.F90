@@ -1,0 +1,89 @@
+! summary.json (doc/RHEOLOGY.md): the rheology of a run over its complete blocks,
+! as mod_rheology's rheo_summarise computes it, with the block layout, the profiles across y and
+! g(theta), in JSON that scripts and the tests read. The numbers carry 17 significant digits, so
+! they are the run's doubles; a quantity that is not finite is null. The kernel computes, this
+! module writes: the file is the only thing here.
+module mod_summary_io
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  use mod_kinds, only: dp, pi
+  use mod_rheology, only: rheology_t, NSUMMARY, summary_names
+  implicit none
+  private
+  public :: summary_write
+
+contains
+
+  !> Write the summary of rheo_summarise (value, err, profile, angles over the complete blocks, the
+  !> last of them ending at last_step) to path as JSON (rank 0 only). info: 0 ok, else the iostat.
+  subroutine summary_write(r, path, last_step, complete, value, err, profile, angles, info)
+    type(rheology_t), intent(in) :: r
+    character(len=*), intent(in) :: path
+    integer, intent(in) :: last_step, complete
+    real(dp), intent(in) :: value(NSUMMARY), err(NSUMMARY), profile(:, :), angles(:, :)
+    integer, intent(out) :: info
+    integer :: u, k
+    real(dp), allocatable :: y(:), theta(:)
+    allocate(y(r%nbins), theta(r%nangles))
+    do k = 1, r%nbins
+      y(k) = (k - 0.5_dp) * r%box(2) / r%nbins
+    end do
+    do k = 1, r%nangles
+      theta(k) = (k - 0.5_dp) * 2 * pi / r%nangles
+    end do
+    open(newunit=u, file=path, status='replace', action='write', iostat=info)
+    if (info /= 0) return
+    write(u, '(a)') '{'
+    write(u, '(a)') '  "program": "fdsusp",'
+    write(u, '(a,a,a)') '  "complete": ', trim(merge('true ', 'false', complete == r%blocks)), ','
+    write(u, '(a,i0,a,i0,a)') '  "blocks": ', r%blocks, ', "blocks_complete": ', complete, ','
+    write(u, '(a,i0,a,i0,a,i0,a)') '  "discard_step": ', r%discard_step, ', "block_steps": ', r%block_steps, &
+         ', "last_step": ', last_step, ','
+    write(u, '(a,a,a)') '  "records_per_block": ', trim(json_array(r%block_records(1:max(1, complete)))), ','
+    write(u, '(a,2(a,a),a)') '  "core": ', trim(json_array(r%core)), ', "shear_rate": ', trim(json_number(r%shear_rate)), ','
+    write(u, '(a)') '  "quantities": {'
+    do k = 1, NSUMMARY
+      write(u, '(5a)') '    "', trim(summary_names(k)), '": {"value": ', trim(json_number(value(k))), &
+           ', "error": '//trim(json_number(err(k)))//'}'//trim(merge(', ', '  ', k < NSUMMARY))
+    end do
+    write(u, '(a)') '  },'
+    write(u, '(a)') '  "profiles": {'
+    write(u, '(a,a,a)') '    "y": ', json_array(y), ','
+    write(u, '(a,a,a)') '    "solid_fraction": ', json_array(profile(:, 1)), ','
+    write(u, '(a,a)') '    "velocity": ', json_array(profile(:, 2))
+    write(u, '(a)') '  },'
+    write(u, '(a)') '  "pair_distribution": {'
+    write(u, '(a,a,a,a,a)') '    "r_outer": ', trim(json_number(r%r_outer)), ', "r_contact": ', &
+         trim(json_number(r%r_contact)), ','
+    write(u, '(a,a,a)') '    "theta": ', json_array(theta), ','
+    write(u, '(a,a,a)') '    "g": ', json_array(angles(:, 1)), ','
+    write(u, '(a,a)') '    "g_contact": ', json_array(angles(:, 2))
+    write(u, '(a)') '  }'
+    write(u, '(a)') '}'
+    close(u)
+  end subroutine summary_write
+
+  !> A number in JSON: 17 significant digits, null when not finite.
+  function json_number(x) result(s)
+    real(dp), intent(in) :: x
+    character(len=32) :: s
+    if (.not. ieee_is_finite(x)) then
+      s = 'null'
+    else
+      write(s, '(es25.16e3)') x
+      s = adjustl(s)
+    end if
+  end function json_number
+
+  function json_array(x) result(s)
+    real(dp), intent(in) :: x(:)
+    character(len=:), allocatable :: s
+    integer :: k
+    s = '['
+    do k = 1, size(x)
+      s = s//trim(json_number(x(k)))
+      if (k < size(x)) s = s//', '
+    end do
+    s = s//']'
+  end function json_array
+
+end module mod_summary_io
