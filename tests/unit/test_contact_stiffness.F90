@@ -294,16 +294,7 @@ contains
       rhs(:, 2) = [-f, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp] + [pc%force(:, 2), pc%torque(:, 2)]
       call particle_contacts_add_stiffness(pc, sys, rhs, u, om, have_prev)
       call particle_system_solve(sys, rhs, sol, 1e-14_dp, its, ok)
-      u = sol(1:3, :)
-      om = sol(4:6, :)
-      call particle_contacts_implicit_update(pc, u, om)
-      if (have_prev) then
-        x = x + dt * (1.5_dp * u - 0.5_dp * u_prev)
-      else
-        x = x + dt * u
-      end if
-      u_prev = u
-      have_prev = .true.
+      call take_step(pc, sol, dt, x, u, om, u_prev, have_prev)
       overlap(step) = 2 + p0%h_r - norm2(x(:, 2) - x(:, 1))
       if (step > size(overlap) / 2 .and. pc%stats%pair_contacts == 0) opened = .true.
       last_force = pc%force
@@ -347,16 +338,7 @@ contains
       call particle_contacts_add_stiffness(pc, sys, rhs, u, om, have_prev)
       call particle_system_solve(sys, rhs, sol, 1e-14_dp, its, ok)
       change = norm2(sol(1:3, 1) - u(:, 1)) + norm2(sol(4:6, 1) - om(:, 1))
-      u = sol(1:3, :)
-      om = sol(4:6, :)
-      call particle_contacts_implicit_update(pc, u, om)
-      if (have_prev) then
-        x = x + dt * (1.5_dp * u - 0.5_dp * u_prev)
-      else
-        x = x + dt * u
-      end if
-      u_prev = u
-      have_prev = .true.
+      call take_step(pc, sol, dt, x, u, om, u_prev, have_prev)
       if (step > 300 .and. pc%stats%sliding > 0) stuck = .false.
     end do
     slip = u(:, 1) - pc%wall_velocity(:, 1) + cross(om(:, 1), nw)
@@ -368,5 +350,24 @@ contains
     call check(abs(pc%force(1, 1) - r * u(1, 1)) < 1e-6_dp * abs(r * u(1, 1)) .and. abs(u(1, 1)) > 0, &
                '7. implicit: a tangential contact force drags the sphere (F_t = r U_x)')
   end subroutine sphere_on_wall
+
+  ! The velocities of the solve sol (6, n) into u, om, the contacts' implicit update, then the
+  ! positions by Adams-Bashforth 2 (Euler on the first step), as bin/fdsusp advances them.
+  subroutine take_step(pc, sol, dt, x, u, om, u_prev, have_prev)
+    type(particle_contacts_t), intent(inout) :: pc
+    real(dp), intent(in) :: sol(:, :), dt
+    real(dp), intent(inout) :: x(:, :), u(:, :), om(:, :), u_prev(:, :)
+    logical, intent(inout) :: have_prev
+    u = sol(1:3, :)
+    om = sol(4:6, :)
+    call particle_contacts_implicit_update(pc, u, om)
+    if (have_prev) then
+      x = x + dt * (1.5_dp * u - 0.5_dp * u_prev)
+    else
+      x = x + dt * u
+    end if
+    u_prev = u
+    have_prev = .true.
+  end subroutine take_step
 
 end program test_contact_stiffness
