@@ -15,7 +15,7 @@ program fdsusp
   use mod_grid, only: grid_t, grid_create, grid_destroy, direct_solves_wanted
   use mod_fluid, only: fluid_t, fluid_create, fluid_step, fluid_destroy, fluid_errors_vs_manufactured, &
                        fluid_mean_profile
-  use mod_series, only: series_t, series_open, series_record, series_flush, series_attributes
+  use mod_series, only: series_t, series_column, series_open, series_record, series_flush, series_attributes
   use mod_output, only: write_fields, progress_line
   use mod_checkpoint, only: checkpoint_write, checkpoint_check, checkpoint_read
   use mod_system, only: install_signal_handlers, stop_signal, make_directory, probe_directory, lock_directory, &
@@ -66,10 +66,8 @@ program fdsusp
   logical :: carry_lambda                           ! -fd_carry_lambda (default true)
   logical :: has_particles, has_contacts, has_lubrication
   integer :: info
-  integer, allocatable :: shapes(:, :)
   character(len=max_line) :: deck, restart, checkpoint_path
   character(len=400) :: text
-  character(len=32), allocatable :: columns(:)
   integer :: step, first_step, stop_reason, cold_its
   integer :: iterations_sum(4)
   real(dp) :: time, wall_start, wall_now, wall_per_step, wall_loop, cold_seconds, core_edge_speed
@@ -194,46 +192,9 @@ program fdsusp
     end if
     if (allocated(rh)) call rheo_restore(rh, statistics, info)
   end if
-  columns = [character(len=32) :: 'step', 'time', 'wall_time', 'tau_wall_bottom', 'tau_wall_top', &
-             'divergence', 'rate_of_change', 'iterations_u', 'iterations_v', 'iterations_w', 'iterations_p']
-  ! without a fluid the columns of the fluid solve are not written
-  if (.not. cfg%resolved) columns = columns(1:3)
-  if (cfg%lees_edwards) columns = [character(len=32) :: columns, 'lees_edwards_offset']
-  if (cfg%manufactured_solution) columns = [character(len=32) :: columns, 'mms_error_velocity_max', &
-             'mms_error_pressure_max', 'mms_error_pressure_rms']
-  allocate(shapes(3, size(columns)))
-  shapes = 0
-  if (has_particles) then
-    columns = [character(len=32) :: columns, 'particles/position', 'particles/velocity', 'particles/omega', &
-               'particles/force_hydro', 'particles/torque_hydro', 'particles/stresslet_hydro']
-    shapes = reshape([shapes, [3, parts%n, 0], [3, parts%n, 0], [3, parts%n, 0], [3, parts%n, 0], &
-                      [3, parts%n, 0], [3, 3, parts%n]], [3, size(columns)])
-  end if
-  if (has_lubrication) then
-    columns = [character(len=32) :: columns, 'lubrication_pairs', 'lubrication_walls', 'min_gap', &
-               'particles/force_lubrication', 'particles/torque_lubrication']
-    shapes = reshape([shapes, [0, 0, 0], [0, 0, 0], [0, 0, 0], [3, parts%n, 0], [3, parts%n, 0]], [3, size(columns)])
-  end if
-  if (has_contacts) then
-    columns = [character(len=32) :: columns, 'contacts_pair', 'contacts_wall', 'contacts_sliding', &
-               'contact_max_overlap', 'particles/force_contact', 'particles/torque_contact', &
-               'particles/stresslet_contact']
-    shapes = reshape([shapes, [0, 0, 0], [0, 0, 0], [0, 0, 0], [0, 0, 0], [3, parts%n, 0], &
-                      [3, parts%n, 0], [3, 3, parts%n]], [3, size(columns)])
-  end if
-  if (allocated(rh)) then
-    columns = [character(len=32) :: columns, 'core/stress_hydro', 'core/stress_contact', 'core/solid_fraction', &
-               'core/velocity_fit', 'core/flow_fit', 'core/shear_rate', 'min_pair_gap', 'pairs/references', 'pairs/shell', &
-               'pairs/contact', 'profiles/solid_fraction', 'profiles/momentum']
-    shapes = reshape([shapes, [5, 0, 0], [5, 0, 0], [0, 0, 0], [5, 0, 0], [5, 0, 0], [0, 0, 0], [0, 0, 0], [0, 0, 0], &
-                      [cfg%angle_bins, 0, 0], [cfg%angle_bins, 0, 0], [cfg%profile_bins, 0, 0], &
-                      [cfg%profile_bins, 0, 0]], [3, size(columns)])
-    if (has_contacts) then
-      columns = [character(len=32) :: columns, 'contact_overlap_over_roughness']
-      shapes = reshape([shapes, [0, 0, 0]], [3, size(columns)])
-    end if
-  end if
-  call series_open(series, cfg%output_directory, columns, merge(step, -1, restarting), shapes)
+  ! the columns of series.h5, declared by the routine that also fills each record
+  call series_columns()
+  call series_open(series, cfg%output_directory, merge(step, -1, restarting))
   if (allocated(rh)) then
     ! what scripts/rheology.py needs to repeat the statistics from series.h5 alone
     call series_attributes(series, [character(len=32) :: 'box_x', 'box_y', 'box_z', 'radius', 'shear_rate', &
@@ -593,49 +554,83 @@ contains
     is_rank0 = (rank == 0)
   end function is_rank0
 
+  ! One record of series.h5, and the statistics' share of it.
   subroutine record()
-    real(dp) :: values(14)
-    integer :: n
-    real(dp), allocatable :: row(:)
-    values(1:3) = [real(step, dp), time, MPI_Wtime() - wall_start]
-    n = 3
-    if (cfg%lees_edwards) then
-      values(4) = le%offset
-      n = 4
-    end if
-    if (cfg%resolved) then
-      values(4:11) = [fl%tau_bottom, fl%tau_top, fl%divergence, fl%max_rate, real(fl%solver(1)%iterations, dp), &
-                      real(fl%solver(2)%iterations, dp), real(fl%solver(3)%iterations, dp), &
-                      real(fl%solver(4)%iterations, dp)]
-      n = 11
-    end if
-    if (cfg%manufactured_solution) then
-      PetscCallA(fluid_errors_vs_manufactured(grid, fl, cfg%shear_rate, err_vel, err_p_max, err_p_rms, ierr))
-      values(12:14) = [err_vel, err_p_max, err_p_rms]
-      n = 14
-    end if
-    if (has_particles) then
-      row = [values(1:n), reshape(parts%position, [3 * parts%n]), reshape(parts%velocity, [3 * parts%n]), &
-             reshape(parts%omega, [3 * parts%n]), reshape(parts%force_hydro, [3 * parts%n]), &
-             reshape(parts%torque_hydro, [3 * parts%n]), reshape(parts%stresslet_hydro, [9 * parts%n])]
-      if (has_lubrication) row = [row, real(pl%npairs, dp), real(pl%nwalls, dp), pl%min_gap, &
-                                  reshape(pl%force, [3 * parts%n]), reshape(pl%torque, [3 * parts%n])]
-      if (has_contacts) row = [row, real(pc%stats%pair_contacts, dp), real(pc%stats%wall_contacts, dp), &
-             real(pc%stats%sliding, dp), pc%max_overlap, reshape(pc%force, [3 * parts%n]), &
-             reshape(pc%torque, [3 * parts%n]), reshape(pc%stresslet, [9 * parts%n])]
-      if (allocated(rh)) then
-        row = [row, rh%values, rh%shear_rate_core, rh%min_pair_gap, rh%references, &
-               rh%angles(:, 1), rh%angles(:, 2), rh%profile(:, 1), rh%profile(:, 2)]
-        if (has_contacts) row = [row, pc%max_overlap / max(pc%params%h_r, tiny(1.0_dp))]
-        ! only the records on the series_every grid enter the statistics (a restart then adds
-        ! exactly the records an uninterrupted run would)
-        if (mod(step, cfg%series_every) == 0) call rheo_accumulate(rh, step)
-      end if
-      call series_record(series, row)
-    else
-      call series_record(series, values(1:n))
+    call series_columns()
+    call series_record(series)
+    ! only the records on the series_every grid enter the statistics (a restart then adds
+    ! exactly the records an uninterrupted run would)
+    if (has_particles .and. allocated(rh)) then
+      if (mod(step, cfg%series_every) == 0) call rheo_accumulate(rh, step)
     end if
   end subroutine record
+
+  ! The columns of series.h5 in the file's order: the name and the value of each (the value's shape
+  ! is the column's). Called once before series_open, which makes these calls the declaration of
+  ! the columns, then for every record, so the header and the records cannot differ.
+  subroutine series_columns()
+    call series_column(series, 'step', step)
+    call series_column(series, 'time', time)
+    call series_column(series, 'wall_time', MPI_Wtime() - wall_start)
+    ! without a fluid the columns of the fluid solve are not written
+    if (cfg%resolved) then
+      call series_column(series, 'tau_wall_bottom', fl%tau_bottom)
+      call series_column(series, 'tau_wall_top', fl%tau_top)
+      call series_column(series, 'divergence', fl%divergence)
+      call series_column(series, 'rate_of_change', fl%max_rate)
+      call series_column(series, 'iterations_u', fl%solver(1)%iterations)
+      call series_column(series, 'iterations_v', fl%solver(2)%iterations)
+      call series_column(series, 'iterations_w', fl%solver(3)%iterations)
+      call series_column(series, 'iterations_p', fl%solver(4)%iterations)
+    end if
+    if (cfg%lees_edwards) call series_column(series, 'lees_edwards_offset', le%offset)
+    if (cfg%manufactured_solution) then
+      PetscCallA(fluid_errors_vs_manufactured(grid, fl, cfg%shear_rate, err_vel, err_p_max, err_p_rms, ierr))
+      call series_column(series, 'mms_error_velocity_max', err_vel)
+      call series_column(series, 'mms_error_pressure_max', err_p_max)
+      call series_column(series, 'mms_error_pressure_rms', err_p_rms)
+    end if
+    if (.not. has_particles) return
+    call series_column(series, 'particles/position', parts%position)
+    call series_column(series, 'particles/velocity', parts%velocity)
+    call series_column(series, 'particles/omega', parts%omega)
+    call series_column(series, 'particles/force_hydro', parts%force_hydro)
+    call series_column(series, 'particles/torque_hydro', parts%torque_hydro)
+    call series_column(series, 'particles/stresslet_hydro', parts%stresslet_hydro)
+    if (has_lubrication) then
+      call series_column(series, 'lubrication_pairs', pl%npairs)
+      call series_column(series, 'lubrication_walls', pl%nwalls)
+      call series_column(series, 'min_gap', pl%min_gap)
+      call series_column(series, 'particles/force_lubrication', pl%force)
+      call series_column(series, 'particles/torque_lubrication', pl%torque)
+    end if
+    if (has_contacts) then
+      call series_column(series, 'contacts_pair', pc%stats%pair_contacts)
+      call series_column(series, 'contacts_wall', pc%stats%wall_contacts)
+      call series_column(series, 'contacts_sliding', pc%stats%sliding)
+      call series_column(series, 'contact_max_overlap', pc%max_overlap)
+      call series_column(series, 'particles/force_contact', pc%force)
+      call series_column(series, 'particles/torque_contact', pc%torque)
+      call series_column(series, 'particles/stresslet_contact', pc%stresslet)
+    end if
+    if (allocated(rh)) then
+      ! rh%values: stress_hydro(5), stress_contact(5), phi_core, particle fit(5), suspension fit(5)
+      call series_column(series, 'core/stress_hydro', rh%values(1:5))
+      call series_column(series, 'core/stress_contact', rh%values(6:10))
+      call series_column(series, 'core/solid_fraction', rh%values(11))
+      call series_column(series, 'core/velocity_fit', rh%values(12:16))
+      call series_column(series, 'core/flow_fit', rh%values(17:21))
+      call series_column(series, 'core/shear_rate', rh%shear_rate_core)
+      call series_column(series, 'min_pair_gap', rh%min_pair_gap)
+      call series_column(series, 'pairs/references', rh%references)
+      call series_column(series, 'pairs/shell', rh%angles(:, 1))
+      call series_column(series, 'pairs/contact', rh%angles(:, 2))
+      call series_column(series, 'profiles/solid_fraction', rh%profile(:, 1))
+      call series_column(series, 'profiles/momentum', rh%profile(:, 2))
+      if (has_contacts) call series_column(series, 'contact_overlap_over_roughness', &
+                                           pc%max_overlap / max(pc%params%h_r, tiny(1.0_dp)))
+    end if
+  end subroutine series_columns
 
   subroutine checkpoint()
     call series_flush(series)
