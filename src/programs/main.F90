@@ -17,14 +17,14 @@ program fdsusp
                        fluid_mean_profile
   use mod_series, only: series_t, series_column, series_open, series_record, series_flush, series_attributes
   use mod_output, only: write_fields, progress_line
-  use mod_checkpoint, only: checkpoint_write, checkpoint_check, checkpoint_read
+  use mod_checkpoint, only: checkpoint_state_t, checkpoint_write, checkpoint_check, checkpoint_read
   use mod_system, only: install_signal_handlers, stop_signal, make_directory, probe_directory, lock_directory, &
                         release_directory
   use mod_timers, only: timers_register, stage_push, stage_pop, STAGE_SETUP, STAGE_FLUID, STAGE_OUTPUT, &
                         STAGE_PARTICLES, STAGE_CONTACTS, STAGE_LUBRICATION
   use mod_particles, only: particles_t, advance_positions, displacements, MOTION_FREE
   use mod_particles_io, only: particles_load, particles_snapshot
-  use mod_rheology, only: rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, rheo_state, rheo_restore, &
+  use mod_rheology, only: rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, &
                           rheo_write_summary, rheo_summarise, summary_names, NSUMMARY
   use mod_fictitious_domain, only: fd_t, fd_create, fd_geometry, fd_follow, fd_moments, fd_solve_motion, fd_update, &
                                    fd_destroy
@@ -46,19 +46,19 @@ program fdsusp
   PetscErrorCode :: ierr
   type(config_t) :: cfg
   type(grid_t) :: grid
-  type(fluid_t) :: fl
+  type(fluid_t), target :: fl
   type(solver_t) :: yardstick                       ! -bench_cold_poisson's multigrid solve
   type(series_t) :: series
-  type(particles_t) :: parts
-  type(fd_t) :: fd
-  type(particle_contacts_t) :: pc
+  type(particles_t), target :: parts
+  type(fd_t), target :: fd
+  type(particle_contacts_t), target :: pc
   type(lubrication_t) :: lub
   type(particle_lubrication_t), allocatable :: pl   ! allocated when lubrication is on
-  type(rheology_t), allocatable :: rh               ! allocated when the deck has &rheology
-  type(lees_edwards_t) :: le                        ! y_boundary = 'lees-edwards' (le%active), its offset
+  type(rheology_t), allocatable, target :: rh       ! allocated when the deck has &rheology
+  type(lees_edwards_t), target :: le                ! y_boundary = 'lees-edwards' (le%active), its offset
   type(lubrication_dynamics_t) :: ld                ! &fluid model = 'none': the spheres alone
   type(particle_solver_t) :: ld_solver              ! its sparse 6N solve
-  real(dp), allocatable :: statistics(:)            ! rh's accumulators, for checkpoints
+  type(checkpoint_state_t) :: state                 ! what the checkpoints hold: the pieces this run has
   real(dp), allocatable :: mean_flow(:)             ! x-z plane means of u, per cell row
   real(dp) :: largest_overlap = 0.0_dp              ! of this run (since the start or restart) [a]
   integer :: largest_overlap_step = 0
@@ -128,7 +128,6 @@ program fdsusp
     if (info /= 0) call input_error(cfg%deck_file, 'domain', 'box', &
          'with &rheology every periodic length must be >= 2 (pair_shell + 0.3) a')
     allocate(mean_flow(0:cfg%cells(2) - 1))
-    statistics = rheo_state(rh)
     write(text, '(a,i0,a,i0,a,i0,a,i0)') 'statistics: discard ', cfg%discard_step, ' steps, then ', cfg%blocks, &
          ' blocks of ', cfg%block_steps, ' steps, ending at step ', cfg%discard_step + cfg%blocks * cfg%block_steps
     call log_line(text)
@@ -170,27 +169,15 @@ program fdsusp
     call ld_create(ld, parts%radius, 1.0_dp, cfg%shear_rate, cfg%box, cfg%walls .or. cfg%lees_edwards)
     PetscCallA(psolver_create(ld_solver, ierr))
   end if
-  if (restarting .and. .not. cfg%resolved) then
-    ! (statistics: absent when unallocated, i.e. without &rheology; history: without contacts)
-    if (has_contacts) then
-      PetscCallA(checkpoint_read(restart, ierr=ierr, parts=parts, history=pc%history, statistics=statistics))
-    else
-      PetscCallA(checkpoint_read(restart, ierr=ierr, parts=parts, statistics=statistics))
-    end if
-    if (cfg%lees_edwards) then
-      PetscCallA(checkpoint_read(restart, ierr=ierr, offset=le%offset))
-    end if
-    if (allocated(rh)) call rheo_restore(rh, statistics, info)
-  else if (restarting) then
-    ! (statistics: absent when unallocated, i.e. without &rheology)
-    if (has_contacts) then
-      PetscCallA(checkpoint_read(restart, fl, ierr, fd%lambda, parts, pc%history, statistics=statistics))
-    else if (has_particles) then
-      PetscCallA(checkpoint_read(restart, fl, ierr, fd%lambda, parts, statistics=statistics))
-    else
-      PetscCallA(checkpoint_read(restart, fl, ierr))
-    end if
-    if (allocated(rh)) call rheo_restore(rh, statistics, info)
+  ! the state the checkpoints hold and a restart restores: the pieces this run has
+  if (cfg%resolved) state%fl => fl
+  if (cfg%resolved .and. has_particles) state%lambda => fd%lambda
+  if (has_particles) state%parts => parts
+  if (has_contacts) state%history => pc%history
+  if (allocated(rh)) state%rh => rh
+  if (cfg%lees_edwards) state%offset => le%offset
+  if (restarting) then
+    PetscCallA(checkpoint_read(restart, state, ierr))
   end if
   ! the columns of series.h5, declared by the routine that also fills each record
   call series_columns()
@@ -634,31 +621,8 @@ contains
 
   subroutine checkpoint()
     call series_flush(series)
-    if (allocated(rh)) statistics = rheo_state(rh)
-    if (.not. cfg%resolved) then
-      call checkpoint_particles(checkpoint_path)
-    else if (has_contacts) then
-      PetscCallA(checkpoint_write(checkpoint_path, cfg, fl, step, time, ierr, fd%lambda, parts, pc%history, statistics))
-    else if (has_particles) then
-      PetscCallA(checkpoint_write(checkpoint_path, cfg, fl, step, time, ierr, fd%lambda, parts, statistics=statistics))
-    else
-      PetscCallA(checkpoint_write(checkpoint_path, cfg, fl, step, time, ierr))
-    end if
+    PetscCallA(checkpoint_write(checkpoint_path, cfg, state, step, time, ierr))
   end subroutine checkpoint
-
-  ! Lubrication dynamics: no fluid; the particles, contacts, statistics and the Lees-Edwards offset.
-  subroutine checkpoint_particles(path)
-    character(len=*), intent(in) :: path
-    if (cfg%lees_edwards .and. has_contacts) then
-      PetscCallA(checkpoint_write(path, cfg, step=step, time=time, ierr=ierr, parts=parts, history=pc%history, statistics=statistics, offset=le%offset))
-    else if (cfg%lees_edwards) then
-      PetscCallA(checkpoint_write(path, cfg, step=step, time=time, ierr=ierr, parts=parts, statistics=statistics, offset=le%offset))
-    else if (has_contacts) then
-      PetscCallA(checkpoint_write(path, cfg, step=step, time=time, ierr=ierr, parts=parts, history=pc%history, statistics=statistics))
-    else
-      PetscCallA(checkpoint_write(path, cfg, step=step, time=time, ierr=ierr, parts=parts, statistics=statistics))
-    end if
-  end subroutine checkpoint_particles
 
   ! summary.json (rank 0) and the rheology in the run log: value +- standard error over the blocks.
   subroutine summary()
@@ -888,13 +852,7 @@ contains
     integer, intent(in) :: at_step
     character(len=*), intent(in) :: what
     call series_flush(series)
-    if (.not. cfg%resolved) then
-      call checkpoint_particles(trim(cfg%output_directory)//'/failed_state.h5')
-    else if (has_particles) then
-      PetscCallA(checkpoint_write(trim(cfg%output_directory)//'/failed_state.h5', cfg, fl, step, time, ierr, fd%lambda, parts))
-    else
-      PetscCallA(checkpoint_write(trim(cfg%output_directory)//'/failed_state.h5', cfg, fl, step, time, ierr))
-    end if
+    PetscCallA(checkpoint_write(trim(cfg%output_directory)//'/failed_state.h5', cfg, state, step, time, ierr))
     write(text, '(a,i0,a)') 'fdsusp: fatal: at step ', at_step, ': '//trim(what)// &
          '; state written to '//trim(cfg%output_directory)//'/failed_state.h5, the last good checkpoint is kept'
     call fatal_error(text, 5)
