@@ -27,9 +27,10 @@ program fdsusp
   use mod_rheology, only: rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, &
                           rheo_write_summary, rheo_summarise, summary_names, NSUMMARY
   use mod_fictitious_domain, only: fd_t, fd_create, fd_geometry, fd_follow, fd_moments, fd_solve_motion, fd_update, &
-                                   fd_destroy
+                                   fd_destroy, fd_pair_lag_limit, fd_stresslet_lag_limit
   use mod_particle_contacts, only: particle_contacts_t, pcontacts_create, pcontacts_step
-  use mod_contact, only: chatter_number, stick_number, flattening_estimate, wall_lower, wall_upper
+  use mod_contact, only: contact_limits, overlap_limit, wall_lower, wall_upper
+  use mod_limits, only: limit_finding_t, LIMIT_REFUSE
   use mod_lubrication, only: lubrication_t, LUB_NONE, LUB_SIMPLE, LUB_EXACT
   use mod_lubrication_io, only: lubrication_load
   use mod_particle_lubrication, only: particle_lubrication_t, plub_create
@@ -76,12 +77,6 @@ program fdsusp
   real(dp) :: err_vel, err_p_max, err_p_rms
   logical :: restarting, continuing
   integer, parameter :: RUNNING = 0, DONE = 1, SIGNALLED = 2, WALL_LIMIT = 3, STEADY = 4
-  ! largest chatter_number accepted (doc/CONTACT.md "Time-step considerations"): explicit contacts
-  ! chatter beyond it; implicit ones were measured free of chatter up to IMPLICIT_CHATTER_LIMIT
-  real(dp), parameter :: CHATTER_LIMIT = 0.025_dp, IMPLICIT_CHATTER_LIMIT = 0.2_dp
-  ! largest stick_number without a warning: friction converged at 1.1-4.6, 14 % low at 11.4
-  ! (doc/CONTACT.md "Time-step considerations", doc/VALIDATION.md §5.4)
-  real(dp), parameter :: STICK_LIMIT = 5.0_dp
 
   PetscCallA(PetscInitialize(ierr))
   ! SIGTERM/SIGUSR1 from now on only ask the run to stop after its next step (they replace
@@ -119,7 +114,9 @@ program fdsusp
     if (info /= 0) call input_error(cfg%deck_file, 'lubrication', 'skin', trim(text))
   end if
   ! rough contacts: the limits of doc/CONTACT.md and doc/VALIDATION.md §6, before any work
-  if (has_contacts .and. (has_lubrication .or. .not. cfg%resolved)) call check_contact_limits()
+  if (has_contacts .and. (has_lubrication .or. .not. cfg%resolved)) call report(contact_limits(pc%params, cfg%dt, &
+       pc%implicit, cfg%walls .or. cfg%lees_edwards, parts%n * (4.0_dp / 3.0_dp) * pi * parts%radius**3 / product(cfg%box), &
+       cfg%eps_bar, cfg%normal_stiffness > 0.0_dp))
   ! statistics of the core region (doc/RHEOLOGY.md)
   if (cfg%rheology_group) then
     allocate(rh)
@@ -131,14 +128,9 @@ program fdsusp
     write(text, '(a,i0,a,i0,a,i0,a,i0)') 'statistics: discard ', cfg%discard_step, ' steps, then ', cfg%blocks, &
          ' blocks of ', cfg%block_steps, ' steps, ending at step ', cfg%discard_step + cfg%blocks * cfg%block_steps
     call log_line(text)
-    ! spheres crossing more than ~0.02 cells per step lose stresslet (doc/VALIDATION.md §5.3)
+    ! spheres at the edge of the core must not outrun their Lambda (mod_fictitious_domain)
     core_edge_speed = abs(cfg%shear_rate) * max(rh%core(2) - 0.5_dp * cfg%box(2), 0.5_dp * cfg%box(2) - rh%core(1))
-    if (cfg%resolved .and. core_edge_speed * cfg%dt > 0.02_dp * cfg%h) then
-      write(text, '(a,f6.3,a,es9.2,a)') 'spheres at the edge of the core cross ', core_edge_speed * cfg%dt / cfg%h, &
-           ' cells per step, and their stresslets lag (doc/VALIDATION.md 5.3): dt <= ', &
-           0.02_dp * cfg%h / core_edge_speed, ' keeps them within 1 %'
-      call warn_line(text)
-    end if
+    if (cfg%resolved) call report(fd_stresslet_lag_limit(core_edge_speed, cfg%dt, cfg%h))
     if (cfg%steps < cfg%discard_step + cfg%blocks * cfg%block_steps) then
       write(text, '(a,i0,a)') '&time steps = ', cfg%steps, ' ends before the averaging window: the summary '// &
            'will hold the blocks complete by then (restart with more steps to finish)'
@@ -191,7 +183,9 @@ program fdsusp
          merge(cfg%friction, 0.0_dp, has_contacts), merge(cfg%roughness, 0.0_dp, has_contacts)])
   end if
   PetscCallA(stage_pop(ierr))
-  if (cfg%resolved .and. has_particles .and. has_lubrication .and. parts%motion == MOTION_FREE) call check_pair_lag()
+  ! free lubricated pairs must not separate faster than their Lambda relaxes (mod_fictitious_domain)
+  if (cfg%resolved .and. has_particles .and. has_lubrication .and. parts%motion == MOTION_FREE) &
+    call report(fd_pair_lag_limit(cfg%dt, cfg%reynolds, cfg%h))
   if (.not. cfg%resolved) then
     write(text, '(a,i0,a)') 'models: lubrication dynamics, no fluid (one-body Stokes drag in the imposed flow, '// &
          trim(merge('Lees-Edwards boundaries', 'walls in y             ', cfg%lees_edwards))//'); ', parts%n, &
@@ -254,7 +248,12 @@ program fdsusp
         PetscCallA(stage_push(STAGE_CONTACTS, ierr))
         call pcontacts_step(pc, parts%position, parts%velocity, parts%omega, info, le%offset)
         if (info /= 0) call contact_failure(info)
-        if (pc%max_overlap > largest_overlap) call note_overlap()
+        if (pc%max_overlap > largest_overlap) then
+          ! a new largest overlap of the run: warned once past h_r/2 (mod_contact)
+          call report(overlap_limit(pc%params, largest_overlap, pc%max_overlap, step))
+          largest_overlap = pc%max_overlap
+          largest_overlap_step = step
+        end if
         PetscCallA(stage_pop(ierr))
       end if
       if (has_lubrication) then
@@ -680,85 +679,19 @@ contains
     end select
   end function lubrication_models
 
-  ! Close free pairs: Lambda on the faces between them relaxes over ~dt^2/(kappa (1 - alpha) Re h^2)
-  ! strains, so a pair that opens separates too fast: by ~0.7 % per 1e-3 of dt^2/(Re h^2) at gaps
-  ! 0.05-0.1 a (a/Delta = 4, 5, 6; doc/VALIDATION.md §4.4, the pair test's mobility table).
-  subroutine check_pair_lag()
-    real(dp), parameter :: LAG_LIMIT = 4.0e-3_dp     ! ~3 % in the separation, measured
-    real(dp) :: lag
-    lag = cfg%dt**2 / (cfg%reynolds * cfg%h**2)
-    if (lag > LAG_LIMIT) then
-      write(text, '(a,es9.2,a,es8.1,a,es9.2,a)') 'close pairs will separate too fast: dt^2/(Re Delta^2) = ', lag, &
-           ' exceeds ', LAG_LIMIT, ' (about 0.7 % per 1e-3 in the separation velocity, doc/VALIDATION.md 4.4): dt <= ', &
-           sqrt(LAG_LIMIT * cfg%reynolds) * cfg%h, ' keeps it within ~3 %'
-      call warn_line(text)
-    end if
-  end subroutine check_pair_lag
-
-  ! The rough contacts against the lubricated response: refused beyond the chatter numbers measured
-  ! (doc/CONTACT.md "Time-step considerations": explicit contacts chatter from ~0.02 on and are
-  ! refused above 0.025; implicit ones were measured clean up to 0.2 and are refused beyond), and
-  ! where the roughness of a dense suspension would flatten completely (doc/VALIDATION.md §6).
-  subroutine check_contact_limits()
-    real(dp) :: chatter, stick, solid_fraction, expected_overlap
-    chatter = chatter_number(pc%params, cfg%dt)
-    ! friction: a step that slips further than a spring sticks makes every contact slide
-    stick = stick_number(pc%params, cfg%dt)
-    if (.not. pc%implicit .and. stick > 0) then
-      call warn_line('explicit frictional contacts: at the one set-up measured (stick number 2.3) 82 % of '// &
-           'them slid and the friction raised eta_r by 1.35 where implicit contacts give 1.67 (doc/CONTACT.md '// &
-           '"Time-step considerations"): &contact implicit = .true. for friction')
-    else if (stick > STICK_LIMIT) then
-      write(text, '(a,f6.1,a,f4.1,a,es9.2,a)') 'friction: a step slips further than a contact sticks: '// &
-           'dt gamma_dot a/((7/2) mu_d delta_0) = ', stick, ' exceeds ', STICK_LIMIT, &
-           ' (contacts that should stick slide; eta_r 14 % low at 11, doc/CONTACT.md): dt <= ', &
-           STICK_LIMIT * cfg%dt / stick, ' (or a larger &contact eps_bar) resolves it'
-      call warn_line(text)
-    end if
-    if (.not. pc%implicit .and. chatter > CHATTER_LIMIT) then
-      write(text, '(a,f6.3,a,f5.3,a,es9.2,a)') 'the explicit rough contacts would chatter: dt gamma_dot h_r/delta_0 = ', &
-           chatter, ' exceeds ', CHATTER_LIMIT, &
-           ' (period-two oscillation measured above it; doc/CONTACT.md): the largest stable dt here is ', &
-           CHATTER_LIMIT * cfg%dt / chatter, ' (or raise &contact eps_bar, or take them implicitly: &contact implicit)'
-      call input_error(cfg%deck_file, 'time', 'dt', trim(text))
-    else if (pc%implicit .and. chatter > IMPLICIT_CHATTER_LIMIT) then
-      write(text, '(a,f6.3,a,f5.3,a,es9.2,a)') 'the rough contacts: dt gamma_dot h_r/delta_0 = ', chatter, &
-           ' exceeds ', IMPLICIT_CHATTER_LIMIT, ', the largest chatter number at which implicit contacts were '// &
-           'measured free of chatter (doc/CONTACT.md): the largest dt measured stable here is ', &
-           IMPLICIT_CHATTER_LIMIT * cfg%dt / chatter, ' (or raise &contact eps_bar)'
-      call input_error(cfg%deck_file, 'time', 'dt', trim(text))
-    end if
-    ! the roughness of a dense suspension flattens under its force chains (doc/VALIDATION.md §6)
-    if (cfg%walls .or. cfg%lees_edwards) then
-      solid_fraction = parts%n * (4.0_dp / 3.0_dp) * pi * parts%radius**3 / product(cfg%box)
-      expected_overlap = flattening_estimate(pc%params, solid_fraction)
-      if (expected_overlap > 1.0_dp) then
-        write(text, '(a,f6.2,a,f5.3,a,es9.2,a)') 'the roughness would flatten completely: expected largest overlap ', &
-             expected_overlap, ' h_r at phi = ', solid_fraction, ' (doc/VALIDATION.md §6); stiffer contacts, eps_bar <= ', &
-             0.5_dp * cfg%eps_bar / expected_overlap, ' (or a larger normal_stiffness), keep it below h_r/2'
-        call input_error(cfg%deck_file, 'contact', trim(merge('normal_stiffness', 'eps_bar         ', &
-                         cfg%normal_stiffness > 0.0_dp)), trim(text))
-      else if (expected_overlap > 0.5_dp) then
-        write(text, '(a,f6.2,a,f5.3,a)') 'expected largest contact overlap ', expected_overlap, ' h_r at phi = ', &
-             solid_fraction, ' (> h_r/2, doc/VALIDATION.md §6): a smaller &contact eps_bar keeps the roughness'
-        call warn_line(text)
+  ! The findings of a limit check (mod_limits), in their order: warnings, and the refusal of the
+  ! deck item named, which stops the run. Collective: every rank finds the same.
+  subroutine report(findings)
+    type(limit_finding_t), intent(in) :: findings(:)
+    integer :: k
+    do k = 1, size(findings)
+      if (findings(k)%level == LIMIT_REFUSE) then
+        call input_error(cfg%deck_file, trim(findings(k)%group), trim(findings(k)%key), trim(findings(k)%text))
+      else
+        call warn_line(findings(k)%text)
       end if
-    end if
-  end subroutine check_contact_limits
-
-  ! A new largest overlap of the run; warned once when it passes h_r/2, the bound the extreme
-  ! scenes hold (doc/VALIDATION.md §6).
-  subroutine note_overlap()
-    if (largest_overlap <= 0.5_dp * pc%params%h_r .and. pc%max_overlap > 0.5_dp * pc%params%h_r) then
-      write(text, '(a,i0,a,f6.3,a)') 'at step ', step, ' a contact overlap reaches ', &
-           pc%max_overlap / pc%params%h_r, ' h_r (> h_r/2): stiffer contacts (a smaller &contact eps_bar '// &
-           'or a larger normal_stiffness, with dt gamma_dot h_r/delta_0 within its limit, doc/CONTACT.md) keep the '// &
-           'roughness from flattening'
-      call warn_line(text)
-    end if
-    largest_overlap = pc%max_overlap
-    largest_overlap_step = step
-  end subroutine note_overlap
+    end do
+  end subroutine report
 
   ! Collective (every rank holds the same contacts): stop with a diagnostic.
   subroutine contact_failure(code)
