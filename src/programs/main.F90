@@ -71,7 +71,7 @@ program fdsusp
   character(len=400) :: text
   integer :: step, first_step, stop_reason, cold_its
   integer :: iterations_sum(4)
-  real(dp) :: time, wall_start, wall_now, wall_per_step, wall_loop, cold_seconds, core_edge_speed
+  real(dp) :: time, wall_start, wall_now, wall_per_step, wall_loop, cold_seconds, core_edge_speed, solid_fraction
   PetscBool :: bench_cold, fault_set
   PetscInt :: fault_nan_step
   real(dp) :: err_vel, err_p_max, err_p_rms
@@ -114,9 +114,11 @@ program fdsusp
     if (info /= 0) call input_error(cfg%deck_file, 'lubrication', 'skin', trim(text))
   end if
   ! rough contacts: the limits of doc/CONTACT.md and doc/VALIDATION.md §6, before any work
-  if (has_contacts .and. (has_lubrication .or. .not. cfg%resolved)) call report(contact_limits(pc%params, cfg%dt, &
-       pc%implicit, cfg%walls .or. cfg%lees_edwards, parts%n * (4.0_dp / 3.0_dp) * pi * parts%radius**3 / product(cfg%box), &
-       cfg%eps_bar, cfg%normal_stiffness > 0.0_dp))
+  if (has_contacts .and. (has_lubrication .or. .not. cfg%resolved)) then
+    solid_fraction = parts%n * (4.0_dp / 3.0_dp) * pi * parts%radius**3 / product(cfg%box)
+    call report(contact_limits(pc%params, cfg%dt, pc%implicit, cfg%walls .or. cfg%lees_edwards, solid_fraction, &
+                               cfg%eps_bar, cfg%normal_stiffness > 0.0_dp))
+  end if
   ! statistics of the core region (doc/RHEOLOGY.md)
   if (cfg%rheology_group) then
     allocate(rh)
