@@ -45,13 +45,15 @@ module mod_fictitious_domain
   use mod_solid_fraction, only: cube_fraction
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates, min_image
   use mod_errors, only: fatal_error
+  use mod_limits, only: limit_finding_t, add_finding, LIMIT_WARN
   use mod_timers, only: event_begin, event_end, EVENT_GEOMETRY, EVENT_CARRY, EVENT_MOMENTS, EVENT_MOTION, &
                         EVENT_UPDATE
   implicit none
   private
   public :: fictitious_domain_t, fictitious_domain_create, fictitious_domain_geometry, &
             fictitious_domain_follow, fictitious_domain_moments, fictitious_domain_solve_motion, &
-            fictitious_domain_update, fictitious_domain_destroy
+            fictitious_domain_update, fictitious_domain_destroy, &
+            fictitious_domain_pair_lag_limit, fictitious_domain_stresslet_lag_limit
 
   type :: fictitious_domain_t
     real(dp) :: beta = 0.0_dp           ! rho/dt = Re/dt
@@ -93,6 +95,42 @@ module mod_fictitious_domain
        0.5_dp, 0.5_dp, 0.0_dp, 0.5_dp, 0.5_dp, 0.5_dp], [3, 4])
 
 contains
+
+  ! Close free pairs: Lambda on the faces between them relaxes over ~dt^2/(kappa (1 - alpha) Re h^2)
+  ! strains, so a pair that opens separates too fast: by ~0.7 % per 1e-3 of dt^2/(Re h^2) at gaps
+  ! 0.05-0.1 a (a/Delta = 4, 5, 6; doc/VALIDATION.md §4.4, the pair test's mobility table).
+  ! A warning beyond LAG_LIMIT (h: the cell size).
+  function fictitious_domain_pair_lag_limit(dt, reynolds, h) result(findings)
+    real(dp), intent(in) :: dt, reynolds, h
+    type(limit_finding_t), allocatable :: findings(:)
+    real(dp), parameter :: LAG_LIMIT = 4.0e-3_dp     ! ~3 % in the separation, measured
+    real(dp) :: lag
+    character(len=400) :: text
+    allocate(findings(0))
+    lag = dt**2 / (reynolds * h**2)
+    if (lag > LAG_LIMIT) then
+      write(text, '(a,es9.2,a,es8.1,a,es9.2,a)') 'close pairs will separate too fast: dt^2/(Re Delta^2) = ', lag, &
+           ' exceeds ', LAG_LIMIT, ' (about 0.7 % per 1e-3 in the separation velocity, doc/VALIDATION.md 4.4): dt <= ', &
+           sqrt(LAG_LIMIT * reynolds) * h, ' keeps it within ~3 %'
+      call add_finding(findings, LIMIT_WARN, text)
+    end if
+  end function fictitious_domain_pair_lag_limit
+
+  ! Spheres crossing more than ~0.02 cells per step lose stresslet: their Lambda lags the moving
+  ! geometry (doc/VALIDATION.md §5.3). edge_speed: the shear velocity at the edge of the region
+  ! measured (the core of &rheology); a warning beyond it (h: the cell size).
+  function fictitious_domain_stresslet_lag_limit(edge_speed, dt, h) result(findings)
+    real(dp), intent(in) :: edge_speed, dt, h
+    type(limit_finding_t), allocatable :: findings(:)
+    character(len=400) :: text
+    allocate(findings(0))
+    if (edge_speed * dt > 0.02_dp * h) then
+      write(text, '(a,f6.3,a,es9.2,a)') 'spheres at the edge of the core cross ', edge_speed * dt / h, &
+           ' cells per step, and their stresslets lag (doc/VALIDATION.md 5.3): dt <= ', &
+           0.02_dp * h / edge_speed, ' keeps them within 1 %'
+      call add_finding(findings, LIMIT_WARN, text)
+    end if
+  end function fictitious_domain_stresslet_lag_limit
 
   subroutine fictitious_domain_create(grid, reynolds, dt, kappa, radius_offset, fd, ierr)
     type(grid_t), intent(in) :: grid

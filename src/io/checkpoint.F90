@@ -12,8 +12,11 @@
 !             with contacts also the group /contacts (mod_contacts_io: the tangential springs)
 !             with statistics (&rheology) also /rheology/accumulators (mod_rheology::rheo_state)
 !   attributes format_version, step, time, cells, box, walls, reynolds, dt, shear_rate, star_history,
-!             fluid_resolved (1, or 0 for lubrication dynamics, which writes no fields: no fl), and
+!             fluid_resolved (1, or 0 for lubrication dynamics, which writes no fields), and
 !             with Lees-Edwards boundaries lees_edwards_offset (the boundary offset delta, exactly)
+! What a file holds is what the run has: one checkpoint_state_t, set up once by the program,
+! names the pieces (fluid, Lambda, particles, contact history, statistics, offset) for the
+! checkpoints, the restart and failed_state.h5 alike.
 ! Written in parallel to NAME.tmp by PETSc's HDF5 viewer, completed by rank 0, flushed to disk
 ! and renamed over NAME: the previous checkpoint survives until the new one is whole.
 #include <petsc/finclude/petscdmda.h>
@@ -32,56 +35,55 @@ module mod_checkpoint
   use mod_particles_io, only: particles_write, particles_read_state
   use mod_contact, only: contact_history_t
   use mod_contacts_io, only: contacts_write, contacts_read
+  use mod_rheology, only: rheology_t, rheo_state, rheo_restore
   implicit none
   private
-  public :: checkpoint_write, checkpoint_check, checkpoint_read, checkpoint_format_version
+  public :: checkpoint_state_t, checkpoint_write, checkpoint_check, checkpoint_read, checkpoint_format_version
 
   integer, parameter :: checkpoint_format_version = 1
   character(len=*), parameter :: field_datasets(5) = ['u  ', 'v  ', 'w  ', 'p  ', 'phi']
 
+  ! The state of a run, as its checkpoints hold it: each piece associated when the run has it. One
+  ! bundle, set up once by the program, serves the checkpoints, the restart and the failed state,
+  ! so that all three carry the same pieces.
+  type :: checkpoint_state_t
+    type(fluid_t), pointer :: fl => null()                  ! the resolved fluid (none in lubrication dynamics)
+    Vec, pointer :: lambda(:) => null()                     ! Lambda on the u, v, w faces (fluid and particles)
+    type(particles_t), pointer :: parts => null()           ! the particles
+    type(contact_history_t), pointer :: history => null()   ! the contacts' springs (with the particles)
+    type(rheology_t), pointer :: rh => null()               ! &rheology: its accumulators (rheo_state)
+    real(dp), pointer :: offset => null()                   ! the Lees-Edwards offset (y_boundary = 'lees-edwards')
+  end type checkpoint_state_t
+
 contains
 
-  ! fl: the fluid, absent in lubrication dynamics (&fluid model = 'none'); lambda and parts: present
-  ! when the run has particles; history: when it has contacts; statistics: the accumulators of
-  ! &rheology; offset: the Lees-Edwards offset (y_boundary = 'lees-edwards').
-  subroutine checkpoint_write(path, cfg, fl, step, time, ierr, lambda, parts, history, statistics, offset)
+  ! The checkpoint of STATE at step and time, published as PATH once whole.
+  subroutine checkpoint_write(path, cfg, state, step, time, ierr)
     character(len=*), intent(in) :: path
     type(config_t), intent(in) :: cfg
-    type(fluid_t), intent(inout), optional :: fl
+    type(checkpoint_state_t), intent(in) :: state
     integer, intent(in) :: step
     real(dp), intent(in) :: time
     PetscErrorCode, intent(out) :: ierr
-    Vec, intent(in), optional :: lambda(3)
-    type(particles_t), intent(in), optional :: parts
-    type(contact_history_t), intent(in), optional :: history
-    real(dp), intent(in), optional :: statistics(:)
-    real(dp), intent(in), optional :: offset
     PetscViewer :: viewer
     integer(HID_T) :: file, group
-    integer :: err, e(13), c, walls, stars
+    integer :: err, k, stars
+    logical :: failed
     character(len=1100) :: tmp
     character(len=16) :: code
+    Vec, allocatable :: fields(:)
+    real(dp), allocatable :: statistics(:)
 
     tmp = trim(path)//'.tmp'
     stars = 0
-    if (present(fl)) then
+    if (associated(state%fl)) then
+      fields = field_vectors(state, .true.)
       PetscCall(PetscViewerHDF5Open(PETSC_COMM_WORLD, trim(tmp), FILE_MODE_WRITE, viewer, ierr))
-      do c = FIELD_U, FIELD_W
-        PetscCall(VecView(fl%vel(c), viewer, ierr))
+      do k = 1, size(fields)
+        PetscCall(VecView(fields(k), viewer, ierr))
       end do
-      PetscCall(VecView(fl%pressure, viewer, ierr))
-      PetscCall(VecView(fl%phi, viewer, ierr))
-      do c = FIELD_U, FIELD_W
-        PetscCall(VecView(fl%vel_star(c), viewer, ierr))
-        PetscCall(VecView(fl%vel_star_old(c), viewer, ierr))
-      end do
-      if (present(lambda)) then
-        do c = 1, 3
-          PetscCall(VecView(lambda(c), viewer, ierr))
-        end do
-      end if
       PetscCall(PetscViewerDestroy(viewer, ierr))
-      stars = fl%star_history
+      stars = state%fl%star_history
     else if (is_root()) then
       ! no fields: rank 0 makes the file alone
       call h5fcreate_f(trim(tmp), H5F_ACC_TRUNC_F, file, err)
@@ -92,31 +94,34 @@ contains
     if (is_root()) then
       call h5fopen_f(trim(tmp), H5F_ACC_RDWR_F, file, err)
       if (err /= 0) call abort_run('cannot reopen '//trim(tmp)//' to complete the checkpoint')
-      walls = merge(1, 0, cfg%walls)
-      e = 0
-      call write_attribute(file, 'format_version', [checkpoint_format_version], e(1))
-      call write_attribute(file, 'step', [step], e(2))
-      call write_attribute(file, 'time', [time], e(3))
-      call write_attribute(file, 'cells', cfg%cells, e(4))
-      call write_attribute(file, 'box', cfg%box, e(5))
-      call write_attribute(file, 'walls', [walls], e(6))
-      call write_attribute(file, 'reynolds', [cfg%reynolds], e(7))
-      call write_attribute(file, 'dt', [cfg%dt], e(8))
-      call write_attribute(file, 'shear_rate', [cfg%shear_rate], e(9))
-      call write_string_attribute(file, 'program', 'fdsusp', e(10))
-      call write_attribute(file, 'star_history', [stars], e(11))
-      call write_attribute(file, 'fluid_resolved', [merge(1, 0, present(fl))], e(12))
-      if (present(offset)) call write_attribute(file, 'lees_edwards_offset', [offset], e(13))
-      if (present(parts)) call particles_write(file, parts, cfg%box, .true.)
-      if (present(history) .and. present(parts)) call contacts_write(file, history, parts%n)
-      if (present(statistics)) then
+      failed = .false.
+      call put_int('format_version', [checkpoint_format_version])
+      call put_int('step', [step])
+      call put_real('time', [time])
+      call put_int('cells', cfg%cells)
+      call put_real('box', cfg%box)
+      call put_int('walls', [merge(1, 0, cfg%walls)])
+      call put_real('reynolds', [cfg%reynolds])
+      call put_real('dt', [cfg%dt])
+      call put_real('shear_rate', [cfg%shear_rate])
+      call write_string_attribute(file, 'program', 'fdsusp', err)
+      failed = failed .or. err /= 0
+      call put_int('star_history', [stars])
+      call put_int('fluid_resolved', [merge(1, 0, associated(state%fl))])
+      if (associated(state%offset)) call put_real('lees_edwards_offset', [state%offset])
+      if (associated(state%parts)) then
+        call particles_write(file, state%parts, cfg%box, .true.)
+        if (associated(state%history)) call contacts_write(file, state%history, state%parts%n)
+      end if
+      if (associated(state%rh)) then
+        statistics = rheo_state(state%rh)
         call h5gcreate_f(file, 'rheology', group, err)
         if (err == 0) call write_dataset(group, 'accumulators', reshape(statistics, [size(statistics), 1]), err)
         if (err /= 0) call abort_run('cannot write /rheology/accumulators to '//trim(tmp))
         call h5gclose_f(group, err)
       end if
       call h5fclose_f(file, err)
-      if (any(e /= 0) .or. err /= 0) call abort_run('cannot write the attributes of '//trim(tmp))
+      if (failed .or. err /= 0) call abort_run('cannot write the attributes of '//trim(tmp))
       err = publish_file(tmp, path)
       if (err /= 0) then
         write(code, '(i0)') err
@@ -124,7 +129,40 @@ contains
       end if
     end if
     call MPI_Barrier(PETSC_COMM_WORLD, ierr)
+
+  contains
+
+    subroutine put_int(name, values)
+      character(len=*), intent(in) :: name
+      integer, intent(in) :: values(:)
+      call write_attribute(file, name, values, err)
+      failed = failed .or. err /= 0
+    end subroutine put_int
+
+    subroutine put_real(name, values)
+      character(len=*), intent(in) :: name
+      real(dp), intent(in) :: values(:)
+      call write_attribute(file, name, values, err)
+      failed = failed .or. err /= 0
+    end subroutine put_real
   end subroutine checkpoint_write
+
+  ! The vectors of the fluid in the file's order (the datasets are named by the vectors):
+  ! u, v, w, p, phi, with stars the provisional velocities u*^n, u*^{n-1} of each component, and
+  ! with particles Lambda. One list for the write and the read.
+  function field_vectors(state, stars) result(v)
+    type(checkpoint_state_t), intent(in) :: state
+    logical, intent(in) :: stars
+    Vec, allocatable :: v(:)
+    integer :: c
+    v = [state%fl%vel(FIELD_U:FIELD_W), state%fl%pressure, state%fl%phi]
+    if (stars) then
+      do c = FIELD_U, FIELD_W
+        v = [v, state%fl%vel_star(c), state%fl%vel_star_old(c)]
+      end do
+    end if
+    if (associated(state%lambda)) v = [v, state%lambda]
+  end function field_vectors
 
   ! Before any work: is PATH a checkpoint of this scene? Returns its step and time. Rank 0
   ! inspects the file, every rank learns the verdict, and a bad file stops the run with a message
@@ -264,68 +302,53 @@ contains
     call h5fclose_f(file, err)
   end subroutine inspect
 
-  ! fl: the fluid (absent in lubrication dynamics); history (with parts): the contact history,
-  ! when the run has contacts; statistics: the accumulators of &rheology (its size is the run's; a
-  ! checkpoint without them, or with another size, stops the run); offset: the Lees-Edwards offset.
-  subroutine checkpoint_read(path, fl, ierr, lambda, parts, history, statistics, offset)
+  ! Restore STATE from the checkpoint PATH (checked before by checkpoint_check). The statistics of
+  ! &rheology must fit the run's (a checkpoint without them, or of another size, stops the run).
+  subroutine checkpoint_read(path, state, ierr)
     character(len=*), intent(in) :: path
-    type(fluid_t), intent(inout), optional :: fl
+    type(checkpoint_state_t), intent(in) :: state
     PetscErrorCode, intent(out) :: ierr
-    Vec, intent(inout), optional :: lambda(3)
-    type(particles_t), intent(inout), optional :: parts
-    type(contact_history_t), intent(inout), optional :: history
-    real(dp), intent(inout), optional :: statistics(:)
-    real(dp), intent(out), optional :: offset
     PetscViewer :: viewer
-    integer :: c, rank, err, stars(1)
+    integer :: k, rank, err, stars(1), info
     real(dp) :: delta(1)
     integer(HID_T) :: file
     integer(HSIZE_T) :: dims(2)
     character(len=200) :: message
     real(dp), allocatable :: buffer(:, :)
-    if (present(offset)) then
-      delta = 0.0_dp
-      if (is_root()) then
-        call h5fopen_f(trim(path), H5F_ACC_RDONLY_F, file, err)
-        call read_attribute(file, 'lees_edwards_offset', delta, err)
-        call h5fclose_f(file, err)
-      end if
-      call MPI_Bcast(delta, 1, MPI_DOUBLE_PRECISION, 0, PETSC_COMM_WORLD, ierr)
-      offset = delta(1)
-    end if
-    if (present(fl)) then
-      ! how many provisional velocities the file holds (none in a checkpoint older than them)
-      stars = 0
-      if (is_root()) then
-        call h5fopen_f(trim(path), H5F_ACC_RDONLY_F, file, err)
+    Vec, allocatable :: fields(:)
+    ! the Lees-Edwards offset, and how many provisional velocities the file holds (none in a
+    ! checkpoint older than them)
+    delta = 0.0_dp
+    stars = 0
+    if (is_root()) then
+      call h5fopen_f(trim(path), H5F_ACC_RDONLY_F, file, err)
+      if (associated(state%offset)) call read_attribute(file, 'lees_edwards_offset', delta, err)
+      if (associated(state%fl)) then
         if (has_object(file, 'u_star_old')) call read_attribute(file, 'star_history', stars, err)
         if (err /= 0) stars = 0
-        call h5fclose_f(file, err)
       end if
+      call h5fclose_f(file, err)
+    end if
+    if (associated(state%offset)) then
+      call MPI_Bcast(delta, 1, MPI_DOUBLE_PRECISION, 0, PETSC_COMM_WORLD, ierr)
+      state%offset = delta(1)
+    end if
+    if (associated(state%fl)) then
       call MPI_Bcast(stars, 1, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
-      fl%star_history = stars(1)
+      state%fl%star_history = stars(1)
+      fields = field_vectors(state, stars(1) > 0)
       PetscCall(PetscViewerHDF5Open(PETSC_COMM_WORLD, trim(path), FILE_MODE_READ, viewer, ierr))
-      do c = FIELD_U, FIELD_W
-        PetscCall(VecLoad(fl%vel(c), viewer, ierr))
+      do k = 1, size(fields)
+        PetscCall(VecLoad(fields(k), viewer, ierr))
       end do
-      PetscCall(VecLoad(fl%pressure, viewer, ierr))
-      PetscCall(VecLoad(fl%phi, viewer, ierr))
-      if (fl%star_history > 0) then
-        do c = FIELD_U, FIELD_W
-          PetscCall(VecLoad(fl%vel_star(c), viewer, ierr))
-          PetscCall(VecLoad(fl%vel_star_old(c), viewer, ierr))
-        end do
-      end if
-      if (present(lambda)) then
-        do c = 1, 3
-          PetscCall(VecLoad(lambda(c), viewer, ierr))
-        end do
-      end if
       PetscCall(PetscViewerDestroy(viewer, ierr))
     end if
-    if (present(parts)) call particles_read_state(path, parts)
-    if (present(history) .and. present(parts)) call contacts_read(path, history, parts%n)
-    if (present(statistics)) then
+    if (associated(state%parts)) then
+      call particles_read_state(path, state%parts)
+      if (associated(state%history)) call contacts_read(path, state%history, state%parts%n)
+    end if
+    if (associated(state%rh)) then
+      allocate(buffer(size(rheo_state(state%rh)), 1))
       message = ''
       if (is_root()) then
         call h5fopen_f(trim(path), H5F_ACC_RDONLY_F, file, err)
@@ -333,12 +356,10 @@ contains
           message = 'missing: the checkpoint was written by a run without &rheology'
         else
           call dataset_dims(file, 'rheology/accumulators', rank, dims)
-          if (rank /= 2 .or. dims(1) /= size(statistics) .or. dims(2) /= 1) then
+          if (rank /= 2 .or. dims(1) /= size(buffer, 1) .or. dims(2) /= 1) then
             message = 'does not fit this deck''s &rheology (blocks, profile_bins or angle_bins differ)'
           else
-            allocate(buffer(size(statistics), 1))
             call read_dataset(file, 'rheology/accumulators', buffer, err)
-            statistics = buffer(:, 1)
             if (err /= 0) message = 'cannot be read'
           end if
         end if
@@ -346,7 +367,9 @@ contains
       end if
       call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
       if (len_trim(message) > 0) call file_error(path, 'rheology/accumulators', trim(message))
-      call MPI_Bcast(statistics, size(statistics), MPI_DOUBLE_PRECISION, 0, PETSC_COMM_WORLD, ierr)
+      call MPI_Bcast(buffer, size(buffer), MPI_DOUBLE_PRECISION, 0, PETSC_COMM_WORLD, ierr)
+      ! (the size was checked above: info is 0)
+      call rheo_restore(state%rh, buffer(:, 1), info)
     end if
   end subroutine checkpoint_read
 

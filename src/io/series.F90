@@ -2,6 +2,10 @@
 ! as 1-D datasets (records), per-particle quantities with a per-record shape, e.g. (3, N) in
 ! Fortran order, which C and Python see as records x N x 3 (particles/velocity) or, for (3, 3, N),
 ! records x N x 3 x 3 (particles/stresslet_hydro).
+! The columns are named once, by one routine of the program that calls series_column for each
+! (name and value; the value's shape is the column's): called before series_open it declares them,
+! afterwards it fills the record that series_record adds. So the file's header and its records
+! come from the same lines and cannot fall out of step.
 ! Rank 0 buffers the records and appends them when flushed (at progress lines, checkpoints and
 ! the end of the run), opening and closing the file each time, so that a killed run leaves a
 ! readable file. On restart the file is cut back to the checkpoint's step, so that a continued
@@ -13,7 +17,7 @@ module mod_series
   use mod_errors, only: is_root, warn_line, abort_run
   implicit none
   private
-  public :: series_t, series_open, series_record, series_flush, series_attributes
+  public :: series_t, series_column, series_open, series_record, series_flush, series_attributes
 
   type :: series_t
     character(len=1024) :: path = ''
@@ -22,35 +26,101 @@ module mod_series
     integer, allocatable :: first(:)         ! offset of each column in a record
     real(dp), allocatable :: buffer(:, :)    ! (value, record)
     integer :: nbuf = 0
+    logical :: open = .false.                ! series_open done: series_column fills, not declares
+    integer :: filled = 0                    ! columns of the record being assembled
+    real(dp), allocatable :: row(:)          ! the record being assembled (rank 0)
   end type series_t
+
+  ! One column: its value, a scalar or an array whose shape is the column's per-record shape
+  ! (an integer scalar, the step or a count, is stored as real like every value of a record)
+  interface series_column
+    module procedure column_int, column_real, column_vector, column_matrix, column_tensor
+  end interface series_column
 
   integer(HSIZE_T), parameter :: chunk = 1024
 
 contains
 
-  ! Create OUTDIR/series.h5 with the given quantities, or, when restarting from step
-  ! restart_step (>= 0), keep the records up to that step. names(1) must be 'step'.
-  ! shapes(:, c): the per-record shape of column c, 0 where unused (absent or all 0: a scalar).
-  subroutine series_open(s, outdir, names, restart_step, shapes)
+  subroutine column_int(s, name, value)
+    type(series_t), intent(inout) :: s
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: value
+    call column(s, name, [0, 0, 0], [real(value, dp)])
+  end subroutine column_int
+
+  subroutine column_real(s, name, value)
+    type(series_t), intent(inout) :: s
+    character(len=*), intent(in) :: name
+    real(dp), intent(in) :: value
+    call column(s, name, [0, 0, 0], [value])
+  end subroutine column_real
+
+  subroutine column_vector(s, name, value)
+    type(series_t), intent(inout) :: s
+    character(len=*), intent(in) :: name
+    real(dp), intent(in) :: value(:)
+    call column(s, name, [size(value), 0, 0], value)
+  end subroutine column_vector
+
+  subroutine column_matrix(s, name, value)
+    type(series_t), intent(inout) :: s
+    character(len=*), intent(in) :: name
+    real(dp), intent(in) :: value(:, :)
+    call column(s, name, [shape(value), 0], reshape(value, [size(value)]))
+  end subroutine column_matrix
+
+  subroutine column_tensor(s, name, value)
+    type(series_t), intent(inout) :: s
+    character(len=*), intent(in) :: name
+    real(dp), intent(in) :: value(:, :, :)
+    call column(s, name, shape(value), reshape(value, [size(value)]))
+  end subroutine column_tensor
+
+  ! Before series_open: add the column (name, per-record shape). After: put its values (in
+  ! Fortran order) into the record being assembled, the next of the declared columns.
+  subroutine column(s, name, shape, values)
+    type(series_t), intent(inout) :: s
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: shape(3)
+    real(dp), intent(in) :: values(:)
+    integer :: c
+    if (.not. s%open) then
+      if (.not. allocated(s%names)) allocate(s%names(0), s%shapes(3, 0))
+      s%names = [character(len=64) :: s%names, name]
+      s%shapes = reshape([s%shapes, shape], [3, size(s%names)])
+      return
+    end if
+    if (.not. is_root()) return
+    c = s%filled + 1
+    ! the columns are declared and filled by the same calls; another order is a programming error
+    if (c > size(s%names)) call abort_run('series.h5: a record has more columns than declared ('//name//')')
+    if (s%names(c) /= name .or. size(values) /= s%first(c + 1) - s%first(c)) &
+      call abort_run('series.h5: column '//name//' does not match the declared '//trim(s%names(c)))
+    s%row(s%first(c):s%first(c + 1) - 1) = values
+    s%filled = c
+  end subroutine column
+
+  ! Create OUTDIR/series.h5 with the columns declared by series_column, or, when restarting from
+  ! step restart_step (>= 0), keep the records up to that step. The first column must be 'step'.
+  subroutine series_open(s, outdir, restart_step)
     type(series_t), intent(inout) :: s
     character(len=*), intent(in) :: outdir
-    character(len=*), intent(in) :: names(:)
     integer, intent(in) :: restart_step
-    integer, intent(in), optional :: shapes(:, :)
     integer(HID_T) :: file
     logical :: exists, fits
     integer :: err, c
 
-    allocate(s%names(size(names)), s%shapes(3, size(names)), s%first(size(names) + 1))
-    s%names = names
-    s%shapes = 0
-    if (present(shapes)) s%shapes = shapes
+    if (.not. allocated(s%names)) call abort_run('series.h5: no columns declared')
+    if (s%names(1) /= 'step') call abort_run('series.h5: the first column must be the step')
+    allocate(s%first(size(s%names) + 1))
     s%first(1) = 1
-    do c = 1, size(names)
+    do c = 1, size(s%names)
       s%first(c + 1) = s%first(c) + product(max(1, s%shapes(:, c)))
     end do
-    allocate(s%buffer(s%first(size(names) + 1) - 1, 256))
+    allocate(s%buffer(s%first(size(s%names) + 1) - 1, 256), s%row(s%first(size(s%names) + 1) - 1))
     s%nbuf = 0
+    s%filled = 0
+    s%open = .true.
     s%path = trim(outdir)//'/series.h5'
     if (.not. is_root()) return
 
@@ -59,8 +129,8 @@ contains
       call h5fopen_f(trim(s%path), H5F_ACC_RDWR_F, file, err)
       fits = (err == 0)
       if (fits) then
-        do c = 1, size(names)
-          if (.not. has_object(file, trim(names(c)))) fits = .false.
+        do c = 1, size(s%names)
+          if (.not. has_object(file, trim(s%names(c)))) fits = .false.
         end do
         if (fits) call cut_back(file, restart_step, s%names)
         call h5fclose_f(file, err)
@@ -70,8 +140,8 @@ contains
     end if
     call h5fcreate_f(trim(s%path), H5F_ACC_TRUNC_F, file, err)
     if (err /= 0) call abort_run('cannot create '//trim(s%path))
-    do c = 1, size(names)
-      call create_column(file, trim(names(c)), c == 1, s%shapes(:, c))
+    do c = 1, size(s%names)
+      call create_column(file, trim(s%names(c)), c == 1, s%shapes(:, c))
     end do
     call h5fclose_f(file, err)
   end subroutine series_open
@@ -165,20 +235,20 @@ contains
     end do
   end subroutine cut_back
 
-  ! Add one record (values in the order of names, each column's values flattened in Fortran
-  ! order; values(1) is the step).
-  subroutine series_record(s, values)
+  ! Add the record assembled by series_column since the last one (all the declared columns).
+  subroutine series_record(s)
     type(series_t), intent(inout) :: s
-    real(dp), intent(in) :: values(:)
     real(dp), allocatable :: bigger(:, :)
     if (.not. is_root()) return
+    if (s%filled /= size(s%names)) call abort_run('series.h5: a record misses columns of the declared ones')
+    s%filled = 0
     if (s%nbuf == size(s%buffer, 2)) then
       allocate(bigger(size(s%buffer, 1), 2 * size(s%buffer, 2)))
       bigger(:, 1:s%nbuf) = s%buffer(:, 1:s%nbuf)
       call move_alloc(bigger, s%buffer)
     end if
     s%nbuf = s%nbuf + 1
-    s%buffer(:, s%nbuf) = values
+    s%buffer(:, s%nbuf) = s%row
   end subroutine series_record
 
   ! Append the buffered records to the file.

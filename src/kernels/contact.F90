@@ -27,15 +27,24 @@ module mod_contact
   use mod_kinds, only: dp, pi
   use mod_vector, only: cross
   use mod_lees_edwards, only: lees_edwards_t, le_separation
+  use mod_limits, only: limit_finding_t, add_finding, LIMIT_WARN, LIMIT_REFUSE
   implicit none
   private
   public :: contact_params_t, contact_setup, contact_stats_t
   public :: contact_history_t, history_size, history_pack, history_unpack, history_clear
   public :: history_lookup, contact_pair, contact_forces, contact_stresslet
   public :: wall_lower, wall_upper, chatter_number, stick_number, flattening_estimate
+  public :: contact_limits, overlap_limit
   public :: contact_links_t, contact_stiffness
 
   integer, parameter :: wall_lower = -1, wall_upper = -2   ! history partner ids of the walls
+
+  ! largest chatter_number accepted (doc/CONTACT.md "Time-step considerations"): explicit contacts
+  ! chatter beyond it; implicit ones were measured free of chatter up to IMPLICIT_CHATTER_LIMIT
+  real(dp), parameter :: CHATTER_LIMIT = 0.025_dp, IMPLICIT_CHATTER_LIMIT = 0.2_dp
+  ! largest stick_number without a warning: friction converged at 1.1-4.6, 14 % low at 11.4
+  ! (doc/CONTACT.md "Time-step considerations", doc/VALIDATION.md §5.4)
+  real(dp), parameter :: STICK_LIMIT = 5.0_dp
 
   type :: contact_params_t
     real(dp) :: a = 1                   ! sphere radius [a]
@@ -138,6 +147,84 @@ contains
     if (p%mu_d <= 0 .or. p%h_r <= 0 .or. p%gamma_dot == 0 .or. p%k_n <= 0) return
     q = dt * abs(p%gamma_dot) * p%a * p%kt_coeff / (p%mu_d * reference_overlap(p))
   end function stick_number
+
+  !> The rough contacts against the lubricated response, checked before any work: refused beyond
+  !> the chatter numbers measured (doc/CONTACT.md "Time-step considerations": explicit contacts
+  !> chatter from ~0.02 on and are refused above 0.025; implicit ones were measured clean up to 0.2
+  !> and are refused beyond), friction whose step slips further than a contact sticks (a warning),
+  !> and, in a sheared suspension (sheared: between walls or across Lees-Edwards boundaries, at
+  !> solid fraction phi), roughness that would flatten completely (doc/VALIDATION.md §6).
+  !> dt: the time step; implicit: the contacts are taken implicitly; eps_bar: the deck's;
+  !> stiffness_prescribed: k_n is the deck's normal_stiffness (the item a refusal names).
+  function contact_limits(p, dt, implicit, sheared, phi, eps_bar, stiffness_prescribed) result(findings)
+    type(contact_params_t), intent(in) :: p
+    real(dp), intent(in) :: dt, phi, eps_bar
+    logical, intent(in) :: implicit, sheared, stiffness_prescribed
+    type(limit_finding_t), allocatable :: findings(:)
+    real(dp) :: chatter, stick, expected_overlap
+    character(len=400) :: text
+    allocate(findings(0))
+    chatter = chatter_number(p, dt)
+    ! friction: a step that slips further than a spring sticks makes every contact slide
+    stick = stick_number(p, dt)
+    if (.not. implicit .and. stick > 0) then
+      call add_finding(findings, LIMIT_WARN, 'explicit frictional contacts: at the one set-up measured (stick '// &
+           'number 2.3) 82 % of them slid and the friction raised eta_r by 1.35 where implicit contacts give 1.67 '// &
+           '(doc/CONTACT.md "Time-step considerations"): &contact implicit = .true. for friction')
+    else if (stick > STICK_LIMIT) then
+      write(text, '(a,f6.1,a,f4.1,a,es9.2,a)') 'friction: a step slips further than a contact sticks: '// &
+           'dt gamma_dot a/((7/2) mu_d delta_0) = ', stick, ' exceeds ', STICK_LIMIT, &
+           ' (contacts that should stick slide; eta_r 14 % low at 11, doc/CONTACT.md): dt <= ', &
+           STICK_LIMIT * dt / stick, ' (or a larger &contact eps_bar) resolves it'
+      call add_finding(findings, LIMIT_WARN, text)
+    end if
+    if (.not. implicit .and. chatter > CHATTER_LIMIT) then
+      write(text, '(a,f6.3,a,f5.3,a,es9.2,a)') 'the explicit rough contacts would chatter: dt gamma_dot h_r/delta_0 = ', &
+           chatter, ' exceeds ', CHATTER_LIMIT, &
+           ' (period-two oscillation measured above it; doc/CONTACT.md): the largest stable dt here is ', &
+           CHATTER_LIMIT * dt / chatter, ' (or raise &contact eps_bar, or take them implicitly: &contact implicit)'
+      call add_finding(findings, LIMIT_REFUSE, text, 'time', 'dt')
+    else if (implicit .and. chatter > IMPLICIT_CHATTER_LIMIT) then
+      write(text, '(a,f6.3,a,f5.3,a,es9.2,a)') 'the rough contacts: dt gamma_dot h_r/delta_0 = ', chatter, &
+           ' exceeds ', IMPLICIT_CHATTER_LIMIT, ', the largest chatter number at which implicit contacts were '// &
+           'measured free of chatter (doc/CONTACT.md): the largest dt measured stable here is ', &
+           IMPLICIT_CHATTER_LIMIT * dt / chatter, ' (or raise &contact eps_bar)'
+      call add_finding(findings, LIMIT_REFUSE, text, 'time', 'dt')
+    end if
+    ! the roughness of a dense suspension flattens under its force chains (doc/VALIDATION.md §6)
+    if (sheared) then
+      expected_overlap = flattening_estimate(p, phi)
+      if (expected_overlap > 1.0_dp) then
+        write(text, '(a,f6.2,a,f5.3,a,es9.2,a)') 'the roughness would flatten completely: expected largest overlap ', &
+             expected_overlap, ' h_r at phi = ', phi, ' (doc/VALIDATION.md §6); stiffer contacts, eps_bar <= ', &
+             0.5_dp * eps_bar / expected_overlap, ' (or a larger normal_stiffness), keep it below h_r/2'
+        call add_finding(findings, LIMIT_REFUSE, text, 'contact', &
+                         trim(merge('normal_stiffness', 'eps_bar         ', stiffness_prescribed)))
+      else if (expected_overlap > 0.5_dp) then
+        write(text, '(a,f6.2,a,f5.3,a)') 'expected largest contact overlap ', expected_overlap, ' h_r at phi = ', &
+             phi, ' (> h_r/2, doc/VALIDATION.md §6): a smaller &contact eps_bar keeps the roughness'
+        call add_finding(findings, LIMIT_WARN, text)
+      end if
+    end if
+  end function contact_limits
+
+  !> A run's largest contact overlap grows from largest_before to overlap at step: warned once, when
+  !> it passes h_r/2, the bound the extreme scenes hold (doc/VALIDATION.md §6).
+  function overlap_limit(p, largest_before, overlap, step) result(findings)
+    type(contact_params_t), intent(in) :: p
+    real(dp), intent(in) :: largest_before, overlap
+    integer, intent(in) :: step
+    type(limit_finding_t), allocatable :: findings(:)
+    character(len=400) :: text
+    allocate(findings(0))
+    if (largest_before <= 0.5_dp * p%h_r .and. overlap > 0.5_dp * p%h_r) then
+      write(text, '(a,i0,a,f6.3,a)') 'at step ', step, ' a contact overlap reaches ', &
+           overlap / p%h_r, ' h_r (> h_r/2): stiffer contacts (a smaller &contact eps_bar '// &
+           'or a larger normal_stiffness, with dt gamma_dot h_r/delta_0 within its limit, doc/CONTACT.md) keep the '// &
+           'roughness from flattening'
+      call add_finding(findings, LIMIT_WARN, text)
+    end if
+  end function overlap_limit
 
   !> delta_0 = (6 pi eta gamma_dot a^2 / k_n)^(2/3): the Hertz overlap under the force scale
   !> (eps_bar h_r when k_n comes from eps_bar); needs k_n > 0 and gamma_dot /= 0.

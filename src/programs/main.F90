@@ -15,9 +15,9 @@ program fdsusp
   use mod_grid, only: grid_t, grid_create, grid_destroy, direct_solves_wanted
   use mod_fluid, only: fluid_t, fluid_create, fluid_step, fluid_destroy, fluid_mean_profile
   use mod_fluid_verification, only: fluid_errors_vs_manufactured
-  use mod_series, only: series_t, series_open, series_record, series_flush, series_attributes
+  use mod_series, only: series_t, series_column, series_open, series_record, series_flush, series_attributes
   use mod_output, only: write_fields, progress_line
-  use mod_checkpoint, only: checkpoint_write, checkpoint_check, checkpoint_read
+  use mod_checkpoint, only: checkpoint_state_t, checkpoint_write, checkpoint_check, checkpoint_read
   use mod_os_services, only: install_signal_handlers, stop_signal, make_directory, probe_directory, &
                              lock_directory, release_directory
   use mod_timers, only: timers_register, stage_push, stage_pop, STAGE_SETUP, STAGE_FLUID, STAGE_OUTPUT, &
@@ -25,15 +25,17 @@ program fdsusp
   use mod_particles, only: particles_t, advance_positions, displacements, MOTION_FREE
   use mod_particles_io, only: particles_load, particles_snapshot
   use mod_initial_packing, only: initial_packing_make
-  use mod_rheology, only: rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, rheo_state, rheo_restore, &
+  use mod_rheology, only: rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, &
                           rheo_summarise, summary_names, NSUMMARY
   use mod_summary_io, only: summary_write
   use mod_fictitious_domain, only: fictitious_domain_t, fictitious_domain_create, &
                                    fictitious_domain_geometry, fictitious_domain_follow, &
                                    fictitious_domain_moments, fictitious_domain_solve_motion, &
-                                   fictitious_domain_update, fictitious_domain_destroy
+                                   fictitious_domain_update, fictitious_domain_destroy, &
+                                   fictitious_domain_pair_lag_limit, fictitious_domain_stresslet_lag_limit
   use mod_particle_contacts, only: particle_contacts_t, particle_contacts_create, particle_contacts_step
-  use mod_contact, only: chatter_number, stick_number, flattening_estimate, wall_lower, wall_upper
+  use mod_contact, only: contact_limits, overlap_limit, wall_lower, wall_upper
+  use mod_limits, only: limit_finding_t, LIMIT_REFUSE
   use mod_lubrication, only: lubrication_t, LUB_NONE, LUB_SIMPLE, LUB_EXACT
   use mod_lubrication_io, only: lubrication_load
   use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_create
@@ -50,19 +52,19 @@ program fdsusp
   PetscErrorCode :: ierr
   type(config_t) :: cfg
   type(grid_t) :: grid
-  type(fluid_t) :: fl
+  type(fluid_t), target :: fl
   type(solver_t) :: yardstick                       ! -bench_cold_poisson's multigrid solve
   type(series_t) :: series
-  type(particles_t) :: parts
-  type(fictitious_domain_t) :: fd
-  type(particle_contacts_t) :: pc
+  type(particles_t), target :: parts
+  type(fictitious_domain_t), target :: fd
+  type(particle_contacts_t), target :: pc
   type(lubrication_t) :: lub
   type(particle_lubrication_t), allocatable :: pl   ! allocated when lubrication is on
-  type(rheology_t), allocatable :: rh               ! allocated when the deck has &rheology
-  type(lees_edwards_t) :: le                        ! y_boundary = 'lees-edwards' (le%active), its offset
+  type(rheology_t), allocatable, target :: rh       ! allocated when the deck has &rheology
+  type(lees_edwards_t), target :: le                ! y_boundary = 'lees-edwards' (le%active), its offset
   type(lubrication_dynamics_t) :: ld                ! &fluid model = 'none': the spheres alone
   type(particle_solver_t) :: ld_solver              ! its sparse 6N solve
-  real(dp), allocatable :: statistics(:)            ! rh's accumulators, for checkpoints
+  type(checkpoint_state_t) :: state                 ! what the checkpoints hold: the pieces this run has
   real(dp), allocatable :: mean_flow(:)             ! x-z plane means of u, per cell row
   real(dp) :: largest_overlap = 0.0_dp              ! of this run (since the start or restart) [a]
   integer :: largest_overlap_step = 0
@@ -70,24 +72,16 @@ program fdsusp
   logical :: carry_lambda                           ! -fd_carry_lambda (default true)
   logical :: has_particles, has_contacts, has_lubrication
   integer :: info
-  integer, allocatable :: shapes(:, :)
   character(len=max_line) :: deck, restart, checkpoint_path
   character(len=400) :: text
-  character(len=32), allocatable :: columns(:)
   integer :: step, first_step, stop_reason, cold_its
   integer :: iterations_sum(4)
-  real(dp) :: time, wall_start, wall_now, wall_per_step, wall_loop, cold_seconds, core_edge_speed
+  real(dp) :: time, wall_start, wall_now, wall_per_step, wall_loop, cold_seconds, core_edge_speed, solid_fraction
   PetscBool :: bench_cold, fault_set
   PetscInt :: fault_nan_step
   real(dp) :: err_vel, err_p_max, err_p_rms
   logical :: restarting, continuing
   integer, parameter :: RUNNING = 0, DONE = 1, SIGNALLED = 2, WALL_LIMIT = 3, STEADY = 4
-  ! largest chatter_number accepted (doc/CONTACT.md "Time-step considerations"): explicit contacts
-  ! chatter beyond it; implicit ones were measured free of chatter up to IMPLICIT_CHATTER_LIMIT
-  real(dp), parameter :: CHATTER_LIMIT = 0.025_dp, IMPLICIT_CHATTER_LIMIT = 0.2_dp
-  ! largest stick_number without a warning: friction converged at 1.1-4.6, 14 % low at 11.4
-  ! (doc/CONTACT.md "Time-step considerations", doc/VALIDATION.md §5.4)
-  real(dp), parameter :: STICK_LIMIT = 5.0_dp
 
   PetscCallA(PetscInitialize(ierr))
   ! SIGTERM/SIGUSR1 from now on only ask the run to stop after its next step (they replace
@@ -129,7 +123,11 @@ program fdsusp
     if (info /= 0) call input_error(cfg%deck_file, 'lubrication', 'skin', trim(text))
   end if
   ! rough contacts: the limits of doc/CONTACT.md and doc/VALIDATION.md §6, before any work
-  if (has_contacts .and. (has_lubrication .or. .not. cfg%resolved)) call check_contact_limits()
+  if (has_contacts .and. (has_lubrication .or. .not. cfg%resolved)) then
+    solid_fraction = parts%n * (4.0_dp / 3.0_dp) * pi * parts%radius**3 / product(cfg%box)
+    call report(contact_limits(pc%params, cfg%dt, pc%implicit, cfg%walls .or. cfg%lees_edwards, solid_fraction, &
+                               cfg%eps_bar, cfg%normal_stiffness > 0.0_dp))
+  end if
   ! statistics of the core region (doc/RHEOLOGY.md)
   if (cfg%rheology_group) then
     allocate(rh)
@@ -138,18 +136,12 @@ program fdsusp
     if (info /= 0) call input_error(cfg%deck_file, 'domain', 'box', &
          'with &rheology every periodic length must be >= 2 (pair_shell + 0.3) a')
     allocate(mean_flow(0:cfg%cells(2) - 1))
-    statistics = rheo_state(rh)
     write(text, '(a,i0,a,i0,a,i0,a,i0)') 'statistics: discard ', cfg%discard_step, ' steps, then ', cfg%blocks, &
          ' blocks of ', cfg%block_steps, ' steps, ending at step ', cfg%discard_step + cfg%blocks * cfg%block_steps
     call log_line(text)
-    ! spheres crossing more than ~0.02 cells per step lose stresslet (doc/VALIDATION.md §5.3)
+    ! spheres at the edge of the core must not outrun their Lambda (mod_fictitious_domain)
     core_edge_speed = abs(cfg%shear_rate) * max(rh%core(2) - 0.5_dp * cfg%box(2), 0.5_dp * cfg%box(2) - rh%core(1))
-    if (cfg%resolved .and. core_edge_speed * cfg%dt > 0.02_dp * cfg%h) then
-      write(text, '(a,f6.3,a,es9.2,a)') 'spheres at the edge of the core cross ', core_edge_speed * cfg%dt / cfg%h, &
-           ' cells per step, and their stresslets lag (doc/VALIDATION.md 5.3): dt <= ', &
-           0.02_dp * cfg%h / core_edge_speed, ' keeps them within 1 %'
-      call warn_line(text)
-    end if
+    if (cfg%resolved) call report(fictitious_domain_stresslet_lag_limit(core_edge_speed, cfg%dt, cfg%h))
     if (cfg%steps < cfg%discard_step + cfg%blocks * cfg%block_steps) then
       write(text, '(a,i0,a)') '&time steps = ', cfg%steps, ' ends before the averaging window: the summary '// &
            'will hold the blocks complete by then (restart with more steps to finish)'
@@ -180,68 +172,19 @@ program fdsusp
     call lubrication_dynamics_create(ld, parts%radius, 1.0_dp, cfg%shear_rate, cfg%box, cfg%walls .or. cfg%lees_edwards)
     PetscCallA(particle_solver_create(ld_solver, ierr))
   end if
-  if (restarting .and. .not. cfg%resolved) then
-    ! (statistics: absent when unallocated, i.e. without &rheology; history: without contacts)
-    if (has_contacts) then
-      PetscCallA(checkpoint_read(restart, ierr=ierr, parts=parts, history=pc%history, statistics=statistics))
-    else
-      PetscCallA(checkpoint_read(restart, ierr=ierr, parts=parts, statistics=statistics))
-    end if
-    if (cfg%lees_edwards) then
-      PetscCallA(checkpoint_read(restart, ierr=ierr, offset=le%offset))
-    end if
-    if (allocated(rh)) call rheo_restore(rh, statistics, info)
-  else if (restarting) then
-    ! (statistics: absent when unallocated, i.e. without &rheology)
-    if (has_contacts) then
-      PetscCallA(checkpoint_read(restart, fl, ierr, fd%lambda, parts, pc%history, statistics=statistics))
-    else if (has_particles) then
-      PetscCallA(checkpoint_read(restart, fl, ierr, fd%lambda, parts, statistics=statistics))
-    else
-      PetscCallA(checkpoint_read(restart, fl, ierr))
-    end if
-    if (allocated(rh)) call rheo_restore(rh, statistics, info)
+  ! the state the checkpoints hold and a restart restores: the pieces this run has
+  if (cfg%resolved) state%fl => fl
+  if (cfg%resolved .and. has_particles) state%lambda => fd%lambda
+  if (has_particles) state%parts => parts
+  if (has_contacts) state%history => pc%history
+  if (allocated(rh)) state%rh => rh
+  if (cfg%lees_edwards) state%offset => le%offset
+  if (restarting) then
+    PetscCallA(checkpoint_read(restart, state, ierr))
   end if
-  columns = [character(len=32) :: 'step', 'time', 'wall_time', 'tau_wall_bottom', 'tau_wall_top', &
-             'divergence', 'rate_of_change', 'iterations_u', 'iterations_v', 'iterations_w', 'iterations_p']
-  ! without a fluid the columns of the fluid solve are not written
-  if (.not. cfg%resolved) columns = columns(1:3)
-  if (cfg%lees_edwards) columns = [character(len=32) :: columns, 'lees_edwards_offset']
-  if (cfg%manufactured_solution) columns = [character(len=32) :: columns, 'mms_error_velocity_max', &
-             'mms_error_pressure_max', 'mms_error_pressure_rms']
-  allocate(shapes(3, size(columns)))
-  shapes = 0
-  if (has_particles) then
-    columns = [character(len=32) :: columns, 'particles/position', 'particles/velocity', 'particles/omega', &
-               'particles/force_hydro', 'particles/torque_hydro', 'particles/stresslet_hydro']
-    shapes = reshape([shapes, [3, parts%n, 0], [3, parts%n, 0], [3, parts%n, 0], [3, parts%n, 0], &
-                      [3, parts%n, 0], [3, 3, parts%n]], [3, size(columns)])
-  end if
-  if (has_lubrication) then
-    columns = [character(len=32) :: columns, 'lubrication_pairs', 'lubrication_walls', 'min_gap', &
-               'particles/force_lubrication', 'particles/torque_lubrication']
-    shapes = reshape([shapes, [0, 0, 0], [0, 0, 0], [0, 0, 0], [3, parts%n, 0], [3, parts%n, 0]], [3, size(columns)])
-  end if
-  if (has_contacts) then
-    columns = [character(len=32) :: columns, 'contacts_pair', 'contacts_wall', 'contacts_sliding', &
-               'contact_max_overlap', 'particles/force_contact', 'particles/torque_contact', &
-               'particles/stresslet_contact']
-    shapes = reshape([shapes, [0, 0, 0], [0, 0, 0], [0, 0, 0], [0, 0, 0], [3, parts%n, 0], &
-                      [3, parts%n, 0], [3, 3, parts%n]], [3, size(columns)])
-  end if
-  if (allocated(rh)) then
-    columns = [character(len=32) :: columns, 'core/stress_hydro', 'core/stress_contact', 'core/solid_fraction', &
-               'core/velocity_fit', 'core/flow_fit', 'core/shear_rate', 'min_pair_gap', 'pairs/references', 'pairs/shell', &
-               'pairs/contact', 'profiles/solid_fraction', 'profiles/momentum']
-    shapes = reshape([shapes, [5, 0, 0], [5, 0, 0], [0, 0, 0], [5, 0, 0], [5, 0, 0], [0, 0, 0], [0, 0, 0], [0, 0, 0], &
-                      [cfg%angle_bins, 0, 0], [cfg%angle_bins, 0, 0], [cfg%profile_bins, 0, 0], &
-                      [cfg%profile_bins, 0, 0]], [3, size(columns)])
-    if (has_contacts) then
-      columns = [character(len=32) :: columns, 'contact_overlap_over_roughness']
-      shapes = reshape([shapes, [0, 0, 0]], [3, size(columns)])
-    end if
-  end if
-  call series_open(series, cfg%output_directory, columns, merge(step, -1, restarting), shapes)
+  ! the columns of series.h5, declared by the routine that also fills each record
+  call series_columns()
+  call series_open(series, cfg%output_directory, merge(step, -1, restarting))
   if (allocated(rh)) then
     ! what scripts/rheology.py needs to repeat the statistics from series.h5 alone
     call series_attributes(series, [character(len=32) :: 'box_x', 'box_y', 'box_z', 'radius', 'shear_rate', &
@@ -251,7 +194,9 @@ program fdsusp
          merge(cfg%friction, 0.0_dp, has_contacts), merge(cfg%roughness, 0.0_dp, has_contacts)])
   end if
   PetscCallA(stage_pop(ierr))
-  if (cfg%resolved .and. has_particles .and. has_lubrication .and. parts%motion == MOTION_FREE) call check_pair_lag()
+  ! free lubricated pairs must not separate faster than their Lambda relaxes (mod_fictitious_domain)
+  if (cfg%resolved .and. has_particles .and. has_lubrication .and. parts%motion == MOTION_FREE) &
+    call report(fictitious_domain_pair_lag_limit(cfg%dt, cfg%reynolds, cfg%h))
   if (.not. cfg%resolved) then
     write(text, '(a,i0,a)') 'models: lubrication dynamics, no fluid (one-body Stokes drag in the imposed flow, '// &
          trim(merge('Lees-Edwards boundaries', 'walls in y             ', cfg%lees_edwards))//'); ', parts%n, &
@@ -314,7 +259,12 @@ program fdsusp
         PetscCallA(stage_push(STAGE_CONTACTS, ierr))
         call particle_contacts_step(pc, parts%position, parts%velocity, parts%omega, info, le%offset)
         if (info /= 0) call contact_failure(info)
-        if (pc%max_overlap > largest_overlap) call note_overlap()
+        if (pc%max_overlap > largest_overlap) then
+          ! a new largest overlap of the run: warned once past h_r/2 (mod_contact)
+          call report(overlap_limit(pc%params, largest_overlap, pc%max_overlap, step))
+          largest_overlap = pc%max_overlap
+          largest_overlap_step = step
+        end if
         PetscCallA(stage_pop(ierr))
       end if
       if (has_lubrication) then
@@ -601,77 +551,88 @@ contains
     is_rank0 = (rank == 0)
   end function is_rank0
 
+  ! One record of series.h5, and the statistics' share of it.
   subroutine record()
-    real(dp) :: values(14)
-    integer :: n
-    real(dp), allocatable :: row(:)
-    values(1:3) = [real(step, dp), time, MPI_Wtime() - wall_start]
-    n = 3
-    if (cfg%lees_edwards) then
-      values(4) = le%offset
-      n = 4
-    end if
-    if (cfg%resolved) then
-      values(4:11) = [fl%tau_bottom, fl%tau_top, fl%divergence, fl%max_rate, real(fl%solver(1)%iterations, dp), &
-                      real(fl%solver(2)%iterations, dp), real(fl%solver(3)%iterations, dp), &
-                      real(fl%solver(4)%iterations, dp)]
-      n = 11
-    end if
-    if (cfg%manufactured_solution) then
-      PetscCallA(fluid_errors_vs_manufactured(grid, fl, cfg%shear_rate, err_vel, err_p_max, err_p_rms, ierr))
-      values(12:14) = [err_vel, err_p_max, err_p_rms]
-      n = 14
-    end if
-    if (has_particles) then
-      row = [values(1:n), reshape(parts%position, [3 * parts%n]), reshape(parts%velocity, [3 * parts%n]), &
-             reshape(parts%omega, [3 * parts%n]), reshape(parts%force_hydro, [3 * parts%n]), &
-             reshape(parts%torque_hydro, [3 * parts%n]), reshape(parts%stresslet_hydro, [9 * parts%n])]
-      if (has_lubrication) row = [row, real(pl%npairs, dp), real(pl%nwalls, dp), pl%min_gap, &
-                                  reshape(pl%force, [3 * parts%n]), reshape(pl%torque, [3 * parts%n])]
-      if (has_contacts) row = [row, real(pc%stats%pair_contacts, dp), real(pc%stats%wall_contacts, dp), &
-             real(pc%stats%sliding, dp), pc%max_overlap, reshape(pc%force, [3 * parts%n]), &
-             reshape(pc%torque, [3 * parts%n]), reshape(pc%stresslet, [9 * parts%n])]
-      if (allocated(rh)) then
-        row = [row, rh%values, rh%shear_rate_core, rh%min_pair_gap, rh%references, &
-               rh%angles(:, 1), rh%angles(:, 2), rh%profile(:, 1), rh%profile(:, 2)]
-        if (has_contacts) row = [row, pc%max_overlap / max(pc%params%h_r, tiny(1.0_dp))]
-        ! only the records on the series_every grid enter the statistics (a restart then adds
-        ! exactly the records an uninterrupted run would)
-        if (mod(step, cfg%series_every) == 0) call rheo_accumulate(rh, step)
-      end if
-      call series_record(series, row)
-    else
-      call series_record(series, values(1:n))
+    call series_columns()
+    call series_record(series)
+    ! only the records on the series_every grid enter the statistics (a restart then adds
+    ! exactly the records an uninterrupted run would)
+    if (has_particles .and. allocated(rh)) then
+      if (mod(step, cfg%series_every) == 0) call rheo_accumulate(rh, step)
     end if
   end subroutine record
 
+  ! The columns of series.h5 in the file's order: the name and the value of each (the value's shape
+  ! is the column's). Called once before series_open, which makes these calls the declaration of
+  ! the columns, then for every record, so the header and the records cannot differ.
+  subroutine series_columns()
+    call series_column(series, 'step', step)
+    call series_column(series, 'time', time)
+    call series_column(series, 'wall_time', MPI_Wtime() - wall_start)
+    ! without a fluid the columns of the fluid solve are not written
+    if (cfg%resolved) then
+      call series_column(series, 'tau_wall_bottom', fl%tau_bottom)
+      call series_column(series, 'tau_wall_top', fl%tau_top)
+      call series_column(series, 'divergence', fl%divergence)
+      call series_column(series, 'rate_of_change', fl%max_rate)
+      call series_column(series, 'iterations_u', fl%solver(1)%iterations)
+      call series_column(series, 'iterations_v', fl%solver(2)%iterations)
+      call series_column(series, 'iterations_w', fl%solver(3)%iterations)
+      call series_column(series, 'iterations_p', fl%solver(4)%iterations)
+    end if
+    if (cfg%lees_edwards) call series_column(series, 'lees_edwards_offset', le%offset)
+    if (cfg%manufactured_solution) then
+      PetscCallA(fluid_errors_vs_manufactured(grid, fl, cfg%shear_rate, err_vel, err_p_max, err_p_rms, ierr))
+      call series_column(series, 'mms_error_velocity_max', err_vel)
+      call series_column(series, 'mms_error_pressure_max', err_p_max)
+      call series_column(series, 'mms_error_pressure_rms', err_p_rms)
+    end if
+    if (.not. has_particles) return
+    call series_column(series, 'particles/position', parts%position)
+    call series_column(series, 'particles/velocity', parts%velocity)
+    call series_column(series, 'particles/omega', parts%omega)
+    call series_column(series, 'particles/force_hydro', parts%force_hydro)
+    call series_column(series, 'particles/torque_hydro', parts%torque_hydro)
+    call series_column(series, 'particles/stresslet_hydro', parts%stresslet_hydro)
+    if (has_lubrication) then
+      call series_column(series, 'lubrication_pairs', pl%npairs)
+      call series_column(series, 'lubrication_walls', pl%nwalls)
+      call series_column(series, 'min_gap', pl%min_gap)
+      call series_column(series, 'particles/force_lubrication', pl%force)
+      call series_column(series, 'particles/torque_lubrication', pl%torque)
+    end if
+    if (has_contacts) then
+      call series_column(series, 'contacts_pair', pc%stats%pair_contacts)
+      call series_column(series, 'contacts_wall', pc%stats%wall_contacts)
+      call series_column(series, 'contacts_sliding', pc%stats%sliding)
+      call series_column(series, 'contact_max_overlap', pc%max_overlap)
+      call series_column(series, 'particles/force_contact', pc%force)
+      call series_column(series, 'particles/torque_contact', pc%torque)
+      call series_column(series, 'particles/stresslet_contact', pc%stresslet)
+    end if
+    if (allocated(rh)) then
+      ! rh%values: stress_hydro(5), stress_contact(5), phi_core, particle fit(5), suspension fit(5)
+      call series_column(series, 'core/stress_hydro', rh%values(1:5))
+      call series_column(series, 'core/stress_contact', rh%values(6:10))
+      call series_column(series, 'core/solid_fraction', rh%values(11))
+      call series_column(series, 'core/velocity_fit', rh%values(12:16))
+      call series_column(series, 'core/flow_fit', rh%values(17:21))
+      call series_column(series, 'core/shear_rate', rh%shear_rate_core)
+      call series_column(series, 'min_pair_gap', rh%min_pair_gap)
+      call series_column(series, 'pairs/references', rh%references)
+      call series_column(series, 'pairs/shell', rh%angles(:, 1))
+      call series_column(series, 'pairs/contact', rh%angles(:, 2))
+      call series_column(series, 'profiles/solid_fraction', rh%profile(:, 1))
+      call series_column(series, 'profiles/momentum', rh%profile(:, 2))
+      if (has_contacts) call series_column(series, 'contact_overlap_over_roughness', &
+                                           pc%max_overlap / max(pc%params%h_r, tiny(1.0_dp)))
+    end if
+  end subroutine series_columns
+
   subroutine checkpoint()
     call series_flush(series)
-    if (allocated(rh)) statistics = rheo_state(rh)
-    if (.not. cfg%resolved) then
-      call checkpoint_particles(checkpoint_path)
-    else if (has_contacts) then
-      PetscCallA(checkpoint_write(checkpoint_path, cfg, fl, step, time, ierr, fd%lambda, parts, pc%history, statistics))
-    else if (has_particles) then
-      PetscCallA(checkpoint_write(checkpoint_path, cfg, fl, step, time, ierr, fd%lambda, parts, statistics=statistics))
-    else
-      PetscCallA(checkpoint_write(checkpoint_path, cfg, fl, step, time, ierr))
-    end if
+    PetscCallA(checkpoint_write(checkpoint_path, cfg, state, step, time, ierr))
   end subroutine checkpoint
-
-  ! Lubrication dynamics: no fluid; the particles, contacts, statistics and the Lees-Edwards offset.
-  subroutine checkpoint_particles(path)
-    character(len=*), intent(in) :: path
-    if (cfg%lees_edwards .and. has_contacts) then
-      PetscCallA(checkpoint_write(path, cfg, step=step, time=time, ierr=ierr, parts=parts, history=pc%history, statistics=statistics, offset=le%offset))
-    else if (cfg%lees_edwards) then
-      PetscCallA(checkpoint_write(path, cfg, step=step, time=time, ierr=ierr, parts=parts, statistics=statistics, offset=le%offset))
-    else if (has_contacts) then
-      PetscCallA(checkpoint_write(path, cfg, step=step, time=time, ierr=ierr, parts=parts, history=pc%history, statistics=statistics))
-    else
-      PetscCallA(checkpoint_write(path, cfg, step=step, time=time, ierr=ierr, parts=parts, statistics=statistics))
-    end if
-  end subroutine checkpoint_particles
 
   ! summary.json (rank 0) and the rheology in the run log: value +- standard error over the blocks.
   subroutine summary()
@@ -729,85 +690,19 @@ contains
     end select
   end function lubrication_models
 
-  ! Close free pairs: Lambda on the faces between them relaxes over ~dt^2/(kappa (1 - alpha) Re h^2)
-  ! strains, so a pair that opens separates too fast: by ~0.7 % per 1e-3 of dt^2/(Re h^2) at gaps
-  ! 0.05-0.1 a (a/Delta = 4, 5, 6; doc/VALIDATION.md §4.4, the pair test's mobility table).
-  subroutine check_pair_lag()
-    real(dp), parameter :: LAG_LIMIT = 4.0e-3_dp     ! ~3 % in the separation, measured
-    real(dp) :: lag
-    lag = cfg%dt**2 / (cfg%reynolds * cfg%h**2)
-    if (lag > LAG_LIMIT) then
-      write(text, '(a,es9.2,a,es8.1,a,es9.2,a)') 'close pairs will separate too fast: dt^2/(Re Delta^2) = ', lag, &
-           ' exceeds ', LAG_LIMIT, ' (about 0.7 % per 1e-3 in the separation velocity, doc/VALIDATION.md 4.4): dt <= ', &
-           sqrt(LAG_LIMIT * cfg%reynolds) * cfg%h, ' keeps it within ~3 %'
-      call warn_line(text)
-    end if
-  end subroutine check_pair_lag
-
-  ! The rough contacts against the lubricated response: refused beyond the chatter numbers measured
-  ! (doc/CONTACT.md "Time-step considerations": explicit contacts chatter from ~0.02 on and are
-  ! refused above 0.025; implicit ones were measured clean up to 0.2 and are refused beyond), and
-  ! where the roughness of a dense suspension would flatten completely (doc/VALIDATION.md §6).
-  subroutine check_contact_limits()
-    real(dp) :: chatter, stick, solid_fraction, expected_overlap
-    chatter = chatter_number(pc%params, cfg%dt)
-    ! friction: a step that slips further than a spring sticks makes every contact slide
-    stick = stick_number(pc%params, cfg%dt)
-    if (.not. pc%implicit .and. stick > 0) then
-      call warn_line('explicit frictional contacts: at the one set-up measured (stick number 2.3) 82 % of '// &
-           'them slid and the friction raised eta_r by 1.35 where implicit contacts give 1.67 (doc/CONTACT.md '// &
-           '"Time-step considerations"): &contact implicit = .true. for friction')
-    else if (stick > STICK_LIMIT) then
-      write(text, '(a,f6.1,a,f4.1,a,es9.2,a)') 'friction: a step slips further than a contact sticks: '// &
-           'dt gamma_dot a/((7/2) mu_d delta_0) = ', stick, ' exceeds ', STICK_LIMIT, &
-           ' (contacts that should stick slide; eta_r 14 % low at 11, doc/CONTACT.md): dt <= ', &
-           STICK_LIMIT * cfg%dt / stick, ' (or a larger &contact eps_bar) resolves it'
-      call warn_line(text)
-    end if
-    if (.not. pc%implicit .and. chatter > CHATTER_LIMIT) then
-      write(text, '(a,f6.3,a,f5.3,a,es9.2,a)') 'the explicit rough contacts would chatter: dt gamma_dot h_r/delta_0 = ', &
-           chatter, ' exceeds ', CHATTER_LIMIT, &
-           ' (period-two oscillation measured above it; doc/CONTACT.md): the largest stable dt here is ', &
-           CHATTER_LIMIT * cfg%dt / chatter, ' (or raise &contact eps_bar, or take them implicitly: &contact implicit)'
-      call input_error(cfg%deck_file, 'time', 'dt', trim(text))
-    else if (pc%implicit .and. chatter > IMPLICIT_CHATTER_LIMIT) then
-      write(text, '(a,f6.3,a,f5.3,a,es9.2,a)') 'the rough contacts: dt gamma_dot h_r/delta_0 = ', chatter, &
-           ' exceeds ', IMPLICIT_CHATTER_LIMIT, ', the largest chatter number at which implicit contacts were '// &
-           'measured free of chatter (doc/CONTACT.md): the largest dt measured stable here is ', &
-           IMPLICIT_CHATTER_LIMIT * cfg%dt / chatter, ' (or raise &contact eps_bar)'
-      call input_error(cfg%deck_file, 'time', 'dt', trim(text))
-    end if
-    ! the roughness of a dense suspension flattens under its force chains (doc/VALIDATION.md §6)
-    if (cfg%walls .or. cfg%lees_edwards) then
-      solid_fraction = parts%n * (4.0_dp / 3.0_dp) * pi * parts%radius**3 / product(cfg%box)
-      expected_overlap = flattening_estimate(pc%params, solid_fraction)
-      if (expected_overlap > 1.0_dp) then
-        write(text, '(a,f6.2,a,f5.3,a,es9.2,a)') 'the roughness would flatten completely: expected largest overlap ', &
-             expected_overlap, ' h_r at phi = ', solid_fraction, ' (doc/VALIDATION.md §6); stiffer contacts, eps_bar <= ', &
-             0.5_dp * cfg%eps_bar / expected_overlap, ' (or a larger normal_stiffness), keep it below h_r/2'
-        call input_error(cfg%deck_file, 'contact', trim(merge('normal_stiffness', 'eps_bar         ', &
-                         cfg%normal_stiffness > 0.0_dp)), trim(text))
-      else if (expected_overlap > 0.5_dp) then
-        write(text, '(a,f6.2,a,f5.3,a)') 'expected largest contact overlap ', expected_overlap, ' h_r at phi = ', &
-             solid_fraction, ' (> h_r/2, doc/VALIDATION.md §6): a smaller &contact eps_bar keeps the roughness'
-        call warn_line(text)
+  ! The findings of a limit check (mod_limits), in their order: warnings, and the refusal of the
+  ! deck item named, which stops the run. Collective: every rank finds the same.
+  subroutine report(findings)
+    type(limit_finding_t), intent(in) :: findings(:)
+    integer :: k
+    do k = 1, size(findings)
+      if (findings(k)%level == LIMIT_REFUSE) then
+        call input_error(cfg%deck_file, trim(findings(k)%group), trim(findings(k)%key), trim(findings(k)%text))
+      else
+        call warn_line(findings(k)%text)
       end if
-    end if
-  end subroutine check_contact_limits
-
-  ! A new largest overlap of the run; warned once when it passes h_r/2, the bound the extreme
-  ! scenes hold (doc/VALIDATION.md §6).
-  subroutine note_overlap()
-    if (largest_overlap <= 0.5_dp * pc%params%h_r .and. pc%max_overlap > 0.5_dp * pc%params%h_r) then
-      write(text, '(a,i0,a,f6.3,a)') 'at step ', step, ' a contact overlap reaches ', &
-           pc%max_overlap / pc%params%h_r, ' h_r (> h_r/2): stiffer contacts (a smaller &contact eps_bar '// &
-           'or a larger normal_stiffness, with dt gamma_dot h_r/delta_0 within its limit, doc/CONTACT.md) keep the '// &
-           'roughness from flattening'
-      call warn_line(text)
-    end if
-    largest_overlap = pc%max_overlap
-    largest_overlap_step = step
-  end subroutine note_overlap
+    end do
+  end subroutine report
 
   ! Collective (every rank holds the same contacts): stop with a diagnostic.
   subroutine contact_failure(code)
@@ -901,13 +796,7 @@ contains
     integer, intent(in) :: at_step
     character(len=*), intent(in) :: what
     call series_flush(series)
-    if (.not. cfg%resolved) then
-      call checkpoint_particles(trim(cfg%output_directory)//'/failed_state.h5')
-    else if (has_particles) then
-      PetscCallA(checkpoint_write(trim(cfg%output_directory)//'/failed_state.h5', cfg, fl, step, time, ierr, fd%lambda, parts))
-    else
-      PetscCallA(checkpoint_write(trim(cfg%output_directory)//'/failed_state.h5', cfg, fl, step, time, ierr))
-    end if
+    PetscCallA(checkpoint_write(trim(cfg%output_directory)//'/failed_state.h5', cfg, state, step, time, ierr))
     write(text, '(a,i0,a)') 'fdsusp: fatal: at step ', at_step, ': '//trim(what)// &
          '; state written to '//trim(cfg%output_directory)//'/failed_state.h5, the last good checkpoint is kept'
     call fatal_error(text, 5)

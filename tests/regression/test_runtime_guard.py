@@ -13,7 +13,8 @@ Third guard: a linear solver that does not converge stops the run (status 3) wit
 naming the solver, its KSP reason and iterations, and the last good checkpoint survives: the
 run of the first guard is restarted from its step-14 checkpoint with the pressure solver capped
 at one iteration (-fluid_solver krylov -p_ksp_max_it 1, a stand-in for a diverging or stagnating solve).
-Fourth guard: a contact overlap beyond h_r (see the fourth case).
+Fourth guard: a contact overlap beyond h_r (see the fourth case); its failed_state.h5 holds the
+contact history like any checkpoint.
 Fifth guard: the default path, whose fluid solves are direct (nothing to fail to converge), still
 has one iterative solve, the particles' 6N system: a pair of spheres 0.1a apart couples it through
 lubrication, and with that solve capped at one iteration (-particles_ksp_max_it 1, a stand-in for a
@@ -88,6 +89,12 @@ messages = [l for l in err.splitlines() if l.startswith('fdsusp: fatal')]
 T.check(status == 5 and len(messages) == 1 and 'particle 1 and particle 2' in messages[0] and 'exceeds' in messages[0],
         'an overlap beyond h_r stops the run: status %d, %s' % (status, messages[:1]))
 T.check(os.path.exists(os.path.join(d, 'out', 'failed_state.h5')), 'failed_state.h5 written')
+# the failed state holds what a checkpoint holds (one state bundle, mod_checkpoint): with it the
+# contact history
+failed_path = os.path.join(d, 'out', 'failed_state.h5')
+failed = T.h5_contents(failed_path) if os.path.exists(failed_path) else {}
+T.check('contacts@count' in failed and 'lambda_u' in failed,
+        'failed_state.h5 holds Lambda and the contact history (%s)' % sorted(failed))
 ck = os.path.join(d, 'out', 'checkpoint.h5')
 T.check(os.path.exists(ck) and int(T.h5_attr(ck, 'step')) % 5 == 0 and np.isfinite(T.read_h5(ck, ['u'])['u']).all(),
         'the last good checkpoint is kept (step %s)' % (T.h5_attr(ck, 'step') if os.path.exists(ck) else None))
