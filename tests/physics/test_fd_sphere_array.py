@@ -2,7 +2,7 @@
 in a triply periodic cube of side L, a/Delta = 5). A uniform body force -F/L^3 on the fluid balances
 the pull, so the mean velocity over the box stays zero and the sphere's steady velocity U gives the
 array's drag coefficient K = F / (6 pi eta a U).
-References (independent of the code):
+References (independent of the code; tests/physics/sphere_array_reference.py):
  - Sangani & Acrivos (1982, Int. J. Multiphase Flow 8:343) series for the simple cubic array,
    K = 1/(1 - 1.7601 chi + phi - 1.5593 phi^2 + 3.9799 phi^(8/3) - 3.0734 phi^(10/3)), chi = phi^(1/3);
    it reproduces Zick & Homsy (1982, JFM 115:13, Table 2) to 0.03 % at phi = 0.027, 0.064, 0.125;
@@ -19,6 +19,7 @@ import os
 import sys
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
+from sphere_array_reference import k_reference  # noqa: E402
 
 DECK = """&domain box = {L}, {L}, {L}, cells_per_radius = 5, y_boundary = 'periodic', shear_rate = 0 /
 &fluid reynolds = 0.01, body_force = {fb:.15e}, 0, 0 /
@@ -26,17 +27,6 @@ DECK = """&domain box = {L}, {L}, {L}, cells_per_radius = 5, y_boundary = 'perio
 &output directory = 'out', progress_every = 80 /
 &particles number = 1, position(:,1) = {c}, {c}, {c}, external_force(:,1) = {F:.15e}, 0, 0 /
 """
-
-
-def k_series(phi):
-    chi = phi ** (1 / 3)
-    return 1 / (1 - 1.7601 * chi + phi - 1.5593 * phi ** 2 + 3.9799 * phi ** (8 / 3) - 3.0734 * phi ** (10 / 3))
-
-
-def k_reference(phi):
-    if phi <= 0.13:
-        return k_series(phi)
-    return k_series(phi) * 7.442 / k_series(0.216)
 
 
 F = 6 * math.pi
