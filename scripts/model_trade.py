@@ -45,6 +45,9 @@ ROWS = {
     # at phi 0.45 and mu_d 0.5 eps_bar 0.05 reaches the overlap guard within a strain (step 409)
     'ld_phi0.45_eb002': ('lubrication dynamics at bulk phi 0.45, eps_bar 0.02, dt 8e-4',
                          dict(LD, phi=0.45, eps_bar=0.02, dt=8e-4)),
+    # at phi 0.45 and mu_d 0.5 the DNS too reaches the overlap guard with eps_bar 0.05 (step 539)
+    'dns_phi0.45_eb002': ('DNS at bulk phi 0.45, eps_bar 0.02, dt 8e-4 (run at mu_d 0.5 only: without friction eps_bar '
+                          'does not matter, §5.4)', dict(phi=0.45, eps_bar=0.02, dt=8e-4)),
     # the cut-off 0.5a at the other fractions (is 0.5a's agreement with the DNS at phi 0.4 general?)
     'ld_phi0.3_cut0.5': ('lubrication dynamics at bulk phi 0.3, pair and wall resistance cut at 0.5a',
                          dict(LD, phi=0.3, cutoff=0.5)),
@@ -61,6 +64,7 @@ PAIRS = [
     ('phi 0.3, §5.4 set-up', (None, 'dns_phi0.3'), ['ld_phi0.3', 'ld_phi0.3_cut0.5']),
     ('phi 0.4, §5.4 set-up', (FRICTION_RECORD, 'base'), ['ld', 'ld_eb002', 'ld_cut0.5']),
     ('phi 0.45, §5.4 set-up', (None, 'dns_phi0.45'), ['ld_phi0.45', 'ld_phi0.45_eb002', 'ld_phi0.45_cut0.5']),
+    ('phi 0.45, eps_bar 0.02', (None, 'dns_phi0.45_eb002'), ['ld_phi0.45_eb002', 'ld_phi0.45_cut0.5']),
     ('phi 0.4, paper set-up', (FRICTION_RECORD, 'paperdt2'), ['ld_paper']),
 ]
 QUANTITIES = ('eta_r', 'eta_h', 'eta_c', 'N1/tau', 'N2/tau', 'Pi/tau', 'phi_core')
