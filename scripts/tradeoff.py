@@ -37,6 +37,7 @@ plot with its Pareto front (doc/figures/tradeoff.png by default).
 import argparse
 import glob
 import json
+import math
 import os
 import re
 import shutil
@@ -48,8 +49,12 @@ from jobpool import ENV, run_all  # noqa: E402
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
 BASE = {'cells': 4, 'dt': 1e-3, 'vtol': 1e-8, 'ptol': 1e-10, 'lub': 'full', 'model': 'resolved'}
-# the settings that are the code's defaults (doc/INPUT.md): ringed in the figure
-DEFAULTS = {'tol 1e-06 (default)', 'full', 'DNS (resolved fluid)'}
+# each knob's setting that is the code's default (doc/INPUT.md: cells_per_radius 5, dt 1e-3,
+# tolerances 1e-6, 'full', the resolved fluid): ringed in the left panel; in the right one the
+# run of the default configuration (a/Delta 5, dt 1e-3, 'full', the default direct solves)
+DEFAULTS = {'a/D 5 full', 'dt 0.001', 'tol 1e-06 (default)', 'full', 'DNS (resolved fluid)'}
+DEFAULT_RUN = 'a5_dt0.001_tol1e-08-1e-10_full'
+BASE_RUN = 'a4_dt0.001_tol1e-08-1e-10_full'
 DECK = """&domain box = 7, 10, 7, cells_per_radius = {cells}, y_boundary = 'walls', shear_rate = 1 /
 &fluid model = '{model}', reynolds = 0.01, initial_flow = 'shear', velocity_tolerance = {vtol:g}, pressure_tolerance = {ptol:g} /
 &time dt = {dt:g} /
@@ -95,7 +100,9 @@ def settings(knobs):
     out = []
     for knob, members in series.items():
         for label, p in members:
-            name = 'a%(cells)d_dt%(dt)g_tol%(vtol)g-%(ptol)g_%(lub)s' % p + ('_ld' if p['model'] == 'none' else '')
+            # the Krylov rows get their own directory: the base shares its tolerances but solves directly
+            name = 'a%(cells)d_dt%(dt)g_tol%(vtol)g-%(ptol)g_%(lub)s' % p + ('_ld' if p['model'] == 'none' else '') \
+                + ('_krylov' if p.get('krylov') else '')
             out.append({'name': name, 'knob': knob, 'label': label, 'parameters': p,
                         'finest': members[-1][0]})
     return out
@@ -143,19 +150,22 @@ def pareto(points):
     return sorted(front, key=lambda i: points[i][0])
 
 
-def plot_front(rows, path, cost, markers, xlabel, title, floor=1e-5):
+def plot_front(rows, path, cost, markers, xlabel, title, floor=1e-5, default_run=None, base_run=None, base_label=None):
     """Two panels of error against cost, one marker and colour per knob. Left: each knob's settings
     against that knob's finest (error_knob), each labelled, the finest itself left out (its error is
     0 by construction). Right: every setting against the reference (error), the Pareto front over
-    the distinct configurations, and only the front's points labelled. Defaults are ringed; errors
-    below floor are drawn at floor (log axis)."""
+    the distinct configurations, and only the front's points labelled, each run once (base_run, which
+    several knobs share, as base_label). Each knob's default setting is ringed on the left, the run
+    of the default configuration (default_run) on the right; errors below floor are drawn at floor
+    (log axis)."""
     import matplotlib
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt
     fig, axes = plt.subplots(1, 2, figsize=(14.5, 5.5), sharey=True)
     colours = dict(zip(markers, ['C%d' % i for i in range(len(markers))]))
 
-    def draw(ax, key, labelled):
+    def draw(ax, key, labelled, ringed):
+        placed = []                     # the labels so far, (x, y) of their points
         for knob, marker in markers.items():
             pts = [r for r in rows if r['knob'] == knob and r[key] is not None
                    and not (key == 'error_knob' and r['label'] == r['finest'])]
@@ -163,24 +173,38 @@ def plot_front(rows, path, cost, markers, xlabel, title, floor=1e-5):
                 x, y = r[cost], max(r[key], floor)
                 ax.scatter([x], [y], marker=marker, color=colours[knob], s=45,
                            label=knob if i == 0 else None, zorder=3)
-                if r['label'] in DEFAULTS:
+                if ringed(r):
                     ax.scatter([x], [y], marker='o', s=220, facecolors='none', edgecolors='k', lw=1, zorder=2)
-                if labelled(r):
-                    # alternate the label above and below its point, so that neighbours do not overlap
-                    ax.annotate(r['label'], (x, y), fontsize=7, color=colours[knob],
-                                xytext=(5, 6 if i % 2 == 0 else -11), textcoords='offset points')
+                text = labelled(r)
+                if text:
+                    # above its point, or below when a label already sits near it (within ~15 % in
+                    # cost and a factor 1.6 in error), so that neighbours do not overlap
+                    near = any(abs(math.log(x / px)) < 0.15 and abs(math.log(y / py)) < 0.5 for px, py in placed) \
+                        or r['name'] == base_run          # (its long label would cross the default's ring)
+                    placed.append((x, y))
+                    ax.annotate(text, (x, y), fontsize=7, color=colours[knob],
+                                xytext=(5, -11 if near else 6), textcoords='offset points')
         ax.set_xscale('log')
         ax.set_yscale('log')
         ax.set_xlabel(xlabel)
         ax.grid(True, which='major', lw=0.3)
 
-    draw(axes[0], 'error_knob', lambda r: True)
+    draw(axes[0], 'error_knob', lambda r: r['label'], lambda r: r['label'] in DEFAULTS)
     axes[0].set_ylabel('|eta_r - eta_r(finest)| / eta_r(finest)')
     axes[0].set_title("each knob against its own finest setting", fontsize=10)
     pts = list({r['name']: r for r in rows if r['knob'] in markers and r['error'] is not None}.values())
     front = pareto([(r[cost], max(r['error'], floor)) for r in pts])
     on_front = {pts[i]['name'] for i in front}
-    draw(axes[1], 'error', lambda r: r['name'] in on_front)
+    # one label per distinct run on the front (the base is shared by the grid, dt, lubrication and
+    # model knobs: labelled once as such)
+    named = set()
+
+    def front_label(r):
+        if r['name'] not in on_front or r['name'] in named:
+            return None
+        named.add(r['name'])
+        return base_label if r['name'] == base_run and base_label else r['label']
+    draw(axes[1], 'error', front_label, lambda r: r['name'] == default_run)
     axes[1].plot([pts[i][cost] for i in front], [max(pts[i]['error'], floor) for i in front], 'k--', lw=1,
                  label='Pareto front')
     axes[1].set_title('total error against the reference (finest grid, dt, tolerance)', fontsize=10)
@@ -258,7 +282,8 @@ def main():
                    {'grid (full)': 'o', 'grid (simple)': 'v', 'dt': 's', 'tolerance': '^', 'lubrication': 'D',
                     'model': 'P'},
                    'cost: CPU seconds per unit strain (1 rank)',
-                   'fdsusp speed against accuracy (phi = 0.3, 7a x 10a x 7a, mu_d = 0.5)')
+                   'fdsusp speed against accuracy (phi = 0.3, 7a x 10a x 7a, mu_d = 0.5)',
+                   default_run=DEFAULT_RUN, base_run=BASE_RUN, base_label='base: a/D 4, dt 1e-3, full, DNS')
         print('plot: %s' % os.path.relpath(args.plot, ROOT))
     return 0
 
