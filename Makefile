@@ -158,9 +158,9 @@ extremes: all
 	$(PYTHON) scripts/extremes.py --json out/extremes/extremes.json
 
 # Speed against accuracy (issue 7), one knob at a time: the suspension scene (error of each
-# setting against the finest, CPU s per strain; doc/figures/tradeoff.png; 24 CPU minutes with the a/Delta 4-5 tables, more since 6 and 8 have tables)
+# setting against the finest, CPU s per strain; doc/figures/tradeoff.png; 8 CPU minutes, 2026-11-26)
 # and the pair test (resistance against exact theory, CPU s per run; doc/figures/tradeoff_pair.png,
-# about 20 CPU minutes): ~25 min on 2 cores before the a/Delta 6 and 8 tables. Tables in doc/BENCHMARKS.md §9.
+# about 3 CPU minutes): ~6 min on 2 cores (2026-11-26). Tables in doc/BENCHMARKS.md §9.
 tradeoff: all
 	$(PYTHON) scripts/tradeoff_pair.py
 	$(PYTHON) scripts/tradeoff.py

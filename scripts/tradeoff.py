@@ -150,18 +150,23 @@ def pareto(points):
     return sorted(front, key=lambda i: points[i][0])
 
 
-def plot_front(rows, path, cost, markers, xlabel, title, floor=1e-5, default_run=None, base_run=None, base_label=None):
+def plot_front(rows, path, cost, markers, xlabel, title, floor=1e-5, default_run=None, base_run=None, base_label=None,
+               ylabel=None, reference_title=None):
     """Two panels of error against cost, one marker and colour per knob. Left: each knob's settings
     against that knob's finest (error_knob), each labelled, the finest itself left out (its error is
     0 by construction). Right: every setting against the reference (error), the Pareto front over
     the distinct configurations, and only the front's points labelled, each run once (base_run, which
     several knobs share, as base_label). Each knob's default setting is ringed on the left, the run
     of the default configuration (default_run) on the right; errors below floor are drawn at floor
-    (log axis)."""
+    (log axis). Rows without error_knob (the pair test, whose every error is against exact theory)
+    get the right panel alone, with ylabel and reference_title."""
     import matplotlib
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt
-    fig, axes = plt.subplots(1, 2, figsize=(14.5, 5.5), sharey=True)
+    per_knob = all('error_knob' in r for r in rows)
+    fig, axes = plt.subplots(1, 2 if per_knob else 1, figsize=(14.5 if per_knob else 9, 5.5), sharey=True,
+                             squeeze=False)
+    axes = axes[0]
     colours = dict(zip(markers, ['C%d' % i for i in range(len(markers))]))
 
     def draw(ax, key, labelled, ringed):
@@ -189,9 +194,12 @@ def plot_front(rows, path, cost, markers, xlabel, title, floor=1e-5, default_run
         ax.set_xlabel(xlabel)
         ax.grid(True, which='major', lw=0.3)
 
-    draw(axes[0], 'error_knob', lambda r: r['label'], lambda r: r['label'] in DEFAULTS)
-    axes[0].set_ylabel('|eta_r - eta_r(finest)| / eta_r(finest)')
-    axes[0].set_title("each knob against its own finest setting", fontsize=10)
+    if per_knob:
+        draw(axes[0], 'error_knob', lambda r: r['label'], lambda r: r['label'] in DEFAULTS)
+        axes[0].set_ylabel('|eta_r - eta_r(finest)| / eta_r(finest)')
+        axes[0].set_title("each knob against its own finest setting", fontsize=10)
+    else:
+        axes[0].set_ylabel(ylabel or 'error')
     pts = list({r['name']: r for r in rows if r['knob'] in markers and r['error'] is not None}.values())
     front = pareto([(r[cost], max(r['error'], floor)) for r in pts])
     on_front = {pts[i]['name'] for i in front}
@@ -204,12 +212,13 @@ def plot_front(rows, path, cost, markers, xlabel, title, floor=1e-5, default_run
             return None
         named.add(r['name'])
         return base_label if r['name'] == base_run and base_label else r['label']
-    draw(axes[1], 'error', front_label, lambda r: r['name'] == default_run)
-    axes[1].plot([pts[i][cost] for i in front], [max(pts[i]['error'], floor) for i in front], 'k--', lw=1,
+    draw(axes[-1], 'error', front_label, lambda r: r['name'] == default_run)
+    axes[-1].plot([pts[i][cost] for i in front], [max(pts[i]['error'], floor) for i in front], 'k--', lw=1,
                  label='Pareto front')
-    axes[1].set_title('total error against the reference (finest grid, dt, tolerance)', fontsize=10)
-    axes[1].scatter([], [], marker='o', s=220, facecolors='none', edgecolors='k', label="the code's default")
-    axes[1].legend(fontsize=8, loc='center left', bbox_to_anchor=(1.01, 0.5))
+    axes[-1].set_title(reference_title or 'total error against the reference (finest grid, dt, tolerance)',
+                       fontsize=10)
+    axes[-1].scatter([], [], marker='o', s=220, facecolors='none', edgecolors='k', label="the code's default")
+    axes[-1].legend(fontsize=8, loc='center left', bbox_to_anchor=(1.01, 0.5))
     fig.suptitle(title, fontsize=11)
     fig.tight_layout()
     os.makedirs(os.path.dirname(path), exist_ok=True)
