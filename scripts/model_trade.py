@@ -59,12 +59,14 @@ ROWS = {
 DEFAULT = [r for r in ROWS if r != 'ld_paper']
 
 FRICTION_RECORD = os.path.join(ROOT, 'doc', 'data', 'friction_phi04')
-# (case, where the DNS record is: (record directory or None for this study's, row), LD rows)
+# (case, where the DNS record is: (record directory or None for this study's, row or {mu_d: row}),
+# LD rows). At phi 0.45 with friction eps_bar 0.05 stops both models on the overlap guard: the DNS
+# there is row dns_phi0.45_eb002 (without friction eps_bar does not matter, §5.4)
 PAIRS = [
     ('phi 0.3, §5.4 set-up', (None, 'dns_phi0.3'), ['ld_phi0.3', 'ld_phi0.3_cut0.5']),
     ('phi 0.4, §5.4 set-up', (FRICTION_RECORD, 'base'), ['ld', 'ld_eb002', 'ld_cut0.5']),
-    ('phi 0.45, §5.4 set-up', (None, 'dns_phi0.45'), ['ld_phi0.45', 'ld_phi0.45_eb002', 'ld_phi0.45_cut0.5']),
-    ('phi 0.45, eps_bar 0.02', (None, 'dns_phi0.45_eb002'), ['ld_phi0.45_eb002', 'ld_phi0.45_cut0.5']),
+    ('phi 0.45, §5.4 set-up', (None, {0.0: 'dns_phi0.45', 0.5: 'dns_phi0.45_eb002'}),
+     ['ld_phi0.45', 'ld_phi0.45_eb002', 'ld_phi0.45_cut0.5']),
     ('phi 0.4, paper set-up', (FRICTION_RECORD, 'paperdt2'), ['ld_paper']),
 ]
 QUANTITIES = ('eta_r', 'eta_h', 'eta_c', 'N1/tau', 'N2/tau', 'Pi/tau', 'phi_core')
@@ -83,7 +85,10 @@ def cpu_per_strain(s):
 
 
 def dns_record(study, where, row, mu):
-    """The DNS record of a case: in the friction study's records (where) or this study's (None)."""
+    """The DNS record of a case: in the friction study's records (where) or this study's (None);
+    row may name one row per mu_d."""
+    if isinstance(row, dict):
+        row = row[mu]
     return load(os.path.join(where or study.record_dir, run_name(row, mu), 'summary.json'))
 
 
