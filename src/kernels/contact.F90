@@ -45,6 +45,12 @@ module mod_contact
   ! largest stick_number without a warning: friction converged at 1.1-4.6, 14 % low at 11.4
   ! (doc/CONTACT.md "Time-step considerations", doc/VALIDATION.md §5.4)
   real(dp), parameter :: STICK_LIMIT = 5.0_dp
+  ! shear jamming of rough frictional spheres in a rate-controlled cell (doc/VALIDATION.md §6):
+  ! from SHEAR_JAM_MU on, bulk phi >= SHEAR_JAM_PHI jammed in every run (both fluid models,
+  ! walls and Lees-Edwards boundaries, 77 and 306 spheres, contacts 1-32 times as stiff); with
+  ! mu_d >= SHEAR_JAM_WARN_MU it was measured from SHEAR_JAM_WARN_PHI on, between walls
+  real(dp), parameter :: SHEAR_JAM_MU = 0.2_dp, SHEAR_JAM_PHI = 0.545_dp
+  real(dp), parameter :: SHEAR_JAM_WARN_MU = 0.5_dp, SHEAR_JAM_WARN_PHI = 0.52_dp
 
   type :: contact_params_t
     real(dp) :: a = 1                   ! sphere radius [a]
@@ -153,7 +159,8 @@ contains
   !> chatter from ~0.02 on and are refused above 0.025; implicit ones were measured clean up to 0.2
   !> and are refused beyond), friction whose step slips further than a contact sticks (a warning),
   !> and, in a sheared suspension (sheared: between walls or across Lees-Edwards boundaries, at
-  !> solid fraction phi), roughness that would flatten completely (doc/VALIDATION.md §6).
+  !> solid fraction phi), frictional spheres packed densely enough to jam (refused; a warning close
+  !> to it) and roughness that would flatten completely (doc/VALIDATION.md §6).
   !> dt: the time step; implicit: the contacts are taken implicitly; eps_bar: the deck's;
   !> stiffness_prescribed: k_n is the deck's normal_stiffness (the item a refusal names).
   function contact_limits(p, dt, implicit, sheared, phi, eps_bar, stiffness_prescribed) result(findings)
@@ -190,6 +197,23 @@ contains
            'measured free of chatter (doc/CONTACT.md): the largest dt measured stable here is ', &
            IMPLICIT_CHATTER_LIMIT * dt / chatter, ' (or raise &contact eps_bar)'
       call add_finding(findings, LIMIT_REFUSE, text, 'time', 'dt')
+    end if
+    ! frictional spheres at the densest fractions jam in shear: the contact forces grow without bound
+    ! within the first strain whatever the contacts' stiffness, so no steady flow exists to measure
+    ! (doc/VALIDATION.md §6); the roughness estimate below would only name a stiffness
+    if (sheared .and. p%h_r > 0 .and. p%mu_d >= SHEAR_JAM_MU .and. phi >= SHEAR_JAM_PHI) then
+      write(text, '(a,f6.4,a,f5.2,a,f5.3,a,f4.2,a)') 'rough frictional spheres at phi = ', phi, ' with mu_d = ', &
+           p%mu_d, ' jam in shear: from phi = ', SHEAR_JAM_PHI, ' and mu_d = ', SHEAR_JAM_MU, &
+           ' on, every run measured had its contact forces grow without bound within the first strain, '// &
+           'at any contact stiffness and in both fluid models (doc/VALIDATION.md §6): a smaller friction '// &
+           'or solid fraction flows'
+      call add_finding(findings, LIMIT_REFUSE, text, 'contact', 'friction')
+      return
+    else if (sheared .and. p%h_r > 0 .and. p%mu_d >= SHEAR_JAM_WARN_MU .and. phi >= SHEAR_JAM_WARN_PHI) then
+      write(text, '(a,f6.4,a,f5.2,a)') 'phi = ', phi, ' with mu_d = ', p%mu_d, ' is close to shear jamming: '// &
+           'lubrication dynamics between walls jammed at phi 0.53 (mu_d 0.5) and 0.52 (mu_d 1) within the first '// &
+           'strain (doc/VALIDATION.md §6): the overlap guard may stop this run'
+      call add_finding(findings, LIMIT_WARN, text)
     end if
     ! the roughness of a dense suspension flattens under its force chains (doc/VALIDATION.md §6)
     if (sheared) then

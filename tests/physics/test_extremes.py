@@ -5,7 +5,8 @@ with one message that names the limit. Short version for make check: each runnin
 results in doc/VALIDATION.md §6), through scripts/extremes.py, which applies the criteria:
 'stable' needs exit status 0, every step run, overlap < h_r/2 (the bound of the issue) and finite
 stresslets and velocities; 'refused' needs status 2 with an input error and no time step taken.
-The refusals are checked for the words that state their limit. The ld_* scenes are the same limits
+The refusals are checked for the words that state their limit (phi055 and ld_phi055: frictional
+spheres at phi 0.55 jam in shear in both models, doc/VALIDATION.md §6; their frictionless twins run). The ld_* scenes are the same limits
 in lubrication dynamics (&fluid model = 'none', issue 30)."""
 import json
 import os
@@ -15,16 +16,16 @@ sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 EXPECTED = {
-    'phi050': ('stable', []), 'phi055': ('stable', []), 'mu1': ('stable', []),
+    'phi050': ('stable', []), 'phi055_mu0': ('stable', []), 'mu1': ('stable', []),
+    'phi055': ('refused', ['&contact', 'friction', 'jam in shear', 'phi = 0.545']),
     'epsr1e-4': ('stable', []),
     'gamma1e-1': ('refused', ['&contact', 'eps_bar', 'flatten', 'eps_bar <=  7.']),
     'gamma1e-3': ('stable', []), 'dt5x': ('stable', []),
     'wall_touch': ('refused', ['&particles', 'position(:,1)', 'wall gap', 'h_r/2']),
     'pair_overlap': ('refused', ['&particles', 'position(:,1)', 'start at a gap of', 'h_r/2']),
     # lubrication dynamics (issue 30): the same limits without the fluid
-    # (ld_phi055 is stable over these 100 steps; its full 5 strains stop on the overlap guard at
-    # strain 0.47 today: doc/VALIDATION.md §6, issue 30 open)
-    'ld_phi055': ('stable', []), 'ld_mu1': ('stable', []), 'ld_epsr1e-4': ('stable', []),
+    'ld_phi055_mu0': ('stable', []), 'ld_mu1': ('stable', []), 'ld_epsr1e-4': ('stable', []),
+    'ld_phi055': ('refused', ['&contact', 'friction', 'jam in shear', 'phi = 0.545']),
     'ld_dt_too_large': ('refused', ['&time', 'dt', 'the largest dt measured stable here is  2.00E-03']),
 }
 d = T.scratch('extremes')

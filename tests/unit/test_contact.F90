@@ -30,14 +30,20 @@
 !  13. The flattening estimate eps_bar g(phi) takes the measured g at its table points (6.9 at
 !      phi = 0.4, 26 at 0.55; 1e-13), is continuous at the joins (0.3, 0.5: 1e-12) and is eps_bar
 !      at phi = 0 (one pair under the force scale).
+!  14. Shear jamming (doc/VALIDATION.md §6: frictional spheres at phi 0.55 jammed in every run):
+!      contact_limits refuses phi 0.5485 with mu_d 0.5 in a sheared cell, naming &contact friction,
+!      warns at phi 0.53 with mu_d 0.5, and lets phi 0.5485 pass frictionless (measured to flow),
+!      with mu_d 0.1, or without shear.
 program test_contact
   use mod_kinds, only: dp, pi
   use mod_vector, only: cross
   use mod_contact, only: contact_params_t, contact_setup, chatter_number, stick_number, flattening_estimate, contact_history_t, history_size, &
-                         contact_pair, contact_forces, contact_stats_t, history_lookup
+                         contact_limits, contact_pair, contact_forces, contact_stats_t, history_lookup
+  use mod_limits, only: limit_finding_t, LIMIT_REFUSE, LIMIT_WARN
   use mod_unit_checks, only: check, finish
   implicit none
   type(contact_params_t) :: p, p0, pb
+  type(limit_finding_t), allocatable :: found(:)
   type(contact_history_t) :: h
   type(contact_stats_t) :: st
   integer :: info, k, step
@@ -244,6 +250,25 @@ program test_contact
   call check(abs(flattening_estimate(p, 0.5_dp - 1e-12_dp) &
              / flattening_estimate(p, 0.5_dp + 1e-12_dp) - 1) < 1e-10_dp, 'flattening continuous at phi = 0.5')
   call check(abs(flattening_estimate(p, 0.0_dp) / 0.05_dp - 1) < 1e-13_dp, 'flattening at phi = 0 is eps_bar')
+
+  ! 14. shear jamming, with eps_bar 0.01 (the extreme scenes'; the flattening estimate stays below
+  ! h_r there) and dt 1e-3 (chatter number 0.1)
+  call contact_setup(p0, 1.0_dp, 5.0e-3_dp, 0.5_dp, 0.01_dp, 0.0_dp, 1.0_dp, 1.0_dp, info, msg)
+  found = contact_limits(p0, 1.0e-3_dp, .true., .true., 0.5485_dp, 0.01_dp, .false.)
+  call check(count(found%level == LIMIT_REFUSE) == 1, 'phi 0.5485, mu_d 0.5, sheared: refused')
+  call check(any(found%group == 'contact' .and. found%key == 'friction' .and. index(found%text, 'jam in shear') > 0), &
+             'the refusal names &contact friction and the jamming')
+  found = contact_limits(p0, 1.0e-3_dp, .true., .false., 0.5485_dp, 0.01_dp, .false.)
+  call check(count(found%level == LIMIT_REFUSE) == 0, 'not sheared: no refusal')
+  found = contact_limits(p0, 1.0e-3_dp, .true., .true., 0.53_dp, 0.01_dp, .false.)
+  call check(count(found%level == LIMIT_REFUSE) == 0 .and. any(index(found%text, 'close to shear jamming') > 0 &
+             .and. found%level == LIMIT_WARN), 'phi 0.53, mu_d 0.5: a warning, no refusal')
+  call contact_setup(p0, 1.0_dp, 5.0e-3_dp, 0.1_dp, 0.01_dp, 0.0_dp, 1.0_dp, 1.0_dp, info, msg)
+  found = contact_limits(p0, 1.0e-3_dp, .true., .true., 0.5485_dp, 0.01_dp, .false.)
+  call check(count(found%level == LIMIT_REFUSE) == 0, 'mu_d 0.1 at phi 0.5485: no refusal')
+  call contact_setup(p0, 1.0_dp, 5.0e-3_dp, 0.0_dp, 0.01_dp, 0.0_dp, 1.0_dp, 1.0_dp, info, msg)
+  found = contact_limits(p0, 1.0e-3_dp, .true., .true., 0.5485_dp, 0.01_dp, .false.)
+  call check(count(found%level == LIMIT_REFUSE) == 0, 'frictionless at phi 0.5485: no refusal')
 
   call finish('test_contact')
 
