@@ -39,6 +39,11 @@ ROWS = {
     'core040': ('bulk phi 0.375 (core ~0.40)', dict(phi=0.375)),
     'a5':      ('a/Delta 5', dict(cells=5)),
     'dt5e-4':  ('dt 5e-4 (the paper\'s frictional step)', dict(dt=5e-4)),
+    # the paper's figure-16 sweep at the stick number of the base at mu_d 0.5 (4.6): the stick
+    # number grows as dt/mu_d, so mu_d 0.1, 0.2, 0.3 take dt 4e-4, 8e-4, 1.2e-3 (run as ROW:MU)
+    'dt4e-4':  ('dt 4e-4 (stick number 4.6 at mu_d 0.1)', dict(dt=4e-4)),
+    'dt8e-4':  ('dt 8e-4 (stick number 4.6 at mu_d 0.2)', dict(dt=8e-4)),
+    'dt1.2e-3': ('dt 1.2e-3 (stick number 4.6 at mu_d 0.3)', dict(dt=1.2e-3)),
     'w12':     ('x, z periods 12a', dict(box=(12, 20, 12))),
     'w20':     ('x, z periods 20a', dict(box=(20, 20, 20))),
     'w20s2':   ('x, z periods 20a, seed 2', dict(box=(20, 20, 20), seed=2)),
