@@ -169,6 +169,7 @@ contains
     logical, intent(in) :: implicit, sheared, stiffness_prescribed
     type(limit_finding_t), allocatable :: findings(:)
     real(dp) :: chatter, stick, expected_overlap
+    logical :: shear_jamming   ! the jamming checks apply: rough contacts under shear
     character(len=400) :: text
     allocate(findings(0))
     chatter = chatter_number(p, dt)
@@ -201,7 +202,8 @@ contains
     ! frictional spheres at the densest fractions jam in shear: the contact forces grow without bound
     ! within the first strain whatever the contacts' stiffness, so no steady flow exists to measure
     ! (doc/VALIDATION.md §6); the roughness estimate below would only name a stiffness
-    if (sheared .and. p%h_r > 0 .and. p%mu_d >= SHEAR_JAM_MU .and. phi >= SHEAR_JAM_PHI) then
+    shear_jamming = sheared .and. p%gamma_dot /= 0 .and. p%h_r > 0
+    if (shear_jamming .and. p%mu_d >= SHEAR_JAM_MU .and. phi >= SHEAR_JAM_PHI) then
       write(text, '(a,f6.4,a,f5.2,a,f5.3,a,f4.2,a)') 'rough frictional spheres at phi = ', phi, ' with mu_d = ', &
            p%mu_d, ' jam in shear: from phi = ', SHEAR_JAM_PHI, ' and mu_d = ', SHEAR_JAM_MU, &
            ' on, every run measured had its contact forces grow without bound within the first strain, '// &
@@ -209,7 +211,7 @@ contains
            'or solid fraction flows'
       call add_finding(findings, LIMIT_REFUSE, text, 'contact', 'friction')
       return
-    else if (sheared .and. p%h_r > 0 .and. p%mu_d >= SHEAR_JAM_WARN_MU .and. phi >= SHEAR_JAM_WARN_PHI) then
+    else if (shear_jamming .and. p%mu_d >= SHEAR_JAM_WARN_MU .and. phi >= SHEAR_JAM_WARN_PHI) then
       write(text, '(a,f6.4,a,f5.2,a)') 'phi = ', phi, ' with mu_d = ', p%mu_d, ' is close to shear jamming: '// &
            'lubrication dynamics between walls jammed at phi 0.53 (mu_d 0.5) and 0.52 (mu_d 1) within the first '// &
            'strain (doc/VALIDATION.md §6): the overlap guard may stop this run'

@@ -33,7 +33,7 @@
 !  14. Shear jamming (doc/VALIDATION.md §6: frictional spheres at phi 0.55 jammed in every run):
 !      contact_limits refuses phi 0.5485 with mu_d 0.5 in a sheared cell, naming &contact friction,
 !      warns at phi 0.53 with mu_d 0.5, and lets phi 0.5485 pass frictionless (measured to flow),
-!      with mu_d 0.1, or without shear.
+!      with mu_d 0.1, or without shear (no sliding boundary, or walls at rest).
 program test_contact
   use mod_kinds, only: dp, pi
   use mod_vector, only: cross
@@ -260,6 +260,9 @@ program test_contact
              'the refusal names &contact friction and the jamming')
   found = contact_limits(p0, 1.0e-3_dp, .true., .false., 0.5485_dp, 0.01_dp, .false.)
   call check(count(found%level == LIMIT_REFUSE) == 0, 'not sheared: no refusal')
+  call contact_setup(pb, 1.0_dp, 5.0e-3_dp, 0.5_dp, 0.01_dp, 1.0e8_dp, 1.0_dp, 0.0_dp, info, msg)
+  found = contact_limits(pb, 1.0e-3_dp, .true., .true., 0.5485_dp, 0.01_dp, .true.)
+  call check(info == 0 .and. count(found%level == LIMIT_REFUSE) == 0, 'walls at rest (shear_rate 0): no refusal')
   found = contact_limits(p0, 1.0e-3_dp, .true., .true., 0.53_dp, 0.01_dp, .false.)
   call check(count(found%level == LIMIT_REFUSE) == 0 .and. any(index(found%text, 'close to shear jamming') > 0 &
              .and. found%level == LIMIT_WARN), 'phi 0.53, mu_d 0.5: a warning, no refusal')
