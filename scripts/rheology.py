@@ -308,16 +308,17 @@ def load_records(paths):
 
 def stick_number(run):
     """dt gamma_dot a/((7/2) mu_d eps_bar h_r) (doc/CONTACT.md): above ~5 contacts that should stick
-    slide; infinite without friction reported as 0."""
+    slide. 0 without friction (no spring to stick)."""
     if run['friction'] <= 0:
         return 0.0
     return run['dt'] / (3.5 * run['friction'] * run['eps_bar'] * run['roughness'])
 
 
 def setup_key(run):
-    """What a run's set-up is apart from its friction: runs with the same key form a sweep."""
+    """What a run's set-up is apart from its friction and time step: runs with the same key form a
+    sweep (the time step follows the friction, to keep the stick resolved)."""
     return (tuple(run['box']), run['cells_per_radius'], run['solid_fraction_bulk'], run['seed'],
-            run['eps_bar'], run['dt'], run['roughness'])
+            run['eps_bar'], run['roughness'])
 
 
 def record_figures(records, directory):
@@ -369,8 +370,7 @@ def record_figures(records, directory):
     # should stick slide: a lower bound, doc/CONTACT.md)
     sweeps = {}
     for label, r, q in records:
-        key = setup_key(r)[:5] + setup_key(r)[6:]
-        best = sweeps.setdefault(key, {})
+        best = sweeps.setdefault(setup_key(r), {})
         if r['friction'] not in best or r['dt'] < best[r['friction']][0]['dt']:
             best[r['friction']] = (r, q)
     sweeps = {k: [(mu, r, q) for mu, (r, q) in sorted(v.items())] for k, v in sweeps.items() if len(v) >= 3}
