@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Rheology of fdsusp runs from their series.h5 (doc/RHEOLOGY.md).
 
-    scripts/rheology.py OUTDIR [OUTDIR ...] [--plots DIR] [--compare]
+    scripts/rheology.py OUTDIR [OUTDIR ...] [--plots DIR] [--compare] [--window D A B] [--json FILE]
     scripts/rheology.py --records SUMMARY.json [...] --plots DIR
 
 
@@ -10,7 +10,11 @@ the rules of src/kernels/rheology.F90 (records on the series_every grid after di
 blocks of block_steps steps, quantities evaluated on the block means; value from the mean of the
 block means, error = standard deviation over the complete blocks (ddof 1) / sqrt(blocks)), and
 prints it. --compare: also compare with the run's own summary.json and exit 1 if any number
-differs by more than 1e-10 (relative). --plots DIR: PNG figures: per run the core stress time
+differs by more than 1e-10 (relative). --window DISCARD AVERAGE BLOCKS: the statistics over
+another window than the run's &rheology (strains discarded and averaged, blocks), e.g. a later
+window of a run extended from its checkpoint, or the paper's 50 transient strains; steps are
+rounded as src/runtime/params.F90 rounds them. --json FILE (one OUTDIR): write the recomputed
+summary there, with the keys of fdsusp's summary.json. --plots DIR: PNG figures: per run the core stress time
 series, phi(y) and u_x(y), g(theta) and g_c(theta) (paper figs. 6 and 15); over all runs given,
 eta_r, N1/tau and N2/tau against phi_core, one series per friction coefficient (paper figs. 9,
 11).
@@ -21,7 +25,9 @@ no series needed: paper_fig9.png (eta_r, eta_h against phi_core with the Zarraga
 and the paper's eta_inf), paper_fig11.png (N1/tau, N2/tau with the Dai et al. 2013 fits),
 paper_fig16.png (eta_r, N1/tau, N2/tau against mu_d for each set-up, dt aside, with three or
 more frictions: at each mu_d the run of the smallest dt), paper_fig20_22.png (normal viscosity with Morris & Boulay 1999; phi and mu against
-I_v with Boyer, Guazzelli & Pouliquen 2011).
+I_v with Boyer, Guazzelli & Pouliquen 2011); and from the records of extended runs
+(scripts/friction_study.py --extend, with "by_strain") friction_by_strain.png (eta_r, phi_core and
+N2/tau over successive strain windows).
 """
 import argparse
 import json
@@ -104,6 +110,57 @@ def load(outdir):
     return a, s
 
 
+def with_window(a, discard_strain, average_strain, blocks):
+    """The settings a with the averaging window of &rheology discard_strain, average_strain and
+    blocks, in steps as src/runtime/params.F90 computes them (nint of strain / (|shear_rate| dt))."""
+    per_step = abs(a['shear_rate']) * a['dt']
+    a = dict(a)
+    a['blocks'] = int(blocks)
+    a['discard_step'] = math.floor(discard_strain / per_step + 0.5)
+    a['block_steps'] = math.floor(average_strain / (blocks * per_step) + 0.5)
+    if a['blocks'] < 1 or a['block_steps'] < 1:
+        raise SystemExit('--window: blocks and average_strain/blocks must be at least one step')
+    return a
+
+
+def strain_windows(a, s, width, names):
+    """The quantities names over successive windows of `width` strains from the start of the run
+    (records on the series_every grid with strain in (k width, (k + 1) width]), each from the mean of
+    its records as a block's: whether and how a run drifts. Returns {'width', 'strain_start', name: [...]}."""
+    step = np.rint(s['step']).astype(np.int64)
+    strain = s['time'] * abs(a['shear_rate'])
+    values = np.hstack([s['core/stress_hydro'], s['core/stress_contact'], s['core/solid_fraction'][:, None],
+                        s['core/velocity_fit'], s['core/flow_fit']])
+    on_grid = step % int(a['series_every']) == 0
+    out = {'width': width, 'strain_start': []}
+    out.update({n: [] for n in names})
+    for k in range(int(math.ceil(strain.max() / width - 1e-9))):
+        m = on_grid & (strain > k * width + 1e-9) & (strain <= (k + 1) * width + 1e-9)
+        if not m.any():
+            continue
+        q = quantities(values[m].mean(axis=0), a['shear_rate'])
+        out['strain_start'].append(k * width)
+        for n in names:
+            v = q[NAMES.index(n)]
+            out[n].append(float(v) if math.isfinite(v) else None)
+    return out
+
+
+def as_json(a, summ):
+    """A recomputed summary with the keys of fdsusp's summary.json (NaN as null)."""
+    def clean(x):
+        return [None if not math.isfinite(v) else float(v) for v in x]
+    return {'program': 'scripts/rheology.py', 'complete': summ['blocks_complete'] == summ['blocks'],
+            'blocks': summ['blocks'], 'blocks_complete': summ['blocks_complete'],
+            'discard_step': int(a['discard_step']), 'block_steps': int(a['block_steps']),
+            'last_step': summ['last_step'], 'records_per_block': summ['records_per_block'], 'core': [a['core_lo'], a['core_hi']], 'shear_rate': a['shear_rate'],
+            'quantities': {n: {k: (v if math.isfinite(v) else None) for k, v in q.items()}
+                           for n, q in summ['quantities'].items()},
+            'profiles': {k: clean(v) for k, v in summ['profiles'].items()},
+            'pair_distribution': {'r_outer': a['pair_radius'], 'r_contact': a['contact_radius'],
+                                  **{k: clean(v) for k, v in summ['pair_distribution'].items()}}}
+
+
 def summarise(a, s):
     """The summary as src/kernels/rheology.F90 computes it (see the module header there)."""
     step = np.rint(s['step']).astype(np.int64)
@@ -148,6 +205,7 @@ def summarise(a, s):
         phi = velocity = np.full(nbins, NAN)
         g = gc = np.full(nang, NAN)
     return {'blocks': blocks, 'blocks_complete': complete, 'last_step': last_step,
+            'records_per_block': [float(r) for r in records],
             'quantities': {n: {'value': v, 'error': e} for n, v, e in zip(NAMES, value, error)},
             'profiles': {'y': y, 'solid_fraction': phi, 'velocity': velocity},
             'pair_distribution': {'theta': theta, 'g': g, 'g_contact': gc}}
@@ -294,13 +352,16 @@ def eta_inf(phi):
 
 
 def load_records(paths):
-    """Recorded summaries: (label, run settings, quantities); only complete ones."""
+    """Recorded summaries: (label, run settings, quantities); only complete ones, and not the
+    extensions of runs (their later windows are drawn by strain_figure)."""
     out = []
     for path in paths:
         with open(path) as f:
             s = json.load(f)
         if not s.get('complete') or 'run' not in s:
             print(f'{path}: not a complete recorded summary (no "run" object), skipped')
+            continue
+        if 'continues' in s['run']:
             continue
         out.append((os.path.basename(os.path.dirname(os.path.abspath(path))), s['run'], s['quantities']))
     return out
@@ -319,6 +380,38 @@ def setup_key(run):
     sweep (the time step follows the friction, to keep the stick resolved)."""
     return (tuple(run['box']), run['cells_per_radius'], run['solid_fraction_bulk'], run['seed'],
             run['eps_bar'], run['roughness'])
+
+
+def strain_figure(paths, directory):
+    """friction_by_strain.png: eta_r, phi_core and N2/tau over successive strain windows of the
+    recorded extensions (their "by_strain"), one line per run: whether a run's first window was
+    steady."""
+    runs = []
+    for path in paths:
+        with open(path) as f:
+            s = json.load(f)
+        if 'by_strain' in s and 'run' in s:
+            runs.append((s['run']['continues'], s['run'], s['by_strain']))
+    if not runs:
+        return
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    os.makedirs(directory, exist_ok=True)
+    fig, axes = plt.subplots(1, 3, figsize=(14, 4.2))
+    for label, run, b in runs:
+        x = np.array(b['strain_start']) + 0.5 * b['width']
+        for ax, name in zip(axes, ('eta_r', 'phi_core', 'N2/tau')):
+            y = np.array([np.nan if v is None else v for v in b[name]])
+            ax.plot(x, y, marker='.', label='%s (%d spheres)' % (label, run['spheres'] or 0))
+    for ax, name in zip(axes, ('eta_r', 'phi_core', 'N2/tau')):
+        ax.set_xlabel('strain (window of %g)' % runs[0][2]['width'])
+        ax.set_ylabel(name)
+        ax.axvline(runs[0][1]['strain_discarded'], color='grey', lw=0.8, ls=':')
+    axes[0].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(os.path.join(directory, 'friction_by_strain.png'), dpi=110)
+    plt.close(fig)
 
 
 def record_figures(records, directory):
@@ -435,11 +528,17 @@ def main():
     ap.add_argument('--plots', metavar='DIR')
     ap.add_argument('--compare', action='store_true')
     ap.add_argument('--records', nargs='+', metavar='SUMMARY', help='recorded summary.json files')
+    ap.add_argument('--window', nargs=3, type=float, metavar=('DISCARD', 'AVERAGE', 'BLOCKS'),
+                    help='strains discarded and averaged, and blocks, instead of the run\'s &rheology')
+    ap.add_argument('--json', metavar='FILE', help='write the recomputed summary (one OUTDIR)')
     args = ap.parse_args()
+    if args.json and len(args.outdirs) != 1:
+        ap.error('--json needs exactly one OUTDIR')
     if args.records:
         if not args.plots:
             ap.error('--records needs --plots DIR')
         record_figures(load_records(args.records), args.plots)
+        strain_figure(args.records, args.plots)
         return 0
     if not args.outdirs:
         ap.error('give run output directories or --records')
@@ -447,7 +546,13 @@ def main():
     status = 0
     for outdir in args.outdirs:
         a, s = load(outdir)
+        if args.window:
+            a = with_window(a, *args.window)
         summ = summarise(a, s)
+        if args.json:
+            with open(args.json, 'w') as f:
+                json.dump(as_json(a, summ), f, indent=1)
+                f.write('\n')
         print_summary(outdir, summ)
         if args.compare:
             bad = compare(summ, os.path.join(outdir, 'summary.json'))

@@ -10,6 +10,14 @@ continues from it (`-restart`); otherwise it starts. --hours sets &run max_wall_
 stops with a checkpoint in time and the next call continues it (on the same machine: out/ is not
 in git). The CPU seconds of every call are added up in <run>/cpu_seconds.
 
+--extend STRAIN continues finished runs from their last checkpoint to STRAIN, each in a directory
+<work>/<row>_mu<mu>_to<STRAIN> of its own (the finished run stays as it was), with a deck that
+averages the new strains alone (discard_strain = the finished run's end), so the program starts
+its statistics afresh there (doc/INPUT.md &rheology). The record <record>/<row>_mu<mu>_to<STRAIN>/
+holds that later window, recomputed by scripts/rheology.py from series.h5 (which the extension
+carries on from the start), and "by_strain": eta_r, N1/tau, N2/tau and phi_core over successive
+2-strain windows of the whole run, which shows whether the first window had reached steady state.
+
 Each finished run is recorded in <record>/<row>_mu<mu>/ as deck.nml and summary.json: fdsusp's
 summary with a "run" object added that says what was run without the deck beside it (model,
 spheres, box, boundaries, a/Delta, bulk phi, mu_d, eps_r, eps_bar, dt, strains discarded and
@@ -116,8 +124,11 @@ class Study:
         s.update(self.rows[row][1])
         return s
 
-    def deck_text(self, row, mu, hours):
+    def deck_text(self, row, mu, hours, window=None):
+        """The deck of a run; window = (discard, average) strains replaces the row's."""
         s = self.settings(row)
+        if window is not None:
+            s['discard'], s['average'] = window
         packing = '' if s['min_gap'] is None else ', packing_min_gap = %g' % s['min_gap']
         return DECK.format(study=self.title, title=self.title, row=row, what=self.rows[row][0], mu=mu,
                            box=', '.join('%g' % b for b in s['box']), cells=s['cells'],
@@ -139,9 +150,58 @@ class Study:
                 f.write(commit_of_binary() + '\n')
         return proc
 
+    def start_extension(self, d, row, mu, strain, work, args):
+        """The finished run (row, mu) of work continued in d from its last checkpoint to strain."""
+        if not os.path.exists(os.path.join(d, 'fdsusp')):
+            source = os.path.join(work, run_name(row, mu))
+            if not finished(source):
+                raise SystemExit('--extend: %s has not finished (its checkpoint is where the extension starts)' % source)
+            os.makedirs(os.path.join(d, 'out'), exist_ok=True)
+            for f in ('out/checkpoint.h5', 'out/series.h5', 'fdsusp', 'version'):
+                shutil.copy2(os.path.join(source, f), os.path.join(d, f))
+        end = self.end_strain(row)
+        proc, _ = start_resumable(d, self.deck_text(row, mu, args.hours, window=(end, strain - end)), args.ranks)
+        return proc
+
+    def end_strain(self, row):
+        s = self.settings(row)
+        return s['discard'] + s['average']
+
+    def record_extension(self, d, row, mu, strain, target, ranks=1):
+        """Record an extension: its later window and the whole run's 2-strain windows, both
+        recomputed from series.h5 (the program's own summary.json is not used: a program older
+        than the restart rule of 2026-11-27 mixes the finished run's accumulators into it)."""
+        import rheology
+        st = self.settings(row)
+        end = self.end_strain(row)
+        a, series = rheology.load(os.path.join(d, 'out'))
+        a = rheology.with_window(a, end, strain - end, st['blocks'])
+        s = rheology.as_json(a, rheology.summarise(a, series))
+        s['run'] = self.run_object(d, row, mu, ranks, end, strain - end)
+        s['run']['continues'] = run_name(row, mu)
+        if s['run']['cpu_seconds']:     # the extension's own cost, over the strains it ran
+            s['run']['cpu_seconds_per_strain'] = s['run']['cpu_seconds'] / (strain - end)
+        s['contacts'] = contact_statistics(os.path.join(d, 'out', 'series.h5'), end)
+        s['by_strain'] = rheology.strain_windows(a, series, 2.0, ['eta_r', 'eta_h', 'eta_c', 'N1/tau', 'N2/tau', 'phi_core'])
+        self.write_record(d, target, s)
+
+    def write_record(self, d, target, s):
+        os.makedirs(target, exist_ok=True)
+        shutil.copy2(os.path.join(d, 'deck.nml'), os.path.join(target, 'deck.nml'))
+        with open(os.path.join(target, 'summary.json'), 'w') as f:
+            json.dump(s, f, indent=1)
+            f.write('\n')
+
     def record(self, d, row, mu, target, ranks=1):
         """Copy a finished run's deck and summary (with the "run" object) into the record."""
         s = load(os.path.join(d, 'out', 'summary.json'))
+        st = self.settings(row)
+        s['run'] = self.run_object(d, row, mu, ranks, st['discard'], st['average'])
+        s['contacts'] = contact_statistics(os.path.join(d, 'out', 'series.h5'), st['discard'])
+        self.write_record(d, target, s)
+
+    def run_object(self, d, row, mu, ranks, discard, average):
+        """What a run was, without its deck: set-up, window, program and cost."""
         st = self.settings(row)
         log = open(os.path.join(d, 'log')).read()
         spheres = [int(n) for n in re.findall(r'(\d+) rigid spheres', log)]
@@ -149,27 +209,21 @@ class Study:
         version = open(os.path.join(d, 'version')).read().strip() if os.path.exists(os.path.join(d, 'version')) else 'unknown'
         cpu_file = os.path.join(d, 'cpu_seconds')
         cpu = sum(float(x) for x in open(cpu_file).read().split()) if os.path.exists(cpu_file) else None
-        strain = st['discard'] + st['average']
-        s['run'] = {
+        strain = discard + average
+        return {
             'study': '%s, row %s: %s' % (self.title, row, self.rows[row][0]),
             'fluid_model': st['model'], 'spheres': spheres[-1] if spheres else None,
             'box': list(st['box']), 'cells_per_radius': st['cells'], 'y_boundary': st['boundary'],
             'solid_fraction_bulk': st['phi'], 'seed': st['seed'], 'friction': mu,
             'roughness': st['eps_r'], 'eps_bar': st['eps_bar'], 'implicit_contacts': st['implicit'],
             'dt': st['dt'], 'reynolds': 0.01,
-            'lubrication': 'full', 'lubrication_outer_cutoff': st['cutoff'], 'strain_discarded': st['discard'], 'strain_averaged': st['average'],
+            'lubrication': 'full', 'lubrication_outer_cutoff': st['cutoff'], 'strain_discarded': discard, 'strain_averaged': average,
             'blocks': st['blocks'], 'fdsusp_version': version,
             'wall_time_per_step_s': float(walls[-1]) if walls else None,
             'ranks': ranks,
             # CPU seconds over every call (the runs' own rusage, whatever ran beside them)
             'cpu_seconds': cpu, 'cpu_seconds_per_strain': cpu / strain if cpu else None,
         }
-        s['contacts'] = contact_statistics(os.path.join(d, 'out', 'series.h5'), st['discard'])
-        os.makedirs(target, exist_ok=True)
-        shutil.copy2(os.path.join(d, 'deck.nml'), os.path.join(target, 'deck.nml'))
-        with open(os.path.join(target, 'summary.json'), 'w') as f:
-            json.dump(s, f, indent=1)
-            f.write('\n')
 
     def main(self, argv=None):
         ap = argparse.ArgumentParser(description=self.doc, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -180,6 +234,8 @@ class Study:
         ap.add_argument('--hours', type=float, default=0.0)
         ap.add_argument('--work', default=self.work)
         ap.add_argument('--record', default=self.record_dir)
+        ap.add_argument('--extend', type=float, metavar='STRAIN',
+                        help='continue the finished runs named to STRAIN, each in <run>_to<STRAIN> (module doc)')
         ap.add_argument('--table', action='store_true', help='print the table from the records, run nothing')
         ap.add_argument('--list', action='store_true', help='print each run\'s deck, run nothing')
         ap.add_argument('--rerecord', action='store_true',
@@ -201,32 +257,54 @@ class Study:
                     self.record(d, row, float(mu), os.path.join(args.record, name))
                     print('recorded', name)
             return 0
+        extend = args.extend
         if args.list:
             for row, mu in runs:
-                print(self.deck_text(row, mu, args.hours))
+                end = self.end_strain(row)
+                print(self.deck_text(row, mu, args.hours, window=(end, extend - end) if extend else None))
             return 0
+
+        def name_of(run):
+            return run_name(*run) + ('_to%g' % extend if extend else '')
+
+        def record(run, ranks):
+            d, target = where(run), os.path.join(args.record, name_of(run))
+            if extend:
+                self.record_extension(d, run[0], run[1], extend, target, ranks)
+            else:
+                self.record(d, run[0], run[1], target, ranks)
+
+        def start(run):
+            if extend:
+                return self.start_extension(where(run), run[0], run[1], extend, args.work, args)
+            return self.start(where(run), run[0], run[1], args)
+
+        def where(run):
+            return os.path.join(args.work, name_of(run))
+
+        if extend:
+            for row, mu in runs:
+                if extend <= self.end_strain(row):
+                    ap.error('--extend %g: %s ends at strain %g already' % (extend, run_name(row, mu), self.end_strain(row)))
         if not args.table:
-            def where(run):
-                return os.path.join(args.work, run_name(*run))
 
             def report(run, status, cpu):
                 d = where(run)
                 with open(os.path.join(d, 'cpu_seconds'), 'a') as f:
                     f.write('%.1f\n' % cpu)
                 if status != 0:
-                    print('%s stopped with status %d (see %s/log)' % (run_name(*run), status, d), flush=True)
+                    print('%s stopped with status %d (see %s/log)' % (name_of(run), status, d), flush=True)
                 elif finished(d):
-                    self.record(d, run[0], run[1], os.path.join(args.record, run_name(*run)), args.ranks)
-                    print('%s finished (%.0f CPU s), recorded' % (run_name(*run), cpu), flush=True)
+                    record(run, args.ranks)
+                    print('%s finished (%.0f CPU s), recorded' % (name_of(run), cpu), flush=True)
                 else:
                     print('%s stopped at its wall-time limit (%.0f CPU s): call again to continue'
-                          % (run_name(*run), cpu), flush=True)
+                          % (name_of(run), cpu), flush=True)
 
             for run in runs:    # finished before, but not yet recorded (e.g. the record was lost)
-                target = os.path.join(args.record, run_name(*run))
-                if finished(where(run)) and not os.path.exists(os.path.join(target, 'summary.json')):
-                    self.record(where(run), run[0], run[1], target, args.ranks)
+                if finished(where(run)) and not os.path.exists(os.path.join(args.record, name_of(run), 'summary.json')):
+                    record(run, args.ranks)
             waiting = [r for r in runs if not finished(where(r))]
-            run_all(waiting, lambda r: self.start(where(r), r[0], r[1], args), args.jobs, report)
+            run_all(waiting, start, args.jobs, report)
         self.table(self, rows)
         return 0

@@ -11,6 +11,8 @@
 !             (mod_particles_io: positions with attribute box, velocities, Adams-Bashforth history)
 !             with contacts also the group /contacts (mod_contacts_io: the tangential springs)
 !             with statistics (&rheology) also /rheology/accumulators (mod_rheology::rheo_state)
+!             and the attributes rheology_window (discard_step, block_steps) and rheology_core
+!             (y_lo, y_hi of the core [a]): the window the accumulators were taken over
 !   attributes format_version, step, time, cells, box, walls, reynolds, dt, shear_rate, star_history,
 !             fluid_resolved (1, or 0 for lubrication dynamics, which writes no fields), and
 !             with Lees-Edwards boundaries lees_edwards_offset (the boundary offset delta, exactly)
@@ -30,7 +32,7 @@ module mod_checkpoint
   use mod_h5util, only: write_attribute, read_attribute, write_string_attribute, has_object, dataset_dims, &
                         write_dataset, read_dataset, has_attribute
   use mod_os_services, only: publish_file
-  use mod_errors, only: is_root, abort_run, file_error
+  use mod_errors, only: is_root, abort_run, file_error_from_root
   use mod_particles, only: particles_t
   use mod_particles_io, only: particles_write, particles_read_state
   use mod_contact, only: contact_history_t
@@ -114,6 +116,8 @@ contains
         if (associated(state%history)) call contacts_write(file, state%history, state%parts%n)
       end if
       if (associated(state%rh)) then
+        call put_int('rheology_window', [state%rh%discard_step, state%rh%block_steps])
+        call put_real('rheology_core', state%rh%core)
         statistics = rheo_state(state%rh)
         call h5gcreate_f(file, 'rheology', group, err)
         if (err == 0) call write_dataset(group, 'accumulators', reshape(statistics, [size(statistics), 1]), err)
@@ -182,9 +186,8 @@ contains
     values = 0.0_dp
     if (is_root()) call inspect(path, cfg, particles, item, message, values)
     call MPI_Bcast(item, len(item), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
-    call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
+    call file_error_from_root(path, item, message)
     call MPI_Bcast(values, 2, MPI_DOUBLE_PRECISION, 0, PETSC_COMM_WORLD, ierr)
-    if (len_trim(message) > 0) call file_error(path, item, message)
     step = nint(values(1))
     time = values(2)
   end subroutine checkpoint_check
@@ -303,23 +306,27 @@ contains
   end subroutine inspect
 
   ! Restore STATE from the checkpoint PATH (checked before by checkpoint_check). The statistics of
-  ! &rheology must fit the run's (a checkpoint without them, or of another size, stops the run).
-  subroutine checkpoint_read(path, state, ierr)
+  ! &rheology must fit the run's (a checkpoint without them, or of another size, stops the run),
+  ! and so must their averaging window (compare_window): statistics_afresh is true when the deck's
+  ! window begins after the checkpoint's step, and the statistics start from zero.
+  subroutine checkpoint_read(path, state, statistics_afresh, ierr)
     character(len=*), intent(in) :: path
     type(checkpoint_state_t), intent(in) :: state
+    logical, intent(out) :: statistics_afresh
     PetscErrorCode, intent(out) :: ierr
     PetscViewer :: viewer
-    integer :: k, rank, err, stars(1), info
+    integer :: k, rank, err, stars(1), info, afresh(1)
     real(dp) :: delta(1)
     integer(HID_T) :: file
     integer(HSIZE_T) :: dims(2)
-    character(len=200) :: message
+    character(len=600) :: message
     real(dp), allocatable :: buffer(:, :)
     Vec, allocatable :: fields(:)
     ! the Lees-Edwards offset, and how many provisional velocities the file holds (none in a
     ! checkpoint older than them)
     delta = 0.0_dp
     stars = 0
+    statistics_afresh = .false.
     if (is_root()) then
       call h5fopen_f(trim(path), H5F_ACC_RDONLY_F, file, err)
       if (associated(state%offset)) call read_attribute(file, 'lees_edwards_offset', delta, err)
@@ -350,27 +357,74 @@ contains
     if (associated(state%rh)) then
       allocate(buffer(size(rheo_state(state%rh)), 1))
       message = ''
+      afresh = 0
       if (is_root()) then
         call h5fopen_f(trim(path), H5F_ACC_RDONLY_F, file, err)
         if (.not. has_object(file, 'rheology')) then
           message = 'missing: the checkpoint was written by a run without &rheology'
         else
-          call dataset_dims(file, 'rheology/accumulators', rank, dims)
-          if (rank /= 2 .or. dims(1) /= size(buffer, 1) .or. dims(2) /= 1) then
-            message = 'does not fit this deck''s &rheology (blocks, profile_bins or angle_bins differ)'
-          else
-            call read_dataset(file, 'rheology/accumulators', buffer, err)
-            if (err /= 0) message = 'cannot be read'
+          call compare_window(file, state%rh, message, afresh(1))
+          if (len_trim(message) == 0 .and. afresh(1) == 0) then
+            call dataset_dims(file, 'rheology/accumulators', rank, dims)
+            if (rank /= 2 .or. dims(1) /= size(buffer, 1) .or. dims(2) /= 1) then
+              message = 'does not fit this deck''s &rheology (blocks, profile_bins or angle_bins differ)'
+            else
+              call read_dataset(file, 'rheology/accumulators', buffer, err)
+              if (err /= 0) message = 'cannot be read'
+            end if
           end if
         end if
         call h5fclose_f(file, err)
       end if
-      call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
-      if (len_trim(message) > 0) call file_error(path, 'rheology/accumulators', trim(message))
-      call MPI_Bcast(buffer, size(buffer), MPI_DOUBLE_PRECISION, 0, PETSC_COMM_WORLD, ierr)
-      ! (the size was checked above: info is 0)
-      call rheo_restore(state%rh, buffer(:, 1), info)
+      call file_error_from_root(path, 'rheology/accumulators', message)
+      call MPI_Bcast(afresh, 1, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
+      statistics_afresh = afresh(1) == 1
+      if (.not. statistics_afresh) then
+        call MPI_Bcast(buffer, size(buffer), MPI_DOUBLE_PRECISION, 0, PETSC_COMM_WORLD, ierr)
+        ! (the size was checked above: info is 0)
+        call rheo_restore(state%rh, buffer(:, 1), info)
+      end if
     end if
   end subroutine checkpoint_read
+
+  ! The averaging window the accumulators of FILE were taken over against this run's (&rheology
+  ! discard_strain, average_strain, blocks, core). A window that begins after the checkpoint's step
+  ! has accumulated nothing yet, whatever the checkpoint's own window: the statistics start from
+  ! zero (afresh = 1), which extends a finished run with a later window. A window already begun
+  ! must be the checkpoint's: blocks accumulated cannot be cut anew (message). A checkpoint written
+  ! before the window was recorded (2026-11-27) is taken to have the run's.
+  subroutine compare_window(file, rh, message, afresh)
+    integer(HID_T), intent(in) :: file
+    type(rheology_t), intent(in) :: rh
+    character(len=*), intent(out) :: message
+    integer, intent(out) :: afresh
+    integer :: window(2), step(1), err
+    real(dp) :: core(2)
+    message = ''
+    afresh = 0
+    call read_attribute(file, 'step', step, err)
+    if (err /= 0) then
+      message = 'the attribute step cannot be read'
+      return
+    end if
+    if (step(1) <= rh%discard_step) then
+      afresh = 1
+      return
+    end if
+    if (.not. has_attribute(file, 'rheology_window')) return
+    call read_attribute(file, 'rheology_window', window, err)
+    if (err == 0) call read_attribute(file, 'rheology_core', core, err)
+    if (err /= 0) then
+      message = 'the attributes rheology_window or rheology_core cannot be read'
+    else if (any(window /= [rh%discard_step, rh%block_steps]) .or. any(abs(core - rh%core) > 1.0e-9_dp)) then
+      write(message, '(a,i0,a,i0,a,2(f0.3,a),i0,a,i0,a,2(f0.3,a),i0,a)') &
+           'they average from step ', window(1), ' in blocks of ', window(2), ' steps over the core y in [', &
+           core(1), ', ', core(2), '], this deck''s &rheology (discard_strain, average_strain, blocks, core) from step ', &
+           rh%discard_step, ' in blocks of ', rh%block_steps, ' over [', rh%core(1), ', ', rh%core(2), &
+           ']: blocks begun cannot be cut anew. Keep &rheology, or set discard_strain to begin after the '// &
+           'checkpoint''s step ', step(1), ' (the statistics then start afresh); scripts/rheology.py --window '// &
+           'recomputes any window from series.h5'
+    end if
+  end subroutine compare_window
 
 end module mod_checkpoint

@@ -11,7 +11,7 @@ module mod_contacts_io
   use mod_kinds, only: dp
   use mod_contact, only: contact_history_t, history_size, history_pack, history_unpack, history_clear
   use mod_h5util, only: write_attribute, read_attribute, has_object, write_dataset, read_dataset
-  use mod_errors, only: is_root, file_error, abort_run, warn_line
+  use mod_errors, only: is_root, file_error, file_error_from_root, abort_run, warn_line
   implicit none
   private
   public :: contacts_write, contacts_read
@@ -84,8 +84,7 @@ contains
       end if
       call h5fclose_f(file, err)
     end if
-    call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
-    if (len_trim(message) > 0) call file_error(path, 'contacts', trim(message))
+    call file_error_from_root(path, 'contacts', message)
     call MPI_Bcast(meta, 3, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
     call history_clear(h)
     if (meta(1) == 0) then

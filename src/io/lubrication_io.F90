@@ -13,7 +13,7 @@ module mod_lubrication_io
   use mod_lubrication, only: lubrication_t, lub_setup, model_code, LUB_FULL, LUB_NONE, LUB_EXACT, n_wall_scalars
   use mod_pair_resistance, only: n_pair_scalars
   use mod_h5util, only: read_attribute, read_dataset, dataset_dims, has_attribute
-  use mod_errors, only: is_root, input_error, file_error, log_line
+  use mod_errors, only: is_root, input_error, file_error_from_root, log_line
   use mod_os_services, only: executable_dir
   implicit none
   private
@@ -98,8 +98,7 @@ contains
       dims = 0
       call log_line('lubrication table: '//path)
       if (is_root()) call read_table(path, cfg, pair, wall, message)
-      call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
-      if (len_trim(message) > 0) call file_error(path, 'lubrication table', trim(message))
+      call file_error_from_root(path, 'lubrication table', message)
       if (is_root()) dims = [size(pair, 2), size(wall, 2)]
       call MPI_Bcast(dims, 2, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
       if (.not. is_root()) allocate(pair(1 + n_pair_scalars, dims(1)), wall(1 + n_wall_scalars, dims(2)))

@@ -11,7 +11,7 @@ module mod_particles_io
   use mod_params, only: config_t
   use mod_particles, only: particles_t, particles_init, motion_code, configuration_fault
   use mod_h5util, only: write_attribute, read_attribute, has_object, write_dataset, read_dataset, dataset_dims
-  use mod_errors, only: is_root, input_error, file_error, abort_run
+  use mod_errors, only: is_root, input_error, file_error, file_error_from_root, abort_run
   implicit none
   private
   public :: particles_load, particles_write, particles_read_state, particles_snapshot
@@ -48,8 +48,7 @@ contains
     message = ''
     n = 0
     if (is_root()) call read_positions(trim(cfg%position_file), position, message)
-    call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
-    if (len_trim(message) > 0) call file_error(trim(cfg%position_file), 'particles/position', trim(message))
+    call file_error_from_root(trim(cfg%position_file), 'particles/position', message)
     if (is_root()) n = size(position, 2)
     call MPI_Bcast(n, 1, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
     if (.not. is_root()) allocate(position(3, n))
@@ -244,8 +243,7 @@ contains
       end if
       call h5fclose_f(file, err)
     end if
-    call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
-    if (len_trim(message) > 0) call file_error(path, 'particles', trim(message))
+    call file_error_from_root(path, 'particles', message)
     call MPI_Bcast(buffer, size(buffer), MPI_DOUBLE_PRECISION, 0, PETSC_COMM_WORLD, ierr)
     call MPI_Bcast(flag, 1, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
     parts%position = buffer(:, :, 1)

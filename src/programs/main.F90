@@ -81,6 +81,7 @@ program fdsusp
   PetscInt :: fault_nan_step
   real(dp) :: err_vel, err_p_max, err_p_rms
   logical :: restarting, continuing
+  logical :: statistics_afresh                      ! a restart before its &rheology window begins
   integer, parameter :: RUNNING = 0, DONE = 1, SIGNALLED = 2, WALL_LIMIT = 3, STEADY = 4
 
   PetscCallA(PetscInitialize(ierr))
@@ -180,7 +181,9 @@ program fdsusp
   if (allocated(rh)) state%rh => rh
   if (cfg%lees_edwards) state%offset => le%offset
   if (restarting) then
-    PetscCallA(checkpoint_read(restart, state, ierr))
+    PetscCallA(checkpoint_read(restart, state, statistics_afresh, ierr))
+    if (statistics_afresh) call log_line('statistics: the &rheology window begins after the checkpoint''s step; '// &
+         'they start from zero there (nothing the checkpoint accumulated is carried over)')
   end if
   ! the columns of series.h5, declared by the routine that also fills each record
   call series_columns()

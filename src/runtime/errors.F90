@@ -8,7 +8,7 @@ module mod_errors
   use mod_os_services, only: release_directory
   implicit none
   private
-  public :: input_error, file_error, fatal_error, abort_run, is_root, log_line, warn_line
+  public :: input_error, file_error, file_error_from_root, fatal_error, abort_run, is_root, log_line, warn_line
 
 contains
 
@@ -54,6 +54,16 @@ contains
     if (len_trim(item) > 0) where = where//', item '//trim(item)
     call fatal_error(where//': '//trim(message), 2)
   end subroutine file_error
+
+  ! A fault in a file that rank 0 alone read (message: empty when the file is sound): every rank
+  ! learns rank 0's verdict, and a fault stops the run on all of them (file_error). Collective.
+  subroutine file_error_from_root(file, item, message)
+    character(len=*), intent(in) :: file, item
+    character(len=*), intent(inout) :: message
+    PetscErrorCode :: ierr
+    call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
+    if (len_trim(message) > 0) call file_error(file, item, message)
+  end subroutine file_error_from_root
 
   ! A collective fatal error: every rank calls it. Rank 0 prints and releases the output
   ! directory (mod_os_services; a no-op before it is locked); all ranks finalise and exit.
