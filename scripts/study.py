@@ -170,7 +170,7 @@ class Study:
     def record_extension(self, d, row, mu, strain, target, ranks=1):
         """Record an extension: its later window and the whole run's 2-strain windows, both
         recomputed from series.h5 (the program's own summary.json is not used: a program older
-        than the restart rule of 2026-11-27 mixes the finished run's accumulators into it)."""
+        than the restart rule of 2026-11-26 mixes the finished run's accumulators into it)."""
         import rheology
         st = self.settings(row)
         end = self.end_strain(row)

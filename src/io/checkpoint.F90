@@ -392,7 +392,7 @@ contains
   ! has accumulated nothing yet, whatever the checkpoint's own window: the statistics start from
   ! zero (afresh = 1), which extends a finished run with a later window. A window already begun
   ! must be the checkpoint's: blocks accumulated cannot be cut anew (message). A checkpoint written
-  ! before the window was recorded (2026-11-27) is taken to have the run's.
+  ! before the window was recorded (2026-11-26) is taken to have the run's.
   subroutine compare_window(file, rh, message, afresh)
     integer(HID_T), intent(in) :: file
     type(rheology_t), intent(in) :: rh
