@@ -14,7 +14,12 @@ summary.json with "run" and "contacts" objects): scripts/study.py. --rerecord wr
 of every finished run again. --table prints, from the records, the rows of the sensitivity table: the friction
 ratio eta_r(0.5)/eta_r(0), the relative change of |N1|/tau and |N2|/tau, N2/N1 at both mu_d,
 each with its error propagated from the block errors.
+--extend STRAIN (scripts/study.py) continues finished runs to STRAIN; --table then also prints,
+for each extension recorded, its first window against the later one and the slopes of eta_r and
+phi_core over 2-strain windows (drift_table).
 """
+import json
+import math
 import os
 import sys
 
@@ -94,9 +99,63 @@ def table(study, rows):
                  s0['contacts']['largest_overlap_over_h_r_mean'], s1['contacts']['largest_overlap_over_h_r_mean']))
 
 
+def drift_table(study):
+    """The extended runs (records <row>_mu<mu>_to<strain>, scripts/study.py --extend): the first
+    window against the later one, and the slope of eta_r and phi_core over the 2-strain windows
+    after the first discard (least squares, its standard error from the scatter about the line)."""
+    import glob
+    import numpy as np
+    paths = sorted(glob.glob(os.path.join(study.record_dir, '*_to*', 'summary.json')))
+    if not paths:
+        return
+    print()
+    print('| run | spheres | strains | eta_r (first window) | eta_r (later window) | change | phi_core (first / later) '
+          '| N2/tau (first / later) | eta_r slope per 10 strains | phi_core slope per 10 strains |')
+    print('|---|---|---|---|---|---|---|---|---|---|')
+    for path in paths:
+        with open(path) as f:
+            later = json.load(f)
+        run = later['run']
+        first = study.load_record(*split_name(run['continues']))
+        if first is None:
+            continue
+        q0, q1 = first['quantities'], later['quantities']
+        b = later['by_strain']
+        x = np.array(b['strain_start']) + 0.5 * b['width']
+        keep = x > first['run']['strain_discarded']
+
+        def slope(name):
+            y = np.array([np.nan if v is None else v for v in b[name]])[keep]
+            xs = x[keep]
+            p = np.polyfit(xs, y, 1)
+            r = y - np.polyval(p, xs)
+            se = math.sqrt((r ** 2).sum() / (len(xs) - 2) / ((xs - xs.mean()) ** 2).sum())
+            return 10 * p[0], 10 * se
+
+        d = q1['eta_r']['value'] - q0['eta_r']['value']
+        de = math.hypot(q1['eta_r']['error'], q0['eta_r']['error'])
+        print('| %s | %s | %g-%g / %g-%g | %.2f +- %.2f | %.2f +- %.2f | %+.2f +- %.2f | %.4f / %.4f | %.3f / %.3f '
+              '| %+.2f +- %.2f | %+.4f +- %.4f |'
+              % (os.path.basename(os.path.dirname(path)), run['spheres'], first['run']['strain_discarded'],
+                 first['run']['strain_discarded'] + first['run']['strain_averaged'], run['strain_discarded'],
+                 run['strain_discarded'] + run['strain_averaged'], q0['eta_r']['value'], q0['eta_r']['error'],
+                 q1['eta_r']['value'], q1['eta_r']['error'], d, de, q0['phi_core']['value'], q1['phi_core']['value'],
+                 q0['N2/tau']['value'], q1['N2/tau']['value'], *slope('eta_r'), *slope('phi_core')))
+
+
+def split_name(name):
+    row, _, mu = name.rpartition('_mu')
+    return row, float(mu)
+
+
+def tables(study, rows):
+    table(study, rows)
+    drift_table(study)
+
+
 STUDY = Study('issue 28 friction study', ROWS, BASE, SENSITIVITY,
               work=os.path.join(ROOT, 'out', 'friction_phi04'),
-              record=os.path.join(ROOT, 'doc', 'data', 'friction_phi04'), table=table, doc=__doc__)
+              record=os.path.join(ROOT, 'doc', 'data', 'friction_phi04'), table=tables, doc=__doc__)
 
 if __name__ == '__main__':
     sys.exit(STUDY.main())

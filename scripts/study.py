@@ -252,9 +252,13 @@ class Study:
         if args.rerecord:
             for name in sorted(os.listdir(args.work)):
                 row, _, mu = name.rpartition('_mu')
+                mu, _, strain = mu.partition('_to')     # an extension: <row>_mu<mu>_to<strain>
                 d = os.path.join(args.work, name)
                 if row in self.rows and finished(d):
-                    self.record(d, row, float(mu), os.path.join(args.record, name))
+                    if strain:
+                        self.record_extension(d, row, float(mu), float(strain), os.path.join(args.record, name))
+                    else:
+                        self.record(d, row, float(mu), os.path.join(args.record, name))
                     print('recorded', name)
             return 0
         extend = args.extend
