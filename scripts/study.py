@@ -262,6 +262,10 @@ class Study:
                     print('recorded', name)
             return 0
         extend = args.extend
+        if extend:
+            for row, mu in runs:
+                if extend <= self.end_strain(row):
+                    ap.error('--extend %g: %s ends at strain %g already' % (extend, run_name(row, mu), self.end_strain(row)))
         if args.list:
             for row, mu in runs:
                 end = self.end_strain(row)
@@ -286,10 +290,6 @@ class Study:
         def where(run):
             return os.path.join(args.work, name_of(run))
 
-        if extend:
-            for row, mu in runs:
-                if extend <= self.end_strain(row):
-                    ap.error('--extend %g: %s ends at strain %g already' % (extend, run_name(row, mu), self.end_strain(row)))
         if not args.table:
 
             def report(run, status, cpu):
