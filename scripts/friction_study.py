@@ -24,7 +24,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from study import BASE, ROOT, Study, ratio  # noqa: E402
+from study import BASE, ROOT, Study, ratio, split_run_name  # noqa: E402
 
 # The base (study.BASE): the §5.4 set-up (8a x 20a x 8a Couette cell, a/Delta = 4, bulk phi 0.40
 # (seed 1), eps_r 5e-3, full lubrication, dt 2e-3, 2 strains discarded and 20 averaged in 5 blocks)
@@ -116,7 +116,7 @@ def drift_table(study):
         with open(path) as f:
             later = json.load(f)
         run = later['run']
-        first = study.load_record(*split_name(run['continues']))
+        first = study.load_record(*split_run_name(run['continues'])[:2])
         if first is None:
             continue
         q0, q1 = first['quantities'], later['quantities']
@@ -141,11 +141,6 @@ def drift_table(study):
                  run['strain_discarded'] + run['strain_averaged'], q0['eta_r']['value'], q0['eta_r']['error'],
                  q1['eta_r']['value'], q1['eta_r']['error'], d, de, q0['phi_core']['value'], q1['phi_core']['value'],
                  q0['N2/tau']['value'], q1['N2/tau']['value'], *slope('eta_r'), *slope('phi_core')))
-
-
-def split_name(name):
-    row, _, mu = name.rpartition('_mu')
-    return row, float(mu)
 
 
 def tables(study, rows):

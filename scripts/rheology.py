@@ -110,6 +110,12 @@ def load(outdir):
     return a, s
 
 
+def core_values(s):
+    """Per record, the 21 core values in the order quantities() takes them."""
+    return np.hstack([s['core/stress_hydro'], s['core/stress_contact'], s['core/solid_fraction'][:, None],
+                      s['core/velocity_fit'], s['core/flow_fit']])
+
+
 def with_window(a, discard_strain, average_strain, blocks):
     """The settings a with the averaging window of &rheology discard_strain, average_strain and
     blocks, in steps as src/runtime/params.F90 computes them (nint of strain / (|shear_rate| dt))."""
@@ -129,8 +135,7 @@ def strain_windows(a, s, width, names):
     its records as a block's: whether and how a run drifts. Returns {'width', 'strain_start', name: [...]}."""
     step = np.rint(s['step']).astype(np.int64)
     strain = s['time'] * abs(a['shear_rate'])
-    values = np.hstack([s['core/stress_hydro'], s['core/stress_contact'], s['core/solid_fraction'][:, None],
-                        s['core/velocity_fit'], s['core/flow_fit']])
+    values = core_values(s)
     on_grid = step % int(a['series_every']) == 0
     out = {'width': width, 'strain_start': []}
     out.update({n: [] for n in names})
@@ -169,8 +174,7 @@ def summarise(a, s):
     last_step = int(step.max())
     block = np.where((step > discard) & (step % every == 0), (step - discard - 1) // block_steps, -1)
     block[block >= blocks] = -1
-    values = np.hstack([s['core/stress_hydro'], s['core/stress_contact'], s['core/solid_fraction'][:, None],
-                        s['core/velocity_fit'], s['core/flow_fit']])
+    values = core_values(s)
     records = np.array([np.count_nonzero(block == b) for b in range(blocks)])
     complete = 0
     for b in range(1, blocks + 1):

@@ -68,6 +68,14 @@ def load(path):
         return json.load(f)
 
 
+def split_run_name(name):
+    """(row, mu, strain) of a run directory <row>_mu<mu>, or of an extension <row>_mu<mu>_to<strain>
+    (strain None otherwise); the inverse of run_name and of --extend's naming."""
+    row, _, rest = name.rpartition('_mu')
+    mu, _, strain = rest.partition('_to')
+    return row, float(mu), float(strain) if strain else None
+
+
 def finished(d):
     s = load(os.path.join(d, 'out', 'summary.json'))
     return s is not None and s.get('complete')
@@ -251,14 +259,13 @@ class Study:
         rows = list(dict.fromkeys(r for r, _ in runs))
         if args.rerecord:
             for name in sorted(os.listdir(args.work)):
-                row, _, mu = name.rpartition('_mu')
-                mu, _, strain = mu.partition('_to')     # an extension: <row>_mu<mu>_to<strain>
                 d = os.path.join(args.work, name)
-                if row in self.rows and finished(d):
+                if name.rpartition('_mu')[0] in self.rows and finished(d):
+                    row, mu, strain = split_run_name(name)
                     if strain:
-                        self.record_extension(d, row, float(mu), float(strain), os.path.join(args.record, name))
+                        self.record_extension(d, row, mu, strain, os.path.join(args.record, name))
                     else:
-                        self.record(d, row, float(mu), os.path.join(args.record, name))
+                        self.record(d, row, mu, os.path.join(args.record, name))
                     print('recorded', name)
             return 0
         extend = args.extend
