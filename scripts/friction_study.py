@@ -50,6 +50,11 @@ ROWS = {
     'dt8e-4':  ('dt 8e-4 (stick number 4.6 at mu_d 0.2)', dict(dt=8e-4)),
     'dt1.2e-3': ('dt 1.2e-3 (stick number 4.6 at mu_d 0.3)', dict(dt=1.2e-3)),
     'w12':     ('x, z periods 12a', dict(box=(12, 20, 12))),
+    # the figure-16 sweep in the 12a cell (rows w12 at mu_d 0, 0.1 (stick number 23: at mu_d 0.1 the
+    # base cell gives the same eta_r at dt 2e-3 and 4e-4), 0.5 and 1), with these at mu_d 0.2, 0.3
+    'w12dt8e-4': ('x, z periods 12a, dt 8e-4 (stick number 4.6 at mu_d 0.2)', dict(box=(12, 20, 12), dt=8e-4)),
+    'w12dt1.2e-3': ('x, z periods 12a, dt 1.2e-3 (stick number 4.6 at mu_d 0.3)',
+                    dict(box=(12, 20, 12), dt=1.2e-3)),
     'w20':     ('x, z periods 20a', dict(box=(20, 20, 20))),
     'w20s2':   ('x, z periods 20a, seed 2', dict(box=(20, 20, 20), seed=2)),
     # issue 28 item 2, the paper's set-up: 20a cube at a/Delta 5 (~760 spheres); dt 1e-3 keeps the
