@@ -15,7 +15,8 @@ program fdsusp
   use mod_grid, only: grid_t, grid_create, grid_destroy, direct_solves_wanted
   use mod_fluid, only: fluid_t, fluid_create, fluid_step, fluid_destroy, fluid_mean_profile
   use mod_fluid_verification, only: fluid_errors_vs_manufactured
-  use mod_series, only: series_t, series_column, series_open, series_record, series_flush, series_attributes
+  use mod_series, only: series_t, series_column, series_open, series_record, series_flush, series_close, &
+                        series_attributes
   use mod_output, only: write_fields, progress_line
   use mod_checkpoint, only: checkpoint_state_t, checkpoint_write, checkpoint_check, checkpoint_read
   use mod_os_services, only: install_signal_handlers, stop_signal, make_directory, probe_directory, &
@@ -187,7 +188,6 @@ program fdsusp
   end if
   ! the columns of series.h5, declared by the routine that also fills each record
   call series_columns()
-  call series_open(series, cfg%output_directory, merge(step, -1, restarting))
   if (allocated(rh)) then
     ! what scripts/rheology.py needs to repeat the statistics from series.h5 alone
     call series_attributes(series, [character(len=32) :: 'box_x', 'box_y', 'box_z', 'radius', 'shear_rate', &
@@ -196,6 +196,8 @@ program fdsusp
          rh%r_outer, rh%r_contact, real([cfg%blocks, cfg%discard_step, cfg%block_steps, cfg%series_every], dp), &
          merge(cfg%friction, 0.0_dp, has_contacts), merge(cfg%roughness, 0.0_dp, has_contacts)])
   end if
+  ! from the start: an empty series; from a checkpoint: its records up to the checkpoint's step
+  call series_open(series, cfg%output_directory, merge(step, -1, restarting))
   PetscCallA(stage_pop(ierr))
   ! free lubricated pairs must not separate faster than their Lambda relaxes (mod_fictitious_domain)
   if (cfg%resolved .and. has_particles .and. has_lubrication .and. parts%motion == MOTION_FREE) &
@@ -405,7 +407,7 @@ program fdsusp
   end if
   PetscCallA(stage_push(STAGE_OUTPUT, ierr))
   if (step > first_step .and. mod(step, cfg%series_every) /= 0) call record()
-  call series_flush(series)
+  call series_close(series)
   if (step > first_step) then
     if (cfg%resolved) then
       PetscCallA(write_fields(cfg%output_directory, grid, fl, step, time, ierr))
@@ -798,7 +800,7 @@ contains
   subroutine stop_with_state(at_step, what)
     integer, intent(in) :: at_step
     character(len=*), intent(in) :: what
-    call series_flush(series)
+    call series_close(series)
     PetscCallA(checkpoint_write(trim(cfg%output_directory)//'/failed_state.h5', cfg, state, step, time, ierr))
     write(text, '(a,i0,a)') 'fdsusp: fatal: at step ', at_step, ': '//trim(what)// &
          '; state written to '//trim(cfg%output_directory)//'/failed_state.h5, the last good checkpoint is kept'

@@ -8,7 +8,8 @@ module mod_errors
   use mod_os_services, only: release_directory
   implicit none
   private
-  public :: input_error, file_error, file_error_from_root, fatal_error, abort_run, is_root, log_line, warn_line
+  public :: input_error, file_error, file_error_from_root, fatal_error, abort_run, abort_if_any, is_root, log_line, &
+            warn_line
 
 contains
 
@@ -79,6 +80,23 @@ contains
     call PetscFinalize(ierr)
     call exit(status)
   end subroutine fatal_error
+
+  ! A fault that may be seen by some ranks only, after a collective operation (a parallel write):
+  ! when any rank saw it, rank 0 prints the message and every rank aborts the job (status 3).
+  ! Collective.
+  subroutine abort_if_any(failed, message)
+    logical, intent(in) :: failed
+    character(len=*), intent(in) :: message
+    logical :: any_failed
+    PetscErrorCode :: ierr
+    call MPI_Allreduce(failed, any_failed, 1, MPI_LOGICAL, MPI_LOR, PETSC_COMM_WORLD, ierr)
+    if (.not. any_failed) return
+    if (is_root()) then
+      write(0, '(a)') 'fdsusp: fatal: '//trim(message)
+      flush(0)
+    end if
+    call MPI_Abort(PETSC_COMM_WORLD, 3, ierr)
+  end subroutine abort_if_any
 
   ! A fault seen by one rank only: print it and abort the whole job.
   subroutine abort_run(message)
