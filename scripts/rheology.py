@@ -38,6 +38,9 @@ import sys
 import h5py
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import series  # noqa: E402
+
 # order and definitions as mod_rheology::rheo_quantities
 NAMES = ['eta_r', 'eta_h', 'eta_c', 'N1/tau', 'N2/tau', 'Pi/tau',
          'Sigma_xx/tau', 'Sigma_yy/tau', 'Sigma_zz/tau', 'Sigma_xx_c/tau', 'Sigma_yy_c/tau', 'Sigma_zz_c/tau',
@@ -99,14 +102,16 @@ def quantities(m, shear_rate):
 
 
 def load(outdir):
-    """The series of a run, with its settings (attributes written by fdsusp)."""
-    with h5py.File(os.path.join(outdir, 'series.h5'), 'r') as f:
-        if 'core/stress_hydro' not in f:
-            raise SystemExit(f'{outdir}/series.h5 holds no core statistics: the run had no &rheology')
-        a = {k: float(np.ravel(v)[0]) for k, v in f.attrs.items()}
-        s = {k: f[k][()] for k in ['step', 'time', 'core/stress_hydro', 'core/stress_contact', 'core/solid_fraction',
-                                   'core/velocity_fit', 'core/flow_fit', 'core/shear_rate', 'pairs/references', 'pairs/shell',
-                                   'pairs/contact', 'profiles/solid_fraction', 'profiles/momentum']}
+    """The series of a run, with its settings (attributes written by fdsusp); records still in
+    series.parts/ (a running or killed run) included (scripts/series.py)."""
+    names = ['step', 'time', 'core/stress_hydro', 'core/stress_contact', 'core/solid_fraction', 'core/velocity_fit',
+             'core/flow_fit', 'core/shear_rate', 'pairs/references', 'pairs/shell', 'pairs/contact',
+             'profiles/solid_fraction', 'profiles/momentum']
+    try:
+        s, attrs = series.read(outdir, names)
+    except KeyError:
+        raise SystemExit(f'{outdir}/series.h5 holds no core statistics: the run had no &rheology')
+    a = {k: float(np.ravel(v)[0]) for k, v in attrs.items()}
     return a, s
 
 

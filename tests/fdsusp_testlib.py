@@ -19,6 +19,9 @@ from checks import check, finish, failures  # noqa: E402,F401
 
 ROOT = os.environ.get('FDSUSP_ROOT', os.path.abspath(os.path.join(os.path.dirname(__file__), '..')))
 BIN = os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin'))
+# the one reader of a run's series (series.h5 and series.parts/), from this checkout's scripts
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'scripts'))
+import series as series_reader  # noqa: E402
 FDSUSP = os.path.join(BIN, 'fdsusp')
 
 ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT='1', OMPI_ALLOW_RUN_AS_ROOT_CONFIRM='1',
@@ -91,12 +94,9 @@ def h5_attr(path, name):
 
 
 def series(outdir):
-    """Every dataset of series.h5 by its path ('time', 'particles/velocity', ...)."""
-    out = {}
-    with h5py.File(os.path.join(outdir, 'series.h5'), 'r') as f:
-        f.visititems(lambda name, obj: out.__setitem__(name, np.array(obj))
-                     if isinstance(obj, h5py.Dataset) else None)
-    return out
+    """Every dataset of the run's series by its path ('time', 'particles/velocity', ...): series.h5
+    and the records still in series.parts/ (scripts/series.py)."""
+    return series_reader.read(outdir)[0]
 
 
 def h5_contents(path):

@@ -184,6 +184,7 @@ contains
       if (present(real_values)) call h5dwrite_f(dset, dtype, real_values, dims, err)
       if (present(int_values)) call h5dwrite_f(dset, dtype, int_values, dims, err)
       call h5dclose_f(dset, e)
+      if (err == 0) err = e
     end if
     call h5sclose_f(space, e)
   end subroutine write_dataset_2d

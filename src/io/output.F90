@@ -8,7 +8,9 @@ module mod_output
   use mod_kinds, only: dp
   use mod_grid, only: grid_t, field_names, FIELD_U, FIELD_V, FIELD_W, FIELD_P
   use mod_fluid, only: fluid_t
-  use mod_errors, only: is_root
+  use mod_errors, only: is_root, abort_run, abort_if_any
+  use mod_os_services, only: publish_file
+  use mod_file_services, only: errno_text, write_failure_cause, require_free_space
   implicit none
   private
   public :: write_fields, progress_line
@@ -31,7 +33,9 @@ contains
     PetscViewer :: viewer
     PetscScalar, pointer :: a(:,:,:), c(:,:,:)
     character(len=32) :: base
+    character(len=1100) :: path
     integer :: f, e(3), i, j, k
+    logical :: failed
 
     do f = 1, 3
       e = 0
@@ -55,13 +59,34 @@ contains
     end do
 
     write(base, '(a,i8.8)') 'fields_', step
-    PetscCall(PetscViewerHDF5Open(PETSC_COMM_WORLD, trim(outdir)//'/'//trim(base)//'.h5', FILE_MODE_WRITE, viewer, ierr))
+    ! written to .tmp and renamed: a snapshot on disk is whole. A failed write (a full disk) stops
+    ! the run on every rank with one message naming the file and the cause, not PETSc's alone.
+    path = trim(outdir)//'/'//trim(base)//'.h5'
+    call require_free_space(outdir, 32.0_dp * product(real(grid%n, dp)), path)
+    call PetscViewerHDF5Open(PETSC_COMM_WORLD, trim(path)//'.tmp', FILE_MODE_WRITE, viewer, ierr)
+    failed = ierr /= 0
     do f = 1, 3
-      PetscCall(VecView(centre(f), viewer, ierr))
+      if (.not. failed) then
+        call VecView(centre(f), viewer, ierr)
+        failed = ierr /= 0
+      end if
       PetscCall(VecDestroy(centre(f), ierr))
     end do
-    PetscCall(VecView(fl%pressure, viewer, ierr))
-    PetscCall(PetscViewerDestroy(viewer, ierr))
+    if (.not. failed) then
+      call VecView(fl%pressure, viewer, ierr)
+      failed = ierr /= 0
+    end if
+    if (.not. failed) then
+      call PetscViewerDestroy(viewer, ierr)
+      failed = ierr /= 0
+    end if
+    call abort_if_any(failed, trim(path)//' cannot be written: '// &
+                      write_failure_cause(outdir, 32.0_dp * product(real(grid%n, dp))))
+    if (is_root()) then
+      e(1) = publish_file(trim(path)//'.tmp', path)
+      if (e(1) /= 0) call abort_run(trim(path)//' cannot be published ('//errno_text(e(1))//'): '// &
+                                    write_failure_cause(outdir, 0.0_dp))
+    end if
 
     if (.not. allocated(snap_step)) allocate(snap_step(max_snapshots), snap_time(max_snapshots))
     if (nsnap < max_snapshots) nsnap = nsnap + 1
@@ -81,35 +106,43 @@ contains
     real(dp), intent(in) :: times(:)
     character(len=*), parameter :: names(4) = ['u', 'v', 'w', 'p']
     character(len=64) :: nodes, cells, h5
-    integer :: unit, s, f
+    character(len=200) :: line
+    character(len=:), allocatable :: doc
+    character(len=1) :: nl
+    integer :: unit, s, f, err, slash
     write(nodes, '(3(i0,1x))') grid%n(3) + 1, grid%n(2) + 1, grid%n(1) + 1
     write(cells, '(3(i0,1x))') grid%n(3), grid%n(2), grid%n(1)
-    open(newunit=unit, file=path, status='replace', action='write')
-    write(unit, '(a)') '<?xml version="1.0" ?>'
-    write(unit, '(a)') '<Xdmf Version="2.0">'
-    write(unit, '(a)') ' <Domain>'
-    write(unit, '(a)') '  <Grid Name="fields" GridType="Collection" CollectionType="Temporal">'
+    nl = new_line('a')
+    doc = '<?xml version="1.0" ?>'//nl//'<Xdmf Version="2.0">'//nl//' <Domain>'//nl// &
+          '  <Grid Name="fields" GridType="Collection" CollectionType="Temporal">'//nl
     do s = 1, size(steps)
       write(h5, '(a,i8.8,a)') 'fields_', steps(s), '.h5'
-      write(unit, '(a,i0,a)') '   <Grid Name="step ', steps(s), '" GridType="Uniform">'
-      write(unit, '(a,es23.15,a)') '    <Time Value="', times(s), '"/>'
-      write(unit, '(3a)') '    <Topology TopologyType="3DCoRectMesh" Dimensions="', trim(nodes), '"/>'
-      write(unit, '(a)') '    <Geometry GeometryType="ORIGIN_DXDYDZ">'
-      write(unit, '(a)') '     <DataItem Dimensions="3" Format="XML">0 0 0</DataItem>'
-      write(unit, '(a,3es23.15,a)') '     <DataItem Dimensions="3" Format="XML">', grid%h, grid%h, grid%h, '</DataItem>'
-      write(unit, '(a)') '    </Geometry>'
+      write(line, '(a,i0,a)') '   <Grid Name="step ', steps(s), '" GridType="Uniform">'
+      doc = doc//trim(line)//nl
+      write(line, '(a,es23.15,a)') '    <Time Value="', times(s), '"/>'
+      doc = doc//trim(line)//nl//'    <Topology TopologyType="3DCoRectMesh" Dimensions="'//trim(nodes)//'"/>'//nl// &
+            '    <Geometry GeometryType="ORIGIN_DXDYDZ">'//nl// &
+            '     <DataItem Dimensions="3" Format="XML">0 0 0</DataItem>'//nl
+      write(line, '(a,3es23.15,a)') '     <DataItem Dimensions="3" Format="XML">', grid%h, grid%h, grid%h, '</DataItem>'
+      doc = doc//trim(line)//nl//'    </Geometry>'//nl
       do f = 1, 4
-        write(unit, '(3a)') '    <Attribute Name="', names(f), '" AttributeType="Scalar" Center="Cell">'
-        write(unit, '(5a)') '     <DataItem Dimensions="', trim(cells), &
-             '" NumberType="Float" Precision="8" Format="HDF">', trim(h5)//':/'//names(f), '</DataItem>'
-        write(unit, '(a)') '    </Attribute>'
+        doc = doc//'    <Attribute Name="'//names(f)//'" AttributeType="Scalar" Center="Cell">'//nl// &
+              '     <DataItem Dimensions="'//trim(cells)//'" NumberType="Float" Precision="8" Format="HDF">'// &
+              trim(h5)//':/'//names(f)//'</DataItem>'//nl//'    </Attribute>'//nl
       end do
-      write(unit, '(a)') '   </Grid>'
+      doc = doc//'   </Grid>'//nl
     end do
-    write(unit, '(a)') '  </Grid>'
-    write(unit, '(a)') ' </Domain>'
-    write(unit, '(a)') '</Xdmf>'
-    close(unit)
+    doc = doc//'  </Grid>'//nl//' </Domain>'//nl//'</Xdmf>'//nl
+    ! written whole to .tmp, checked, and renamed
+    open(newunit=unit, file=path//'.tmp', status='replace', action='write', access='stream', form='unformatted', &
+         iostat=err)
+    if (err == 0) write(unit, iostat=err) doc
+    if (err == 0) flush(unit, iostat=err)
+    close(unit, iostat=s)
+    if (err == 0) err = s
+    if (err == 0) err = publish_file(path//'.tmp', path)
+    slash = index(path, '/', back=.true.)
+    if (err /= 0) call abort_run(path//' cannot be written: '//write_failure_cause(path(1:max(slash - 1, 1)), 0.0_dp))
   end subroutine write_xdmf
 
   ! step, strain, wall time, estimated time left, iterations of each solver, divergence (fl

@@ -12,6 +12,8 @@ module mod_particles_io
   use mod_particles, only: particles_t, particles_init, motion_code, configuration_fault
   use mod_h5util, only: write_attribute, read_attribute, has_object, write_dataset, read_dataset, dataset_dims
   use mod_errors, only: is_root, input_error, file_error, file_error_from_root, abort_run
+  use mod_os_services, only: publish_file
+  use mod_file_services, only: errno_text, write_failure_cause
   implicit none
   private
   public :: particles_load, particles_write, particles_read_state, particles_snapshot
@@ -142,57 +144,72 @@ contains
     integer :: err, unit, k
     character(len=32) :: h5
     character(len=64) :: dims
+    character(len=1100) :: path
+    character(len=200) :: line
+    character(len=:), allocatable :: doc
+    character(len=1) :: nl
     if (.not. is_root()) return
     if (.not. allocated(steps)) allocate(steps(0), times(0))
     if (nsnap > 0) then
       if (steps(nsnap) == step) return          ! already written (last record of the run)
     end if
     write(h5, '(a,i8.8,a)') 'particles_', step, '.h5'
-    call h5fcreate_f(trim(outdir)//'/'//trim(h5), H5F_ACC_TRUNC_F, file, err)
-    if (err /= 0) call abort_run('cannot create '//trim(outdir)//'/'//trim(h5))
+    ! written to .tmp and renamed: a snapshot on disk is whole (a full disk stops the run, naming it)
+    path = trim(outdir)//'/'//trim(h5)
+    call h5fcreate_f(trim(path)//'.tmp', H5F_ACC_TRUNC_F, file, err)
+    if (err /= 0) call write_failed(path, 'cannot be created')
     call particles_write(file, parts, box, .false.)
     call h5gopen_f(file, 'particles', group, err)
     call write_matrix(group, 'velocity', parts%velocity)
     call write_matrix(group, 'omega', parts%omega)
     call write_dataset(group, 'radius', spread(spread(parts%radius, 1, 1), 2, parts%n), err)
+    if (err /= 0) call write_failed(path, 'cannot take /particles/radius')
     call h5gclose_f(group, err)
     call h5fclose_f(file, err)
+    if (err /= 0) call write_failed(path, 'cannot be completed (closing it failed)')
+    err = publish_file(trim(path)//'.tmp', path)
+    if (err /= 0) call write_failed(path, 'cannot be published ('//errno_text(err)//')')
     nsnap = nsnap + 1
     steps = [steps, step]
     times = [times, time]
     write(dims, '(i0,a)') parts%n, ' 3'
-    open(newunit=unit, file=trim(outdir)//'/particles.xmf', status='replace', action='write')
-    write(unit, '(a)') '<?xml version="1.0" ?>'
-    write(unit, '(a)') '<Xdmf Version="2.0">'
-    write(unit, '(a)') ' <Domain>'
-    write(unit, '(a)') '  <Grid Name="particles" GridType="Collection" CollectionType="Temporal">'
+    ! the XDMF index, assembled whole and written with one checked statement
+    nl = new_line('a')
+    doc = '<?xml version="1.0" ?>'//nl//'<Xdmf Version="2.0">'//nl//' <Domain>'//nl// &
+          '  <Grid Name="particles" GridType="Collection" CollectionType="Temporal">'//nl
     do k = 1, nsnap
       write(h5, '(a,i8.8,a)') 'particles_', steps(k), '.h5'
-      write(unit, '(a,i0,a)') '   <Grid Name="step ', steps(k), '" GridType="Uniform">'
-      write(unit, '(a,es23.15,a)') '    <Time Value="', times(k), '"/>'
-      write(unit, '(a,i0,a)') '    <Topology TopologyType="Polyvertex" NumberOfElements="', parts%n, '"/>'
-      write(unit, '(a)') '    <Geometry GeometryType="XYZ">'
-      write(unit, '(5a)') '     <DataItem Dimensions="', trim(dims), '" NumberType="Float" Precision="8" Format="HDF">', &
-           trim(h5), ':/particles/position</DataItem>'
-      write(unit, '(a)') '    </Geometry>'
+      write(line, '(a,i0,a)') '   <Grid Name="step ', steps(k), '" GridType="Uniform">'
+      doc = doc//trim(line)//nl
+      write(line, '(a,es23.15,a)') '    <Time Value="', times(k), '"/>'
+      doc = doc//trim(line)//nl
+      write(line, '(a,i0,a)') '    <Topology TopologyType="Polyvertex" NumberOfElements="', parts%n, '"/>'
+      doc = doc//trim(line)//nl//'    <Geometry GeometryType="XYZ">'//nl
+      doc = doc//'     <DataItem Dimensions="'//trim(dims)//'" NumberType="Float" Precision="8" Format="HDF">'// &
+            trim(h5)//':/particles/position</DataItem>'//nl//'    </Geometry>'//nl
       call attribute('velocity', 'Vector', dims)
       call attribute('omega', 'Vector', dims)
-      write(dims, '(i0,a)') parts%n, ' 1'
-      call attribute('radius', 'Scalar', dims)
-      write(dims, '(i0,a)') parts%n, ' 3'
-      write(unit, '(a)') '   </Grid>'
+      write(line, '(i0,a)') parts%n, ' 1'
+      call attribute('radius', 'Scalar', line)
+      doc = doc//'   </Grid>'//nl
     end do
-    write(unit, '(a)') '  </Grid>'
-    write(unit, '(a)') ' </Domain>'
-    write(unit, '(a)') '</Xdmf>'
-    close(unit)
+    doc = doc//'  </Grid>'//nl//' </Domain>'//nl//'</Xdmf>'//nl
+    path = trim(outdir)//'/particles.xmf'
+    open(newunit=unit, file=trim(path)//'.tmp', status='replace', action='write', access='stream', &
+         form='unformatted', iostat=err)
+    if (err /= 0) call write_failed(path, 'cannot be created')
+    write(unit, iostat=err) doc
+    if (err == 0) flush(unit, iostat=err)
+    close(unit, iostat=k)
+    if (err /= 0 .or. k /= 0) call write_failed(path, 'cannot be written')
+    err = publish_file(trim(path)//'.tmp', path)
+    if (err /= 0) call write_failed(path, 'cannot be published ('//errno_text(err)//')')
   contains
     subroutine attribute(name, kind, shape)
       character(len=*), intent(in) :: name, kind, shape
-      write(unit, '(5a)') '    <Attribute Name="', name, '" AttributeType="', kind, '" Center="Node">'
-      write(unit, '(5a)') '     <DataItem Dimensions="', trim(shape), '" NumberType="Float" Precision="8" Format="HDF">', &
-           trim(h5), ':/particles/'//name//'</DataItem>'
-      write(unit, '(a)') '    </Attribute>'
+      doc = doc//'    <Attribute Name="'//name//'" AttributeType="'//kind//'" Center="Node">'//nl// &
+            '     <DataItem Dimensions="'//trim(shape)//'" NumberType="Float" Precision="8" Format="HDF">'// &
+            trim(h5)//':/particles/'//name//'</DataItem>'//nl//'    </Attribute>'//nl
     end subroutine attribute
   end subroutine particles_snapshot
 
@@ -204,6 +221,14 @@ contains
     call write_dataset(group, name, values, err)
     if (err /= 0) call abort_run('cannot write /particles/'//name)
   end subroutine write_matrix
+
+  ! A write of a particle file failed: stop the run naming the file and the cause.
+  subroutine write_failed(path, what)
+    character(len=*), intent(in) :: path, what
+    integer :: slash
+    slash = index(path, '/', back=.true.)
+    call abort_run(trim(path)//' '//what//': '//write_failure_cause(path(1:max(slash - 1, 1)), 0.0_dp))
+  end subroutine write_failed
 
   ! Restart: positions, velocities and history from a checkpoint (collective). The particle count
   ! must match the deck's.

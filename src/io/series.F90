@@ -23,7 +23,8 @@ module mod_series
   use mod_h5util, only: has_object, write_attribute
   use mod_errors, only: is_root, warn_line, log_line, abort_run
   use mod_os_services, only: publish_file, make_directory
-  use mod_file_services, only: list_directory, copy_file, remove_file, rename_file, errno_text, write_failure_cause
+  use mod_file_services, only: list_directory, copy_file, remove_file, rename_file, errno_text, write_failure_cause, &
+                               free_bytes
   implicit none
   private
   public :: series_t, series_column, series_open, series_record, series_flush, series_close, series_attributes
@@ -140,10 +141,11 @@ contains
   ! records up to that step, from series.h5 and from the parts a killed run left. Partial files of a
   ! killed write (.tmp) are removed. A series.h5 that cannot be read, or that holds other columns,
   ! is kept aside under another name, with a warning, never replaced.
-  subroutine series_open(s, outdir, restart_step)
+  ! records_to_come: the records this run will add, for the projection of the file's size.
+  subroutine series_open(s, outdir, restart_step, records_to_come)
     type(series_t), intent(inout) :: s
     character(len=*), intent(in) :: outdir
-    integer, intent(in) :: restart_step
+    integer, intent(in) :: restart_step, records_to_come
     integer :: c, record_length, err
 
     if (.not. allocated(s%names)) call abort_run('series.h5: no columns declared')
@@ -173,7 +175,29 @@ contains
       call remove_parts(s)
       call start_empty(s)
     end if
+    call project_size(s, outdir, 8.0_dp * record_length * max(records_to_come, 0))
   end subroutine series_open
+
+  ! The size series.h5 will reach, on the log; a warning when the disk cannot hold it and the copy
+  ! that consolidation makes (a run is not refused: space may be freed while it runs).
+  subroutine project_size(s, outdir, added)
+    type(series_t), intent(in) :: s
+    character(len=*), intent(in) :: outdir
+    real(dp), intent(in) :: added
+    character(len=300) :: text
+    real(dp) :: final, free
+    final = s%consolidated_bytes + added
+    free = free_bytes(outdir)
+    write(text, '(a,f0.3,a,f0.3,a)') 'series.h5: about ', final / 1.0e9_dp, ' GB at the end of this run (', &
+         free / 1.0e9_dp, ' GB free on its file system)'
+    call log_line(text)
+    if (free >= 0.0_dp .and. added + final > free) then
+      write(text, '(a,f0.3,a,f0.3,a)') 'series.h5 will need about ', (added + final) / 1.0e9_dp, &
+           ' GB (the records and a copy while consolidating) but ', free / 1.0e9_dp, ' GB are free in '// &
+           trim(outdir)//': the run will stop when the disk is full (raise &output series_every, or free space)'
+      call warn_line(text)
+    end if
+  end subroutine project_size
 
   ! Add the record assembled by series_column since the last one (all the declared columns).
   ! A full buffer is flushed as a part.
@@ -496,9 +520,11 @@ contains
   subroutine write_failed(s, name, what)
     type(series_t), intent(in) :: s
     character(len=*), intent(in) :: name, what
-    integer :: slash
+    integer :: slash, err
     real(dp) :: needed
     slash = index(s%path, '/', back=.true.)
+    ! a partial .tmp would only hold space the user needs back; what it was to replace is whole
+    if (index(name, '.tmp', back=.true.) == len_trim(name) - 3) err = remove_file(name)
     needed = 0.0_dp
     if (allocated(s%buffer)) needed = 8.0_dp * size(s%buffer, 1) * max(1, s%nbuf)
     call abort_run(trim(name)//' '//what//': '//write_failure_cause(s%path(1:max(slash - 1, 1)), needed)// &
@@ -592,6 +618,7 @@ contains
     call h5dcreate_f(file, name, dtype, space, dset, e, plist)
     err = max(err, abs(e))
     call h5dclose_f(dset, e)
+    err = max(err, abs(e))
     call h5pclose_f(plist, e)
     call h5sclose_f(space, e)
     if (err /= 0) call write_failed(s, filename, 'cannot hold the dataset '//name)
@@ -634,7 +661,9 @@ contains
       err = max(err, abs(e))
       call h5sclose_f(mspace, e)
       call h5sclose_f(fspace, e)
+      ! closing writes the dataset's cached chunks: a full disk may show only here
       call h5dclose_f(dset, e)
+      err = max(err, abs(e))
       if (err /= 0) call write_failed(s, filename, 'cannot take the records of '//trim(s%names(c)))
     end do
   end subroutine append_records

@@ -7,6 +7,7 @@ module mod_summary_io
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use mod_kinds, only: dp, pi
   use mod_rheology, only: rheology_t, NSUMMARY, summary_names
+  use mod_os_services, only: publish_file
   implicit none
   private
   public :: summary_write
@@ -14,7 +15,7 @@ module mod_summary_io
 contains
 
   !> Write the summary of rheo_summarise (value, err, profile, angles over the complete blocks, the
-  !> last of them ending at last_step) to path as JSON (rank 0 only). info: 0 ok, else the iostat.
+  !> last of them ending at last_step) to path as JSON (rank 0 only). info: 0 ok, else an iostat or errno.
   subroutine summary_write(r, path, last_step, complete, value, err, profile, angles, info)
     type(rheology_t), intent(in) :: r
     character(len=*), intent(in) :: path
@@ -30,36 +31,43 @@ contains
     do k = 1, r%nangles
       theta(k) = (k - 0.5_dp) * 2 * pi / r%nangles
     end do
-    open(newunit=u, file=path, status='replace', action='write', iostat=info)
+    ! written to path.tmp (every statement checked: a full disk jumps to 90) and renamed
+    open(newunit=u, file=trim(path)//'.tmp', status='replace', action='write', iostat=info)
     if (info /= 0) return
-    write(u, '(a)') '{'
-    write(u, '(a)') '  "program": "fdsusp",'
-    write(u, '(a,a,a)') '  "complete": ', trim(merge('true ', 'false', complete == r%blocks)), ','
-    write(u, '(a,i0,a,i0,a)') '  "blocks": ', r%blocks, ', "blocks_complete": ', complete, ','
-    write(u, '(a,i0,a,i0,a,i0,a)') '  "discard_step": ', r%discard_step, ', "block_steps": ', r%block_steps, &
+    write(u, '(a)', err=90) '{'
+    write(u, '(a)', err=90) '  "program": "fdsusp",'
+    write(u, '(a,a,a)', err=90) '  "complete": ', trim(merge('true ', 'false', complete == r%blocks)), ','
+    write(u, '(a,i0,a,i0,a)', err=90) '  "blocks": ', r%blocks, ', "blocks_complete": ', complete, ','
+    write(u, '(a,i0,a,i0,a,i0,a)', err=90) '  "discard_step": ', r%discard_step, ', "block_steps": ', r%block_steps, &
          ', "last_step": ', last_step, ','
-    write(u, '(a,a,a)') '  "records_per_block": ', trim(json_array(r%block_records(1:max(1, complete)))), ','
-    write(u, '(a,2(a,a),a)') '  "core": ', trim(json_array(r%core)), ', "shear_rate": ', trim(json_number(r%shear_rate)), ','
-    write(u, '(a)') '  "quantities": {'
+    write(u, '(a,a,a)', err=90) '  "records_per_block": ', trim(json_array(r%block_records(1:max(1, complete)))), ','
+    write(u, '(a,2(a,a),a)', err=90) '  "core": ', trim(json_array(r%core)), ', "shear_rate": ', trim(json_number(r%shear_rate)), ','
+    write(u, '(a)', err=90) '  "quantities": {'
     do k = 1, NSUMMARY
-      write(u, '(5a)') '    "', trim(summary_names(k)), '": {"value": ', trim(json_number(value(k))), &
+      write(u, '(5a)', err=90) '    "', trim(summary_names(k)), '": {"value": ', trim(json_number(value(k))), &
            ', "error": '//trim(json_number(err(k)))//'}'//trim(merge(', ', '  ', k < NSUMMARY))
     end do
-    write(u, '(a)') '  },'
-    write(u, '(a)') '  "profiles": {'
-    write(u, '(a,a,a)') '    "y": ', json_array(y), ','
-    write(u, '(a,a,a)') '    "solid_fraction": ', json_array(profile(:, 1)), ','
-    write(u, '(a,a)') '    "velocity": ', json_array(profile(:, 2))
-    write(u, '(a)') '  },'
-    write(u, '(a)') '  "pair_distribution": {'
-    write(u, '(a,a,a,a,a)') '    "r_outer": ', trim(json_number(r%r_outer)), ', "r_contact": ', &
+    write(u, '(a)', err=90) '  },'
+    write(u, '(a)', err=90) '  "profiles": {'
+    write(u, '(a,a,a)', err=90) '    "y": ', json_array(y), ','
+    write(u, '(a,a,a)', err=90) '    "solid_fraction": ', json_array(profile(:, 1)), ','
+    write(u, '(a,a)', err=90) '    "velocity": ', json_array(profile(:, 2))
+    write(u, '(a)', err=90) '  },'
+    write(u, '(a)', err=90) '  "pair_distribution": {'
+    write(u, '(a,a,a,a,a)', err=90) '    "r_outer": ', trim(json_number(r%r_outer)), ', "r_contact": ', &
          trim(json_number(r%r_contact)), ','
-    write(u, '(a,a,a)') '    "theta": ', json_array(theta), ','
-    write(u, '(a,a,a)') '    "g": ', json_array(angles(:, 1)), ','
-    write(u, '(a,a)') '    "g_contact": ', json_array(angles(:, 2))
-    write(u, '(a)') '  }'
-    write(u, '(a)') '}'
-    close(u)
+    write(u, '(a,a,a)', err=90) '    "theta": ', json_array(theta), ','
+    write(u, '(a,a,a)', err=90) '    "g": ', json_array(angles(:, 1)), ','
+    write(u, '(a,a)', err=90) '    "g_contact": ', json_array(angles(:, 2))
+    write(u, '(a)', err=90) '  }'
+    write(u, '(a)', err=90) '}'
+    flush(u, iostat=info)
+    close(u, iostat=k)
+    if (info == 0) info = k
+    if (info == 0) info = publish_file(trim(path)//'.tmp', path)
+    return
+90  info = 1
+    close(u, iostat=k)
   end subroutine summary_write
 
   !> A number in JSON: 17 significant digits, null when not finite.

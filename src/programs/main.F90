@@ -11,7 +11,8 @@ program fdsusp
   use mod_kinds, only: dp, pi
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
   use mod_params, only: config_t, read_deck, echo_deck, max_line
-  use mod_errors, only: log_line, warn_line, input_error, fatal_error, is_root
+  use mod_errors, only: log_line, warn_line, input_error, fatal_error, is_root, abort_run
+  use mod_file_services, only: write_failure_cause
   use mod_grid, only: grid_t, grid_create, grid_destroy, direct_solves_wanted
   use mod_fluid, only: fluid_t, fluid_create, fluid_step, fluid_destroy, fluid_mean_profile
   use mod_fluid_verification, only: fluid_errors_vs_manufactured
@@ -197,7 +198,7 @@ program fdsusp
          merge(cfg%friction, 0.0_dp, has_contacts), merge(cfg%roughness, 0.0_dp, has_contacts)])
   end if
   ! from the start: an empty series; from a checkpoint: its records up to the checkpoint's step
-  call series_open(series, cfg%output_directory, merge(step, -1, restarting))
+  call series_open(series, cfg%output_directory, merge(step, -1, restarting), (cfg%steps - step) / cfg%series_every)
   PetscCallA(stage_pop(ierr))
   ! free lubricated pairs must not separate faster than their Lambda relaxes (mod_fictitious_domain)
   if (cfg%resolved .and. has_particles .and. has_lubrication .and. parts%motion == MOTION_FREE) &
@@ -651,7 +652,7 @@ contains
     path = trim(cfg%output_directory)//'/summary.json'
     call rheo_summarise(rh, step, complete, value, error, profile, angles)
     call summary_write(rh, path, step, complete, value, error, profile, angles, err)
-    if (err /= 0) call warn_line('cannot write '//trim(path))
+    if (err /= 0) call abort_run(trim(path)//' cannot be written: '//write_failure_cause(cfg%output_directory, 0.0_dp))
     write(text, '(a,i0,a,i0,a)') 'rheology of the core region (', complete, ' of ', cfg%blocks, &
          ' blocks complete; value +- standard error; doc/RHEOLOGY.md):'
     call log_line(text)

@@ -2,12 +2,16 @@
 ! src/runtime/file_services_c.c: list a directory, copy a file durably, remove or move a file,
 ! and name the cause of a failed write (doc/DESIGN.md "series.h5: immutable parts, atomic
 ! consolidation").
+#include <petsc/finclude/petscsys.h>
 module mod_file_services
   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_double, c_null_char
+  use petscsys
   use mod_kinds, only: dp
+  use mod_errors, only: is_root, abort_if_any
   implicit none
   private
-  public :: list_directory, copy_file, remove_file, rename_file, free_bytes, errno_text, write_failure_cause
+  public :: list_directory, copy_file, remove_file, rename_file, free_bytes, errno_text, write_failure_cause, &
+            require_free_space
 
   interface
     integer(c_int) function fdsusp_list_directory(dir, suffix, buf, len) bind(C, name='fdsusp_list_directory')
@@ -126,11 +130,29 @@ contains
     if (free < 0.0_dp) then
       cause = 'an I/O error (the file system of '//trim(dir)//' cannot be queried)'
     else if (free < max(needed, 1048576.0_dp)) then
-      write(amount, '(es10.3)') free
-      cause = 'the disk is full ('//trim(adjustl(amount))//' bytes free on the file system of '//trim(dir)//')'
+      write(amount, '(i0)') int(free, kind=8)
+      cause = 'the disk is full ('//trim(amount)//' bytes free on the file system of '//trim(dir)//')'
     else
       cause = 'an I/O error (the disk is not full)'
     end if
   end function write_failure_cause
+
+  ! Before a parallel write of about BYTES into PATH (in directory DIR): stop the run on every rank,
+  ! naming the file and the full disk, when the disk cannot hold it. Collective. Why before: in a
+  ! parallel HDF5 write rank 0 alone writes the metadata, so a full disk fails there only and the
+  ! other ranks would wait for it in the next collective call for ever.
+  subroutine require_free_space(dir, bytes, path)
+    character(len=*), intent(in) :: dir, path
+    real(dp), intent(in) :: bytes
+    real(dp) :: free(1)
+    character(len=40) :: amount
+    PetscErrorCode :: ierr
+    free = -1.0_dp
+    if (is_root()) free(1) = free_bytes(dir)
+    call MPI_Bcast(free, 1, MPI_DOUBLE_PRECISION, 0, PETSC_COMM_WORLD, ierr)
+    write(amount, '(i0)') int(bytes, kind=8)
+    call abort_if_any(free(1) >= 0.0_dp .and. free(1) < bytes + 1048576.0_dp, trim(path)//' cannot be written ('// &
+                      trim(amount)//' bytes): '//write_failure_cause(dir, bytes + 1048576.0_dp))
+  end subroutine require_free_space
 
 end module mod_file_services
