@@ -23,6 +23,8 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
+# Lx = Lz: the restart refuses a checkpoint of a grid with n1 /= n3 ('dataset of the wrong shape
+# for this grid': src/io/checkpoint.F90 compares HDF5's Fortran-order dimensions with n3, n2, n1)
 LX, LZ = 8.0, 8.0
 DECK = """&domain box = 8, 6, 8, cells_per_radius = 4, y_boundary = 'walls', shear_rate = 1 /
 &fluid reynolds = 0.01, initial_flow = 'shear', body_force = 0, 0, 0.3 /
