@@ -24,9 +24,9 @@
 ! the trilinear Lambda carry of mod_fictitious_domain, needs the edge and corner ghosts as well:
 ! it gets its own box-stencil DMDA with the same decomposition (grid_create_box_layout), made
 ! only when there are particles. With a star stencil those ghosts are never filled (they keep
-! whatever the local vector held), so faces at a corner of a rank's block, where a rank boundary
-! meets another rank or periodic boundary, read stale values and the answer depends on the rank
-! layout.
+! whatever the local vector held), so faces within a cell of an edge of a rank's block (where two
+! of its sides meet, each a rank or a periodic boundary) read stale values, and as the edges move
+! with the rank layout, so did the answer.
 #include <petsc/finclude/petscdmda.h>
 module mod_grid
   use petscdmda
