@@ -32,7 +32,7 @@ module mod_fictitious_domain
   use petscdmda
   use petscksp
   use mod_kinds, only: dp
-  use mod_grid, only: grid_t, FIELD_U, FIELD_V, FIELD_W, FIELD_P
+  use mod_grid, only: grid_t, grid_create_box_layout, FIELD_U, FIELD_V, FIELD_W, FIELD_P
   use mod_particles, only: particles_t, MOTION_FREE, MOTION_FROZEN, impose_motion
   use mod_particle_system, only: particle_system_reset, particle_system_add_diagonal
   use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_corrections, &
@@ -61,6 +61,9 @@ module mod_fictitious_domain
     real(dp) :: radius_offset = 0.38_dp ! in grid cells
     real(dp) :: eta = 1.0_dp
     Vec :: lambda(3)                    ! Lambda = rho*lambda on the u, v, w faces
+    ! The layout of the faces with edge and corner ghosts (box stencil, mod_grid): the trilinear
+    ! carry of fictitious_domain_follow reads them; the fields' own DMDAs (star) never fill them.
+    DM :: carry_layout
     ! the covered faces and cells of this rank, in runs of one sphere and one component
     integer :: nf = 0
     integer, allocatable :: f_ijk(:, :)
@@ -147,6 +150,7 @@ contains
       PetscCall(VecSet(fd%lambda(c), 0.0_dp, ierr))
       PetscCall(PetscObjectSetName(fd%lambda(c), trim(names(c)), ierr))
     end do
+    PetscCall(grid_create_box_layout(grid, fd%carry_layout, ierr))
     PetscCall(particle_solver_create(fd%solver, ierr))
     allocate(fd%f_ijk(3, 1024), fd%f_r(3, 1024), fd%f_alpha(1024), fd%f_relax(1024))
     allocate(fd%run_start(1), fd%run_comp(0), fd%run_part(0))
@@ -460,7 +464,10 @@ contains
   ! relative to the centre, x_f - dX, interpolated trilinearly on its own staggered grid; faces no
   ! sphere owns get zero. Only the translation is carried: the traction on a sphere that turns in
   ! a steady flow is steady in the lab frame, not in the body's. displacement (3, n): X^{n+1} - X^n,
-  ! unwrapped; each component must stay below one cell (the ghost width). Collective.
+  ! unwrapped; each component must stay below one cell (the ghost width). The eight corners of a
+  ! face next to an edge or corner of this rank's block lie in edge or corner ghosts: Lambda^n is
+  ! exchanged on fd%carry_layout (box stencil), which fills them (doc/DESIGN.md "Ghost layers").
+  ! Collective.
   subroutine fictitious_domain_follow(grid, fd, parts, displacement, ierr)
     type(grid_t), intent(in) :: grid
     type(fictitious_domain_t), intent(inout) :: fd
@@ -481,11 +488,11 @@ contains
     end if
     PetscCall(event_begin(EVENT_CARRY, ierr))
     do c = 1, 3
-      PetscCall(DMGetLocalVector(grid%da(c), old(c), ierr))
-      PetscCall(DMGlobalToLocalBegin(grid%da(c), fd%lambda(c), INSERT_VALUES, old(c), ierr))
-      PetscCall(DMGlobalToLocalEnd(grid%da(c), fd%lambda(c), INSERT_VALUES, old(c), ierr))
+      PetscCall(DMGetLocalVector(fd%carry_layout, old(c), ierr))
+      PetscCall(DMGlobalToLocalBegin(fd%carry_layout, fd%lambda(c), INSERT_VALUES, old(c), ierr))
+      PetscCall(DMGlobalToLocalEnd(fd%carry_layout, fd%lambda(c), INSERT_VALUES, old(c), ierr))
       PetscCall(VecSet(fd%lambda(c), 0.0_dp, ierr))
-      PetscCall(DMDAVecGetArrayReadF90(grid%da(c), old(c), lam_old(c)%ptr, ierr))
+      PetscCall(DMDAVecGetArrayReadF90(fd%carry_layout, old(c), lam_old(c)%ptr, ierr))
       PetscCall(DMDAVecGetArrayF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
     end do
     ! The list comes in runs of one sphere and one component: the eight corner offsets and
@@ -519,8 +526,8 @@ contains
     fd%lambda_listed = .true.
     do c = 1, 3
       PetscCall(DMDAVecRestoreArrayF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
-      PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), old(c), lam_old(c)%ptr, ierr))
-      PetscCall(DMRestoreLocalVector(grid%da(c), old(c), ierr))
+      PetscCall(DMDAVecRestoreArrayReadF90(fd%carry_layout, old(c), lam_old(c)%ptr, ierr))
+      PetscCall(DMRestoreLocalVector(fd%carry_layout, old(c), ierr))
     end do
     PetscCall(event_end(EVENT_CARRY, ierr))
   end subroutine fictitious_domain_follow
@@ -870,6 +877,7 @@ contains
     do c = 1, 3
       PetscCall(VecDestroy(fd%lambda(c), ierr))
     end do
+    PetscCall(DMDestroy(fd%carry_layout, ierr))
     PetscCall(particle_solver_destroy(fd%solver, ierr))
   end subroutine fictitious_domain_destroy
 

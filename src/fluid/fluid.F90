@@ -170,6 +170,9 @@ contains
 
   ! Ghosted copy of a face field with the wall ghosts of cell-centred-in-y components set to
   ! 2 U_wall - x_0 (second order, method.md §1.3). v needs nothing: its wall face holds 0.
+  ! The wall ghosts are set above and below the owned (i, k) only: the 7-point stencil reads
+  ! nothing else there, and the star-stencil exchange leaves the edge ghosts beside them unfilled
+  ! (mod_grid, doc/DESIGN.md "Ghost layers").
   subroutine ghosted(grid, fl, c, global, ierr)
     type(grid_t), intent(in) :: grid
     type(fluid_t), intent(inout) :: fl
@@ -177,14 +180,18 @@ contains
     Vec, intent(in) :: global
     PetscErrorCode, intent(out) :: ierr
     PetscScalar, pointer :: a(:,:,:)
-    integer :: ny
+    integer :: ny, lo(3), hi(3)
     PetscCall(DMGlobalToLocalBegin(grid%da(c), global, INSERT_VALUES, fl%loc(c), ierr))
     PetscCall(DMGlobalToLocalEnd(grid%da(c), global, INSERT_VALUES, fl%loc(c), ierr))
     if (.not. grid%walls .or. c == FIELD_V .or. c == FIELD_P) return
     ny = grid%n(2)
+    lo = grid%lo
+    hi = grid%hi
     PetscCall(DMDAVecGetArrayF90(grid%da(c), fl%loc(c), a, ierr))
-    if (grid%lo(2) == 0) a(:, -1, :) = 2.0_dp * wall_velocity(fl, c, -1) - a(:, 0, :)
-    if (grid%hi(2) == ny - 1) a(:, ny, :) = 2.0_dp * wall_velocity(fl, c, +1) - a(:, ny - 1, :)
+    if (grid%lo(2) == 0) a(lo(1):hi(1), -1, lo(3):hi(3)) = 2.0_dp * wall_velocity(fl, c, -1) &
+                                                          - a(lo(1):hi(1), 0, lo(3):hi(3))
+    if (grid%hi(2) == ny - 1) a(lo(1):hi(1), ny, lo(3):hi(3)) = 2.0_dp * wall_velocity(fl, c, +1) &
+                                                               - a(lo(1):hi(1), ny - 1, lo(3):hi(3))
     PetscCall(DMDAVecRestoreArrayF90(grid%da(c), fl%loc(c), a, ierr))
   end subroutine ghosted
 

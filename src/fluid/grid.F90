@@ -14,6 +14,19 @@
 ! layout identifies with j = 0, so it holds the same zero. Cell-centred fields see the walls
 ! between j = n(2)-1 and j = 0 and never couple across them. This keeps one layout for all
 ! fields and lets PETSc's periodic DMDA coarsening (n -> n/2) build the multigrid hierarchy.
+!
+! Stencils (doc/DESIGN.md "Ghost layers"): a ghost exchange fills only the ghosts its DMDA's stencil
+! names. The four field DMDAs have a star stencil of width 1: every operator of the fluid step (the
+! 7-point Laplacian, the one-sided gradient and divergence, the wall ghosts, the cell-centre
+! averages of the output) reads the six face neighbours only, never an edge or corner ghost, and
+! a box stencil would make DMCreateMatrix preallocate and store 27 entries per row instead of 7 in
+! every Krylov operator and multigrid level. A read that interpolates across cells diagonally,
+! the trilinear Lambda carry of mod_fictitious_domain, needs the edge and corner ghosts as well:
+! it gets its own box-stencil DMDA with the same decomposition (grid_create_box_layout), made
+! only when there are particles. With a star stencil those ghosts are never filled (they keep
+! whatever the local vector held), so faces within a cell of an edge of a rank's block (where two
+! of its sides meet, each a rank or a periodic boundary) read stale values, and as the edges move
+! with the rank layout, so did the answer.
 #include <petsc/finclude/petscdmda.h>
 module mod_grid
   use petscdmda
@@ -23,6 +36,7 @@ module mod_grid
   implicit none
   private
   public :: grid_t, grid_create, grid_destroy, grid_position, grid_fixed_row, direct_solves_wanted
+  public :: grid_create_box_layout
   public :: FIELD_U, FIELD_V, FIELD_W, FIELD_P, field_names
 
   integer, parameter :: FIELD_U = 1, FIELD_V = 2, FIELD_W = 3, FIELD_P = 4
@@ -35,7 +49,9 @@ module mod_grid
     logical :: walls = .true.     ! walls at y = 0 and y = Ly
     integer :: mg_levels = 1      ! levels the decomposition allows for geometric multigrid
     integer :: nprocs(3) = 1      ! process grid
-    DM :: da(4)                   ! u, v, w, p
+    DM :: da(4)                   ! u, v, w, p (star stencil, width 1)
+    ! cells owned by each rank of the process grid along x, y, z (the same for every field)
+    PetscInt, allocatable :: rank_cells_x(:), rank_cells_y(:), rank_cells_z(:)
     integer :: lo(3) = 0, hi(3) = -1    ! owned index range (inclusive, 0-based)
     integer :: glo(3) = 0, ghi(3) = -1  ! owned range with one layer of ghosts
   end type grid_t
@@ -83,6 +99,10 @@ contains
     call shares(grid%n(2) / block, m(2), block, ly)
     call shares(grid%n(3) / block, m(3), block, lz)
 
+    grid%rank_cells_x = lx
+    grid%rank_cells_y = ly
+    grid%rank_cells_z = lz
+    ! star: the fluid's operators read face neighbours only (see the top of this file)
     do f = 1, 4
       PetscCall(DMDACreate3d(PETSC_COMM_WORLD, DM_BOUNDARY_PERIODIC, DM_BOUNDARY_PERIODIC, DM_BOUNDARY_PERIODIC, DMDA_STENCIL_STAR, grid%n(1), grid%n(2), grid%n(3), m(1), m(2), m(3), 1, 1, lx, ly, lz, grid%da(f), ierr))
       PetscCall(DMSetOptionsPrefix(grid%da(f), field_names(f)//'_', ierr))
@@ -106,6 +126,19 @@ contains
       end if
     end do
   end subroutine grid_create
+
+  ! A scalar DMDA with the decomposition of the fields (the same owned and ghosted index ranges, so
+  ! every vector of grid%da works with it) whose one layer of ghosts holds the edge and corner
+  ! neighbours too (box stencil): for reads that interpolate trilinearly across a cell, the Lambda
+  ! carry of mod_fictitious_domain. Width 1 is enough as a sphere moves less than a cell per step.
+  ! The caller destroys it.
+  subroutine grid_create_box_layout(grid, da, ierr)
+    type(grid_t), intent(in) :: grid
+    DM, intent(out) :: da
+    PetscErrorCode, intent(out) :: ierr
+    PetscCall(DMDACreate3d(PETSC_COMM_WORLD, DM_BOUNDARY_PERIODIC, DM_BOUNDARY_PERIODIC, DM_BOUNDARY_PERIODIC, DMDA_STENCIL_BOX, grid%n(1), grid%n(2), grid%n(3), grid%nprocs(1), grid%nprocs(2), grid%nprocs(3), 1, 1, grid%rank_cells_x, grid%rank_cells_y, grid%rank_cells_z, da, ierr))
+    PetscCall(DMSetUp(da, ierr))
+  end subroutine grid_create_box_layout
 
   ! Split nblocks blocks of size block over nproc ranks as evenly as possible.
   subroutine shares(nblocks, nproc, block, l)
