@@ -13,9 +13,13 @@
 !             with statistics (&rheology) also /rheology/accumulators (mod_rheology::rheo_state)
 !             and the attributes rheology_window (discard_step, block_steps) and rheology_core
 !             (y_lo, y_hi of the core [a]): the window the accumulators were taken over
+!             and the attributes rheology_shells (the pair and contact shells of g(theta) [a]) and
+!             rheology_sampling (series_every: the records the statistics take)
 !   attributes format_version, step, time, cells, box, walls, reynolds, dt, shear_rate, star_history,
 !             fluid_resolved (1, or 0 for lubrication dynamics, which writes no fields), and
 !             with Lees-Edwards boundaries lees_edwards_offset (the boundary offset delta, exactly)
+!   group /deck: the deck's variables, one attribute each (mod_restart_deck), which a restart
+!             compares with its own deck before any work (doc/INPUT.md "Restart")
 ! What a file holds is what the run has: one checkpoint_state_t, set up once by the program,
 ! names the pieces (fluid, Lambda, particles, contact history, statistics, offset) for the
 ! checkpoints, the restart and failed_state.h5 alike.
@@ -32,7 +36,8 @@ module mod_checkpoint
   use mod_h5util, only: write_attribute, read_attribute, write_string_attribute, has_object, dataset_dims, &
                         write_dataset, read_dataset, has_attribute
   use mod_os_services, only: publish_file
-  use mod_errors, only: is_root, abort_run, file_error_from_root
+  use mod_errors, only: is_root, abort_run, file_error_from_root, input_error, log_line
+  use mod_restart_deck, only: deck_record, deck_compare
   use mod_particles, only: particles_t
   use mod_particles_io, only: particles_write, particles_read_state
   use mod_contact, only: contact_history_t
@@ -112,12 +117,20 @@ contains
       call put_int('fluid_resolved', [merge(1, 0, associated(state%fl))])
       if (associated(state%offset)) call put_real('lees_edwards_offset', [state%offset])
       if (associated(state%parts)) then
+        call deck_record(file, cfg, state%parts%n, err)
+      else
+        call deck_record(file, cfg, 0, err)
+      end if
+      failed = failed .or. err /= 0
+      if (associated(state%parts)) then
         call particles_write(file, state%parts, cfg%box, .true.)
         if (associated(state%history)) call contacts_write(file, state%history, state%parts%n)
       end if
       if (associated(state%rh)) then
         call put_int('rheology_window', [state%rh%discard_step, state%rh%block_steps])
         call put_real('rheology_core', state%rh%core)
+        call put_real('rheology_shells', [state%rh%r_outer, state%rh%r_contact])
+        call put_int('rheology_sampling', [cfg%series_every])
         statistics = rheo_state(state%rh)
         call h5gcreate_f(file, 'rheology', group, err)
         if (err == 0) call write_dataset(group, 'accumulators', reshape(statistics, [size(statistics), 1]), err)
@@ -168,44 +181,62 @@ contains
     if (associated(state%lambda)) v = [v, state%lambda]
   end function field_vectors
 
-  ! Before any work: is PATH a checkpoint of this scene? Returns its step and time. Rank 0
-  ! inspects the file, every rank learns the verdict, and a bad file stops the run with a message
-  ! naming the file and the item at fault.
-  subroutine checkpoint_check(path, cfg, particles, step, time)
+  ! Before any work: is PATH a checkpoint of this scene, run with this deck's physics (doc/INPUT.md
+  ! "Restart")? Returns its step and time. Rank 0 inspects the file, every rank learns the verdict,
+  ! and a bad file stops the run with a message naming the file and the item at fault, or the
+  ! group and the variable of the deck that differs from the checkpoint's. rh: the run's
+  ! statistics (&rheology), whose window must fit the checkpoint's accumulators.
+  subroutine checkpoint_check(path, cfg, particles, step, time, rh)
     character(len=*), intent(in) :: path
     type(config_t), intent(in) :: cfg
     integer, intent(in) :: particles        ! the run's particle count (0: none)
     integer, intent(out) :: step
     real(dp), intent(out) :: time
-    character(len=400) :: item, message
+    type(rheology_t), intent(in), optional :: rh
+    character(len=400) :: item
+    character(len=2000) :: message
+    character(len=16) :: group
+    character(len=40) :: variable
     real(dp) :: values(2)
     PetscErrorCode :: ierr
 
     item = ''
     message = ''
+    group = ''
+    variable = ''
     values = 0.0_dp
-    if (is_root()) call inspect(path, cfg, particles, item, message, values)
+    if (is_root()) call inspect(path, cfg, particles, item, message, values, group, variable, rh)
     call MPI_Bcast(item, len(item), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
+    call MPI_Bcast(group, len(group), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
+    call MPI_Bcast(variable, len(variable), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
+    if (len_trim(group) > 0) then
+      call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
+      if (len_trim(message) > 0) call input_error(path, group, variable, message)
+    end if
     call file_error_from_root(path, item, message)
     call MPI_Bcast(values, 2, MPI_DOUBLE_PRECISION, 0, PETSC_COMM_WORLD, ierr)
     step = nint(values(1))
     time = values(2)
   end subroutine checkpoint_check
 
-  subroutine inspect(path, cfg, particles, item, message, values)
+  subroutine inspect(path, cfg, particles, item, message, values, group, variable, rh)
     character(len=*), intent(in) :: path
     type(config_t), intent(in) :: cfg
     integer, intent(in) :: particles
     character(len=*), intent(out) :: item, message
     real(dp), intent(out) :: values(2)
+    character(len=*), intent(out) :: group, variable
+    type(rheology_t), intent(in), optional :: rh
     integer(HID_T) :: file, dset, space
     integer(HSIZE_T) :: dims(3), maxdims(3), pdims(2)
-    integer :: err, version(1), cells(3), walls(1), istep(1), rank, d, n_saved, resolved(1)
+    integer :: err, version(1), cells(3), walls(1), istep(1), rank, d, n_saved, resolved(1), afresh
     real(dp) :: box(3), t(1)
-    logical :: exists
+    logical :: exists, springs
 
     item = ''
     message = ''
+    group = ''
+    variable = ''
     values = 0.0_dp
     inquire(file=path, exist=exists)
     if (.not. exists) then
@@ -302,8 +333,93 @@ contains
              ': restart with the deck that wrote it'
       end if
     end if
+    ! contacts: the springs are there exactly when the checkpoint's run had contacts
+    if (len_trim(message) == 0 .and. particles > 0) then
+      springs = has_object(file, 'contacts')
+      if (springs .neqv. cfg%contact_group) then
+        group = 'contact'
+        if (springs) then
+          message = 'the checkpoint''s run had contacts (its springs are in /contacts), the deck "'// &
+                    trim(cfg%deck_file)//'" has no &contact group: a restart continues the checkpoint''s physics'
+        else
+          message = 'the checkpoint''s run had no contacts (no /contacts), the deck "'//trim(cfg%deck_file)// &
+                    '" has a &contact group: a restart continues the checkpoint''s physics'
+        end if
+      end if
+    end if
+    ! every other input that sets the physics (mod_restart_deck)
+    if (len_trim(message) == 0) call deck_compare(file, cfg, particles, group, variable, message)
+    ! the statistics: the deck's window against the checkpoint's accumulators
+    if (len_trim(message) == 0 .and. present(rh)) then
+      call rheology_verdict(file, rh, cfg%series_every, message, group, variable, afresh)
+      if (len_trim(message) > 0 .and. len_trim(group) == 0) item = 'rheology/accumulators'
+    else if (len_trim(message) == 0) then
+      if (has_object(file, 'rheology')) &
+        call log_line('restart: the checkpoint''s statistics are not continued: the deck has no &rheology')
+    end if
     call h5fclose_f(file, err)
   end subroutine inspect
+
+  ! The statistics of FILE against this run's &rheology (RH; doc/INPUT.md "&rheology"): afresh = 1
+  ! when the deck's window begins after the checkpoint's step (the statistics start from zero,
+  ! whatever the file holds); else the file must hold accumulators taken over the same window, with
+  ! the same pair and contact shells, the same records (series_every; < 0: not checked) and the
+  ! same bins. A fault sets message, and for a variable of the deck its group and name.
+  subroutine rheology_verdict(file, rh, series_every, message, group, variable, afresh)
+    integer(HID_T), intent(in) :: file
+    type(rheology_t), intent(in) :: rh
+    integer, intent(in) :: series_every
+    character(len=*), intent(out) :: message, group, variable
+    integer, intent(out) :: afresh
+    integer :: rank, err, sampling(1)
+    integer(HSIZE_T) :: dims(2)
+    real(dp) :: shells(2)
+    character(len=200) :: text
+    group = ''
+    variable = ''
+    call compare_window(file, rh, message, afresh)
+    if (afresh == 1 .or. len_trim(message) > 0) return
+    if (.not. has_object(file, 'rheology')) then
+      message = 'missing: the checkpoint was written by a run without &rheology, and this deck''s averaging '// &
+                'window has begun (set discard_strain to begin after the checkpoint''s step)'
+      return
+    end if
+    if (has_attribute(file, 'rheology_shells')) then
+      call read_attribute(file, 'rheology_shells', shells, err)
+      if (err == 0 .and. abs(shells(1) - rh%r_outer) > 1.0e-12_dp * rh%r_outer) then
+        group = 'rheology'
+        variable = 'pair_shell'
+        write(text, '(a,f0.6,a,f0.6,a)') 'the checkpoint''s accumulators count pairs at r < ', shells(1), &
+             ' a, this deck at r < ', rh%r_outer, ' a'
+      else if (err == 0 .and. abs(shells(2) - rh%r_contact) > 1.0e-12_dp * rh%r_contact) then
+        group = 'rheology'
+        variable = 'contact_shell'
+        write(text, '(a,f0.6,a,f0.6,a)') 'the checkpoint''s accumulators count contacts at r < ', shells(2), &
+             ' a, this deck at r < ', rh%r_contact, ' a'
+      end if
+      if (len_trim(group) > 0) then
+        message = trim(text)//': counts begun cannot be changed (or set discard_strain to begin after the '// &
+                  'checkpoint''s step: the statistics then start afresh)'
+        return
+      end if
+    end if
+    sampling = series_every
+    if (has_attribute(file, 'rheology_sampling')) call read_attribute(file, 'rheology_sampling', sampling, err)
+    if (series_every > 0) then
+      if (sampling(1) /= series_every) then
+        group = 'output'
+        variable = 'series_every'
+        write(message, '(a,i0,a,i0,a)') 'the checkpoint''s statistics take every ', sampling(1), &
+             '-th step, this deck every ', series_every, &
+             '-th: an averaging window begun keeps its records (or set &rheology discard_strain to begin after '// &
+             'the checkpoint''s step)'
+        return
+      end if
+    end if
+    call dataset_dims(file, 'rheology/accumulators', rank, dims)
+    if (rank /= 2 .or. dims(1) /= size(rheo_state(rh)) .or. dims(2) /= 1) &
+      message = 'does not fit this deck''s &rheology (blocks, profile_bins or angle_bins differ)'
+  end subroutine rheology_verdict
 
   ! Restore STATE from the checkpoint PATH (checked before by checkpoint_check). The statistics of
   ! &rheology must fit the run's (a checkpoint without them, or of another size, stops the run),
@@ -315,11 +431,11 @@ contains
     logical, intent(out) :: statistics_afresh
     PetscErrorCode, intent(out) :: ierr
     PetscViewer :: viewer
-    integer :: k, rank, err, stars(1), info, afresh(1)
+    integer :: k, err, stars(1), info, afresh(1)
     real(dp) :: delta(1)
     integer(HID_T) :: file
-    integer(HSIZE_T) :: dims(2)
     character(len=600) :: message
+    character(len=40) :: group, variable
     real(dp), allocatable :: buffer(:, :)
     Vec, allocatable :: fields(:)
     ! the Lees-Edwards offset, and how many provisional velocities the file holds (none in a
@@ -359,20 +475,12 @@ contains
       message = ''
       afresh = 0
       if (is_root()) then
+        ! (checked before any work by checkpoint_check; here the verdict decides afresh)
         call h5fopen_f(trim(path), H5F_ACC_RDONLY_F, file, err)
-        if (.not. has_object(file, 'rheology')) then
-          message = 'missing: the checkpoint was written by a run without &rheology'
-        else
-          call compare_window(file, state%rh, message, afresh(1))
-          if (len_trim(message) == 0 .and. afresh(1) == 0) then
-            call dataset_dims(file, 'rheology/accumulators', rank, dims)
-            if (rank /= 2 .or. dims(1) /= size(buffer, 1) .or. dims(2) /= 1) then
-              message = 'does not fit this deck''s &rheology (blocks, profile_bins or angle_bins differ)'
-            else
-              call read_dataset(file, 'rheology/accumulators', buffer, err)
-              if (err /= 0) message = 'cannot be read'
-            end if
-          end if
+        call rheology_verdict(file, state%rh, -1, message, group, variable, afresh(1))
+        if (len_trim(message) == 0 .and. afresh(1) == 0) then
+          call read_dataset(file, 'rheology/accumulators', buffer, err)
+          if (err /= 0) message = 'cannot be read'
         end if
         call h5fclose_f(file, err)
       end if

@@ -8,7 +8,7 @@ module mod_h5util
   implicit none
   private
   public :: h5util_init, write_attribute, read_attribute, has_attribute, has_object
-  public :: write_string_attribute, write_dataset, read_dataset, dataset_dims
+  public :: write_string_attribute, read_string_attribute, write_dataset, read_dataset, dataset_dims
   public :: HID_T, HSIZE_T
 
   interface write_attribute
@@ -77,18 +77,53 @@ contains
     integer, intent(out) :: err
     integer(HID_T) :: space, attr, strtype
     integer(HSIZE_T) :: dims(1)
+    character(len=max(1, len_trim(text))) :: stored      ! '' is stored as one blank
+    stored = text
     dims(1) = 1
     call h5tcopy_f(H5T_FORTRAN_S1, strtype, err)
-    call h5tset_size_f(strtype, int(max(1, len_trim(text)), kind=8), err)
+    call h5tset_size_f(strtype, int(len(stored), kind=8), err)
     call h5screate_f(H5S_SCALAR_F, space, err)
     call h5acreate_f(loc, name, strtype, space, attr, err)
     if (err == 0) then
-      call h5awrite_f(attr, strtype, trim(text), dims, err)
+      call h5awrite_f(attr, strtype, stored, dims, err)
       call h5aclose_f(attr, err)
     end if
     call h5sclose_f(space, err)
     call h5tclose_f(strtype, err)
   end subroutine write_string_attribute
+
+  ! A fixed-length string attribute (write_string_attribute) into text, blank-padded; err /= 0 if
+  ! it is absent, not a fixed-length string or longer than text.
+  subroutine read_string_attribute(loc, name, text, err)
+    integer(HID_T), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    character(len=*), intent(out) :: text
+    integer, intent(out) :: err
+    integer(HID_T) :: attr, ftype, mtype
+    integer(SIZE_T) :: length
+    integer(HSIZE_T) :: dims(1)
+    integer :: class, e, k
+    text = ''
+    call h5aopen_f(loc, name, attr, err)
+    if (err /= 0) return
+    call h5aget_type_f(attr, ftype, err)
+    call h5tget_class_f(ftype, class, e)
+    call h5tget_size_f(ftype, length, e)
+    call h5tclose_f(ftype, e)
+    if (err /= 0 .or. class /= H5T_STRING_F .or. length > len(text) .or. length < 1) then
+      err = -1
+    else
+      dims(1) = 1
+      call h5tcopy_f(H5T_FORTRAN_S1, mtype, err)
+      call h5tset_size_f(mtype, length, e)
+      call h5aread_f(attr, mtype, text(1:length), dims, err)
+      call h5tclose_f(mtype, e)
+      do k = 1, int(length)
+        if (text(k:k) == achar(0)) text(k:k) = ' '
+      end do
+    end if
+    call h5aclose_f(attr, e)
+  end subroutine read_string_attribute
 
   logical function has_attribute(loc, name)
     integer(HID_T), intent(in) :: loc

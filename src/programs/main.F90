@@ -164,7 +164,7 @@ program fdsusp
   step = 0
   time = 0.0_dp
   if (restarting) then
-    call checkpoint_check(restart, cfg, parts%n, step, time)
+    call checkpoint_check(restart, cfg, parts%n, step, time, rh)   ! rh: absent unless allocated
     write(text, '(a,i0,a,es12.5)') 'restart from '//trim(restart)//' at step ', step, ', time ', time
     call log_line(text)
   end if
