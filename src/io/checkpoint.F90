@@ -20,6 +20,12 @@
 !             with Lees-Edwards boundaries lees_edwards_offset (the boundary offset delta, exactly)
 !   group /deck: the deck's variables, one attribute each (mod_restart_deck), which a restart
 !             compares with its own deck before any work (doc/INPUT.md "Restart")
+! Checksums: every dataset written through mod_h5util (particles, contacts, statistics) carries
+! HDF5's Fletcher-32 filter; the fields, written by PETSc's viewer (which sets no filter), carry
+! the attribute checksum (data_checksum, over the file's content, so independent of the number of
+! ranks). A restart reads every dataset once before any work (verify_datasets): a flipped bit
+! stops it naming the dataset. Checkpoints written before 2026-11-27 have no checksums: they are
+! read, and the log says their data could not be verified.
 ! What a file holds is what the run has: one checkpoint_state_t, set up once by the program,
 ! names the pieces (fluid, Lambda, particles, contact history, statistics, offset) for the
 ! checkpoints, the restart and failed_state.h5 alike.
@@ -29,6 +35,8 @@
 module mod_checkpoint
   use petscdmda
   use hdf5
+  use, intrinsic :: iso_c_binding, only: c_loc, c_ptr
+  use, intrinsic :: iso_fortran_env, only: int64
   use mod_kinds, only: dp
   use mod_params, only: config_t
   use mod_grid, only: grid_t, FIELD_U, FIELD_V, FIELD_W
@@ -74,8 +82,9 @@ contains
     PetscErrorCode, intent(out) :: ierr
     PetscViewer :: viewer
     integer(HID_T) :: file, group
-    integer :: err, k, stars
+    integer :: err, k, stars, unsigned
     logical :: failed
+    character(len=400) :: item, message
     character(len=1100) :: tmp
     character(len=16) :: code
     Vec, allocatable :: fields(:)
@@ -102,6 +111,12 @@ contains
       call h5fopen_f(trim(tmp), H5F_ACC_RDWR_F, file, err)
       if (err /= 0) call abort_run('cannot reopen '//trim(tmp)//' to complete the checkpoint')
       failed = .false.
+      ! the fields PETSc wrote (the only datasets so far): their checksums
+      unsigned = 0
+      item = ''
+      message = ''
+      call walk_datasets(file, '/', .true., item, message, unsigned)
+      if (len_trim(message) > 0) call abort_run('cannot sign '//trim(item)//' of '//trim(tmp)//': '//trim(message))
       call put_int('format_version', [checkpoint_format_version])
       call put_int('step', [step])
       call put_real('time', [time])
@@ -229,7 +244,8 @@ contains
     type(rheology_t), intent(in), optional :: rh
     integer(HID_T) :: file, dset, space
     integer(HSIZE_T) :: dims(3), maxdims(3), pdims(2)
-    integer :: err, version(1), cells(3), walls(1), istep(1), rank, d, n_saved, resolved(1), afresh
+    integer :: err, version(1), cells(3), walls(1), istep(1), rank, d, n_saved, resolved(1), afresh, unverified
+    character(len=200) :: line
     real(dp) :: box(3), t(1)
     logical :: exists, springs
 
@@ -349,6 +365,16 @@ contains
     end if
     ! every other input that sets the physics (mod_restart_deck)
     if (len_trim(message) == 0) call deck_compare(file, cfg, particles, group, variable, message)
+    ! the data: every dataset read once, against its checksum
+    if (len_trim(message) == 0) then
+      unverified = 0
+      call walk_datasets(file, '/', .false., item, message, unverified)
+      if (len_trim(message) == 0 .and. unverified > 0) then
+        write(line, '(i0,a)') unverified, ' datasets of the checkpoint carry no checksum (written before '// &
+             '2026-11-27): their data cannot be verified'
+        call log_line('restart: '//trim(line))
+      end if
+    end if
     ! the statistics: the deck's window against the checkpoint's accumulators
     if (len_trim(message) == 0 .and. present(rh)) then
       call rheology_verdict(file, rh, cfg%series_every, message, group, variable, afresh)
@@ -359,6 +385,146 @@ contains
     end if
     call h5fclose_f(file, err)
   end subroutine inspect
+
+  ! Every dataset under GROUP (whose path is PREFIX), recursively, read whole: the read verifies the
+  ! Fletcher-32 checksum of a dataset that has one, and the values are compared with the checksum
+  ! attribute of one that has it. sign: instead, give every dataset without Fletcher-32 its
+  ! checksum attribute (checkpoint_write). A fault sets item (the dataset's path) and message;
+  ! unverified counts the datasets with neither checksum.
+  recursive subroutine walk_datasets(group, prefix, sign, item, message, unverified)
+    integer(HID_T), intent(in) :: group
+    character(len=*), intent(in) :: prefix
+    logical, intent(in) :: sign
+    character(len=*), intent(inout) :: item, message
+    integer, intent(inout) :: unverified
+    integer :: storage, nlinks, max_corder, err, k, kind
+    integer(HSIZE_T) :: index
+    integer(SIZE_T) :: length
+    integer(HID_T) :: object
+    character(len=256) :: name
+    call h5gget_info_f(group, storage, nlinks, max_corder, err)
+    if (err /= 0) then
+      item = prefix
+      message = 'cannot be listed: the file is damaged'
+      return
+    end if
+    do k = 0, nlinks - 1
+      if (len_trim(message) > 0) return
+      index = k
+      call h5lget_name_by_idx_f(group, '.', H5_INDEX_NAME_F, H5_ITER_INC_F, index, name, err, length)
+      if (err == 0) call h5oopen_f(group, trim(name), object, err)
+      if (err /= 0) then
+        item = prefix//trim(name)
+        message = 'cannot be opened: the file is damaged'
+        return
+      end if
+      call h5iget_type_f(object, kind, err)
+      if (kind == H5I_GROUP_F) then
+        call walk_datasets(object, prefix//trim(name)//'/', sign, item, message, unverified)
+      else if (kind == H5I_DATASET_F) then
+        call check_dataset(object, prefix//trim(name), sign, item, message, unverified)
+      end if
+      call h5oclose_f(object, err)
+    end do
+  end subroutine walk_datasets
+
+  subroutine check_dataset(dset, path, sign, item, message, unverified)
+    integer(HID_T), intent(in) :: dset
+    character(len=*), intent(in) :: path
+    logical, intent(in) :: sign
+    character(len=*), intent(inout) :: item, message
+    integer, intent(inout) :: unverified
+    integer(HID_T) :: space, ftype
+    integer(HSSIZE_T) :: npoints
+    integer :: err, class, e
+    logical :: fletcher
+    real(dp) :: stored(2), computed(2)
+    real(dp), allocatable, target :: values(:)
+    type(c_ptr) :: buffer
+    call h5dget_space_f(dset, space, err)
+    call h5sget_simple_extent_npoints_f(space, npoints, e)
+    call h5sclose_f(space, e)
+    call h5dget_type_f(dset, ftype, e)
+    call h5tget_class_f(ftype, class, e)
+    call h5tclose_f(ftype, e)
+    fletcher = has_fletcher32(dset)
+    if (class /= H5T_FLOAT_F .and. class /= H5T_INTEGER_F) then
+      if (.not. fletcher) unverified = unverified + 1
+      return
+    end if
+    ! numbers are read as doubles (integers of 32 bits convert exactly)
+    allocate(values(max(1_HSSIZE_T, npoints)))
+    values = 0.0_dp
+    buffer = c_loc(values)
+    if (err == 0 .and. npoints > 0) call h5dread_f(dset, H5T_NATIVE_DOUBLE, buffer, err)
+    if (err /= 0) then
+      item = path
+      message = 'cannot be read: its data fail their Fletcher-32 checksum or the file is damaged (restart from '// &
+                'an earlier checkpoint)'
+      return
+    end if
+    computed = data_checksum(values(1:npoints))
+    if (sign) then
+      if (.not. fletcher) then
+        call write_attribute(dset, 'checksum', computed, err)
+        if (err /= 0) then
+          item = path
+          message = 'cannot write its checksum attribute'
+        end if
+      end if
+    else if (has_attribute(dset, 'checksum')) then
+      call read_attribute(dset, 'checksum', stored, err)
+      if (err /= 0 .or. any(stored /= computed)) then
+        item = path
+        message = 'its data do not match their checksum: the file is damaged (restart from an earlier checkpoint)'
+      end if
+    else if (.not. fletcher) then
+      unverified = unverified + 1
+    end if
+  end subroutine check_dataset
+
+  ! Does the dataset carry HDF5's Fletcher-32 filter?
+  logical function has_fletcher32(dset)
+    integer(HID_T), intent(in) :: dset
+    integer(HID_T) :: plist
+    integer :: err, nfilters, k, flags, filter
+    integer(SIZE_T) :: nvalues, namelen
+    integer :: values(8)
+    character(len=64) :: name
+    has_fletcher32 = .false.
+    call h5dget_create_plist_f(dset, plist, err)
+    if (err /= 0) return
+    call h5pget_nfilters_f(plist, nfilters, err)
+    do k = 0, nfilters - 1
+      nvalues = size(values, kind=SIZE_T)
+      namelen = len(name, kind=SIZE_T)
+      call h5pget_filter_f(plist, k, flags, nvalues, values, namelen, name, filter, err)
+      if (err == 0 .and. filter == H5Z_FILTER_FLETCHER32_F) has_fletcher32 = .true.
+    end do
+    call h5pclose_f(plist, err)
+  end function has_fletcher32
+
+  ! The checksum of a dataset's values (attribute checksum): Fletcher's two running sums over the
+  ! 32-bit halves of each value's IEEE bit pattern, modulo the prime 4294967291, as two exact
+  ! doubles. A changed bit changes the first sum, the order of the values the second; computed on
+  ! the file's content in its order, it does not depend on the number of ranks that wrote it.
+  pure function data_checksum(x) result(c)
+    real(dp), intent(in) :: x(:)
+    real(dp) :: c(2)
+    integer(int64), parameter :: prime = 4294967291_int64, low = 4294967295_int64
+    integer(int64) :: a, b, bits
+    integer :: i
+    a = 0
+    b = 0
+    do i = 1, size(x)
+      bits = transfer(x(i), bits)
+      a = mod(a + iand(bits, low), prime)
+      b = mod(b + a, prime)
+      a = mod(a + iand(shiftr(bits, 32), low), prime)
+      b = mod(b + a, prime)
+    end do
+    c = real([a, b], dp)
+  end function data_checksum
 
   ! The statistics of FILE against this run's &rheology (RH; doc/INPUT.md "&rheology"): afresh = 1
   ! when the deck's window begins after the checkpoint's step (the statistics start from zero,

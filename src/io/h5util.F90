@@ -1,5 +1,6 @@
 ! Small helpers over HDF5's Fortran API: attributes, and 2-D datasets written whole and read back
-! with their shape checked (particles, contact history).
+! with their shape checked (particles, contact history). The datasets carry HDF5's Fletcher-32
+! checksum, so a damaged file fails its read instead of being used.
 ! Used by one rank at a time (series.h5 and checkpoint attributes are written by rank 0);
 ! parallel field I/O goes through PETSc's HDF5 viewer instead.
 module mod_h5util
@@ -210,11 +211,19 @@ contains
     integer, intent(out) :: err
     real(dp), intent(in), optional :: real_values(:, :)
     integer, intent(in), optional :: int_values(:, :)
-    integer(HID_T) :: space, dset
+    integer(HID_T) :: space, dset, plist
     integer :: e
     call h5screate_simple_f(2, dims, space, err)
     if (err /= 0) return
-    call h5dcreate_f(loc, name, dtype, space, dset, err)
+    ! one chunk with HDF5's Fletcher-32 checksum, which every read verifies (a dataset of no
+    ! elements has no data to protect, and cannot be chunked)
+    call h5pcreate_f(H5P_DATASET_CREATE_F, plist, err)
+    if (err == 0 .and. all(dims > 0)) then
+      call h5pset_chunk_f(plist, 2, dims, err)
+      if (err == 0) call h5pset_fletcher32_f(plist, err)
+    end if
+    if (err == 0) call h5dcreate_f(loc, name, dtype, space, dset, err, plist)
+    call h5pclose_f(plist, e)
     if (err == 0) then
       if (present(real_values)) call h5dwrite_f(dset, dtype, real_values, dims, err)
       if (present(int_values)) call h5dwrite_f(dset, dtype, int_values, dims, err)
