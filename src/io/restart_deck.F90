@@ -188,6 +188,7 @@ contains
     message = ''
     missing = ''
     call deck_items(cfg, particles, list)
+    deck = -1
     has_deck = has_object(file, deck_group)
     if (has_deck) call h5gopen_f(file, deck_group, deck, err)
     do k = 1, size(list)
