@@ -419,7 +419,7 @@ contains
     end do
     do c = 1, 4
       PetscCall(VecDestroy(fl%loc(c), ierr))
-      call solver_destroy(fl%solver(c), ierr)
+      PetscCall(solver_destroy(fl%solver(c), ierr))
     end do
     PetscCall(VecDestroy(fl%pressure, ierr))
     PetscCall(VecDestroy(fl%phi, ierr))

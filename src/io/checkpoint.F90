@@ -13,9 +13,19 @@
 !             with statistics (&rheology) also /rheology/accumulators (mod_rheology::rheo_state)
 !             and the attributes rheology_window (discard_step, block_steps) and rheology_core
 !             (y_lo, y_hi of the core [a]): the window the accumulators were taken over
+!             and the attributes rheology_shells (the pair and contact shells of g(theta) [a]) and
+!             rheology_sampling (series_every: the records the statistics take)
 !   attributes format_version, step, time, cells, box, walls, reynolds, dt, shear_rate, star_history,
 !             fluid_resolved (1, or 0 for lubrication dynamics, which writes no fields), and
 !             with Lees-Edwards boundaries lees_edwards_offset (the boundary offset delta, exactly)
+!   group /deck: the deck's variables, one attribute each (mod_restart_deck), which a restart
+!             compares with its own deck before any work (doc/INPUT.md "Restart")
+! Checksums: every dataset written through mod_h5util (particles, contacts, statistics) carries
+! HDF5's Fletcher-32 filter; the fields, written by PETSc's viewer (which sets no filter), carry
+! the attribute checksum (data_checksum, over the file's content, so independent of the number of
+! ranks). A restart reads every dataset once before any work (verify_datasets): a flipped bit
+! stops it naming the dataset. Checkpoints written before 2026-11-27 have no checksums: they are
+! read, and the log says their data could not be verified.
 ! What a file holds is what the run has: one checkpoint_state_t, set up once by the program,
 ! names the pieces (fluid, Lambda, particles, contact history, statistics, offset) for the
 ! checkpoints, the restart and failed_state.h5 alike.
@@ -25,6 +35,8 @@
 module mod_checkpoint
   use petscdmda
   use hdf5
+  use, intrinsic :: iso_c_binding, only: c_loc, c_ptr
+  use, intrinsic :: iso_fortran_env, only: int64
   use mod_kinds, only: dp
   use mod_params, only: config_t
   use mod_grid, only: grid_t, FIELD_U, FIELD_V, FIELD_W
@@ -32,7 +44,8 @@ module mod_checkpoint
   use mod_h5util, only: write_attribute, read_attribute, write_string_attribute, has_object, dataset_dims, &
                         write_dataset, read_dataset, has_attribute
   use mod_os_services, only: publish_file
-  use mod_errors, only: is_root, abort_run, file_error_from_root
+  use mod_errors, only: is_root, abort_run, file_error_from_root, input_error, log_line
+  use mod_restart_deck, only: deck_record, deck_compare
   use mod_particles, only: particles_t
   use mod_particles_io, only: particles_write, particles_read_state
   use mod_contact, only: contact_history_t
@@ -69,8 +82,9 @@ contains
     PetscErrorCode, intent(out) :: ierr
     PetscViewer :: viewer
     integer(HID_T) :: file, group
-    integer :: err, k, stars
+    integer :: err, k, stars, unsigned
     logical :: failed
+    character(len=400) :: item, message
     character(len=1100) :: tmp
     character(len=16) :: code
     Vec, allocatable :: fields(:)
@@ -97,6 +111,12 @@ contains
       call h5fopen_f(trim(tmp), H5F_ACC_RDWR_F, file, err)
       if (err /= 0) call abort_run('cannot reopen '//trim(tmp)//' to complete the checkpoint')
       failed = .false.
+      ! the fields PETSc wrote (the only datasets so far): their checksums
+      unsigned = 0
+      item = ''
+      message = ''
+      call walk_datasets(file, '/', .true., item, message, unsigned)
+      if (len_trim(message) > 0) call abort_run('cannot sign '//trim(item)//' of '//trim(tmp)//': '//trim(message))
       call put_int('format_version', [checkpoint_format_version])
       call put_int('step', [step])
       call put_real('time', [time])
@@ -112,12 +132,20 @@ contains
       call put_int('fluid_resolved', [merge(1, 0, associated(state%fl))])
       if (associated(state%offset)) call put_real('lees_edwards_offset', [state%offset])
       if (associated(state%parts)) then
+        call deck_record(file, cfg, state%parts%n, err)
+      else
+        call deck_record(file, cfg, 0, err)
+      end if
+      failed = failed .or. err /= 0
+      if (associated(state%parts)) then
         call particles_write(file, state%parts, cfg%box, .true.)
         if (associated(state%history)) call contacts_write(file, state%history, state%parts%n)
       end if
       if (associated(state%rh)) then
         call put_int('rheology_window', [state%rh%discard_step, state%rh%block_steps])
         call put_real('rheology_core', state%rh%core)
+        call put_real('rheology_shells', [state%rh%r_outer, state%rh%r_contact])
+        call put_int('rheology_sampling', [cfg%series_every])
         statistics = rheo_state(state%rh)
         call h5gcreate_f(file, 'rheology', group, err)
         if (err == 0) call write_dataset(group, 'accumulators', reshape(statistics, [size(statistics), 1]), err)
@@ -168,44 +196,63 @@ contains
     if (associated(state%lambda)) v = [v, state%lambda]
   end function field_vectors
 
-  ! Before any work: is PATH a checkpoint of this scene? Returns its step and time. Rank 0
-  ! inspects the file, every rank learns the verdict, and a bad file stops the run with a message
-  ! naming the file and the item at fault.
-  subroutine checkpoint_check(path, cfg, particles, step, time)
+  ! Before any work: is PATH a checkpoint of this scene, run with this deck's physics (doc/INPUT.md
+  ! "Restart")? Returns its step and time. Rank 0 inspects the file, every rank learns the verdict,
+  ! and a bad file stops the run with a message naming the file and the item at fault, or the
+  ! group and the variable of the deck that differs from the checkpoint's. rh: the run's
+  ! statistics (&rheology), whose window must fit the checkpoint's accumulators.
+  subroutine checkpoint_check(path, cfg, particles, step, time, rh)
     character(len=*), intent(in) :: path
     type(config_t), intent(in) :: cfg
     integer, intent(in) :: particles        ! the run's particle count (0: none)
     integer, intent(out) :: step
     real(dp), intent(out) :: time
-    character(len=400) :: item, message
+    type(rheology_t), intent(in), optional :: rh
+    character(len=400) :: item
+    character(len=2000) :: message
+    character(len=16) :: group
+    character(len=40) :: variable
     real(dp) :: values(2)
     PetscErrorCode :: ierr
 
     item = ''
     message = ''
+    group = ''
+    variable = ''
     values = 0.0_dp
-    if (is_root()) call inspect(path, cfg, particles, item, message, values)
+    if (is_root()) call inspect(path, cfg, particles, item, message, values, group, variable, rh)
     call MPI_Bcast(item, len(item), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
+    call MPI_Bcast(group, len(group), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
+    call MPI_Bcast(variable, len(variable), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
+    if (len_trim(group) > 0) then
+      call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
+      if (len_trim(message) > 0) call input_error(path, group, variable, message)
+    end if
     call file_error_from_root(path, item, message)
     call MPI_Bcast(values, 2, MPI_DOUBLE_PRECISION, 0, PETSC_COMM_WORLD, ierr)
     step = nint(values(1))
     time = values(2)
   end subroutine checkpoint_check
 
-  subroutine inspect(path, cfg, particles, item, message, values)
+  subroutine inspect(path, cfg, particles, item, message, values, group, variable, rh)
     character(len=*), intent(in) :: path
     type(config_t), intent(in) :: cfg
     integer, intent(in) :: particles
     character(len=*), intent(out) :: item, message
     real(dp), intent(out) :: values(2)
+    character(len=*), intent(out) :: group, variable
+    type(rheology_t), intent(in), optional :: rh
     integer(HID_T) :: file, dset, space
     integer(HSIZE_T) :: dims(3), maxdims(3), pdims(2)
-    integer :: err, version(1), cells(3), walls(1), istep(1), rank, d, n_saved, resolved(1)
+    integer :: err, version(1), cells(3), walls(1), istep(1), rank, d, n_saved, resolved(1), afresh, unverified
+    character(len=200) :: line
     real(dp) :: box(3), t(1)
-    logical :: exists
+    logical :: exists, springs
 
     item = ''
     message = ''
+    group = ''
+    variable = ''
     values = 0.0_dp
     inquire(file=path, exist=exists)
     if (.not. exists) then
@@ -302,8 +349,243 @@ contains
              ': restart with the deck that wrote it'
       end if
     end if
+    ! contacts: the springs are there exactly when the checkpoint's run had contacts
+    if (len_trim(message) == 0 .and. particles > 0) then
+      springs = has_object(file, 'contacts')
+      if (springs .neqv. cfg%contact_group) then
+        group = 'contact'
+        if (springs) then
+          message = 'the checkpoint''s run had contacts (its springs are in /contacts), the deck "'// &
+                    trim(cfg%deck_file)//'" has no &contact group: a restart continues the checkpoint''s physics'
+        else
+          message = 'the checkpoint''s run had no contacts (no /contacts), the deck "'//trim(cfg%deck_file)// &
+                    '" has a &contact group: a restart continues the checkpoint''s physics'
+        end if
+      end if
+    end if
+    ! every other input that sets the physics (mod_restart_deck)
+    if (len_trim(message) == 0) call deck_compare(file, cfg, particles, group, variable, message)
+    ! the data: every dataset read once, against its checksum
+    if (len_trim(message) == 0) then
+      unverified = 0
+      call walk_datasets(file, '/', .false., item, message, unverified)
+      if (len_trim(message) == 0 .and. unverified > 0) then
+        write(line, '(i0,a)') unverified, ' datasets of the checkpoint carry no checksum (written before '// &
+             '2026-11-27): their data cannot be verified'
+        call log_line('restart: '//trim(line))
+      end if
+    end if
+    ! the statistics: the deck's window against the checkpoint's accumulators
+    if (len_trim(message) == 0 .and. present(rh)) then
+      call rheology_verdict(file, rh, cfg%series_every, message, group, variable, afresh)
+      if (len_trim(message) > 0 .and. len_trim(group) == 0) item = 'rheology/accumulators'
+    else if (len_trim(message) == 0) then
+      if (has_object(file, 'rheology')) &
+        call log_line('restart: the checkpoint''s statistics are not continued: the deck has no &rheology')
+    end if
     call h5fclose_f(file, err)
   end subroutine inspect
+
+  ! Every dataset under GROUP (whose path is PREFIX), recursively, read whole: the read verifies the
+  ! Fletcher-32 checksum of a dataset that has one, and the values are compared with the checksum
+  ! attribute of one that has it. sign: instead, give every dataset without Fletcher-32 its
+  ! checksum attribute (checkpoint_write). A fault sets item (the dataset's path) and message;
+  ! unverified counts the datasets with neither checksum.
+  recursive subroutine walk_datasets(group, prefix, sign, item, message, unverified)
+    integer(HID_T), intent(in) :: group
+    character(len=*), intent(in) :: prefix
+    logical, intent(in) :: sign
+    character(len=*), intent(inout) :: item, message
+    integer, intent(inout) :: unverified
+    integer :: storage, nlinks, max_corder, err, k, kind
+    integer(HSIZE_T) :: index
+    integer(SIZE_T) :: length
+    integer(HID_T) :: object
+    character(len=256) :: name
+    call h5gget_info_f(group, storage, nlinks, max_corder, err)
+    if (err /= 0) then
+      item = prefix
+      message = 'cannot be listed: the file is damaged'
+      return
+    end if
+    do k = 0, nlinks - 1
+      if (len_trim(message) > 0) return
+      index = k
+      call h5lget_name_by_idx_f(group, '.', H5_INDEX_NAME_F, H5_ITER_INC_F, index, name, err, length)
+      if (err == 0) call h5oopen_f(group, trim(name), object, err)
+      if (err /= 0) then
+        item = prefix//trim(name)
+        message = 'cannot be opened: the file is damaged'
+        return
+      end if
+      call h5iget_type_f(object, kind, err)
+      if (kind == H5I_GROUP_F) then
+        call walk_datasets(object, prefix//trim(name)//'/', sign, item, message, unverified)
+      else if (kind == H5I_DATASET_F) then
+        call check_dataset(object, prefix//trim(name), sign, item, message, unverified)
+      end if
+      call h5oclose_f(object, err)
+    end do
+  end subroutine walk_datasets
+
+  subroutine check_dataset(dset, path, sign, item, message, unverified)
+    integer(HID_T), intent(in) :: dset
+    character(len=*), intent(in) :: path
+    logical, intent(in) :: sign
+    character(len=*), intent(inout) :: item, message
+    integer, intent(inout) :: unverified
+    integer(HID_T) :: space, ftype
+    integer(HSSIZE_T) :: npoints
+    integer :: err, class, e
+    logical :: fletcher
+    real(dp) :: stored(2), computed(2)
+    real(dp), allocatable, target :: values(:)
+    type(c_ptr) :: buffer
+    call h5dget_space_f(dset, space, err)
+    call h5sget_simple_extent_npoints_f(space, npoints, e)
+    call h5sclose_f(space, e)
+    call h5dget_type_f(dset, ftype, e)
+    call h5tget_class_f(ftype, class, e)
+    call h5tclose_f(ftype, e)
+    fletcher = has_fletcher32(dset)
+    if (class /= H5T_FLOAT_F .and. class /= H5T_INTEGER_F) then
+      if (.not. fletcher) unverified = unverified + 1
+      return
+    end if
+    ! numbers are read as doubles (integers of 32 bits convert exactly)
+    allocate(values(max(1_HSSIZE_T, npoints)))
+    values = 0.0_dp
+    buffer = c_loc(values)
+    if (err == 0 .and. npoints > 0) call h5dread_f(dset, H5T_NATIVE_DOUBLE, buffer, err)
+    if (err /= 0) then
+      item = path
+      message = 'cannot be read: its data fail their Fletcher-32 checksum or the file is damaged (restart from '// &
+                'an earlier checkpoint)'
+      return
+    end if
+    computed = data_checksum(values(1:npoints))
+    if (sign) then
+      if (.not. fletcher) then
+        call write_attribute(dset, 'checksum', computed, err)
+        if (err /= 0) then
+          item = path
+          message = 'cannot write its checksum attribute'
+        end if
+      end if
+    else if (has_attribute(dset, 'checksum')) then
+      call read_attribute(dset, 'checksum', stored, err)
+      if (err /= 0 .or. any(stored /= computed)) then
+        item = path
+        message = 'its data do not match their checksum: the file is damaged (restart from an earlier checkpoint)'
+      end if
+    else if (.not. fletcher) then
+      unverified = unverified + 1
+    end if
+  end subroutine check_dataset
+
+  ! Does the dataset carry HDF5's Fletcher-32 filter?
+  logical function has_fletcher32(dset)
+    integer(HID_T), intent(in) :: dset
+    integer(HID_T) :: plist
+    integer :: err, nfilters, k, flags, filter
+    integer(SIZE_T) :: nvalues, namelen
+    integer :: values(8)
+    character(len=64) :: name
+    has_fletcher32 = .false.
+    call h5dget_create_plist_f(dset, plist, err)
+    if (err /= 0) return
+    call h5pget_nfilters_f(plist, nfilters, err)
+    do k = 0, nfilters - 1
+      nvalues = size(values, kind=SIZE_T)
+      namelen = len(name, kind=SIZE_T)
+      call h5pget_filter_f(plist, k, flags, nvalues, values, namelen, name, filter, err)
+      if (err == 0 .and. filter == H5Z_FILTER_FLETCHER32_F) has_fletcher32 = .true.
+    end do
+    call h5pclose_f(plist, err)
+  end function has_fletcher32
+
+  ! The checksum of a dataset's values (attribute checksum): Fletcher's two running sums over the
+  ! 32-bit halves of each value's IEEE bit pattern, modulo the prime 4294967291, as two exact
+  ! doubles. A changed bit changes the first sum, the order of the values the second; computed on
+  ! the file's content in its order, it does not depend on the number of ranks that wrote it.
+  pure function data_checksum(x) result(c)
+    real(dp), intent(in) :: x(:)
+    real(dp) :: c(2)
+    integer(int64), parameter :: prime = 4294967291_int64, low = 4294967295_int64
+    integer(int64) :: a, b, bits
+    integer :: i
+    a = 0
+    b = 0
+    do i = 1, size(x)
+      bits = transfer(x(i), bits)
+      a = mod(a + iand(bits, low), prime)
+      b = mod(b + a, prime)
+      a = mod(a + iand(shiftr(bits, 32), low), prime)
+      b = mod(b + a, prime)
+    end do
+    c = real([a, b], dp)
+  end function data_checksum
+
+  ! The statistics of FILE against this run's &rheology (RH; doc/INPUT.md "&rheology"): afresh = 1
+  ! when the deck's window begins after the checkpoint's step (the statistics start from zero,
+  ! whatever the file holds); else the file must hold accumulators taken over the same window, with
+  ! the same pair and contact shells, the same records (series_every; < 0: not checked) and the
+  ! same bins. A fault sets message, and for a variable of the deck its group and name.
+  subroutine rheology_verdict(file, rh, series_every, message, group, variable, afresh)
+    integer(HID_T), intent(in) :: file
+    type(rheology_t), intent(in) :: rh
+    integer, intent(in) :: series_every
+    character(len=*), intent(out) :: message, group, variable
+    integer, intent(out) :: afresh
+    integer :: rank, err, sampling(1)
+    integer(HSIZE_T) :: dims(2)
+    real(dp) :: shells(2)
+    character(len=200) :: text
+    group = ''
+    variable = ''
+    call compare_window(file, rh, message, afresh)
+    if (afresh == 1 .or. len_trim(message) > 0) return
+    if (.not. has_object(file, 'rheology')) then
+      message = 'missing: the checkpoint was written by a run without &rheology, and this deck''s averaging '// &
+                'window has begun (set discard_strain to begin after the checkpoint''s step)'
+      return
+    end if
+    if (has_attribute(file, 'rheology_shells')) then
+      call read_attribute(file, 'rheology_shells', shells, err)
+      if (err == 0 .and. abs(shells(1) - rh%r_outer) > 1.0e-12_dp * rh%r_outer) then
+        group = 'rheology'
+        variable = 'pair_shell'
+        write(text, '(a,f0.6,a,f0.6,a)') 'the checkpoint''s accumulators count pairs at r < ', shells(1), &
+             ' a, this deck at r < ', rh%r_outer, ' a'
+      else if (err == 0 .and. abs(shells(2) - rh%r_contact) > 1.0e-12_dp * rh%r_contact) then
+        group = 'rheology'
+        variable = 'contact_shell'
+        write(text, '(a,f0.6,a,f0.6,a)') 'the checkpoint''s accumulators count contacts at r < ', shells(2), &
+             ' a, this deck at r < ', rh%r_contact, ' a'
+      end if
+      if (len_trim(group) > 0) then
+        message = trim(text)//': counts begun cannot be changed (or set discard_strain to begin after the '// &
+                  'checkpoint''s step: the statistics then start afresh)'
+        return
+      end if
+    end if
+    sampling = series_every
+    if (has_attribute(file, 'rheology_sampling')) call read_attribute(file, 'rheology_sampling', sampling, err)
+    if (series_every > 0) then
+      if (sampling(1) /= series_every) then
+        group = 'output'
+        variable = 'series_every'
+        write(message, '(a,i0,a,i0,a)') 'the checkpoint''s statistics take every ', sampling(1), &
+             '-th step, this deck every ', series_every, &
+             '-th: an averaging window begun keeps its records (or set &rheology discard_strain to begin after '// &
+             'the checkpoint''s step)'
+        return
+      end if
+    end if
+    call dataset_dims(file, 'rheology/accumulators', rank, dims)
+    if (rank /= 2 .or. dims(1) /= size(rheo_state(rh)) .or. dims(2) /= 1) &
+      message = 'does not fit this deck''s &rheology (blocks, profile_bins or angle_bins differ)'
+  end subroutine rheology_verdict
 
   ! Restore STATE from the checkpoint PATH (checked before by checkpoint_check). The statistics of
   ! &rheology must fit the run's (a checkpoint without them, or of another size, stops the run),
@@ -315,11 +597,11 @@ contains
     logical, intent(out) :: statistics_afresh
     PetscErrorCode, intent(out) :: ierr
     PetscViewer :: viewer
-    integer :: k, rank, err, stars(1), info, afresh(1)
+    integer :: k, err, stars(1), info, afresh(1)
     real(dp) :: delta(1)
     integer(HID_T) :: file
-    integer(HSIZE_T) :: dims(2)
     character(len=600) :: message
+    character(len=40) :: group, variable
     real(dp), allocatable :: buffer(:, :)
     Vec, allocatable :: fields(:)
     ! the Lees-Edwards offset, and how many provisional velocities the file holds (none in a
@@ -359,20 +641,12 @@ contains
       message = ''
       afresh = 0
       if (is_root()) then
+        ! (checked before any work by checkpoint_check; here the verdict decides afresh)
         call h5fopen_f(trim(path), H5F_ACC_RDONLY_F, file, err)
-        if (.not. has_object(file, 'rheology')) then
-          message = 'missing: the checkpoint was written by a run without &rheology'
-        else
-          call compare_window(file, state%rh, message, afresh(1))
-          if (len_trim(message) == 0 .and. afresh(1) == 0) then
-            call dataset_dims(file, 'rheology/accumulators', rank, dims)
-            if (rank /= 2 .or. dims(1) /= size(buffer, 1) .or. dims(2) /= 1) then
-              message = 'does not fit this deck''s &rheology (blocks, profile_bins or angle_bins differ)'
-            else
-              call read_dataset(file, 'rheology/accumulators', buffer, err)
-              if (err /= 0) message = 'cannot be read'
-            end if
-          end if
+        call rheology_verdict(file, state%rh, -1, message, group, variable, afresh(1))
+        if (len_trim(message) == 0 .and. afresh(1) == 0) then
+          call read_dataset(file, 'rheology/accumulators', buffer, err)
+          if (err /= 0) message = 'cannot be read'
         end if
         call h5fclose_f(file, err)
       end if

@@ -1,5 +1,6 @@
 ! Small helpers over HDF5's Fortran API: attributes, and 2-D datasets written whole and read back
-! with their shape checked (particles, contact history).
+! with their shape checked (particles, contact history). The datasets carry HDF5's Fletcher-32
+! checksum, so a damaged file fails its read instead of being used.
 ! Used by one rank at a time (series.h5 and checkpoint attributes are written by rank 0);
 ! parallel field I/O goes through PETSc's HDF5 viewer instead.
 module mod_h5util
@@ -8,7 +9,7 @@ module mod_h5util
   implicit none
   private
   public :: h5util_init, write_attribute, read_attribute, has_attribute, has_object
-  public :: write_string_attribute, write_dataset, read_dataset, dataset_dims
+  public :: write_string_attribute, read_string_attribute, write_dataset, read_dataset, dataset_dims
   public :: HID_T, HSIZE_T
 
   interface write_attribute
@@ -77,18 +78,53 @@ contains
     integer, intent(out) :: err
     integer(HID_T) :: space, attr, strtype
     integer(HSIZE_T) :: dims(1)
+    character(len=max(1, len_trim(text))) :: stored      ! '' is stored as one blank
+    stored = text
     dims(1) = 1
     call h5tcopy_f(H5T_FORTRAN_S1, strtype, err)
-    call h5tset_size_f(strtype, int(max(1, len_trim(text)), kind=8), err)
+    call h5tset_size_f(strtype, int(len(stored), kind=8), err)
     call h5screate_f(H5S_SCALAR_F, space, err)
     call h5acreate_f(loc, name, strtype, space, attr, err)
     if (err == 0) then
-      call h5awrite_f(attr, strtype, trim(text), dims, err)
+      call h5awrite_f(attr, strtype, stored, dims, err)
       call h5aclose_f(attr, err)
     end if
     call h5sclose_f(space, err)
     call h5tclose_f(strtype, err)
   end subroutine write_string_attribute
+
+  ! A fixed-length string attribute (write_string_attribute) into text, blank-padded; err /= 0 if
+  ! it is absent, not a fixed-length string or longer than text.
+  subroutine read_string_attribute(loc, name, text, err)
+    integer(HID_T), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    character(len=*), intent(out) :: text
+    integer, intent(out) :: err
+    integer(HID_T) :: attr, ftype, mtype
+    integer(SIZE_T) :: length
+    integer(HSIZE_T) :: dims(1)
+    integer :: class, e, k
+    text = ''
+    call h5aopen_f(loc, name, attr, err)
+    if (err /= 0) return
+    call h5aget_type_f(attr, ftype, err)
+    call h5tget_class_f(ftype, class, e)
+    call h5tget_size_f(ftype, length, e)
+    call h5tclose_f(ftype, e)
+    if (err /= 0 .or. class /= H5T_STRING_F .or. length > len(text) .or. length < 1) then
+      err = -1
+    else
+      dims(1) = 1
+      call h5tcopy_f(H5T_FORTRAN_S1, mtype, err)
+      call h5tset_size_f(mtype, length, e)
+      call h5aread_f(attr, mtype, text(1:length), dims, err)
+      call h5tclose_f(mtype, e)
+      do k = 1, int(length)
+        if (text(k:k) == achar(0)) text(k:k) = ' '
+      end do
+    end if
+    call h5aclose_f(attr, e)
+  end subroutine read_string_attribute
 
   logical function has_attribute(loc, name)
     integer(HID_T), intent(in) :: loc
@@ -175,11 +211,19 @@ contains
     integer, intent(out) :: err
     real(dp), intent(in), optional :: real_values(:, :)
     integer, intent(in), optional :: int_values(:, :)
-    integer(HID_T) :: space, dset
+    integer(HID_T) :: space, dset, plist
     integer :: e
     call h5screate_simple_f(2, dims, space, err)
     if (err /= 0) return
-    call h5dcreate_f(loc, name, dtype, space, dset, err)
+    ! one chunk with HDF5's Fletcher-32 checksum, which every read verifies (a dataset of no
+    ! elements has no data to protect, and cannot be chunked)
+    call h5pcreate_f(H5P_DATASET_CREATE_F, plist, err)
+    if (err == 0 .and. all(dims > 0)) then
+      call h5pset_chunk_f(plist, 2, dims, err)
+      if (err == 0) call h5pset_fletcher32_f(plist, err)
+    end if
+    if (err == 0) call h5dcreate_f(loc, name, dtype, space, dset, err, plist)
+    call h5pclose_f(plist, e)
     if (err == 0) then
       if (present(real_values)) call h5dwrite_f(dset, dtype, real_values, dims, err)
       if (present(int_values)) call h5dwrite_f(dset, dtype, int_values, dims, err)

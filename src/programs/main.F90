@@ -106,6 +106,17 @@ program fdsusp
     call particles_load(cfg, parts)              ! the deck's or the position file's
   end if
   has_particles = parts%n > 0
+  ! lubrication dynamics moves spheres and nothing else: a file or packing that yields none leaves
+  ! nothing to compute (the deck itself is checked in mod_params::validate_particles)
+  if (.not. cfg%resolved .and. .not. has_particles) then
+    if (len_trim(cfg%position_file) > 0) then
+      call input_error(cfg%deck_file, 'particles', 'position_file', '"'//trim(cfg%position_file)// &
+           '" holds no particles: &fluid model = ''none'' (lubrication dynamics) has nothing to compute')
+    else
+      call input_error(cfg%deck_file, 'particles', 'solid_fraction', 'packs no particles in this box: '// &
+           '&fluid model = ''none'' (lubrication dynamics) has nothing to compute')
+    end if
+  end if
   ! sliding periodic boundaries in y (lubrication dynamics): the offset starts at 0, a restart
   ! reads it from the checkpoint
   if (cfg%lees_edwards) le = le_create(cfg%box, cfg%shear_rate, 0.0_dp)
@@ -155,7 +166,7 @@ program fdsusp
   step = 0
   time = 0.0_dp
   if (restarting) then
-    call checkpoint_check(restart, cfg, parts%n, step, time)
+    call checkpoint_check(restart, cfg, parts%n, step, time, rh)   ! rh: absent unless allocated
     write(text, '(a,i0,a,es12.5)') 'restart from '//trim(restart)//' at step ', step, ', time ', time
     call log_line(text)
   end if
@@ -223,7 +234,7 @@ program fdsusp
     if (fl%solver(FIELD_P)%direct) then
       PetscCallA(solver_create(grid, FIELD_P, 1.0e-8_dp, 0.0_dp, yardstick, ierr, krylov=.true.))
       PetscCallA(solver_cold_solve(yardstick, 1.0e-8_dp, cold_seconds, cold_its, ierr))
-      call solver_destroy(yardstick, ierr)
+      PetscCallA(solver_destroy(yardstick, ierr))
     else
       PetscCallA(solver_cold_solve(fl%solver(FIELD_P), 1.0e-8_dp, cold_seconds, cold_its, ierr))
     end if

@@ -12,6 +12,7 @@
 #include <libgen.h>
 #include <stdlib.h>
 #include <sys/types.h>
+#include <dirent.h>
 
 static volatile sig_atomic_t stop_signal = 0;
 
@@ -50,6 +51,14 @@ int fdsusp_publish_file(const char *tmp, const char *final)
   return 0;
 }
 
+/* What this process created for the output directory, so that a run refused before it wrote
+ * anything there leaves nothing behind (fdsusp_release_directory): the directory itself and the
+ * topmost of its parents that did not exist before (created_top, "" when the directory existed),
+ * and whether the lock file is new (created_lock). */
+static char created_dir[4096] = "";
+static char created_top[4096] = "";
+static int created_lock = 0;
+
 /* Create a directory (and its parents) if missing; 0 on success or errno. */
 int fdsusp_make_directory(const char *path)
 {
@@ -60,12 +69,38 @@ int fdsusp_make_directory(const char *path)
   for (char *p = buf + 1; *p; ++p) {
     if (*p == '/') {
       *p = '\0';
-      if (mkdir(buf, 0775) != 0 && errno != EEXIST) return errno;
+      if (mkdir(buf, 0775) == 0) {
+        if (created_top[0] == '\0') strcpy(created_top, buf);
+      } else if (errno != EEXIST) {
+        return errno;
+      }
       *p = '/';
     }
   }
-  if (mkdir(buf, 0775) != 0 && errno != EEXIST) return errno;
+  if (mkdir(buf, 0775) == 0) {
+    if (created_top[0] == '\0') strcpy(created_top, buf);
+  } else if (errno != EEXIST) {
+    return errno;
+  }
+  if (created_top[0] != '\0') strcpy(created_dir, buf);
   return 0;
+}
+
+/* 1 if the directory holds nothing but the lock file, else 0. */
+static int holds_only_lock(const char *dir)
+{
+  DIR *d = opendir(dir);
+  struct dirent *e;
+  int only = 1;
+  if (!d) return 0;
+  while ((e = readdir(d)) != NULL) {
+    if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0 || strcmp(e->d_name, ".fdsusp.lock") == 0)
+      continue;
+    only = 0;
+    break;
+  }
+  closedir(d);
+  return only;
 }
 
 /* 0 if the directory can be written (a probe file is created and removed), else errno. */
@@ -92,6 +127,7 @@ int fdsusp_probe_directory(const char *path)
  * -1: a live process holds it (`previous` names it); -2: the file system offers no locks (the
  * run goes on unprotected); else the errno of creating the lock file. */
 static int lock_fd = -1;
+static char lock_dir[4096] = "";
 
 static void read_holder(int fd, char *text, int len)
 {
@@ -109,7 +145,12 @@ int fdsusp_lock_directory(const char *dir, char *previous, int len)
   previous[0] = '\0';
   if (lock_fd >= 0) return 0;
   snprintf(path, sizeof(path), "%s/.fdsusp.lock", dir);
-  fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  fd = open(path, O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd >= 0) {
+    created_lock = 1;
+  } else if (errno == EEXIST) {
+    fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  }
   if (fd < 0) return errno;
   memset(&fl, 0, sizeof(fl));
   fl.l_type = F_WRLCK;
@@ -118,6 +159,7 @@ int fdsusp_lock_directory(const char *dir, char *previous, int len)
   fl.l_len = 0;                                /* the whole file */
   if (fcntl(fd, F_SETLK, &fl) != 0) {
     e = errno;
+    created_lock = 0;                          /* not ours to remove */
     if (e == EACCES || e == EAGAIN) {
       read_holder(fd, previous, len);
       e = -1;
@@ -137,15 +179,38 @@ int fdsusp_lock_directory(const char *dir, char *previous, int len)
     return e;
   }
   fsync(fd);
+  snprintf(lock_dir, sizeof(lock_dir), "%s", dir);
   lock_fd = fd;                                /* kept open: closing any descriptor of the file drops the lock */
   return 0;
 }
 
 /* A clean end: empty the lock file (so the next run does not report a run that ended without
- * releasing it) and drop the lock. Nothing when no lock is held. */
+ * releasing it) and drop the lock. Nothing when no lock is held.
+ * A run that wrote nothing into its output directory (one refused at input checking, e.g. a bad
+ * checkpoint, position file or table) leaves nothing it created: the lock file if it made it, and
+ * the directory and the parents it made if they hold nothing else (removed while the lock is
+ * still held, so no other run is using them; rmdir refuses a directory that is not empty). */
 void fdsusp_release_directory(void)
 {
+  char path[4200], parent[4096];
   if (lock_fd < 0) return;
+  if (created_lock && holds_only_lock(lock_dir)) {
+    snprintf(path, sizeof(path), "%s/.fdsusp.lock", lock_dir);
+    unlink(path);
+    if (created_dir[0] != '\0' && strcmp(created_dir, lock_dir) == 0) {
+      /* the directory, then each parent this process made, up to the topmost */
+      snprintf(parent, sizeof(parent), "%s", created_dir);
+      while (rmdir(parent) == 0 && strcmp(parent, created_top) != 0) {
+        char *slash = strrchr(parent, '/');
+        if (slash == NULL || slash == parent) break;
+        *slash = '\0';
+      }
+    }
+    close(lock_fd);
+    lock_fd = -1;
+    created_lock = 0;
+    return;
+  }
   if (ftruncate(lock_fd, 0) == 0) fsync(lock_fd);
   close(lock_fd);
   lock_fd = -1;

@@ -2,7 +2,10 @@
 names the file and the item at fault (group and variable for a deck). 'Before any work' is
 checked by the absence of any time step in the log and of series.h5 in the output directory.
 A deck that runs but is known to be inaccurate (close free pairs lagging, doc/VALIDATION.md §4.4)
-is warned once before the first step."""
+is warned once before the first step.
+A run refused at input checking leaves nothing it created: an output directory (and its parents)
+made by the refused run is removed again when it holds nothing but the lock file, so a fresh
+&output directory does not exist after the refusal (exact check, no tolerance)."""
 import os
 import sys
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
@@ -28,6 +31,9 @@ LD = GOOD.replace('cells_per_radius = 5', "cells_per_radius = 5, y_boundary = 'l
     .replace('reynolds = 0.01', "model = 'none'") + '&particles number = 1, position(:,1) = 1.6, 1.6, 1.6 /\n'
 T.run(T.write_deck(d, 'ld.nml', LD), d)
 os.rename(os.path.join(d, 'out'), os.path.join(d, 'ld_run'))
+# a position file without particles (N = 0): nothing for lubrication dynamics to move
+with T.h5py.File(os.path.join(d, 'empty_positions.h5'), 'w') as f:
+    f.create_dataset('particles/position', data=T.np.zeros((0, 3)))
 
 cases = [
     # name, deck text (None: do not write), extra args, words the message must contain
@@ -132,6 +138,9 @@ cases = [
      ['ld_run/checkpoint.h5', 'fluid_resolved', '&fluid model']),
     ('walls restart from a Lees-Edwards checkpoint', LD.replace("y_boundary = 'lees-edwards'", "y_boundary = 'walls'"),
      ['-restart', 'ld_run/checkpoint.h5'], ['ld_run/checkpoint.h5', 'lees_edwards_offset', 'y_boundary']),
+    ('lubrication dynamics with an empty position file',
+     LD.replace('&particles number = 1, position(:,1) = 1.6, 1.6, 1.6 /', "&particles position_file = 'empty_positions.h5' /"),
+     [], ['bad.nml', '&particles', 'position_file', 'empty_positions.h5', 'holds no particles']),
     ('averaging blocks without records', GOOD + '&particles solid_fraction = 0.1 /\n'
      '&rheology average_strain = 0.01, blocks = 5 /\n', [],
      ['bad.nml', '&rheology', 'average_strain', 'series_every']),
@@ -149,6 +158,25 @@ for name, text, args, words in cases:
     T.check(all(w in err for w in words), '%s: the message names %s' % (name, ', '.join(words)))
     T.check(not any(l.startswith('step ') for l in out.splitlines()) and
             not os.path.exists(os.path.join(d, 'out', 'series.h5')), '%s: no time step was taken' % name)
+
+# A refused run leaves no directory it made: a fresh &output directory (two levels deep) of a run
+# refused for its checkpoint, its position file or its lubrication table is gone afterwards; an
+# existing directory stays (its lock file emptied: tests/regression/test_output_lock.py).
+fresh_cases = [
+    ('missing checkpoint', GOOD, ['-restart', 'nowhere.h5']),
+    ('truncated checkpoint', GOOD, ['-restart', 'truncated.h5']),
+    ('empty position file', LD.replace('&particles number = 1, position(:,1) = 1.6, 1.6, 1.6 /',
+                                       "&particles position_file = 'empty_positions.h5' /"), []),
+    ('table of another fictitious domain', GOOD + '&particles number = 1, position(:,1) = 1.6, 1.6, 1.6, '
+     'radius_offset = 0.3 /\n', []),
+]
+for name, text, args in fresh_cases:
+    T.write_deck(d, 'fresh.nml', text.replace("directory = 'out'", "directory = 'fresh/run'"))
+    status, out, err = T.run('fresh.nml', d, args=args, expect_ok=False)
+    T.check(status == 2 and not os.path.exists(os.path.join(d, 'fresh')),
+            'refused (%s, status %d) into a fresh directory: the directory it made is removed (%s)'
+            % (name, status, os.listdir(os.path.join(d, 'fresh', 'run')) if os.path.isdir(os.path.join(d, 'fresh', 'run'))
+               else 'gone' if not os.path.exists(os.path.join(d, 'fresh')) else 'fresh/ left'))
 
 # A deck that runs but lets close free pairs lag (doc/VALIDATION.md §4.4) is warned once, before the
 # first step; at dt = 1e-3 (dt^2/(Re Delta^2) = 1.6e-3 at a/Delta = 4) it is not.
