@@ -44,6 +44,7 @@ module mod_checkpoint
   use mod_h5util, only: write_attribute, read_attribute, write_string_attribute, has_object, dataset_dims, &
                         write_dataset, read_dataset, has_attribute
   use mod_os_services, only: publish_file
+  use mod_file_services, only: require_free_space, write_failure_cause, errno_text, remove_file
   use mod_errors, only: is_root, abort_run, file_error_from_root, input_error, log_line
   use mod_restart_deck, only: deck_record, deck_compare
   use mod_particles, only: particles_t
@@ -85,15 +86,27 @@ contains
     integer :: err, k, stars, unsigned
     logical :: failed
     character(len=400) :: item, message
-    character(len=1100) :: tmp
-    character(len=16) :: code
+    character(len=1100) :: tmp, dir
+    integer :: slash
+    PetscInt :: length
+    real(dp) :: bytes
     Vec, allocatable :: fields(:)
     real(dp), allocatable :: statistics(:)
 
     tmp = trim(path)//'.tmp'
+    slash = index(path, '/', back=.true.)
+    dir = path(1:max(slash - 1, 1))
+    if (slash == 0) dir = '.'
     stars = 0
     if (associated(state%fl)) then
       fields = field_vectors(state, .true.)
+      ! a full disk must stop every rank here, before the parallel write (mod_file_services)
+      bytes = 0.0_dp
+      do k = 1, size(fields)
+        PetscCall(VecGetSize(fields(k), length, ierr))
+        bytes = bytes + 8.0_dp * length
+      end do
+      call require_free_space(dir, bytes, tmp)
       PetscCall(PetscViewerHDF5Open(PETSC_COMM_WORLD, trim(tmp), FILE_MODE_WRITE, viewer, ierr))
       do k = 1, size(fields)
         PetscCall(VecView(fields(k), viewer, ierr))
@@ -103,13 +116,13 @@ contains
     else if (is_root()) then
       ! no fields: rank 0 makes the file alone
       call h5fcreate_f(trim(tmp), H5F_ACC_TRUNC_F, file, err)
-      if (err /= 0) call abort_run('cannot create '//trim(tmp))
+      if (err /= 0) call write_failed('cannot be created')
       call h5fclose_f(file, err)
     end if
 
     if (is_root()) then
       call h5fopen_f(trim(tmp), H5F_ACC_RDWR_F, file, err)
-      if (err /= 0) call abort_run('cannot reopen '//trim(tmp)//' to complete the checkpoint')
+      if (err /= 0) call write_failed('cannot be reopened to complete the checkpoint')
       failed = .false.
       ! the fields PETSc wrote (the only datasets so far): their checksums
       unsigned = 0
@@ -149,20 +162,26 @@ contains
         statistics = rheo_state(state%rh)
         call h5gcreate_f(file, 'rheology', group, err)
         if (err == 0) call write_dataset(group, 'accumulators', reshape(statistics, [size(statistics), 1]), err)
-        if (err /= 0) call abort_run('cannot write /rheology/accumulators to '//trim(tmp))
+        if (err /= 0) call write_failed('cannot take /rheology/accumulators')
         call h5gclose_f(group, err)
       end if
       call h5fclose_f(file, err)
-      if (failed .or. err /= 0) call abort_run('cannot write the attributes of '//trim(tmp))
+      if (failed .or. err /= 0) call write_failed('cannot take its attributes (or closing it failed)')
       err = publish_file(tmp, path)
-      if (err /= 0) then
-        write(code, '(i0)') err
-        call abort_run('cannot rename '//trim(tmp)//' to '//trim(path)//' (errno '//trim(code)//')')
-      end if
+      if (err /= 0) call write_failed('cannot be renamed to '//trim(path)//' ('//errno_text(err)//')')
     end if
     call MPI_Barrier(PETSC_COMM_WORLD, ierr)
 
   contains
+
+    ! A write of the checkpoint failed (rank 0): the partial .tmp goes, the last checkpoint stays.
+    subroutine write_failed(what)
+      character(len=*), intent(in) :: what
+      integer :: e
+      e = remove_file(tmp)
+      call abort_run(trim(tmp)//' '//what//': '//write_failure_cause(dir, 0.0_dp)//'; the last checkpoint, '// &
+                     trim(path)//', is kept')
+    end subroutine write_failed
 
     subroutine put_int(name, values)
       character(len=*), intent(in) :: name
@@ -332,7 +351,8 @@ contains
       if (rank == 3) call h5sget_simple_extent_dims_f(space, dims, maxdims, err)
       call h5sclose_f(space, err)
       call h5dclose_f(dset, err)
-      if (rank /= 3 .or. any(dims /= int([cfg%cells(3), cfg%cells(2), cfg%cells(1)], HSIZE_T))) then
+      ! PETSc writes nz x ny x nx (C order), which HDF5's Fortran API reports reversed: nx, ny, nz
+      if (rank /= 3 .or. any(dims /= int(cfg%cells, HSIZE_T))) then
         item = '/'//trim(field_datasets(d)); message = 'dataset of the wrong shape for this grid'
       end if
     end do

@@ -218,8 +218,17 @@ contains
     character(len=*), intent(in) :: name
     real(dp), intent(in) :: values(:, :)
     integer :: err
+    character(len=1024) :: file
+    integer(SIZE_T) :: length
+    integer :: slash
     call write_dataset(group, name, values, err)
-    if (err /= 0) call abort_run('cannot write /particles/'//name)
+    if (err /= 0) then
+      file = ''
+      call h5fget_name_f(group, file, length, err)
+      slash = index(file, '/', back=.true.)
+      call abort_run(trim(file)//' cannot take /particles/'//name//': '// &
+                     write_failure_cause(file(1:max(slash - 1, 1)), 8.0_dp * size(values)))
+    end if
   end subroutine write_matrix
 
   ! A write of a particle file failed: stop the run naming the file and the cause.

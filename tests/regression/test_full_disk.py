@@ -11,7 +11,7 @@ metadata, so a failure there would leave the other ranks waiting.
 How: the run's directory is a small tmpfs mounted in a private mount namespace (`unshare -m`, or
 `unshare -r -m` for a user that is not root), at sizes chosen so that the disk fills in different
 files: the fluid-free run's series (1.5 and 2.5 MB), a 2-rank DNS's field snapshots and
-checkpoints (4 and 7 MB)."""
+checkpoints (5 and 9 MB)."""
 import os
 import shutil
 import subprocess
@@ -75,7 +75,7 @@ def check_stop(what, deck_text, size, np_ranks, reference):
             'run\'s first records' % (what, size, k, len(same), len(reference) - 1))
 
 
-for what, text, ranks, sizes in (('fluid-free', LD, 1, ('1500k', '2500k')), ('DNS', DNS, 2, ('4000k', '7000k'))):
+for what, text, ranks, sizes in (('fluid-free', LD, 1, ('1500k', '2500k')), ('DNS', DNS, 2, ('5000k', '9000k'))):
     ref = T.scratch('full_disk_ref_' + what)
     T.run(T.write_deck(ref, 'r.nml', text), ref, np_ranks=ranks)
     reference = T.series(os.path.join(ref, 'out'))
