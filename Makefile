@@ -76,7 +76,7 @@ LIB_OBJ := $(call obj,$(SRC_F90) $(SRC_C))
 # tests link only these, so they run without PETSc.
 PURE_F90 := $(wildcard src/kernels/*.F90)
 PURE_OBJ := $(call obj,$(PURE_F90))
-# pairtraj shares only kinds, vector algebra and the resistance modules with the solver (design.md).
+# pairtraj shares only kinds, vector algebra and the resistance modules with the solver (doc/DESIGN.md "Modules").
 RESISTANCE_F90 := $(addprefix src/kernels/,kinds.F90 vector.F90 resistance_table.F90 pair_resistance.F90 \
                   wall_resistance.F90 resistance_blocks.F90 pair_mobility.F90)
 PAIRTRAJ_OBJ := $(call obj,$(REF_F90) $(RESISTANCE_F90))
@@ -153,11 +153,11 @@ check: all
 bench: all
 	@bash scripts/bench.sh
 
-# The extreme scenes of issue 8 in full (input/extremes, 5 strains each; doc/VALIDATION.md §6)
+# The extreme scenes in full (input/extremes, 5 strains each; doc/VALIDATION.md §6)
 extremes: all
 	$(PYTHON) scripts/extremes.py --json out/extremes/extremes.json
 
-# Speed against accuracy (issue 7), one knob at a time: the suspension scene (error of each
+# Speed against accuracy, one knob at a time: the suspension scene (error of each
 # setting against the finest, CPU s per strain; doc/figures/tradeoff.png; 8 CPU minutes, 2026-11-26)
 # and the pair test (resistance against exact theory, CPU s per run; doc/figures/tradeoff_pair.png,
 # about 3 CPU minutes): ~6 min on 2 cores (2026-11-26). Tables in doc/BENCHMARKS.md §9.

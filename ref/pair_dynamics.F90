@@ -1,7 +1,7 @@
 ! Relative motion of two equal, inertialess, force- and torque-free spheres in unbounded simple
 ! shear u = (gamma_dot y, 0, 0), with the exact two-sphere hydrodynamics (mod_pair_resistance,
 ! mod_resistance_blocks) and the contact law of the reference paper (Gallier et al. 2014 JFM
-! section 2.4, eqs 2.16-2.24; method.md sections 1.7 and 4). Units: a = eta = gamma_dot = 1.
+! section 2.4, eqs 2.16-2.24; doc/METHOD.md §4 and §9). Units: a = eta = gamma_dot = 1.
 !
 ! State y = (r, Upsilon): r = x_2 - x_1 (units of a) and the tangential spring elongation
 ! Upsilon (JFM 2.20), integrated only while the rough surfaces touch. The spheres sit at
@@ -11,7 +11,7 @@
 ! F^h + F^c = 0 (JFM 2.5, 2.6) with F^h = R_FU . (U^inf - U) + R_FE : E^inf (JFM 2.10):
 !   R_FU . w = -(R_FE : E + F^c),  w = U^inf - U,
 ! solved by Cholesky (R_FU is symmetric positive definite, test_resistance_blocks). Using the full
-! 12x12 form rather than the 6-unknown symmetric reduction of method.md 4.1 keeps pairtraj on the
+! 12x12 form rather than the 6-unknown symmetric reduction of doc/METHOD.md §9.1 keeps pairtraj on the
 ! same blocks as the solver's lubrication correction; both are equivalent here.
 !
 ! Contact (force F^c on sphere 1 exerted by sphere 2, n = d = r/|r| from 1 to 2):
@@ -23,7 +23,7 @@
 !     U^s = (U_1 - U_2) - [(U_1 - U_2).n] n + a (Om_1 + Om_2) x n (JFM 2.21);
 !   Coulomb: |F_t| <= mu_d |F_n| (JFM 2.22), with the DEM return mapping after each step
 !     (Upsilon rescaled so that k_t |Upsilon| = mu_d |F_n|, i.e. |Upsilon| <= (7/2) mu_d |delta'|),
-!     Upsilon kept in the tangent plane, and reset to 0 when the contact opens (method.md 1.7);
+!     Upsilon kept in the tangent plane, and reset to 0 when the contact opens (doc/METHOD.md §4.2);
 !   torques T^c_1 = T^c_2 = a n x F^c (JFM 2.23); sphere 2 receives -F^c.
 ! Stresslets: S^h from R_SU . w + R_SE : E (JFM 2.13, mod_resistance_blocks pair_stresslets), and
 ! S^c = (1/2)(F^c r/2 + r/2 F^c) per sphere (JFM 2.24, sphere 1: F^c_1 and r = x_2 - x_1; sphere 2
@@ -170,7 +170,7 @@ contains
     end if
   end subroutine pair_rates
 
-  !> DEM return mapping after an accepted step (method.md 1.7): keep Upsilon in the tangent
+  !> DEM return mapping after an accepted step (doc/METHOD.md §4.2): keep Upsilon in the tangent
   !> plane with its length, cap it at the Coulomb limit, reset it when the contact is open.
   !> Returns changed = .true. if the state was modified.
   subroutine project_spring(model, y, changed)

@@ -4,7 +4,7 @@
 !
 ! Why an explicit method (doc/PAIRTRAJ_INPUT.md, "integrator"): the pair equations are only
 ! mildly stiff. Their fastest time scales are the contact relaxations, tau_n ~ eps_bar/3 (normal,
-! method.md 1.7) and tau_t ~ R_t/k_t ~ 1e-4..1e-2 (tangential spring) in units of 1/gamma_dot,
+! doc/METHOD.md §4.3) and tau_t ~ R_t/k_t ~ 1e-4..1e-2 (tangential spring) in units of 1/gamma_dot,
 ! against O(10) for the whole passage: a stiffness ratio of 1e2..1e4. An explicit 5th-order
 ! method then costs a few thousand stability-limited steps during contact (well under a second)
 ! and needs no Jacobian of a right-hand side that contains a Coulomb cap and Hertz

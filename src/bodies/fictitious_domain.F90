@@ -1,10 +1,10 @@
-! The fictitious domain: inertialess rigid spheres in the MAC-grid fluid (method.md §1.4-1.6,
-! with the correction of §1.5b).
+! The fictitious domain: inertialess rigid spheres in the MAC-grid fluid (doc/METHOD.md §3,
+! with the relaxed constraint of §3.3).
 !
 ! Lambda is stored as the force density Lambda = rho*lambda on the u, v, w faces (fdsusp units:
 ! rho = Re). One time step, given the geometry at X^n:
 !   geometry   solid fraction alpha of every face control volume for a sphere of radius
-!              a + radius_offset*h (§1.5b: the relaxed constraint shrinks the effective sphere);
+!              a + radius_offset*h (§3.3: the relaxed constraint shrinks the effective sphere);
 !              each face goes to the particle covering most of it (one owner, so sum alpha <= 1),
 !              and where two inflated spheres overlap (gaps below 2 radius_offset) the owner's
 !              weight is alpha_1 - alpha_2, the excess of its cover over the runner-up's: the gap
@@ -15,13 +15,13 @@
 !              the discrete rigid-body matrix M_p = sum_f w g g^T dV with g the 6-vector such that
 !              (U + Omega x r)_c = g . (U, Omega), i.e. g = (e_c, r x e_c).
 !   fluid      the projection step with Lambda^n as a body force (mod_fluid) -> u~.
-!   particles  beta M U = beta b(u~) - m(Lambda^n) + F_ext    (method.md eq. (1) with the weights)
+!   particles  beta M U = beta b(u~) - m(Lambda^n) + F_ext    (doc/METHOD.md eq. (1))
 !              b = sum_f w u~_c g dV,  m = sum_f Lambda^n_f/(1+gamma) g dV; later models add their
 !              stiffness and forces to the 6N system (mod_particle_solver).
 !              Lambda^{n+1} = [Lambda^n + beta alpha (g.U - u~)]/(1 + gamma) on owned faces, 0 elsewhere;
 !              u^{n+1} = u~ + (Lambda^{n+1} - Lambda^n)/beta.
 !   moments    F = -sum Lambda e_c dV, T = -sum r x Lambda e_c dV,
-!              S = -1/2 sum Lambda (r e_c + e_c r) dV - (sum_cells alpha p dV) I   (§1.6: the
+!              S = -1/2 sum Lambda (r e_c + e_c r) dV - (sum_cells alpha p dV) I   (§3.7: the
 !              trace of the traction moment needs the interior pressure).
 ! Particle data is replicated; each rank works on the faces it owns and the moments are summed
 ! over ranks, so spheres cross processor boundaries freely and the result does not depend on the
@@ -57,7 +57,7 @@ module mod_fictitious_domain
 
   type :: fictitious_domain_t
     real(dp) :: beta = 0.0_dp           ! rho/dt = Re/dt
-    real(dp) :: kappa = 0.5_dp          ! relaxation constant of §1.5b
+    real(dp) :: kappa = 0.5_dp          ! relaxation constant of doc/METHOD.md §3.3
     real(dp) :: radius_offset = 0.38_dp ! in grid cells
     real(dp) :: eta = 1.0_dp
     Vec :: lambda(3)                    ! Lambda = rho*lambda on the u, v, w faces
@@ -163,7 +163,7 @@ contains
   ! paper scene), the sphere computes their alphas there itself, with the very arithmetic each
   ! rival's own visit uses (the same unwrapped index, the same expressions), so every sphere
   ! takes the same decision: the largest alpha owns the unknown (ties to the lower index) with
-  ! weight alpha - the runner-up's. No grid-sized ownership arrays, no second pass (issue 31: the
+  ! weight alpha - the runner-up's. No grid-sized ownership arrays, no second pass (before 2026-11-26 the
   ! geometry was half of the paper scene's step).
   subroutine fictitious_domain_geometry(grid, fd, parts)
     type(grid_t), intent(in) :: grid
@@ -228,7 +228,7 @@ contains
     dv = h**3
     centre = parts%position(:, q)
     ! The control volume of unknown i spans (i + stagger +- 1/2) h, so only |(i + stagger) h - x_d|
-    ! < R + h/2 can meet the sphere: the box below is that range, no wider (issue 7: the loops are
+    ! < R + h/2 can meet the sphere: the box below is that range, no wider (doc/BENCHMARKS.md §8: the loops are
     ! most of the geometry's cost). Each index is wrapped and tested for ownership once per axis.
     do d = 1, 3
       lo(d) = floor((centre(d) - radius) / h - stagger(d, c) - 0.5_dp)
@@ -253,7 +253,7 @@ contains
     if (radius > 0.5_dp * sqrt(3.0_dp) * h) inside2 = (radius - 0.5_dp * sqrt(3.0_dp) * h)**2
     ! room for every unknown of the box, once, so that the loop below stores without checks
     call reserve_faces(fd, fd%nf + product(hi - lo + 1))
-    ! gamma = kappa (1 - alpha) beta h^2 / eta (relaxation_gamma, method.md §1.5b), written out
+    ! gamma = kappa (1 - alpha) beta h^2 / eta (relaxation_gamma, doc/METHOD.md §3.3), written out
     gamma_unit = 0.0_dp
     sums6 = 0.0_dp
     if (c /= FIELD_P) then
@@ -456,7 +456,7 @@ contains
     end subroutine add_pair
   end subroutine find_rivals
 
-  ! The geometry at the new positions, and Lambda carried with the spheres that moved (issue 7,
+  ! The geometry at the new positions, and Lambda carried with the spheres that moved (doc/METHOD.md §3.6,
   ! doc/VALIDATION.md §5.3). Lambda is incremental: each step only corrects it, so left on the
   ! faces of X^n it lags a sphere that has moved on to X^{n+1}; the leading faces start from zero
   ! and relax over several steps, and a sphere crossing 0.08 cells per step loses 14 % of its
@@ -533,7 +533,7 @@ contains
   end subroutine fictitious_domain_follow
 
   ! The particle sub-problem after the fluid step, in three named parts that main.F90 calls in
-  ! turn (method.md §1.5 eq. (1), §1.5b):
+  ! turn (doc/METHOD.md §3.2 eq. (1), §3.3, §3.5):
   !   fictitious_domain_moments       b(u~) and m(Lambda^n) of every sphere, summed over ranks;
   !   fictitious_domain_solve_motion  the 6N system (rigid-body matrices, lubrication, contacts): U, Omega;
   !   fictitious_domain_update        Lambda^{n+1}, u^{n+1} = u~ + (Lambda^{n+1} - Lambda^n)/beta, and the
@@ -578,7 +578,7 @@ contains
     PetscCall(event_end(EVENT_MOMENTS, ierr))
   end subroutine fictitious_domain_moments
 
-  ! The velocities of the spheres: beta M U = beta b(u~) - m(Lambda^n) + F_ext (method.md eq. (1)
+  ! The velocities of the spheres: beta M U = beta b(u~) - m(Lambda^n) + F_ext (doc/METHOD.md eq. (1)
   ! with the weights), for free motion; prescribed, resistance and fixed motions set them.
   ! extra_force, extra_torque (3, n), optional: further given forces on the particles, added to
   ! the right-hand side next to external_force/external_torque (free and frozen motion).
@@ -627,7 +627,7 @@ contains
   ! Lambda^{n+1} = [Lambda^n + beta alpha (g.U - u~)]/(1 + gamma) on owned faces, 0 elsewhere;
   ! u^{n+1} = u~ + (Lambda^{n+1} - Lambda^n)/beta; the moments F = -sum Lambda e_c dV,
   ! T = -sum r x Lambda e_c dV, S = -1/2 sum Lambda (r e_c + e_c r) dV - (sum_cells alpha p dV) I
-  ! (§1.6). vel: u~ on entry, u^{n+1} on exit. lubrication, optional: its corrections are added to
+  ! (doc/METHOD.md §3.7). vel: u~ on entry, u^{n+1} on exit. lubrication, optional: its corrections are added to
   ! the resolved force, torque and stresslet, which then hold the total hydrodynamics. Collective.
   subroutine fictitious_domain_update(grid, fd, vel, pressure, parts, ierr, lubrication)
     type(grid_t), intent(in) :: grid
@@ -690,7 +690,7 @@ contains
       c = fd%run_comp(run)
       q = fd%run_part(run)
       if (c == FIELD_P) then
-        ! the interior pressure of §1.6
+        ! the interior pressure of doc/METHOD.md §3.7
         call pressure_run(p, grid%lo, grid%hi, f1 - f0 + 1, fd%f_ijk(:, f0:f1), fd%f_alpha(f0:f1), dv, sums(16, q))
       else if (removed) then
         call update_run(c, u(c)%ptr, lam(c)%ptr, grid%lo, grid%hi, f1 - f0 + 1, fd%f_ijk(:, f0:f1), &
@@ -725,7 +725,7 @@ contains
 
 
   ! The kernels below take one run (one sphere, one velocity component c) on plain arrays with the
-  ! bounds of the rank's part of the grid, so that the compiler sees fixed strides (issue 31).
+  ! bounds of the rank's part of the grid, so that the compiler sees fixed strides (doc/DESIGN.md "Fictitious domain", Face runs).
   ! g = (e_c, r x e_c) enters through its three non-zeros: 1 at idx(1), sgn(1) r(k(1)) at idx(2)
   ! and sgn(2) r(k(2)) at idx(3) (torque_arm, once per run).
 
@@ -855,7 +855,7 @@ contains
     end do
   end subroutine update_run
 
-  ! The interior pressure sum_cells alpha p dV of one run of cell centres (method.md §1.6).
+  ! The interior pressure sum_cells alpha p dV of one run of cell centres (doc/METHOD.md §3.7).
   subroutine pressure_run(p, lo, hi, nfaces, ijk, alpha, dv, integral)
     integer, intent(in) :: lo(3), hi(3), nfaces, ijk(3, nfaces)
     real(dp), intent(in) :: p(lo(1):hi(1), lo(2):hi(2), lo(3):hi(3)), alpha(nfaces), dv

@@ -1,4 +1,4 @@
-! The lubrication links of a step shared out over the ranks (issue 31). Every rank needs every
+! The lubrication links of a step shared out over the ranks (doc/DESIGN.md "Fictitious domain", Costs). Every rank needs every
 ! link (the 6N particle system is replicated), but evaluating them (resistance functions, the
 ! 12x12 blocks, their projection onto positive semi-definite matrices) is ~15 us per pair, and the
 ! paper scene has ~4000 pairs: each rank evaluates one contiguous share of the pair candidates

@@ -1,4 +1,4 @@
-! The owner of the implicit 6N particle system (method.md §1.5 eq. (1)) and of its solution. A
+! The owner of the implicit 6N particle system (doc/METHOD.md §3.2 eq. (1)) and of its solution. A
 ! caller (mod_fictitious_domain, mod_ld_motion) resets the system it holds here (%system), lets the
 ! kernels add their blocks to it in plain arrays (mod_particle_system's assembly:
 ! particle_system_reset, particle_system_add_diagonal, particle_system_add_pair, which
@@ -9,7 +9,7 @@
 ! couples the spheres the blocks go into a sparse PETSc matrix and are solved by a KSP with the
 ! options prefix particles_. Defaults: CG preconditioned by the exact
 ! inverse of each 6x6 diagonal block (PCPBJACOBI), relative tolerance 1e-12, started from the
-! velocities of the last step (issue 31: 44 -> 26 iterations per step on the paper scene), on a
+! velocities of the last step (since 2026-11-26: 44 -> 26 iterations per step on the paper scene), on a
 ! block-AIJ matrix (BAIJ, 6x6 blocks: one index per block, assembly and products ~2x faster than
 ! AIJ; -particles_mat_type aij or sbaij changes it). A sparse Cholesky ordered by METIS
 ! (SuiteSparse CHOLMOD's nested dissection) is one option away (PETSc's CHOLMOD factors aij, and

@@ -1,4 +1,4 @@
-! Direct solves of the fluid step's constant-coefficient operators by fast transforms (issue 31).
+! Direct solves of the fluid step's constant-coefficient operators by fast transforms (doc/METHOD.md §2.3).
 !
 ! Every operator of the fluid step (mod_solvers' compute_operator) is a 7-point stencil with
 ! constant coefficients on a uniform grid, periodic in x and z and periodic or bounded by walls in

@@ -1,6 +1,6 @@
 ! The fluid sub-problem: unsteady Stokes, rho du/dt = -grad p + eta lap u + f, div u = 0, on the
 ! MAC grid of mod_grid, by an incremental pressure-correction projection in rotational form with a
-! theta scheme for the viscous term (theta = 1/2: Crank-Nicolson). method.md §1.3. In fdsusp
+! theta scheme for the viscous term (theta = 1/2: Crank-Nicolson). doc/METHOD.md §2.2. In fdsusp
 ! units eta = 1 and rho = Re (Re = rho gamma_dot a^2 / eta).
 !
 ! One step, from u^n and p^{n-1/2}:
@@ -169,7 +169,7 @@ contains
   end function wall_velocity
 
   ! Ghosted copy of a face field with the wall ghosts of cell-centred-in-y components set to
-  ! 2 U_wall - x_0 (second order, method.md §1.3). v needs nothing: its wall face holds 0.
+  ! 2 U_wall - x_0 (second order, doc/METHOD.md §2.1). v needs nothing: its wall face holds 0.
   ! The wall ghosts are set above and below the owned (i, k) only: the 7-point stencil reads
   ! nothing else there, and the star-stencil exchange leaves the edge ghosts beside them unfilled
   ! (mod_grid, doc/DESIGN.md "Ghost layers").

@@ -41,7 +41,7 @@ module mod_solvers
 
 contains
 
-  ! mass = Re/dt, diffusion = theta*eta: the implicit part of the viscous step (method.md §1.3).
+  ! mass = Re/dt, diffusion = theta*eta: the implicit part of the viscous step (doc/METHOD.md §2.2).
   subroutine solvers_configure(mass, diffusion, box, walls)
     real(dp), intent(in) :: mass, diffusion, box(3)
     logical, intent(in) :: walls

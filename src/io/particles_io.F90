@@ -1,4 +1,4 @@
-! Particles in HDF5 files (design.md "Files"): the group /particles with the dataset position
+! Particles in HDF5 files (doc/DESIGN.md "Files, restart and signals"): the group /particles with the dataset position
 ! (N x 3 as seen from C/Python, units of a) and the attribute box (Lx, Ly, Lz) in every file that
 ! holds particles, plus in checkpoints the state an exact restart needs (velocity, omega, the
 ! Adams-Bashforth history). Reading is done by rank 0 and broadcast; a bad file stops the run

@@ -1,4 +1,4 @@
-! Contact law of Gallier et al. (2014, JFM) §2.4 (method.md §1.7); pure kernels, no PETSc.
+! Contact law of Gallier et al. (2014, JFM) §2.4 (doc/METHOD.md §4); pure kernels, no PETSc.
 ! Documented in doc/CONTACT.md (parameters, units, the k_t interpretation, the history).
 !
 ! Conventions. For a pair i < j: r = x_j - x_i (minimum image), n = r/|r|, F = force on i by j;

@@ -1,14 +1,14 @@
-! The subgrid lubrication correction (method.md §2; doc/LUBRICATION.md): what the grid cannot
+! The subgrid lubrication correction (doc/METHOD.md §5; doc/LUBRICATION.md): what the grid cannot
 ! resolve of the two-sphere and sphere-wall resistance, added pairwise to the particle problem.
 !
-!   R_sub = [R_theo - R_theo(one body)] - [R~ - R~(one body)]          (§2.2, §2.4 item 4)
+!   R_sub = [R_theo - R_theo(one body)] - [R~ - R~(one body)]          (doc/METHOD.md §5.3)
 !
 ! per pair (12x12 in (U_1, Om_1, U_2, Om_2)) and per sphere-wall link (6x6), so that
 !   (F, T)_lub = R_sub_FU . (U_inf - U) + R_sub_FE : E_inf     (forces on the spheres)
-!   S_lub      = R_sub_SU . (U_inf - U) + R_sub_SE : E_inf + trace part (§2.7)
+!   S_lub      = R_sub_SU . (U_inf - U) + R_sub_SE : E_inf + trace part (doc/METHOD.md §5.9)
 ! Models:
 !   none    no correction.
-!   simple  singular terms only, as in lattice-Boltzmann practice (§2.5 fallback; Nguyen & Ladd
+!   simple  singular terms only, as in lattice-Boltzmann practice (doc/METHOD.md §5.5; Nguyen & Ladd
 !           2002, Dance & Maxey 2003): f(max(xi, xi_sat)) - f(xi_c) for xi < xi_c, f the g1/xi +
 !           g2 ln(1/xi) part of each scalar, xi_c from Grains3D's rule (0.185 at a/Delta = 5) for
 !           translation, 0.05 for rotation, and a saturation gap xi_sat = 0.02 below which the
@@ -22,7 +22,7 @@
 !           model = 'none', mod_lubrication_dynamics), where no grid resolves anything. Its blocks
 !           are not clipped at 0 but at a floor per link set by the caller (lub_pair_link's floor),
 !           since R_2B - R_1B has negative eigenvalues at every gap (XA11 - 1 + XA12 < 0 far apart).
-! Safeguards (§2.5): gaps below inner_cutoff are evaluated at inner_cutoff; a C1 taper takes the
+! Safeguards (doc/METHOD.md §5.6): gaps below inner_cutoff are evaluated at inner_cutoff; a C1 taper takes the
 ! correction to zero at outer_cutoff over its last 30 %; every pair block of R_sub_FU is made
 ! positive semi-definite by clipping its negative eigenvalues (LAPACK dsyev), so the implicit
 ! 6N system stays symmetric positive definite. Wall blocks may keep eigenvalues down to
@@ -82,7 +82,7 @@ contains
     end select
   end function model_code
 
-  !> Grains3D's cut-off of the simple model (method.md §2.5): xi_c = (Delta/a)[1 + (2a/Delta - 16) 0.1/8].
+  !> Grains3D's cut-off of the simple model (doc/METHOD.md §5.5): xi_c = (Delta/a)[1 + (2a/Delta - 16) 0.1/8].
   pure real(dp) function grains3d_cutoff(cells_per_radius)
     real(dp), intent(in) :: cells_per_radius
     grains3d_cutoff = (1.0_dp + (2.0_dp * cells_per_radius - 16.0_dp) * 0.1_dp / 8.0_dp) / cells_per_radius
@@ -169,7 +169,7 @@ contains
       f([i_xm12, i_ym12, i_zm12]) = 0.0_dp
       f = f - interpolate(lub%pair_gap, lub%pair_resolved, xi)
     case (LUB_EXACT)
-      ! R_2B - R_1B (method.md §2.4 item 4, nothing resolved)
+      ! R_2B - R_1B (doc/METHOD.md §5.3, nothing resolved)
       f = resistance_scalars(xi)
       f(one_body_scalars) = f(one_body_scalars) - 1.0_dp
       f([i_xm11, i_ym11, i_zm11]) = f([i_xm11, i_ym11, i_zm11]) + f([i_xm12, i_ym12, i_zm12])
@@ -191,7 +191,7 @@ contains
   end function simple_difference
 
   !> The subgrid sphere-wall scalars (lambda_perp, f_tt, f_tr, f_rr, x_w) at this gap. The twist
-  !> x_w is not singular and is left to the grid (method.md §2.8).
+  !> x_w is not singular and is left to the grid (doc/METHOD.md §5.8).
   function lub_wall_scalars(lub, gap) result(w)
     type(lubrication_t), intent(in) :: lub
     real(dp), intent(in) :: gap
@@ -263,8 +263,8 @@ contains
     drive = matmul(r(:, 1:3), u_wall)
   end subroutine lub_wall_link
 
-  !> Stresslet corrections of a pair (3, 3, 2): R_sub_SU . w + R_sub_SE : E (deviatoric, §2.6)
-  !> plus the particle-pressure part (§2.7): the near-contact traction sits in the gap, at a d
+  !> Stresslet corrections of a pair (3, 3, 2): R_sub_SU . w + R_sub_SE : E (deviatoric, doc/METHOD.md §5.7)
+  !> plus the particle-pressure part (doc/METHOD.md §5.9): the near-contact traction sits in the gap, at a d
   !> from sphere 1 and -a d from sphere 2, so tr S_alpha = a n_alpha . F^X_alpha with F^X the
   !> squeeze (X-type) part of the corrected force. w = (U_inf - U, Om_inf - Om) of both spheres.
   function lub_pair_stresslets(lub, f, d, w, e_inf) result(s)

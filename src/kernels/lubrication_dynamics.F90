@@ -1,4 +1,4 @@
-! Lubrication dynamics (&fluid model = 'none'; issue 30): the spheres without a resolved fluid.
+! Lubrication dynamics (&fluid model = 'none'; doc/METHOD.md §6): the spheres without a resolved fluid.
 ! Each sphere feels the one-body Stokes resistance relative to the imposed linear flow, each close
 ! pair and each sphere near a wall the exact two-body resistance minus the one-body part
 ! (mod_lubrication's model 'exact': the exact functions of mod_pair_resistance, which bin/pairtraj
@@ -14,7 +14,7 @@
 ! e_y e_x) between walls or across Lees-Edwards boundaries (0 in a periodic box at rest). The
 ! links are those of mod_particle_lubrication (R_2B - R_1B, clipped at a floor per link so the
 ! system stays positive definite); their stresslets are lub_pair_stresslets' (the deviatoric
-! R_SU, R_SE part and the trace of method.md §2.7, as for the DNS correction), so the rheology
+! R_SU, R_SE part and the trace of doc/METHOD.md §5.9, as for the DNS correction), so the rheology
 ! compares with the DNS quantity by quantity.
 ! Pure: no PETSc, MPI or files (the system is solved by its owner, mod_particle_solver, in
 ! mod_ld_motion).

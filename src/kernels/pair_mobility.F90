@@ -1,5 +1,5 @@
-! Force- and torque-free pair of equal spheres in a linear flow (Batchelor & Green 1972; method.md
-! sections 4.1-4.2): the mobility functions A, B, the pair's rotation c and the stresslet
+! Force- and torque-free pair of equal spheres in a linear flow (Batchelor & Green 1972; doc/METHOD.md
+! §9.1-9.2): the mobility functions A, B, the pair's rotation c and the stresslet
 ! functions K, L, M at a gap, reduced from the exact resistance scalars of mod_pair_resistance.
 ! Printed by bin/fdsusp-resistance ('shear'); the unit tests check them against published values
 ! and use them as the isolated pair's reference (the relative motion bin/pairtraj integrates).
@@ -21,7 +21,7 @@ contains
   !> Mobility and stresslet functions of a force- and torque-free equal pair at gap xi:
   !>   dr/dt = Om x r + E.r - [A dd + B (I - dd)].E.r,   Om_pair = Om^inf + c d x (E.d),
   !>   S = (20/3) pi eta a^3 [(1+K) E + L (d(E.d) + (E.d)d - (2/3) I d.E.d) + M (dd - I/3) d.E.d].
-  !> Derived from the six-unknown reduction of method.md section 4.1 (doc/RESISTANCE.md).
+  !> Derived from the six-unknown reduction of doc/METHOD.md §9.1-9.2 (doc/RESISTANCE.md).
   subroutine pair_shear_functions(gap, a_bg, b_bg, c_rot, k_bg, l_bg, m_bg)
     real(dp), intent(in) :: gap
     real(dp), intent(out) :: a_bg, b_bg, c_rot, k_bg, l_bg, m_bg

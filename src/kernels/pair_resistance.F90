@@ -6,7 +6,7 @@
 ! the sphere-wall functions in mod_wall_resistance. Full conventions, join locations and measured
 ! accuracy: doc/RESISTANCE.md.
 !
-! Conventions (method.md section 2.1; Kim & Karrila 1991 chapter 11; Jeffrey & Onishi 1984;
+! Conventions (doc/METHOD.md §5.1; Kim & Karrila 1991 chapter 11; Jeffrey & Onishi 1984;
 ! Jeffrey 1992):
 !   * d is the unit vector from sphere 1 to sphere 2, in every block (11, 12, 21, 22).
 !   * gap xi = r/a - 2 (surface gap over radius); separation s = r/a = 2 + xi.
@@ -25,9 +25,9 @@
 !   * 12-vectors are ordered (U_1, Om_1, U_2, Om_2) and (F_1, T_1, F_2, T_2).
 !
 ! The 22 scalars (XA..ZM, 11 and 12) at any gap are assembled from three pieces
-! (method.md sections 2.3, 3.1, 3.2; doc/RESISTANCE.md for the error budget):
+! (doc/METHOD.md §5.2; doc/RESISTANCE.md for the error budget):
 !   1. gap < 0.025: near-field form g1/xi + g2 ln(1/xi) + c + g3 xi ln(1/xi) (Jeffrey & Onishi
-!      1984, Jeffrey 1992, corrected by Townsend 2023; constants of method.md section 3.1), plus
+!      1984, Jeffrey 1992, corrected by Townsend 2023; constants of doc/METHOD.md §5.2), plus
 !      a linear term b xi whose coefficient b = [f_table(0.025) - f_near(0.025)]/0.025 is the
 !      form's missing O(xi) term, fitted to the first mid-field (Lamb-method) row. It makes the
 !      join continuous in value and slope and tends to the pure asymptotic form at contact.
@@ -38,7 +38,7 @@
 !      What is interpolated is the smooth remainder r = f - [g1/xi + g2 ln(1/xi) + g3 xi ln(1/xi)]
 !      (the singular part removed), by a C2 cubic spline in ln(xi), clamped at both ends to the
 !      slopes of pieces 1 and 3. The spline passes exactly through the rows.
-!   3. s > 4.5: far-field series in 1/s (method.md section 3.2) plus a tail
+!   3. s > 4.5: far-field series in 1/s (doc/METHOD.md §5.2) plus a tail
 !      [f_table(4.5) - f_far(4.5)] (4.5/s)^p, where p is the first power the truncated series
 !      omits. It removes the truncation error of the series at s = 4.5 (up to 0.5 %, XG12), making the join
 !      continuous in value and slope, and decays like the neglected terms.
@@ -75,7 +75,7 @@ module mod_pair_resistance
   public :: resistance_init, resistance_scalars, near_field_scalars, far_field_scalars, &
             series_scalars, contact_constants, leading_singular_part
 
-  ! Near-field coefficients (method.md section 3.1): f = g1/xi + g2 ln(1/xi) + c + g3 xi ln(1/xi).
+  ! Near-field coefficients (doc/METHOD.md §5.2): f = g1/xi + g2 ln(1/xi) + c + g3 xi ln(1/xi).
   real(dp), parameter :: near_g1(n_pair_scalars) = [ &
     0.25_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.375_dp, 0.0_dp, 0.0_dp, 0.15_dp, 0.0_dp, 0.0_dp, &
     -0.25_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, -0.375_dp, 0.0_dp, 0.0_dp, 0.15_dp, 0.0_dp, 0.0_dp]
@@ -136,7 +136,7 @@ contains
 
   !> All 22 dimensionless scalars (index parameters i_xa11 ... i_zm12) at surface gap
   !> gap = r/a - 2 > 0 (non-positive gaps are evaluated at 1e-300: the caller must keep the gap
-  !> positive; lubrication uses the true gap, method.md section 1.7).
+  !> positive; lubrication uses the true gap, doc/METHOD.md §4.1).
   function resistance_scalars(gap) result(f)
     real(dp), intent(in) :: gap
     real(dp) :: f(n_pair_scalars)
@@ -159,7 +159,7 @@ contains
   end function resistance_scalars
 
   !> Near-field asymptotic forms alone, f = g1/xi + g2 ln(1/xi) + c + g3 xi ln(1/xi)
-  !> (method.md section 3.1), at gap xi > 0.
+  !> (doc/METHOD.md §5.2), at gap xi > 0.
   pure function near_field_scalars(gap) result(f)
     real(dp), intent(in) :: gap
     real(dp) :: f(n_pair_scalars)
@@ -281,7 +281,7 @@ contains
     f = near_g1 / xi + near_g2 * log_inv + near_g3 * xi * log_inv
   end function singular_part
 
-  !> The lubrication singularities alone, g1/xi + g2 ln(1/xi) (method.md 3.1): what the 'simple'
+  !> The lubrication singularities alone, g1/xi + g2 ln(1/xi) (doc/METHOD.md §5.2): what the 'simple'
   !> lubrication model corrects with.
   pure function leading_singular_part(xi) result(f)
     real(dp), intent(in) :: xi

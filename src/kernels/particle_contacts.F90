@@ -3,7 +3,7 @@
 ! Pure: no PETSc, MPI or files. Particle data is replicated, so every rank holds the same state
 ! and computes the same forces.
 !
-! One step (method.md §1.9 item 3), at the positions X^n, before the particle sub-problem:
+! One step (doc/METHOD.md §7.1 item 2), at the positions X^n, before the particle sub-problem:
 !   1. the neighbour list (cutoff 2a + h_r + skin, walls a + h_r + skin) is rebuilt when some
 !      sphere has moved more than skin/2 since the last build;
 !   2. its candidates are put in canonical order (pairs by i then j, walls by particle then wall),

@@ -1,6 +1,6 @@
 ! Lubrication in the particle time step (doc/LUBRICATION.md): the model, the neighbour list of
 ! lubricating pairs and sphere-wall links, and per step the 6x6 / 12x12 blocks that the implicit
-! particle system takes (method.md §1.5 equation (1)) and the corrections once the velocities are
+! particle system takes (doc/METHOD.md §3.2 equation (1)) and the corrections once the velocities are
 ! known. Pure: no PETSc, MPI or files; particle data is replicated, so every rank computes the
 ! same blocks in the same order.
 !
@@ -9,7 +9,7 @@
 ! The same shear with Lees-Edwards boundaries (mod_lees_edwards, lubrication dynamics only): a pair
 ! across the sliding boundary is taken with le_separation's image of j, and U_inf of j at its own
 ! centre, since the image's velocity and its undisturbed velocity differ by the same
-! s gamma_dot Ly e_x (the block acts on U - U_inf, method.md §2.1).
+! s gamma_dot Ly e_x (the block acts on U - U_inf, doc/METHOD.md §5.1).
 ! Model 'exact' (lubrication dynamics): the blocks R_2B - R_1B are clipped at a floor per link,
 ! -(1/2) min(6 pi eta a, 8 pi eta a^3) / max(z_i, z_j), z the links (pairs and walls) of each sphere
 ! this step: the links of a sphere then lower the spectrum of its one-body block by at most half,
@@ -296,7 +296,7 @@ contains
     allocate(t2(12, m)); t2(:, 1:pl%npairs) = pl%pair_drive(:, 1:pl%npairs); call move_alloc(t2, pl%pair_drive)
   end subroutine particle_lubrication_reserve_pairs
 
-  !> The links into a 6N system (method.md §1.5 eq. (1)): each pair's 12x12 block as two diagonal
+  !> The links into a 6N system (doc/METHOD.md §3.2 eq. (1)): each pair's 12x12 block as two diagonal
   !> blocks and one coupling block, each wall link's 6x6 on its particle's diagonal; their
   !> velocity-independent parts (R.U_inf + R_FE:E_inf) onto rhs (6, np).
   subroutine particle_lubrication_add_to_system(pl, sys, rhs)

@@ -1,4 +1,4 @@
-! The implicit 6N system of the particle sub-problem (method.md §1.5, equation (1)):
+! The implicit 6N system of the particle sub-problem (doc/METHOD.md §3.2, equation (1)):
 !   [ (rho/dt) M + K ] U = rhs
 ! with U = (U_p, Omega_p) per particle, M block-diagonal (the discrete rigid-body matrices M_p of
 ! the fictitious domain) and K the sparse symmetric coupling that later models add (lubrication

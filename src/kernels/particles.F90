@@ -1,5 +1,5 @@
-! The particles: state of the inertialess rigid spheres, replicated on every rank (design.md
-! "Parallelism"), their motion mode, and the Adams-Bashforth position update (method.md §1.8).
+! The particles: state of the inertialess rigid spheres, replicated on every rank (doc/DESIGN.md
+! "Fictitious domain"), their motion mode, and the Adams-Bashforth position update (doc/METHOD.md §7.3).
 ! Pure: no PETSc, MPI or files.
 module mod_particles
   use mod_kinds, only: dp
@@ -28,7 +28,7 @@ module mod_particles
     logical :: have_prev = .false.                 ! false until one step has been taken
     real(dp), allocatable :: prescribed_velocity(:, :), prescribed_omega(:, :)
     real(dp), allocatable :: external_force(:, :), external_torque(:, :)
-    ! resolved hydrodynamics from lambda (method.md §1.6), on the particle
+    ! resolved hydrodynamics from lambda (doc/METHOD.md §3.7), on the particle
     real(dp), allocatable :: force_hydro(:, :)     ! (3, n) [eta gamma_dot a^2]
     real(dp), allocatable :: torque_hydro(:, :)    ! (3, n) [eta gamma_dot a^3]
     real(dp), allocatable :: stresslet_hydro(:, :, :)   ! (3, 3, n) [eta gamma_dot a^3]

@@ -1,6 +1,6 @@
 ! Resistance tensors from the scalar functions: the pair blocks R_FU (12x12), R_FE, R_SU, R_SE and
-! their written-out contractions (force and torque from the strain, the stresslets; method.md
-! sections 2.1 and 2.6), and the 6x6 sphere-wall block (method.md section 2.8).
+! their written-out contractions (force and torque from the strain, the stresslets; doc/METHOD.md
+! §5.1 and §5.7), and the 6x6 sphere-wall block (doc/METHOD.md §5.2, §5.8).
 !
 ! The blocks take the scalars as arguments (the exact theory of mod_pair_resistance, or theory
 ! minus what the grid resolves for the subgrid correction), the unit vector d from sphere 1 to
@@ -23,13 +23,13 @@ module mod_resistance_blocks
   public :: strain_d0, strain_d1, strain_d2
   public :: wall_resistance_fu, wall_resistance_block
 
-  ! Exchange sign of each base scalar: f22 = sgn f11, f21 = sgn f12 (method.md section 2.1).
+  ! Exchange sign of each base scalar: f22 = sgn f11, f21 = sgn f12 (doc/METHOD.md §5.1).
   real(dp), parameter :: exchange_sign(11) = [1, 1, -1, 1, 1, -1, -1, 1, 1, 1, 1] * 1.0_dp
 
 contains
 
   ! ---------------------------------------------------------------------------------------------
-  ! Pair resistance blocks (method.md sections 2.1 and 2.6)
+  ! Pair resistance blocks (doc/METHOD.md §5.1 and §5.7)
   ! ---------------------------------------------------------------------------------------------
 
   !> Scalar of base index k (1..11) for the block (alpha, beta), from f(22) = (11-scalars, 12-scalars).
@@ -217,7 +217,7 @@ contains
     end do
   end function pair_resistance_se
 
-  !> Contractions of the three M basis tensors with a symmetric traceless E (method.md 2.1).
+  !> Contractions of the three M basis tensors with a symmetric traceless E (doc/METHOD.md §5.1).
   pure function strain_d0(d, e) result(c)
     real(dp), intent(in) :: d(3), e(3, 3)
     real(dp) :: c(3, 3)
@@ -257,7 +257,7 @@ contains
     end do
   end function strain_d2
 
-  !> (F_1, T_1, F_2, T_2) from the strain alone, R_FE : E, written out (method.md section 2.6).
+  !> (F_1, T_1, F_2, T_2) from the strain alone, R_FE : E, written out (doc/METHOD.md §5.7).
   pure function pair_force_torque_from_strain(f, d, e, radius, viscosity) result(ft)
     real(dp), intent(in) :: f(n_pair_scalars), d(3), e(3, 3), radius, viscosity
     real(dp) :: ft(12)
@@ -275,7 +275,7 @@ contains
   end function pair_force_torque_from_strain
 
   !> Stresslets S_1, S_2 (3x3x2) from w = (U^inf_1 - U_1, Om^inf - Om_1, U^inf_2 - U_2,
-  !> Om^inf - Om_2) and E, written out (method.md section 2.6).
+  !> Om^inf - Om_2) and E, written out (doc/METHOD.md §5.7).
   pure function pair_stresslets(f, d, w, e, radius, viscosity) result(s)
     real(dp), intent(in) :: f(n_pair_scalars), d(3), w(12), e(3, 3), radius, viscosity
     real(dp) :: s(3, 3, 2)
@@ -308,7 +308,7 @@ contains
   end function pair_stresslets
 
   ! ---------------------------------------------------------------------------------------------
-  ! Sphere - plane wall (method.md section 2.8)
+  ! Sphere - plane wall (doc/METHOD.md §5.2, §5.8)
   ! ---------------------------------------------------------------------------------------------
 
   !> 6x6 sphere-wall resistance: (F, T) = -R . (U - U_wall, Om) for a sphere at gap eps from a
@@ -345,7 +345,7 @@ contains
         r(i, j) = ca * (lam * nn(i, j) + f_tt * (kron(i, j) - nn(i, j)))
         r(3 + i, 3 + j) = ca * radius**2 * (4.0_dp / 3.0_dp * xw * nn(i, j) &
                                             + 4.0_dp / 3.0_dp * f_rr * (kron(i, j) - nn(i, j)))
-        ! Coupling (method.md 2.8): F_t = +6 pi eta a^2 f_tr Om_b t with b = n x t, i.e.
+        ! Coupling (doc/METHOD.md §5.2): F_t = +6 pi eta a^2 f_tr Om_b t with b = n x t, i.e.
         ! F = 6 pi eta a^2 f_tr (Om x n) = -R_{F,Om} . Om with R_{F,Om} = 6 pi eta a^2 f_tr [n x];
         ! reciprocity makes R_{T,U} its transpose (T = 6 pi eta a^2 f_tr n x U: a sphere sliding
         ! along t is turned in the rolling sense, about b).

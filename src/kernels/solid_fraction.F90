@@ -1,11 +1,11 @@
-! Solid fraction of a MAC control volume covered by a sphere (method.md §1.4), and the weights of
-! the relaxed rigid constraint (method.md §1.5b).
+! Solid fraction of a MAC control volume covered by a sphere (doc/METHOD.md §3.1), and the weights of
+! the relaxed rigid constraint (doc/METHOD.md §3.3).
 !
 ! alpha is the fraction of the cube of side h centred on a face (or a cell centre) that lies inside
 ! a sphere of radius R. Faces wholly inside give 1, wholly outside 0; cut faces are sampled on
 ! n_sub^3 points, each contributing the covered fraction of a segment of length h/n_sub across the
 ! surface, clamp((R - d)/s + 1/2, 0, 1), s = h/n_sub. Every sample's contribution is continuous in
-! the sphere's position, so alpha is too (issue 9: no jumps when a sphere crosses a grid line); the
+! the sphere's position, so alpha is too (no jumps when a sphere crosses a grid line, doc/METHOD.md §3.1); the
 ! volume error of the planar ramp is O(s^2/R) per sample.
 module mod_solid_fraction
   use mod_kinds, only: dp
@@ -21,7 +21,7 @@ contains
   ! Each sub-sample counts min(1, max(0, (radius - dist)/s + 1/2)): 1 inside radius - s/2, 0
   ! beyond radius + s/2. The samples lie on n_sub^2 rows along x; a row wholly inside or wholly
   ! outside that band is counted at once, and only the rows that cross it evaluate their samples,
-  ! without branches (issue 31: this routine was the largest single cost of the particle step,
+  ! without branches (until 2026-11-26 this routine was the largest single cost of the particle step,
   ! mostly mispredicted branches per sample).
   pure real(dp) function cube_fraction(r, radius, h) result(alpha)
     real(dp), intent(in) :: r(3), radius, h
@@ -67,7 +67,7 @@ contains
     alpha = alpha / n_sub**3
   end function cube_fraction
 
-  ! gamma of the implicit relaxation of lambda on partly covered faces (method.md §1.5b):
+  ! gamma of the implicit relaxation of lambda on partly covered faces (doc/METHOD.md §3.3):
   ! gamma = kappa (1 - alpha) beta h^2 / eta with beta = rho/dt. At a steady state this is a
   ! Brinkman slip of permeability ~ (1 - alpha) h^2 / alpha, independent of rho/dt.
   pure real(dp) function relaxation_gamma(alpha, kappa, beta, h, eta) result(gamma)

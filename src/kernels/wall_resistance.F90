@@ -1,4 +1,4 @@
-! Exact resistance of a sphere near a plane wall (method.md section 2.8): the scalar functions of
+! Exact resistance of a sphere near a plane wall (doc/METHOD.md §5.2): the scalar functions of
 ! the normal approach (lambda_perp: Brenner 1961, Cox & Brenner 1967), of tangential translation
 ! and rotation with their coupling (f_tt, f_tr, f_rr: O'Neill 1964, Dean & O'Neill 1963,
 ! Goldman, Cox & Brenner 1967) and of the twist about the normal (x_w: Jeffery 1915), at gap
@@ -16,7 +16,7 @@ module mod_wall_resistance
   public :: wall_tangential_resistance, wall_twist_resistance, wall_tangential_exact, &
             wall_tangential_inner, wall_tangential_far
 
-  ! Sphere-wall joins (method.md section 2.8; doc/RESISTANCE.md).
+  ! Sphere-wall joins (doc/METHOD.md §5.2; doc/RESISTANCE.md).
   real(dp), parameter :: wall_normal_series_min_gap = 1.0e-2_dp   ! below: Cox-Brenner form
   real(dp), parameter :: wall_tangential_exact_lo = 1.0e-3_dp, wall_tangential_exact_hi = 10.0_dp
 
@@ -43,7 +43,7 @@ contains
     lam = 1.0_dp / eps + 0.2_dp * log(1.0_dp / eps) + 0.9713_dp + eps * log(1.0_dp / eps) / 21.0_dp
   end function wall_normal_near_field
 
-  !> Far-field reflection form 1/(1 - 9x/8 + x^3/2 - 0.57 x^4 + 0.2 x^5), x = a/l (method.md 2.8).
+  !> Far-field reflection form 1/(1 - 9x/8 + x^3/2 - 0.57 x^4 + 0.2 x^5), x = a/l (doc/METHOD.md §5.2).
   pure function wall_normal_far_field(gap) result(lam)
     real(dp), intent(in) :: gap
     real(dp) :: lam, x
@@ -77,7 +77,7 @@ contains
     lam = 4.0_dp / 3.0_dp * sh * lam
   end function brenner_wall_series
 
-  !> Tangential sphere-wall functions at gap eps (method.md section 2.8): with s the sphere velocity
+  !> Tangential sphere-wall functions at gap eps (doc/METHOD.md §5.2): with s the sphere velocity
   !> relative to the wall along t and Om_b the rotation about b = n x t,
   !>   F_t = -6 pi eta a [f_tt s - f_tr a Om_b],  T_b = -6 pi eta a^2 [-f_tr s + (4/3) f_rr a Om_b].
   !> 1e-3 <= eps <= 10: the exact bispherical solutions, O'Neill (1964) for translation and Dean &
@@ -106,7 +106,7 @@ contains
     f_rr = v(3)
   end subroutine wall_tangential_resistance
 
-  !> Inner forms (f_tt, f_tr, f_rr) of the tangential functions (method.md 2.8).
+  !> Inner forms (f_tt, f_tr, f_rr) of the tangential functions (doc/METHOD.md §5.2).
   pure function wall_tangential_inner(eps) result(v)
     real(dp), intent(in) :: eps
     real(dp) :: v(3), li

@@ -1,6 +1,6 @@
-! fdsusp: fictitious-domain simulation of sheared suspensions (design.md), or with &fluid model =
+! fdsusp: fictitious-domain simulation of sheared suspensions (doc/METHOD.md), or with &fluid model =
 ! 'none' their lubrication dynamics: the spheres alone, one-body Stokes drag plus exact pair and wall
-! resistance and contacts, between walls or across Lees-Edwards boundaries (issue 30).
+! resistance and contacts, between walls or across Lees-Edwards boundaries (doc/METHOD.md §6).
 !   bin/fdsusp DECK [-restart CHECKPOINT | -continue] [PETSc options]
 ! Reads and checks everything before any work, then steps the flow in time, writing the series,
 ! field snapshots and checkpoints the deck asks for. SIGTERM or SIGUSR1 (what batch schedulers
@@ -296,7 +296,7 @@ program fdsusp
         PetscCallA(fluid_step(grid, fl, ierr, fd%lambda))
         PetscCallA(stage_pop(ierr))
         PetscCallA(stage_push(STAGE_PARTICLES, ierr))
-        ! the particle sub-problem (method.md §1.5 eq. (1)): moments of u~ and Lambda^n, the 6N
+        ! the particle sub-problem (doc/METHOD.md §3.2 eq. (1)): moments of u~ and Lambda^n, the 6N
         ! system for U, Omega (contact forces and lubrication links, each absent when not
         ! allocated), then Lambda^{n+1}, u^{n+1} and the hydrodynamic force, torque, stresslet
         PetscCallA(fictitious_domain_moments(grid, fd, fl%vel, parts%n, ierr))
@@ -745,7 +745,7 @@ contains
     call fatal_error('fdsusp: fatal: the contact history does not belong to this particle set', 4)
   end subroutine contact_failure
 
-  ! A lubrication block LAPACK could not decompose (the kernels return the status, issue 29):
+  ! A lubrication block LAPACK could not decompose (the kernels return the status, the caller stops):
   ! non-finite positions or resistance. Collective (every rank holds the same links).
   subroutine lubrication_failure(link)
     integer, intent(in) :: link(2)
@@ -760,7 +760,7 @@ contains
     call stop_with_state(step, what)
   end subroutine lubrication_failure
 
-  ! Runtime guard (design.md "Errors"): a non-finite velocity, pressure or particle quantity, or a
+  ! Runtime guard (doc/DESIGN.md "Files, restart and signals"): a non-finite velocity, pressure or particle quantity, or a
   ! sphere half way through a wall, stops
   ! the run at once, collectively, with a diagnostic; the state is written to failed_state.h5
   ! beside the last good checkpoint, which is never overwritten. The norms are global reductions

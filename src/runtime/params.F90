@@ -5,7 +5,7 @@
 ! the run stops cleanly with one message (mod_errors::input_error) naming the file, the group and
 ! the variable, before any work is done.
 !
-! Units: radius a = 1, fluid viscosity eta = 1, imposed shear rate = 1 (design.md). Lengths in a,
+! Units: radius a = 1, fluid viscosity eta = 1, imposed shear rate = 1 (doc/METHOD.md §0.2). Lengths in a,
 ! times in strain units 1/gamma_dot, stresses in eta*gamma_dot.
 module mod_params
   use mod_kinds, only: dp

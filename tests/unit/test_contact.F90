@@ -1,4 +1,4 @@
-! Unit test of mod_contact, one rule at a time (issue 4 acceptance; paper §2.4, doc/CONTACT.md).
+! Unit test of mod_contact, one rule at a time (paper §2.4, doc/METHOD.md §4.1, doc/CONTACT.md).
 ! a = eta = gamma_dot = 1, eps_r = 5e-3 (h_r = 5e-3 a), eps_bar = 0.05, mu_d = 0.5 unless said.
 ! Tolerances: results built from a few O(1) products and one power are exact to a few ulps, so
 ! 1e-13 relative is used where the reference is computed along another path, 0 (bitwise) where

@@ -1,5 +1,5 @@
-! Unit test of the contact history of mod_contact (issue 4: "contact history keyed by pair
-! identity, surviving neighbour-list rebuilds and periodic images"; checkpoint pack/unpack).
+! Unit test of the contact history of mod_contact (the history is keyed by pair
+! identity, surviving neighbour-list rebuilds and periodic images; checkpoint pack/unpack).
 ! System: a hard-sphere packing (phi = 0.45, Couette cell 16 x 10 x 16 a, 275 spheres) with
 ! eps_r = 0.02, so that ~70 pairs and some wall contacts are closed; every sphere translates with
 ! U0 = (2, 0, 1.5) plus a random velocity of size 0.05 and spins at random (|Omega| ~ 1), so

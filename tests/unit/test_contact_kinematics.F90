@@ -1,4 +1,4 @@
-! Unit test of mod_contact under prescribed kinematics over many steps (issue 4 acceptance).
+! Unit test of mod_contact under prescribed kinematics over many steps (doc/CONTACT.md "Tests").
 ! a = eta = gamma_dot = 1, eps_r = 5e-3, eps_bar = 0.05, mu_d = 0.5; contact_forces is called
 ! once per step with positions advanced by the prescribed velocities, as a time step would.
 ! Invariants:

@@ -18,7 +18,7 @@
 !     gives a status and NaN instead of stopping the program (the caller reports it);
 !  7. wall link: a sphere moving with the wall feels no correction (drive = R.(u_wall, 0));
 !     the simple normal function equals 1/e + ln(1/e)/5 minus its value at the cut-off;
-!  8. pair stresslet: symmetric, and its trace is a d.F_1 for a squeeze (method.md §2.7).
+!  8. pair stresslet: symmetric, and its trace is a d.F_1 for a squeeze (doc/METHOD.md §5.9).
 program test_lubrication
   use mod_kinds, only: dp
   use mod_pair_resistance, only: n_pair_scalars, resistance_scalars, i_xa11, i_xa12, i_ya11, i_xc11, &
@@ -127,7 +127,7 @@ program test_lubrication
 
 contains
 
-  ! g1/xi + g2 ln(1/xi) of XA11 - XA12 (method.md 3.1)
+  ! g1/xi + g2 ln(1/xi) of XA11 - XA12 (doc/METHOD.md §5.2)
   real(dp) function sing(x)
     real(dp), intent(in) :: x
     sing = 0.5_dp / x + 0.45_dp * log(1.0_dp / x)

@@ -1,4 +1,4 @@
-! Unit test of mod_neighbours (issue 4). Invariants, all exact (integer sets, no tolerance):
+! Unit test of mod_neighbours (doc/CONTACT.md "Neighbour search"). Invariants, all exact (integer sets, no tolerance):
 !   1. The cell list returns exactly the pairs (i < j, image shift s) with |x_j - x_i + s L| <
 !      cutoff found by an O(N^2) search that tries all 27 periodic images of every pair (it does
 !      not assume the minimum image), for random configurations at volume fraction phi = 0.1,

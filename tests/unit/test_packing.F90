@@ -1,4 +1,4 @@
-! Unit test of mod_packing (issue 4 acceptance). Invariants:
+! Unit test of mod_packing (doc/PACKING_INPUT.md "Tests"). Invariants:
 !   1. The generator is L'Ecuyer's MRG32k3a: from the state 12345 x 6 the integers
 !      z = (p1 - p2) mod m1 behind the first five outputs are the published 545508589,
 !      1368065410, 1327943761, 3546985096, 951893194 (exact; u = (z + 1)/(m1 + 1)).

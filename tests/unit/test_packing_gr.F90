@@ -1,4 +1,4 @@
-! Unit test: the packings of mod_packing are equilibrium hard-sphere fluids (issue 4 acceptance).
+! Unit test: the packings of mod_packing are equilibrium hard-sphere fluids (doc/PACKING_INPUT.md "Tests").
 ! Invariant: in a triply periodic box, the radial distribution function at contact g(2a) agrees
 ! within 5 % with the Carnahan-Starling value g_CS(2a) = (1 - phi/2)/(1 - phi)^3 (the contact
 ! value of its equation of state, Z = 1 + 4 phi g(2a), itself within 1 % of simulations for

@@ -1,5 +1,5 @@
 ! Unit test: axisymmetric two-sphere motions of mod_pair_resistance against the exact bispherical-
-! coordinate solutions, implemented here independently of the module (issue 3 acceptance).
+! coordinate solutions, implemented here independently of the module (doc/VALIDATION_pair.md §1).
 ! With cosh(alpha) = s/2 (s = r/a) and m = 2n + 1:
 !   * co-translation along the line of centres, XA11 + XA12 (Stimson & Jeffery 1926):
 !       (4/3) sinh(a) sum n(n+1)/((2n-1)(2n+3)) [1 - (4 sinh^2(m a/2) - m^2 sinh^2 a)
@@ -18,7 +18,7 @@
 !     accuracy is that of the O(1) constants. The module's near piece is the resummed
 !     twin-multipole series truncated at t^200, whose residual coefficients fall like m^-3:
 !     measured 9.4e-6 at contact (0.6451354 against the exact 0.6451414; the published 6-digit
-!     constants of method.md 3.1, 0.995419 - 0.350153 = 0.645266, were 1.9e-4 off, the
+!     constants of doc/METHOD.md §5.2, 0.995419 - 0.350153 = 0.645266, were 1.9e-4 off, the
 !     truncation of Townsend's 100-term sums); 3x margin;
 !   * squeeze 3e-5: measured 7.6e-6, the spline of the Lamb rows between rows;
 !   * rotation 1e-4: X^C is exact (Jeffery's sums) outside the table; inside, the spline between

@@ -1,4 +1,4 @@
-! Unit test: the pair resistance blocks FU, FE, SU, SE of mod_resistance_blocks (method.md 2.1, 2.6).
+! Unit test: the pair resistance blocks FU, FE, SU, SE of mod_resistance_blocks (doc/METHOD.md §5.1, §5.7).
 ! Invariants (none of them is produced by the code itself: each is a theorem of Stokes flow or an
 ! identity of the tensor algebra):
 !   1. R_FU (12x12) is symmetric (Lorentz reciprocity) and positive definite (dissipation is
@@ -7,7 +7,7 @@
 !   2. Reciprocity of the coupling blocks: R_FE(m, j, k) = R_SU(j, k, alpha, m) summed over the
 !      stresslet of the grand matrix, i.e. sum_jk R_FE(m,j,k) E_jk = sum_jk E_jk R_SU(j,k,.,m)
 !      for symmetric traceless E (1e-12 relative).
-!   3. The written-out contractions of method.md 2.6 (pair_force_torque_from_strain,
+!   3. The written-out contractions of doc/METHOD.md §5.7 (pair_force_torque_from_strain,
 !      pair_stresslets) equal the general tensor forms (R_FE : E, R_SU . w + R_SE : E) (1e-12).
 !   4. M basis: with XM = YM = ZM = 1, M : E = E for any symmetric traceless E, both for the
 !      fourth-rank tensor (R_SE) and for the contraction formulas strain_d0 + d1 + d2 (1e-13).

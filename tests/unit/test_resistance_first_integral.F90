@@ -1,5 +1,5 @@
 ! Unit test: Batchelor & Green's (1972) first integral of the in-plane pair trajectories, built
-! from the module's A(rho), B(rho) (method.md 4.3), as an oracle for pairtraj that involves no
+! from the module's A(rho), B(rho) (doc/METHOD.md §9.3), as an oracle for pairtraj that involves no
 ! time integration and no contact law:
 !   mu(rho) sin^2(theta) - int_rho^inf mu B / (rho'(1 - A)) drho' = const along a trajectory,
 !   mu(rho) = rho^2 exp[-int_rho^inf 2(A - B)/(rho'(1 - A)) drho'].

@@ -1,21 +1,21 @@
 ! Unit test: Batchelor & Green's (1972) pair functions computed from the module's scalars
-! (mod_pair_mobility pair_shear_functions, the reduction of method.md 4.1-4.2) against published
-! numbers (issue 3 acceptance):
+! (mod_pair_mobility pair_shear_functions, the reduction of doc/METHOD.md §9.1-9.2) against published
+! numbers:
 !   1. A(s) at the 26 Lamb-method separations (s >= 2.025, where the module interpolates the
 !      table) against the A_BatchelorGreen column of the reference table (6 decimals):
 !      |error| <= 2e-6. Below s = 2.025 the column was computed from the bare asymptotic forms,
 !      which the module corrects by an O(xi) term (doc/RESISTANCE.md): |error| <= 5e-4 there.
 !   2. Near contact, 1 - A ~ 4.077 xi (Batchelor & Green 1972): (1 - A)/xi at xi = 1e-6 and 1e-7
 !      within 1e-3 relative (the next term is O(xi ln xi) ~ 1e-5).
-!   3. B -> 0.406 at contact (Batchelor & Green: 0.406; method.md 4.2: 0.4057). B approaches it
+!   3. B -> 0.406 at contact (Batchelor & Green: 0.406; doc/METHOD.md §9.2: 0.4057). B approaches it
 !      as 1/ln(1/xi), so B is evaluated at ln(1/xi) = 100, 200, 300 (xi = e^-300 is still a
 !      normal double) and extrapolated quadratically in 1/ln(1/xi): |B0 - 0.406| <= 1e-3 (the
 !      published value has 3 digits). Also 0.25 < B(1e-3) < B(1e-5) < B0 (slow monotone approach).
-!   4. Far field (Batchelor & Green 1972, eq. 5.x; method.md 4.2):
+!   4. Far field (Batchelor & Green 1972, eq. 5.x; doc/METHOD.md §9.2):
 !        A = 5/s^3 - 8/s^5 + 25/s^6 - 35/s^8 + 125/s^9 - 102/s^10 + O(s^-11)
 !        B = (16/s^5 + 10/s^8 - 36/s^10)/3 + O(s^-11)
 !      at s = 6, 8, 12, 20: relative error <= 1e-3. The module's far-field scalars carry 4-5
-!      significant digits (method.md 3.2), which limits the agreement to ~1e-4 at s = 6; the
+!      significant digits (doc/METHOD.md §5.2), which limits the agreement to ~1e-4 at s = 6; the
 !      error must also fall faster than s^-7 between s = 6 and 20 (it is a truncation effect).
 program test_resistance_pair_mobility
   use mod_kinds, only: dp

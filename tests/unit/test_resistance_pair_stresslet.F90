@@ -1,7 +1,7 @@
 ! Unit test: stresslet of a force- and torque-free pair in simple shear, two routes.
 !   Route 1 (general blocks): solve R_FU . w = -R_FE : E for w = U^inf - U (12 unknowns, force-
 !     and torque-free), then S_1 = R_SU . w + R_SE : E with mod_resistance_blocks' pair_stresslets.
-!   Route 2 (Batchelor & Green closed forms, method.md 4.2 and 4.4): in the shear plane,
+!   Route 2 (Batchelor & Green closed forms, doc/METHOD.md §9.2 and §9.4): in the shear plane,
 !     d = (cos t, sin t, 0):  N1* = M sin(2t) cos(2t),  N2* = sin(2t) [L + M sin^2 t],
 !     with L, M from pair_shear_functions (which reduces the same scalars to the 6-unknown
 !     symmetric problem by hand: different algebra, same physics).
@@ -12,7 +12,7 @@
 !      Om x r + E.r - [A dd + B (I - dd)].E.r (1e-12 relative);
 !   3. isolated-sphere limit: at s = 1e3 the stresslet of each sphere is (20/3) pi E (Einstein;
 !      S_xy = (10/3) pi), and both spheres rotate at -1/2 (1e-6, the O(s^-3) corrections).
-!   4. K = ZM11 + ZM12 - 1 at contact is -0.04721 (method.md 4.2, from the near-field constants
+!   4. K = ZM11 + ZM12 - 1 at contact is -0.04721 (doc/METHOD.md §9.2, from the near-field constants
 !      1.025097 - 0.072311 - 1): evaluated at xi = 1e-10, within 1e-5.
 program test_resistance_pair_stresslet
   use mod_kinds, only: dp, pi

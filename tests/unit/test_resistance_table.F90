@@ -1,7 +1,7 @@
 ! Unit test: the 22 equal-sphere resistance scalars of mod_pair_resistance against the reference table
 ! (input/tables/two_sphere_resistance_equal_spheres.csv, Jeffrey-Onishi / Lamb-method values,
 ! compiled in as mod_resistance_table), at every tabulated separation and at the joins with the
-! near- and far-field pieces (issue 3 acceptance; method.md sections 2.3, 3.1, 3.2;
+! near- and far-field pieces (doc/METHOD.md §5.2;
 ! doc/RESISTANCE.md).
 !
 ! Errors are |f - f_ref| / max(|f_ref|, 1e-2) ("scaled"): relative for O(1) and singular scalars,
@@ -23,7 +23,7 @@
 !      either is noticed.
 !   3. Near rows (s < 2.025; input/tables/README.md: values of the published asymptotic forms,
 !      Townsend's constants): (a) the bare forms near_field_scalars reproduce them within 1e-4
-!      (checks the coefficients transcribed from method.md 3.1); (b) the module (series) departs
+!      (checks the coefficients transcribed from doc/METHOD.md §5.2); (b) the module (series) departs
 !      from them for gap <= 2e-3 by the truncation error of the published O(1) constants
 !      (Townsend summed 100-200 terms of the same series; its residual coefficients fall like
 !      m^-3, so ~1e-4): bounded by 2e-3 of max(|f|, 0.1) (measured 1.0e-3, YM12); (c) for
@@ -31,7 +31,7 @@
 !   4. Both joins are continuous: value jump < 1e-8, slope jump < 1e-4 of the largest slope
 !      (one-sided finite differences, step 1e-6 relative).
 !   5. The O(1) contact constants of the resummed series against the published ones
-!      (method.md 3.1): within 1e-3 (their truncation at 100-200 terms, item 3b; X^M has the
+!      (doc/METHOD.md §5.2): within 1e-3 (their truncation at 100-200 terms, item 3b; X^M has the
 !      largest residual coefficients, m^3 r_m ~ 100, measured 5.3e-4 for XM11).
 !   6. Isolated-sphere limits at s = 1e4: XA11 = YA11 = XC11 = YC11 = XM11 = YM11 = ZM11 = 1,
 !      the others 0 apart from the Stokeslet terms XA12 = -3/(2s), YA12 = -3/(4s), within 1e-6
@@ -164,7 +164,7 @@ program test_resistance_table
                maxval(abs(slope_hi - slope_lo)) / maxval(abs(slope_lo)), 1.0e-4_dp)
   end do
 
-  print '(a)', '5. O(1) contact constants: resummed series vs published (method.md 3.1)'
+  print '(a)', '5. O(1) contact constants: resummed series vs published (doc/METHOD.md §5.2)'
   c = contact_constants()
   do j = 1, n_pair_scalars
     print '(3x,a4,2f11.6,es10.2)', pair_scalar_names(j), c(j), published_c(j), c(j) - published_c(j)

@@ -1,14 +1,14 @@
-! Unit test: sphere-wall resistance functions of mod_wall_resistance (method.md 2.8) against published
-! exact values and exact identities (issue 3 acceptance).
+! Unit test: sphere-wall resistance functions of mod_wall_resistance (doc/METHOD.md §5.2) against published
+! exact values and exact identities (doc/VALIDATION_pair.md §4).
 !   1. Normal approach against Brenner's (1961) published table, lambda = F/(6 pi eta a U) at
 !      l/a = cosh(alpha), alpha = 0.5, 1, 1.5, 2, 2.5, 3: 9.2518, 3.0361, 1.8375, 1.4129,
 !      1.2220, 1.1253 (5 significant digits): relative error <= 1e-4.
 !   2. Normal: the Cox & Brenner inner form used below eps = 1e-2 joins the exact series within
 !      1e-4 relative (its error is O(eps^2 ln eps)/(1/eps)); lambda eps -> 1 at eps = 1e-8 (1e-6).
 !      The far-field form 1/(1 - 9x/8 + x^3/2 - 0.57x^4 + 0.2x^5) equals the exact series within
-!      2e-4 for l/a >= 3.76 (method.md 2.8: "to 4 digits").
+!      2e-4 for l/a >= 3.76 (doc/METHOD.md §5.2: "to 4 digits").
 !   3. Tangential translation/rotation at delta/a = 1e-3 against O'Neill & Stewartson's (1967)
-!      table as quoted in method.md 2.8: F_xt = 4.640 (f_tt), F_xr = 0.665 (f_tr),
+!      table as quoted in doc/METHOD.md §5.2: F_xt = 4.640 (f_tt), F_xr = 0.665 (f_tr),
 !      T_yr = 4.184 ((4/3) f_rr): relative error <= 1e-3 (4 digits; the module evaluates the
 !      exact bispherical solution there; more in test_resistance_wall_tangential).
 !   4. Rotation about the wall normal: by mirror symmetry a sphere twisting next to a no-slip wall

@@ -1,5 +1,5 @@
 ! Unit test: tangential sphere-wall functions of mod_wall_resistance (f_tt translation, f_tr coupling,
-! f_rr rotation; method.md 2.8) against published values and exact identities (issue 3).
+! f_rr rotation; doc/METHOD.md §5.2) against published values and exact identities.
 ! The module evaluates the exact bispherical solutions (O'Neill 1964 translation, Dean & O'Neill
 ! 1963 rotation) for 1e-3 <= eps <= 10, the inner forms below and the reflection forms above.
 ! Invariants and tolerances:
@@ -33,10 +33,10 @@
 !   3. Far field: at eps = 10 (l/a = 11) the exact solution equals Faxen's f_tt and GCB's f_tr,
 !      f_rr reflection forms within their first omitted order, x^6 = 5.6e-7 (f_tt, f_rr) and
 !      x^6/8 relative to f_tr ~ x^4/8, i.e. x^2 = 8e-3 (f_tr): tolerances 2e-6 and 2e-2.
-!   4. Near field: the inner forms of method.md 2.8 against the exact solution at eps = 1e-4.
+!   4. Near field: the inner forms of doc/METHOD.md §5.2 against the exact solution at eps = 1e-4.
 !      Measured 7.6e-4 (f_tt), 4.8e-3 (f_tr), 2.7e-3 (f_rr): absolute 0.004-0.011, which does
-!      not shrink with eps, i.e. the O(1) constants 0.9588, -0.2526, 0.3817 (tagged [M], from
-!      memory, in method.md) are off by that much (exact ~0.9545, ~-0.2573, ~0.3709). Asserted
+!      not shrink with eps, i.e. the O(1) constants 0.9588, -0.2526, 0.3817 (quoted from
+!      memory of the literature, doc/METHOD.md §5.2) are off by that much (exact ~0.9545, ~-0.2573, ~0.3709). Asserted
 !      <= 6e-3 so that the finding stays visible; the module uses the inner forms only below
 !      eps = 1e-3, matched there to the exact solution (doc/RESISTANCE.md, open item).
 !   5. Continuity of the module across its switches eps = 1e-3 and 10: relative jump < 1e-9.

@@ -1,4 +1,4 @@
-! Invariants of the solid fraction (mod_solid_fraction, method.md §1.4):
+! Invariants of the solid fraction (mod_solid_fraction, doc/METHOD.md §3.1):
 !  1. limits: 1 for a control volume wholly inside the sphere, 0 wholly outside, in [0, 1] always;
 !  2. volume: summed over a grid of cubes, alpha h^3 equals the sphere volume 4/3 pi R^3. The
 !     planar ramp of each sub-sample misses the curvature at O((h/4)^2/R) per cut cell, i.e. a
