@@ -14,7 +14,7 @@ program fdsusp
   use mod_errors, only: log_line, warn_line, input_error, fatal_error, is_root, abort_run
   use mod_file_services, only: write_failure_cause
   use mod_grid, only: grid_t, grid_create, grid_destroy, direct_solves_wanted
-  use mod_fluid, only: fluid_t, fluid_create, fluid_step, fluid_destroy, fluid_mean_profile
+  use mod_fluid, only: fluid_t, fluid_create, fluid_destroy
   use mod_fluid_verification, only: fluid_errors_vs_manufactured
   use mod_series, only: series_t, series_column, series_open, series_record, series_flush, series_close, &
                         series_attributes
@@ -22,38 +22,32 @@ program fdsusp
   use mod_checkpoint, only: checkpoint_state_t, checkpoint_write, checkpoint_check, checkpoint_read
   use mod_os_services, only: install_signal_handlers, stop_signal, make_directory, probe_directory, &
                              lock_directory, release_directory
-  use mod_timers, only: timers_register, stage_push, stage_pop, STAGE_SETUP, STAGE_FLUID, STAGE_OUTPUT, &
-                        STAGE_PARTICLES, STAGE_CONTACTS, STAGE_LUBRICATION
-  use mod_particles, only: particles_t, advance_positions, displacements, MOTION_FREE
+  use mod_timers, only: timers_register, stage_push, stage_pop, STAGE_SETUP, STAGE_OUTPUT
+  use mod_particles, only: particles_t, MOTION_FREE
   use mod_particles_io, only: particles_load, particles_snapshot
   use mod_initial_packing, only: initial_packing_make
-  use mod_rheology, only: rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, &
-                          rheo_summarise, summary_names, NSUMMARY
+  use mod_rheology, only: rheology_t, rheo_create, rheo_accumulate, rheo_summarise, summary_names, NSUMMARY
   use mod_summary_io, only: summary_write
-  use mod_fictitious_domain, only: fictitious_domain_t, fictitious_domain_create, &
-                                   fictitious_domain_geometry, fictitious_domain_follow, &
-                                   fictitious_domain_moments, fictitious_domain_solve_motion, &
-                                   fictitious_domain_update, fictitious_domain_destroy, &
+  use mod_fictitious_domain, only: fictitious_domain_t, fictitious_domain_create, fictitious_domain_destroy, &
                                    fictitious_domain_pair_lag_limit, fictitious_domain_stresslet_lag_limit
-  use mod_particle_contacts, only: particle_contacts_t, particle_contacts_create, particle_contacts_step
+  use mod_particle_contacts, only: particle_contacts_t, particle_contacts_create
   use mod_contact, only: contact_limits, overlap_limit, wall_lower, wall_upper
   use mod_limits, only: limit_finding_t, LIMIT_REFUSE
   use mod_lubrication, only: lubrication_t, LUB_NONE, LUB_SIMPLE, LUB_EXACT
   use mod_lubrication_io, only: lubrication_load
   use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_create
-  use mod_lubrication_links, only: lubrication_links_evaluate
   use mod_h5util, only: h5util_init
   use mod_solvers, only: solver_t, solver_create, solver_cold_solve, solver_destroy, fft_planner_flags
   use mod_grid, only: FIELD_P
-  use mod_lees_edwards, only: lees_edwards_t, le_create, le_wrap, le_advance
+  use mod_lees_edwards, only: lees_edwards_t, le_create
   use mod_lubrication_dynamics, only: lubrication_dynamics_t, lubrication_dynamics_create
-  use mod_ld_motion, only: ld_motion_solve
+  use mod_time_step, only: time_step_t, time_step_create, time_step_advance
   use mod_particle_solver, only: particle_solver_t, particle_solver_create, particle_solver_destroy
   implicit none
 
   PetscErrorCode :: ierr
   type(config_t) :: cfg
-  type(grid_t) :: grid
+  type(grid_t), target :: grid
   type(fluid_t), target :: fl
   type(solver_t) :: yardstick                       ! -bench_cold_poisson's multigrid solve
   type(series_t) :: series
@@ -61,16 +55,15 @@ program fdsusp
   type(fictitious_domain_t), target :: fd
   type(particle_contacts_t), target :: pc
   type(lubrication_t) :: lub
-  type(particle_lubrication_t), allocatable :: pl   ! allocated when lubrication is on
+  type(particle_lubrication_t), allocatable, target :: pl   ! allocated when lubrication is on
   type(rheology_t), allocatable, target :: rh       ! allocated when the deck has &rheology
   type(lees_edwards_t), target :: le                ! y_boundary = 'lees-edwards' (le%active), its offset
-  type(lubrication_dynamics_t) :: ld                ! &fluid model = 'none': the spheres alone
-  type(particle_solver_t) :: ld_solver              ! its sparse 6N solve
+  type(lubrication_dynamics_t), target :: ld        ! &fluid model = 'none': the spheres alone
+  type(particle_solver_t), target :: ld_solver      ! its sparse 6N solve
+  type(time_step_t) :: ts                           ! the step of this run (mod_time_step)
   type(checkpoint_state_t) :: state                 ! what the checkpoints hold: the pieces this run has
-  real(dp), allocatable :: mean_flow(:)             ! x-z plane means of u, per cell row
   real(dp) :: largest_overlap = 0.0_dp              ! of this run (since the start or restart) [a]
   integer :: largest_overlap_step = 0
-  real(dp), allocatable :: position_before(:, :)    ! X^n, then X^{n+1} - X^n, as a step moves the spheres
   logical :: carry_lambda                           ! -fd_carry_lambda (default true)
   logical :: has_particles, has_contacts, has_lubrication
   integer :: info
@@ -149,7 +142,6 @@ program fdsusp
          cfg%angle_bins, cfg%pair_shell, cfg%contact_shell, cfg%blocks, cfg%discard_step, cfg%block_steps, info, le)
     if (info /= 0) call input_error(cfg%deck_file, 'domain', 'box', &
          'with &rheology every periodic length must be >= 2 (pair_shell + 0.3) a')
-    allocate(mean_flow(0:cfg%cells(2) - 1))
     write(text, '(a,i0,a,i0,a,i0,a,i0)') 'statistics: discard ', cfg%discard_step, ' steps, then ', cfg%blocks, &
          ' blocks of ', cfg%block_steps, ' steps, ending at step ', cfg%discard_step + cfg%blocks * cfg%block_steps
     call log_line(text)
@@ -259,93 +251,22 @@ program fdsusp
   first_step = step
   stop_reason = RUNNING
   if (step >= cfg%steps) stop_reason = DONE
-  if (has_particles .and. cfg%resolved) then
-    ! the geometry at X^n; each step then moves it, and Lambda with it, to X^{n+1} (fictitious_domain_follow)
-    PetscCallA(stage_push(STAGE_PARTICLES, ierr))
-    call fictitious_domain_geometry(grid, fd, parts)
-    PetscCallA(stage_pop(ierr))
-    ! -fd_carry_lambda 0: leave Lambda on the faces of X^n (the scheme before 2026-11-23; for the
-    ! comparison of doc/VALIDATION.md §5.3 only)
-    carry_lambda = .true.
-    PetscCallA(PetscOptionsGetBool(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-fd_carry_lambda', carry_lambda, fault_set, ierr))
-  end if
+  ! the step of this run, its variant chosen once (mod_time_step); -fd_carry_lambda 0 leaves Lambda
+  ! on the faces of X^n (the scheme before 2026-11-23; for the comparison of doc/VALIDATION.md §5.3)
+  carry_lambda = .true.
+  PetscCallA(PetscOptionsGetBool(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-fd_carry_lambda', carry_lambda, fault_set, ierr))
+  PetscCallA(make_time_step(ierr))
   do while (stop_reason == RUNNING)
-    if (has_particles) then
-      if (has_contacts) then
-        ! contacts at X^n with the latest velocities (those of the previous step)
-        PetscCallA(stage_push(STAGE_CONTACTS, ierr))
-        call particle_contacts_step(pc, parts%position, parts%velocity, parts%omega, info, le%offset)
-        if (info /= 0) call contact_failure(info)
-        if (pc%max_overlap > largest_overlap) then
-          ! a new largest overlap of the run: warned once past h_r/2 (mod_contact)
-          call report(overlap_limit(pc%params, largest_overlap, pc%max_overlap, step))
-          largest_overlap = pc%max_overlap
-          largest_overlap_step = step
-        end if
-        PetscCallA(stage_pop(ierr))
+    PetscCallA(time_step_advance(ts, ierr))
+    if (ts%contact_failure /= 0) call contact_failure(ts%contact_failure)
+    if (ts%lubrication_failure(1) /= 0) call lubrication_failure(ts%lubrication_failure)
+    if (has_contacts) then
+      if (pc%max_overlap > largest_overlap) then
+        ! a new largest overlap of the run: warned once past h_r/2 (mod_contact)
+        call report(overlap_limit(pc%params, largest_overlap, pc%max_overlap, step))
+        largest_overlap = pc%max_overlap
+        largest_overlap_step = step
       end if
-      if (has_lubrication) then
-        ! the lubrication links at X^n, taken implicitly in the particle problem below
-        PetscCallA(stage_push(STAGE_LUBRICATION, ierr))
-        PetscCallA(lubrication_links_evaluate(pl, parts%position, ierr, le%offset))
-        if (pl%failed_link(1) /= 0) call lubrication_failure(pl%failed_link)
-        PetscCallA(stage_pop(ierr))
-      end if
-      if (cfg%resolved) then
-        PetscCallA(stage_push(STAGE_FLUID, ierr))
-        PetscCallA(fluid_step(grid, fl, ierr, fd%lambda))
-        PetscCallA(stage_pop(ierr))
-        PetscCallA(stage_push(STAGE_PARTICLES, ierr))
-        ! the particle sub-problem (doc/METHOD.md §3.2 eq. (1)): moments of u~ and Lambda^n, the 6N
-        ! system for U, Omega (contact forces and lubrication links, each absent when not
-        ! allocated), then Lambda^{n+1}, u^{n+1} and the hydrodynamic force, torque, stresslet
-        PetscCallA(fictitious_domain_moments(grid, fd, fl%vel, parts%n, ierr))
-        if (has_contacts) then
-          PetscCallA(fictitious_domain_solve_motion(fd, parts, ierr, lubrication=pl, contacts=pc))
-        else
-          PetscCallA(fictitious_domain_solve_motion(fd, parts, ierr, lubrication=pl))
-        end if
-        PetscCallA(fictitious_domain_update(grid, fd, fl%vel, fl%pressure, parts, ierr, pl))
-      else
-        PetscCallA(stage_push(STAGE_PARTICLES, ierr))
-        ! lubrication dynamics: the 6N Stokes balance of the spheres alone (one-body drag in the
-        ! imposed flow, the pair and wall links, the contacts), then their hydrodynamic force,
-        ! torque and stresslet (mod_lubrication_dynamics)
-        if (has_contacts) then
-          PetscCallA(ld_motion_solve(ld, ld_solver, parts, ierr, lubrication=pl, contacts=pc))
-        else
-          PetscCallA(ld_motion_solve(ld, ld_solver, parts, ierr, lubrication=pl))
-        end if
-      end if
-      ! the core statistics of this configuration, before it moves on
-      ! (pc%stresslet is absent, as unallocated, when there are no contacts)
-      if (allocated(rh)) then
-        call rheo_sample(rh, parts%position, parts%velocity, parts%stresslet_hydro, pc%stresslet, le%offset)
-        if (cfg%resolved) then
-          PetscCallA(fluid_mean_profile(grid, fl, mean_flow, ierr))
-          call rheo_sample_flow(rh, mean_flow, grid%h)
-        end if
-      end if
-      position_before = parts%position
-      call advance_positions(parts, cfg%dt, cfg%box, [.true., .not. (cfg%walls .or. cfg%lees_edwards), .true.])
-      if (cfg%lees_edwards) then
-        ! the boundary slides on; spheres that left through y = 0 or Ly re-enter from the image
-        call le_advance(le, cfg%dt)
-        call le_wrap(le, parts%position, parts%velocity, parts%velocity_prev)
-      end if
-      if (cfg%resolved) then
-        if (carry_lambda) then
-          position_before = displacements(parts%position, position_before, cfg%box, [.true., .not. cfg%walls, .true.])
-          PetscCallA(fictitious_domain_follow(grid, fd, parts, position_before, ierr))
-        else
-          call fictitious_domain_geometry(grid, fd, parts)
-        end if
-      end if
-      PetscCallA(stage_pop(ierr))
-    else
-      PetscCallA(stage_push(STAGE_FLUID, ierr))
-      PetscCallA(fluid_step(grid, fl, ierr))
-      PetscCallA(stage_pop(ierr))
     end if
     if (cfg%resolved) iterations_sum = iterations_sum + [fl%solver(1)%iterations, fl%solver(2)%iterations, &
                                                          fl%solver(3)%iterations, fl%solver(4)%iterations]
@@ -645,6 +566,31 @@ contains
                                            pc%max_overlap / max(pc%params%h_r, tiny(1.0_dp)))
     end if
   end subroutine series_columns
+
+  ! The step of this run (mod_time_step) over the pieces it has: the variant follows from them.
+  subroutine make_time_step(ierr)
+    PetscErrorCode, intent(out) :: ierr
+    type(particle_contacts_t), pointer :: contacts
+    type(particle_lubrication_t), pointer :: lubrication
+    type(rheology_t), pointer :: rheology
+    contacts => null()
+    lubrication => null()
+    rheology => null()
+    if (has_contacts) contacts => pc
+    if (allocated(pl)) lubrication => pl
+    if (allocated(rh)) rheology => rh
+    ! (disassociated pointers are absent arguments)
+    if (cfg%resolved .and. has_particles) then
+      call time_step_create(ts, cfg%dt, cfg%box, cfg%walls, le, carry_lambda, ierr, grid=grid, fluid=fl, fd=fd, &
+                            parts=parts, contacts=contacts, lubrication=lubrication, rheology=rheology)
+    else if (cfg%resolved) then
+      call time_step_create(ts, cfg%dt, cfg%box, cfg%walls, le, carry_lambda, ierr, grid=grid, fluid=fl)
+    else
+      call time_step_create(ts, cfg%dt, cfg%box, cfg%walls, le, carry_lambda, ierr, parts=parts, ld=ld, &
+                            ld_solver=ld_solver, contacts=contacts, lubrication=lubrication, rheology=rheology)
+    end if
+    CHKERRQ(ierr)
+  end subroutine make_time_step
 
   subroutine checkpoint()
     call series_flush(series)
