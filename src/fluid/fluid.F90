@@ -24,9 +24,10 @@ module mod_fluid
   use mod_grid, only: grid_t, grid_position, grid_fixed_row, field_names, FIELD_U, FIELD_V, FIELD_W, FIELD_P
   use mod_solvers, only: solver_t, solvers_configure, solver_create, solver_solve, solver_destroy
   use mod_manufactured, only: mms_forcing
+  use mod_columns, only: column_t, column
   implicit none
   private
-  public :: fluid_t, fluid_create, fluid_step, fluid_destroy, fluid_mean_profile
+  public :: fluid_t, fluid_create, fluid_step, fluid_destroy, fluid_mean_profile, fluid_columns
   integer, parameter :: STAR_HISTORY_FULL = 2   ! u*^n and u*^{n-1} known: extrapolate
 
   type :: fluid_t
@@ -426,5 +427,16 @@ contains
     PetscCall(VecDestroy(fl%rhs_p, ierr))
     PetscCall(VecDestroy(fl%div_star, ierr))
   end subroutine fluid_destroy
+
+  ! The fluid's columns of the series: the wall stresses, the divergence after the projection, the
+  ! rate of change and the iterations of each solve (doc/INPUT.md "&output").
+  function fluid_columns(fl) result(c)
+    type(fluid_t), intent(in) :: fl
+    type(column_t), allocatable :: c(:)
+    c = [column('tau_wall_bottom', fl%tau_bottom), column('tau_wall_top', fl%tau_top), &
+         column('divergence', fl%divergence), column('rate_of_change', fl%max_rate), &
+         column('iterations_u', fl%solver(1)%iterations), column('iterations_v', fl%solver(2)%iterations), &
+         column('iterations_w', fl%solver(3)%iterations), column('iterations_p', fl%solver(4)%iterations)]
+  end function fluid_columns
 
 end module mod_fluid

@@ -20,6 +20,7 @@
 module mod_series
   use hdf5
   use mod_kinds, only: dp
+  use mod_columns, only: column_t
   use mod_h5util, only: has_object, write_attribute
   use mod_errors, only: is_root, warn_line, log_line, abort_run
   use mod_os_services, only: publish_file, make_directory
@@ -27,7 +28,7 @@ module mod_series
                                free_bytes
   implicit none
   private
-  public :: series_t, series_column, series_open, series_record, series_flush, series_close, series_attributes
+  public :: series_t, series_column, series_add, series_open, series_record, series_flush, series_close, series_attributes
 
   type :: series_t
     character(len=1024) :: path = ''           ! OUTDIR/series.h5
@@ -99,6 +100,17 @@ contains
     real(dp), intent(in) :: value(:, :, :)
     call column(s, name, shape(value), reshape(value, [size(value)]))
   end subroutine column_tensor
+
+  ! The columns a physics module names (mod_columns), in their order: declared before series_open,
+  ! filled into the record being assembled afterwards.
+  subroutine series_add(s, columns)
+    type(series_t), intent(inout) :: s
+    type(column_t), intent(in) :: columns(:)
+    integer :: k
+    do k = 1, size(columns)
+      call column(s, trim(columns(k)%name), columns(k)%shape, columns(k)%values)
+    end do
+  end subroutine series_add
 
   ! Before series_open: add the column (name, per-record shape). After: put its values (in
   ! Fortran order) into the record being assembled, the next of the declared columns.

@@ -10,9 +10,10 @@
 ! Pure: no PETSc, MPI or files.
 module mod_lees_edwards
   use mod_kinds, only: dp
+  use mod_columns, only: column_t, column
   implicit none
   private
-  public :: lees_edwards_t, le_create, le_separation, le_wrap, le_advance
+  public :: lees_edwards_t, le_create, le_separation, le_wrap, le_advance, le_columns
 
   type :: lees_edwards_t
     logical :: active = .false.
@@ -79,5 +80,12 @@ contains
     real(dp), intent(in) :: dt
     le%offset = modulo(le%offset + le%shear_rate * le%box(2) * dt, le%box(1))
   end subroutine le_advance
+
+  !> The boundaries' column of the series: the offset delta of the image above.
+  function le_columns(le) result(c)
+    type(lees_edwards_t), intent(in) :: le
+    type(column_t), allocatable :: c(:)
+    c = [column('lees_edwards_offset', le%offset)]
+  end function le_columns
 
 end module mod_lees_edwards

@@ -24,10 +24,11 @@ module mod_particle_contacts
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates
   use mod_lees_edwards, only: lees_edwards_t
   use mod_particle_system, only: particle_system_t, particle_system_add_diagonal, particle_system_add_pair
+  use mod_columns, only: column_t, column
   implicit none
   private
   public :: particle_contacts_t, particle_contacts_create, particle_contacts_step
-  public :: particle_contacts_add_stiffness, particle_contacts_implicit_update
+  public :: particle_contacts_add_stiffness, particle_contacts_implicit_update, particle_contacts_columns
 
   type :: particle_contacts_t
     type(contact_params_t) :: params
@@ -226,5 +227,16 @@ contains
     pc%stiffness_added = .false.
   end subroutine particle_contacts_implicit_update
 
+
+  !> The contacts' columns of the series: open and sliding contacts, the largest overlap, and the
+  !> contact force, torque and stresslet on each sphere (doc/INPUT.md "&contact").
+  function particle_contacts_columns(pc) result(c)
+    type(particle_contacts_t), intent(in) :: pc
+    type(column_t), allocatable :: c(:)
+    c = [column('contacts_pair', pc%stats%pair_contacts), column('contacts_wall', pc%stats%wall_contacts), &
+         column('contacts_sliding', pc%stats%sliding), column('contact_max_overlap', pc%max_overlap), &
+         column('particles/force_contact', pc%force), column('particles/torque_contact', pc%torque), &
+         column('particles/stresslet_contact', pc%stresslet)]
+  end function particle_contacts_columns
 
 end module mod_particle_contacts

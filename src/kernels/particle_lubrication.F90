@@ -24,11 +24,12 @@ module mod_particle_lubrication
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates
   use mod_lees_edwards, only: lees_edwards_t, le_separation
   use mod_particle_system, only: particle_system_t, particle_system_add_diagonal, particle_system_add_pair
+  use mod_columns, only: column_t, column
   implicit none
   private
   public :: particle_lubrication_t, particle_lubrication_create, particle_lubrication_links, &
             particle_lubrication_corrections, particle_lubrication_reserve_pairs, &
-            particle_lubrication_add_to_system, particle_lubrication_add_corrections
+            particle_lubrication_add_to_system, particle_lubrication_add_corrections, particle_lubrication_columns
 
   type :: particle_lubrication_t
     type(lubrication_t) :: lub
@@ -364,5 +365,14 @@ contains
     torque = torque + pl%torque
     stresslet = stresslet + pl%stresslet
   end subroutine particle_lubrication_add_corrections
+
+  ! The lubrication's columns of the series: links within the outer cut-off, the smallest gap among
+  ! the candidates, and the correction's force and torque on each sphere (doc/INPUT.md "&lubrication").
+  function particle_lubrication_columns(pl) result(c)
+    type(particle_lubrication_t), intent(in) :: pl
+    type(column_t), allocatable :: c(:)
+    c = [column('lubrication_pairs', pl%npairs), column('lubrication_walls', pl%nwalls), column('min_gap', pl%min_gap), &
+         column('particles/force_lubrication', pl%force), column('particles/torque_lubrication', pl%torque)]
+  end function particle_lubrication_columns
 
 end module mod_particle_lubrication

@@ -4,9 +4,11 @@
 module mod_particles
   use mod_kinds, only: dp
   use mod_neighbours, only: min_image
+  use mod_columns, only: column_t, column
   implicit none
   private
-  public :: particles_t, particles_init, advance_positions, displacements, configuration_fault, impose_motion
+  public :: particles_t, particles_init, advance_positions, displacements, configuration_fault, impose_motion, &
+            particles_columns
   public :: MOTION_FREE, MOTION_PRESCRIBED, MOTION_FROZEN, MOTION_RESISTANCE, MOTION_FIXED, motion_code
 
   ! resistance: velocities imposed as for prescribed, but the configuration is held where it is
@@ -178,5 +180,15 @@ contains
       end do
     end do
   end function configuration_fault
+
+  ! The spheres' columns of the series: their state after the step and the hydrodynamic force, torque
+  ! and stresslet of the fluid on them (doc/INPUT.md "&particles").
+  function particles_columns(p) result(c)
+    type(particles_t), intent(in) :: p
+    type(column_t), allocatable :: c(:)
+    c = [column('particles/position', p%position), column('particles/velocity', p%velocity), &
+         column('particles/omega', p%omega), column('particles/force_hydro', p%force_hydro), &
+         column('particles/torque_hydro', p%torque_hydro), column('particles/stresslet_hydro', p%stresslet_hydro)]
+  end function particles_columns
 
 end module mod_particles

@@ -30,10 +30,11 @@ module mod_rheology
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates, min_image
   use mod_lees_edwards, only: lees_edwards_t, le_separation
+  use mod_columns, only: column_t, column
   implicit none
   private
   public :: rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, rheo_quantities, rheo_block_of, &
-            rheo_state, rheo_restore, rheo_summarise, NQ, NSUMMARY, summary_names, slab_volume
+            rheo_state, rheo_restore, rheo_summarise, rheo_columns, NQ, NSUMMARY, summary_names, slab_volume
 
   ! per-record values that are block-averaged: stress_hydro(5), stress_contact(5), phi_core,
   ! particle fit(5), suspension fit(5)
@@ -388,5 +389,19 @@ contains
       angles = nan
     end if
   end subroutine rheo_summarise
+
+  !> The statistics' columns of the series, this record's values (doc/RHEOLOGY.md): the core's
+  !> stresses, volume fraction and velocity fits (r%values: stress_hydro(5), stress_contact(5),
+  !> phi_core, particle fit(5), suspension fit(5)), pair counts and profiles across y.
+  function rheo_columns(r) result(c)
+    type(rheology_t), intent(in) :: r
+    type(column_t), allocatable :: c(:)
+    c = [column('core/stress_hydro', r%values(1:5)), column('core/stress_contact', r%values(6:10)), &
+         column('core/solid_fraction', r%values(11)), column('core/velocity_fit', r%values(12:16)), &
+         column('core/flow_fit', r%values(17:21)), column('core/shear_rate', r%shear_rate_core), &
+         column('min_pair_gap', r%min_pair_gap), column('pairs/references', r%references), &
+         column('pairs/shell', r%angles(:, 1)), column('pairs/contact', r%angles(:, 2)), &
+         column('profiles/solid_fraction', r%profile(:, 1)), column('profiles/momentum', r%profile(:, 2))]
+  end function rheo_columns
 
 end module mod_rheology

@@ -14,32 +14,32 @@ program fdsusp
   use mod_errors, only: log_line, warn_line, input_error, fatal_error, is_root, abort_run
   use mod_file_services, only: write_failure_cause
   use mod_grid, only: grid_t, grid_create, grid_destroy, direct_solves_wanted
-  use mod_fluid, only: fluid_t, fluid_create, fluid_destroy
+  use mod_fluid, only: fluid_t, fluid_create, fluid_destroy, fluid_columns
   use mod_fluid_verification, only: fluid_errors_vs_manufactured
-  use mod_series, only: series_t, series_column, series_open, series_record, series_flush, series_close, &
+  use mod_series, only: series_t, series_column, series_add, series_open, series_record, series_flush, series_close, &
                         series_attributes
   use mod_output, only: write_fields, progress_line
   use mod_checkpoint, only: checkpoint_state_t, checkpoint_write, checkpoint_check, checkpoint_read
   use mod_os_services, only: install_signal_handlers, stop_signal, make_directory, probe_directory, &
                              lock_directory, release_directory
   use mod_timers, only: timers_register, stage_push, stage_pop, STAGE_SETUP, STAGE_OUTPUT
-  use mod_particles, only: particles_t, MOTION_FREE
+  use mod_particles, only: particles_t, particles_columns, MOTION_FREE
   use mod_particles_io, only: particles_load, particles_snapshot
   use mod_initial_packing, only: initial_packing_make
-  use mod_rheology, only: rheology_t, rheo_create, rheo_accumulate, rheo_summarise, summary_names, NSUMMARY
+  use mod_rheology, only: rheology_t, rheo_create, rheo_accumulate, rheo_summarise, rheo_columns, summary_names, NSUMMARY
   use mod_summary_io, only: summary_write
   use mod_fictitious_domain, only: fictitious_domain_t, fictitious_domain_create, fictitious_domain_destroy, &
                                    fictitious_domain_pair_lag_limit, fictitious_domain_stresslet_lag_limit
-  use mod_particle_contacts, only: particle_contacts_t, particle_contacts_create
+  use mod_particle_contacts, only: particle_contacts_t, particle_contacts_create, particle_contacts_columns
   use mod_contact, only: contact_limits, overlap_limit, wall_lower, wall_upper
   use mod_limits, only: limit_finding_t, LIMIT_REFUSE
   use mod_lubrication, only: lubrication_t, LUB_NONE, LUB_SIMPLE, LUB_EXACT
   use mod_lubrication_io, only: lubrication_load
-  use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_create
+  use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_create, particle_lubrication_columns
   use mod_h5util, only: h5util_init
   use mod_solvers, only: solver_t, solver_create, solver_cold_solve, solver_destroy, fft_planner_flags
   use mod_grid, only: FIELD_P
-  use mod_lees_edwards, only: lees_edwards_t, le_create
+  use mod_lees_edwards, only: lees_edwards_t, le_create, le_columns
   use mod_lubrication_dynamics, only: lubrication_dynamics_t, lubrication_dynamics_create
   use mod_time_step, only: time_step_t, time_step_create, time_step_advance
   use mod_particle_solver, only: particle_solver_t, particle_solver_create, particle_solver_destroy
@@ -507,18 +507,10 @@ contains
     call series_column(series, 'step', step)
     call series_column(series, 'time', time)
     call series_column(series, 'wall_time', MPI_Wtime() - wall_start)
-    ! without a fluid the columns of the fluid solve are not written
-    if (cfg%resolved) then
-      call series_column(series, 'tau_wall_bottom', fl%tau_bottom)
-      call series_column(series, 'tau_wall_top', fl%tau_top)
-      call series_column(series, 'divergence', fl%divergence)
-      call series_column(series, 'rate_of_change', fl%max_rate)
-      call series_column(series, 'iterations_u', fl%solver(1)%iterations)
-      call series_column(series, 'iterations_v', fl%solver(2)%iterations)
-      call series_column(series, 'iterations_w', fl%solver(3)%iterations)
-      call series_column(series, 'iterations_p', fl%solver(4)%iterations)
-    end if
-    if (cfg%lees_edwards) call series_column(series, 'lees_edwards_offset', le%offset)
+    ! each physics module names its columns (mod_columns); the manufactured solution's errors are
+    ! the verification's
+    if (cfg%resolved) call series_add(series, fluid_columns(fl))
+    if (cfg%lees_edwards) call series_add(series, le_columns(le))
     if (cfg%manufactured_solution) then
       PetscCallA(fluid_errors_vs_manufactured(grid, fl, cfg%shear_rate, err_vel, err_p_max, err_p_rms, ierr))
       call series_column(series, 'mms_error_velocity_max', err_vel)
@@ -526,42 +518,11 @@ contains
       call series_column(series, 'mms_error_pressure_rms', err_p_rms)
     end if
     if (.not. has_particles) return
-    call series_column(series, 'particles/position', parts%position)
-    call series_column(series, 'particles/velocity', parts%velocity)
-    call series_column(series, 'particles/omega', parts%omega)
-    call series_column(series, 'particles/force_hydro', parts%force_hydro)
-    call series_column(series, 'particles/torque_hydro', parts%torque_hydro)
-    call series_column(series, 'particles/stresslet_hydro', parts%stresslet_hydro)
-    if (has_lubrication) then
-      call series_column(series, 'lubrication_pairs', pl%npairs)
-      call series_column(series, 'lubrication_walls', pl%nwalls)
-      call series_column(series, 'min_gap', pl%min_gap)
-      call series_column(series, 'particles/force_lubrication', pl%force)
-      call series_column(series, 'particles/torque_lubrication', pl%torque)
-    end if
-    if (has_contacts) then
-      call series_column(series, 'contacts_pair', pc%stats%pair_contacts)
-      call series_column(series, 'contacts_wall', pc%stats%wall_contacts)
-      call series_column(series, 'contacts_sliding', pc%stats%sliding)
-      call series_column(series, 'contact_max_overlap', pc%max_overlap)
-      call series_column(series, 'particles/force_contact', pc%force)
-      call series_column(series, 'particles/torque_contact', pc%torque)
-      call series_column(series, 'particles/stresslet_contact', pc%stresslet)
-    end if
+    call series_add(series, particles_columns(parts))
+    if (has_lubrication) call series_add(series, particle_lubrication_columns(pl))
+    if (has_contacts) call series_add(series, particle_contacts_columns(pc))
     if (allocated(rh)) then
-      ! rh%values: stress_hydro(5), stress_contact(5), phi_core, particle fit(5), suspension fit(5)
-      call series_column(series, 'core/stress_hydro', rh%values(1:5))
-      call series_column(series, 'core/stress_contact', rh%values(6:10))
-      call series_column(series, 'core/solid_fraction', rh%values(11))
-      call series_column(series, 'core/velocity_fit', rh%values(12:16))
-      call series_column(series, 'core/flow_fit', rh%values(17:21))
-      call series_column(series, 'core/shear_rate', rh%shear_rate_core)
-      call series_column(series, 'min_pair_gap', rh%min_pair_gap)
-      call series_column(series, 'pairs/references', rh%references)
-      call series_column(series, 'pairs/shell', rh%angles(:, 1))
-      call series_column(series, 'pairs/contact', rh%angles(:, 2))
-      call series_column(series, 'profiles/solid_fraction', rh%profile(:, 1))
-      call series_column(series, 'profiles/momentum', rh%profile(:, 2))
+      call series_add(series, rheo_columns(rh))
       if (has_contacts) call series_column(series, 'contact_overlap_over_roughness', &
                                            pc%max_overlap / max(pc%params%h_r, tiny(1.0_dp)))
     end if

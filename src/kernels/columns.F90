@@ -1,0 +1,68 @@
+! A column of the run's series (series.h5): a name and one record's value, a scalar or an array whose
+! shape is the column's per-record shape. Each physics module names its own columns by a function
+! returning them (particles_columns, particle_contacts_columns, ...); the series (src/io/series.F90)
+! takes them in order, declaring them on the first call and filling records afterwards. Pure data:
+! no I/O here (doc/DESIGN.md "Files, restart and signals").
+module mod_columns
+  use mod_kinds, only: dp
+  implicit none
+  private
+  public :: column_t, column
+
+  type :: column_t
+    character(len=64) :: name = ''
+    integer :: shape(3) = 0                  ! per-record shape, 0 where unused (a scalar: all 0)
+    real(dp), allocatable :: values(:)       ! in Fortran order
+  end type column_t
+
+  ! column(name, value): an integer or real scalar, a vector, a matrix (3 x N) or a tensor (3 x 3 x N)
+  interface column
+    module procedure column_int, column_real, column_vector, column_matrix, column_tensor
+  end interface column
+
+contains
+
+  pure function column_int(name, value) result(c)
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: value
+    type(column_t) :: c
+    c%name = name
+    c%values = [real(value, dp)]
+  end function column_int
+
+  pure function column_real(name, value) result(c)
+    character(len=*), intent(in) :: name
+    real(dp), intent(in) :: value
+    type(column_t) :: c
+    c%name = name
+    c%values = [value]
+  end function column_real
+
+  pure function column_vector(name, value) result(c)
+    character(len=*), intent(in) :: name
+    real(dp), intent(in) :: value(:)
+    type(column_t) :: c
+    c%name = name
+    c%shape = [size(value), 0, 0]
+    c%values = value
+  end function column_vector
+
+  pure function column_matrix(name, value) result(c)
+    character(len=*), intent(in) :: name
+    real(dp), intent(in) :: value(:, :)
+    type(column_t) :: c
+    c%name = name
+    c%shape = [shape(value), 0]
+    c%values = reshape(value, [size(value)])
+  end function column_matrix
+
+  pure function column_tensor(name, value) result(c)
+    character(len=*), intent(in) :: name
+    real(dp), intent(in) :: value(:, :, :)
+    type(column_t) :: c
+    c%name = name
+    c%shape = shape(value)
+    c%values = reshape(value, [size(value)])
+  end function column_tensor
+
+end module mod_columns
