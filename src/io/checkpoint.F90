@@ -332,7 +332,8 @@ contains
       if (rank == 3) call h5sget_simple_extent_dims_f(space, dims, maxdims, err)
       call h5sclose_f(space, err)
       call h5dclose_f(dset, err)
-      if (rank /= 3 .or. any(dims /= int([cfg%cells(3), cfg%cells(2), cfg%cells(1)], HSIZE_T))) then
+      ! HDF5's Fortran API gives the dimensions in Fortran order: x, y, z (C, h5py: z, y, x)
+      if (rank /= 3 .or. any(dims /= int(cfg%cells, HSIZE_T))) then
         item = '/'//trim(field_datasets(d)); message = 'dataset of the wrong shape for this grid'
       end if
     end do
