@@ -237,16 +237,18 @@ contains
   ! The documented layout: per-record shape first (Fortran order), records last; the step an
   ! integer dataset, the other columns doubles.
   subroutine verify_layout()
-    logical :: ok(2)
+    logical :: ok(2), shapes(4)
     integer(HID_T) :: file, dset, dtype
     integer :: err, class
     ok = .false.
     if (rank == 0) then
       call h5fopen_f(trim(dir)//'/series.h5', H5F_ACC_RDONLY_F, file, err)
       ok = .true.
-      ok(1) = shape_is(file, 'particles/velocity', [3_HSIZE_T, int(n_particles, HSIZE_T), 12_HSIZE_T]) .and. &
-              shape_is(file, 'particles/stresslet', [3_HSIZE_T, 3_HSIZE_T, int(n_particles, HSIZE_T), 12_HSIZE_T]) .and. &
-              shape_is(file, 'wall/force', [4_HSIZE_T, 12_HSIZE_T]) .and. shape_is(file, 'time', [12_HSIZE_T])
+      shapes(1) = shape_is(file, 'particles/velocity', [3_HSIZE_T, int(n_particles, HSIZE_T), 12_HSIZE_T])
+      shapes(2) = shape_is(file, 'particles/stresslet', [3_HSIZE_T, 3_HSIZE_T, int(n_particles, HSIZE_T), 12_HSIZE_T])
+      shapes(3) = shape_is(file, 'wall/force', [4_HSIZE_T, 12_HSIZE_T])
+      shapes(4) = shape_is(file, 'time', [12_HSIZE_T])
+      ok(1) = all(shapes)
       call h5dopen_f(file, 'step', dset, err)
       call h5dget_type_f(dset, dtype, err)
       call h5tget_class_f(dtype, class, err)
