@@ -68,6 +68,10 @@ SRC_F90 := $(filter-out $(PROGRAM_SRC),$(wildcard src/*/*.F90))
 SRC_C := $(wildcard src/*/*.c)
 REF_F90 := $(wildcard ref/*.F90)
 UNIT_F90 := $(wildcard tests/unit/test_*.F90)
+# unit tests of the modules on PETSc, MPI, FFTW and HDF5 (fluid solvers, checkpoint, series): linked
+# against the whole library, run as MPI singletons by tests/run_tests.sh (on 3 ranks by
+# tests/regression/test_unit_petsc_ranks.sh)
+UNIT_PETSC_F90 := $(wildcard tests/unit_petsc/test_*.F90)
 
 # Objects mirror the sources: src/kernels/contact.F90 -> $(BUILD)/src/kernels/contact.o.
 obj = $(addprefix $(BUILD)/,$(patsubst %.F90,%.o,$(patsubst %.c,%.o,$(1))))
@@ -81,6 +85,7 @@ RESISTANCE_F90 := $(addprefix src/kernels/,kinds.F90 vector.F90 resistance_table
                   wall_resistance.F90 resistance_blocks.F90 pair_mobility.F90)
 PAIRTRAJ_OBJ := $(call obj,$(REF_F90) $(RESISTANCE_F90))
 UNIT_BIN := $(patsubst tests/unit/%.F90,$(BUILD)/tests/%,$(UNIT_F90))
+UNIT_PETSC_BIN := $(patsubst tests/unit_petsc/%.F90,$(BUILD)/tests/%,$(UNIT_PETSC_F90))
 # pass/fail bookkeeping every unit test links (mod_unit_checks)
 UNIT_CHECKS_F90 := tests/unit/unit_checks.F90
 UNIT_CHECKS_OBJ := $(call obj,$(UNIT_CHECKS_F90))
@@ -88,7 +93,7 @@ UNIT_CHECKS_OBJ := $(call obj,$(UNIT_CHECKS_F90))
 PROGRAMS := $(BIN)/fdsusp $(BIN)/fdsusp-pack $(BIN)/fdsusp-resistance $(if $(REF_F90),$(BIN)/pairtraj)
 
 .PHONY: all debug check run bench extremes tradeoff pair-dns calibrate clean tests-build install layout-check
-all: $(PROGRAMS) $(UNIT_BIN)
+all: $(PROGRAMS) $(UNIT_BIN) $(UNIT_PETSC_BIN)
 
 debug:
 	$(MAKE) MODE=debug all
@@ -118,11 +123,13 @@ $(BIN)/pairtraj: $(PAIRTRAJ_OBJ) | $(BIN)
 	$(FC_LINKER) $(OPTFLAGS) -o $@ $^
 $(UNIT_BIN): $(BUILD)/tests/%: $(BUILD)/tests/unit/%.o $(UNIT_CHECKS_OBJ) $(PURE_OBJ) | $(BUILD)/tests
 	$(FC_LINKER) $(OPTFLAGS) -o $@ $^ -llapack -lblas
+$(UNIT_PETSC_BIN): $(BUILD)/tests/%: $(BUILD)/tests/unit_petsc/%.o $(UNIT_CHECKS_OBJ) $(LIB_OBJ) | $(BUILD)/tests
+	$(FC_LINKER) $(OPTFLAGS) -o $@ $^ $(LIBS)
 
 # Module dependencies, regenerated whenever a source changes.
-$(BUILD)/deps.mk: $(SRC_F90) $(PROGRAM_SRC) $(REF_F90) $(UNIT_F90) $(UNIT_CHECKS_F90) scripts/f90deps
+$(BUILD)/deps.mk: $(SRC_F90) $(PROGRAM_SRC) $(REF_F90) $(UNIT_F90) $(UNIT_CHECKS_F90) $(UNIT_PETSC_F90) scripts/f90deps
 	@mkdir -p $(@D)
-	@scripts/f90deps $(BUILD) $(SRC_F90) $(PROGRAM_SRC) $(REF_F90) $(UNIT_F90) $(UNIT_CHECKS_F90) > $@
+	@scripts/f90deps $(BUILD) $(SRC_F90) $(PROGRAM_SRC) $(REF_F90) $(UNIT_F90) $(UNIT_CHECKS_F90) $(UNIT_PETSC_F90) > $@
 -include $(BUILD)/deps.mk
 
 NP ?= 2

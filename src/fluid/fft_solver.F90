@@ -226,6 +226,7 @@ contains
     s%buffer = C_NULL_PTR
     s%data => null()
     s%result => null()
+    deallocate(s%inverse)      ! all fft_create made: the solver can be created again
   end subroutine fft_destroy
 
 end module mod_fft_solver

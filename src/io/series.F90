@@ -396,7 +396,7 @@ contains
       end if
     end do
     keep = count(steps(1:keep) <= limit)
-    if (keep < size(steps)) call log_line('series.h5: records after step '//step_text(steps, keep)// &
+    if (keep < size(steps)) call log_line('series.h5: records after step '//trim(step_text(steps, keep))// &
          ' are not kept (beyond the checkpoint, or an unfinished write)')
     do c = 1, size(s%names)
       call h5dopen_f(file, trim(s%names(c)), dset, err)
