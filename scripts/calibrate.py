@@ -42,6 +42,8 @@ torques about e2 = d x e1 and rotation about e1 forces along e2.
 import argparse, math, os, shutil, subprocess, sys, time
 import numpy as np
 import h5py
+import _fdsusp_path  # noqa: F401,E402  (this checkout's python/ on sys.path)
+from fdsusp.run import program  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 GAPS = [0.001, 0.01, 0.05, 0.1, 0.2, 0.35, 0.6, 1.0]
@@ -174,7 +176,7 @@ class Runner:
         self.binary = os.path.join(work, 'fdsusp')
         if os.path.exists(self.binary):
             os.remove(self.binary)
-        shutil.copy2(os.path.join(os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin')), 'fdsusp'), self.binary)
+        shutil.copy2(program('fdsusp'), self.binary)
 
     def add(self, name, **kw):
         out = os.path.join(self.work, name)
@@ -271,7 +273,6 @@ def main():
     recip = []
     wall = np.zeros((args.samples, len(WALL_GAPS), 5))
     one_body = []
-    sys.path.insert(0, os.path.join(ROOT, 'scripts'))
     from resistance_exact import pair_scalars, wall_excess
     for s, (off, d, e1, e2, t, dc) in enumerate(samples):
         o = {}

@@ -16,9 +16,9 @@ import json
 import os
 import subprocess
 import sys
+import _fdsusp_path  # noqa: F401,E402  (this checkout's python/ on sys.path)
+from fdsusp.run import ENV, program, run_all  # noqa: E402
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from jobpool import ENV, run_all  # noqa: E402
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
 DECK = """&domain box = {box}, cells_per_radius = {cells}, shear_rate = 1 /
@@ -54,7 +54,7 @@ def main():
             f.write(DECK.format(box=', '.join('%g' % b for b in args.box), cells=args.cells, phi=case[0],
                                 seed=case[1], discard=discard))
         log = open(os.path.join(d, 'log'), 'w')
-        return subprocess.Popen([os.path.join(os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin')), 'fdsusp'), 'deck.nml'], cwd=d, env=ENV, stdout=log,
+        return subprocess.Popen([program('fdsusp'), 'deck.nml'], cwd=d, env=ENV, stdout=log,
                                 stderr=subprocess.STDOUT)
 
     if not args.table_only:

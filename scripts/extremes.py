@@ -21,9 +21,9 @@ import subprocess
 import sys
 
 import numpy as np
+import _fdsusp_path  # noqa: F401,E402  (this checkout's python/ on sys.path)
+from fdsusp.run import ENV, program, run_all  # noqa: E402
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from jobpool import ENV, run_all  # noqa: E402
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
 SCENES = os.path.join(ROOT, 'input', 'extremes')
@@ -102,7 +102,7 @@ def main():
     args.work = os.path.abspath(args.work)
     os.makedirs(args.work, exist_ok=True)
     binary = os.path.join(args.work, 'fdsusp')
-    shutil.copy2(os.path.join(os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin')), 'fdsusp'), binary)
+    shutil.copy2(program('fdsusp'), binary)
     waiting, records = list(names), []
     if args.table_only:
         waiting = []

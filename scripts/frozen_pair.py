@@ -13,7 +13,6 @@ import os
 import sys
 import h5py
 import numpy as np
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import calibrate as C
 from resistance_exact import shear_functions
 

@@ -9,7 +9,6 @@ import sys
 import h5py
 import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.join(ROOT, 'scripts'))
 from resistance_exact import pair_scalars, wall_excess, NAMES
 
 I = {n: k for k, n in enumerate(NAMES)}

@@ -42,12 +42,12 @@ import subprocess
 import sys
 
 import numpy as np
+import _fdsusp_path  # noqa: F401,E402  (this checkout's python/ on sys.path)
+from fdsusp.run import ENV, bin_dir, run_all  # noqa: E402
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from jobpool import ENV, run_all  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BIN = os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin'))
+BIN = bin_dir()
 S_INF = 20.0 / 3.0 * math.pi
 # case: (pairtraj deck under input/ used as the template, eps_r, mu_d)
 CASES = {'eps0': ('pair_eps0', 0.0, 0.0),

@@ -43,9 +43,9 @@ import re
 import shutil
 import subprocess
 import sys
+import _fdsusp_path  # noqa: F401,E402  (this checkout's python/ on sys.path)
+from fdsusp.run import ENV, program, run_all  # noqa: E402
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from jobpool import ENV, run_all  # noqa: E402
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
 BASE = {'cells': 4, 'dt': 1e-3, 'vtol': 1e-8, 'ptol': 1e-10, 'lub': 'full', 'model': 'resolved'}
@@ -248,7 +248,7 @@ def main():
         params.setdefault(r['name'], r['parameters'])
     if not args.table_only:
         os.makedirs(args.work, exist_ok=True)
-        shutil.copy2(os.path.join(os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin')), 'fdsusp'), os.path.join(args.work, 'fdsusp'))
+        shutil.copy2(program('fdsusp'), os.path.join(args.work, 'fdsusp'))
 
         def report(name, status, seconds):
             cpu[name] = seconds

@@ -41,11 +41,11 @@ import sys
 import numpy as np
 import h5py
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from jobpool import ENV, run_all  # noqa: E402
 import calibrate as C  # noqa: E402
 from resistance_exact import pair_scalars, NAMES  # noqa: E402
 from tradeoff import plot_front, tabled_grids  # noqa: E402
+import _fdsusp_path  # noqa: F401,E402  (this checkout's python/ on sys.path)
+from fdsusp.run import ENV, program, run_all  # noqa: E402
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
 PI = math.pi
@@ -176,7 +176,7 @@ def main():
             cpu = json.load(f)
     if not args.table_only:
         os.makedirs(args.work, exist_ok=True)
-        shutil.copy2(os.path.join(os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin')), 'fdsusp'), os.path.join(args.work, 'fdsusp'))
+        shutil.copy2(program('fdsusp'), os.path.join(args.work, 'fdsusp'))
         status = {}
 
         def report(run, st, seconds):

@@ -23,9 +23,9 @@ import argparse
 import json
 import os
 import sys
+import _fdsusp_path  # noqa: F401,E402  (this checkout's python/ on sys.path)
+from fdsusp.run import run_all, start_resumable  # noqa: E402
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from jobpool import run_all, start_resumable  # noqa: E402
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
 DECK = """&domain box = {box}, cells_per_radius = {cells}, y_boundary = 'walls', shear_rate = 1 /
