@@ -17,36 +17,37 @@ ones: comments, several lines per group, array elements such as position(:,1) as
 """
 
 
-def value(v):
-    """One namelist value (module doc)."""
+def value(v, float_format=None):
+    """One namelist value (module doc); float_format ('%g', ...) rounds floats instead of their repr."""
     if isinstance(v, str):
         return "'%s'" % v.replace("'", "''")
     if isinstance(v, (list, tuple)):
-        return ', '.join(value(x) for x in v)
+        return ', '.join(value(x, float_format) for x in v)
     if type(v).__name__ in ('bool', 'bool_'):
         return '.true.' if v else '.false.'
     if isinstance(v, int) or type(v).__name__.startswith(('int', 'uint')):
         return str(int(v))
     if hasattr(v, 'tolist') and not isinstance(v, float) and getattr(v, 'ndim', 0) > 0:   # numpy arrays
-        return value(v.tolist())
-    return repr(float(v))
+        return value(v.tolist(), float_format)
+    return float_format % float(v) if float_format else repr(float(v))
 
 
-def group(name, settings):
+def group(name, settings, float_format=None):
     """'&name key = value, ... /' (keys whose value is None left out)."""
-    items = ['%s = %s' % (k, value(v)) for k, v in settings.items() if v is not None]
+    items = ['%s = %s' % (k, value(v, float_format)) for k, v in settings.items() if v is not None]
     return '&%s %s /' % (name, ', '.join(items)) if items else '&%s /' % name
 
 
-def text(groups, comment=None):
+def text(groups, comment=None, float_format=None):
     """A deck: comment lines ('! ...'; a string or a list of them), then one line per group;
-    groups: a list of (name, settings) or a dict {name: settings}."""
+    groups: a list of (name, settings) or a dict {name: settings}. float_format: as value()'s
+    (a study whose settings are rounded on purpose, e.g. '%g'; default: floats exactly)."""
     if isinstance(groups, dict):
         groups = list(groups.items())
     lines = []
     if comment is not None:
         lines += ['! ' + c for c in ([comment] if isinstance(comment, str) else comment)]
-    lines += [group(n, s) for n, s in groups]
+    lines += [group(n, s, float_format) for n, s in groups]
     return '\n'.join(lines) + '\n'
 
 

@@ -18,6 +18,8 @@ def test_values():
     assert deck.value("it's") == "'it''s'"
     assert deck.value((8, 20, 8)) == '8, 20, 8'
     assert deck.value(np.array([1.5, 2.0])) == '1.5, 2.0'
+    assert deck.value([8.0, 1.6000000000000003], '%g') == '8, 1.6'
+    assert deck.text({'time': {'dt': 5e-3, 'steps': 3}}, float_format='%g') == '&time dt = 0.005, steps = 3 /\n'
 
 
 def test_text_layout():
