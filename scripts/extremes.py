@@ -22,6 +22,7 @@ import sys
 
 import numpy as np
 import _fdsusp_path  # noqa: F401,E402  (this checkout's python/ on sys.path)
+from fdsusp import series  # noqa: E402
 from fdsusp.run import ENV, program, run_all  # noqa: E402
 
 
@@ -69,11 +70,12 @@ def verdict(name, d, status, requested, dt):
     record['strain'] = done * dt
     m = re.search(r"largest overlap \|delta'\| over this run\s+([0-9.eE+-]+) h_r", log)
     record['overlap_over_hr'] = float(m.group(1)) if m else 0.0
-    import h5py
-    with h5py.File(os.path.join(d, 'out', 'series.h5'), 'r') as f:
-        finite = all(np.isfinite(f[k][:]).all() for k in
-                     ('particles/stresslet_hydro', 'particles/stresslet_contact', 'particles/velocity')
-                     if k in f)
+    out = os.path.join(d, 'out')
+    present = series.names(out)
+    wanted = [k for k in ('particles/stresslet_hydro', 'particles/stresslet_contact', 'particles/velocity')
+              if k in present]
+    columns = series.read(out, wanted)[0]       # series.h5 and the records still in series.parts/
+    finite = all(np.isfinite(columns[k]).all() for k in wanted)
     record['finite'] = bool(finite)
     reasons = []
     if done != requested:

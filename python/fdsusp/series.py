@@ -38,6 +38,17 @@ def files(outdir):
     return out
 
 
+def names(outdir):
+    """The columns (dataset paths) of the run's series, as its first file holds them."""
+    paths = files(outdir)
+    if not paths:
+        raise FileNotFoundError(f'{outdir} holds no series (series.h5 or series.parts/)')
+    found = []
+    with h5py.File(paths[0], 'r') as f:
+        f.visititems(lambda n, o: found.append(n) if isinstance(o, h5py.Dataset) else None)
+    return found
+
+
 def pending_parts(outdir):
     """How many parts of series.parts/ are not yet consolidated into series.h5."""
     parts = os.path.join(outdir, 'series.parts')

@@ -75,3 +75,4 @@ def test_describe_and_settings(tmp_path):
     assert lines[0].endswith('2 records, steps 5..10, 0 part(s) not yet in series.h5')
     assert any(l.split()[0] == 'particles/velocity' and l.endswith('(2, 2)') for l in lines[1:])
     assert series.settings(series.read(str(tmp_path))[1]) == {'dt': 0.25, 'blocks': 5.0}
+    assert sorted(series.names(str(tmp_path))) == ['particles/velocity', 'step', 'time']
