@@ -43,6 +43,7 @@ import argparse, math, os, shutil, subprocess, sys, time
 import numpy as np
 import h5py
 import _fdsusp_path  # noqa: F401,E402  (this checkout's python/ on sys.path)
+from fdsusp import deck as fdeck  # noqa: E402
 from fdsusp.run import program  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -75,22 +76,21 @@ def with_flow(x, height):
 def deck(path, out, box, walls, shear, spheres, h, model='none', vtol=1e-6, ptol=1e-8, motion='resistance'):
     """spheres: list of (position, velocity, omega); motion: 'resistance' (the velocities imposed)
     or 'frozen' (the velocities force-free, scripts/frozen_pair.py); model: the lubrication model (calibration
-    measures the resolved part alone, so 'none'); vtol, ptol: the solver tolerances."""
-    lines = [f"&domain box = {box[0]}, {box[1]}, {box[2]}, cells_per_radius = {round(1 / h)},",
-             f"  y_boundary = '{'walls' if walls else 'periodic'}', shear_rate = {shear} /",
-             f"&fluid reynolds = {REYNOLDS}, viscous_theta = 1.0, initial_flow = 'shear',",
-             f"  velocity_tolerance = {vtol:g}, pressure_tolerance = {ptol:g} /",
-             f"&time dt = {REYNOLDS / BETA!r}, steps = {STEPS} /",
-             f"&output directory = '{out}', progress_every = {STEPS}, series_every = {EVERY} /",
-             f"&lubrication model = '{model}' /",
-             f"&particles number = {len(spheres)}, motion = '{motion}'"]
+    measures the resolved part alone, so 'none'); vtol, ptol: the solver tolerances. Written by
+    fdsusp.deck (floats exactly)."""
+    particles = {'number': len(spheres), 'motion': motion}
     for i, (x, u, w) in enumerate(spheres, 1):
-        lines.append(f"  position(:,{i}) = {x[0]!r}, {x[1]!r}, {x[2]!r}")
-        lines.append(f"  velocity(:,{i}) = {u[0]!r}, {u[1]!r}, {u[2]!r}")
-        lines.append(f"  omega(:,{i}) = {w[0]!r}, {w[1]!r}, {w[2]!r}")
-    lines.append("/")
-    with open(path, 'w') as f:
-        f.write("\n".join(lines) + "\n")
+        particles.update({'position(:,%d)' % i: [float(c) for c in x], 'velocity(:,%d)' % i: [float(c) for c in u],
+                          'omega(:,%d)' % i: [float(c) for c in w]})
+    fdeck.write(path, fdeck.text([
+        ('domain', {'box': list(box), 'cells_per_radius': round(1 / h),
+                    'y_boundary': 'walls' if walls else 'periodic', 'shear_rate': shear}),
+        ('fluid', {'reynolds': REYNOLDS, 'viscous_theta': 1.0, 'initial_flow': 'shear',
+                   'velocity_tolerance': vtol, 'pressure_tolerance': ptol}),
+        ('time', {'dt': REYNOLDS / BETA, 'steps': STEPS}),
+        ('output', {'directory': out, 'progress_every': STEPS, 'series_every': EVERY}),
+        ('lubrication', {'model': model}),
+        ('particles', particles)]))
 
 
 def aitken(x):

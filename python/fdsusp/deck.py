@@ -8,8 +8,8 @@
     deck.write('deck.nml', text)
     groups = deck.parse(text)      # [('domain', {'box': [8, 20, 8], ...}), ...]
 
-The one writer of the study scripts' decks: a group is '&name key = value, ... /' on one line,
-keys in the order given (None leaves a key out, so that a deck holds only what differs from the
+The one writer of the study scripts' decks: a group is '&name key = value, ... /' on one line
+(broken between keys over WIDTH characters: fdsusp reads lines of at most 1024), keys in the order given (None leaves a key out, so that a deck holds only what differs from the
 program's defaults); values: True/False as .true./.false., strings quoted ('' doubling a quote),
 integers as written, floats as Python's shortest repr (0.002, 1e-05, 20.0: read back exactly),
 sequences as comma-separated lists. parse() is a small reader of such decks (and of the shipped
@@ -32,10 +32,28 @@ def value(v, float_format=None):
     return float_format % float(v) if float_format else repr(float(v))
 
 
+# fdsusp reads a deck line by line into 1024 characters (src/runtime/deck_text.F90 deck_line_length);
+# a group longer than WIDTH is broken between its keys, continuation lines indented
+WIDTH = 132
+
+
 def group(name, settings, float_format=None):
-    """'&name key = value, ... /' (keys whose value is None left out)."""
+    """'&name key = value, ... /' (keys whose value is None left out); over WIDTH characters, one
+    line per key or per as many keys as fit (a namelist group may span lines)."""
     items = ['%s = %s' % (k, value(v, float_format)) for k, v in settings.items() if v is not None]
-    return '&%s %s /' % (name, ', '.join(items)) if items else '&%s /' % name
+    line = '&%s %s /' % (name, ', '.join(items)) if items else '&%s /' % name
+    if len(line) <= WIDTH:
+        return line
+    lines, cur = [], '&%s' % name
+    for k, item in enumerate(items):
+        piece = item + (',' if k < len(items) - 1 else ' /')
+        if len(cur) + 1 + len(piece) > WIDTH and cur.strip() and cur != '&%s' % name:
+            lines.append(cur)
+            cur = ' ' * 2 + piece
+        else:
+            cur += ' ' + piece if cur.strip() else piece
+    lines.append(cur)
+    return '\n'.join(lines)
 
 
 def text(groups, comment=None, float_format=None):

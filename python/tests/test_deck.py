@@ -31,6 +31,17 @@ def test_text_layout():
     assert deck.text({'time': {'dt': 1e-3}}) == '&time dt = 0.001 /\n'
 
 
+def test_long_group_wrapped():
+    many = {'number': 40}
+    for i in range(1, 41):
+        many['position(:,%d)' % i] = [0.1 * i + 1 / 3, 2 / 3, 1 / 7]
+    t = deck.text([('particles', many), ('time', {'dt': 1e-3})])
+    lines = t.splitlines()
+    assert len(lines) > 10 and max(len(l) for l in lines) <= deck.WIDTH
+    assert lines[0].startswith('&particles number = 40,') and lines[-2].endswith(' /') and lines[-1] == '&time dt = 0.001 /'
+    assert deck.parse(t) == [('particles', many), ('time', {'dt': 1e-3})]
+
+
 def test_round_trip():
     groups = [('domain', {'box': [7.5, 20, 7.5], 'cells_per_radius': 4, 'y_boundary': 'lees-edwards'}),
               ('particles', {'number': 2, 'position(:,1)': [2.9, 4, 4], 'position(:,2)': [5.1, 4, 4]}),
@@ -81,6 +92,15 @@ def test_fdsusp_accepts_and_refuses(tmp_path):
     deck.write(str(tmp_path / 'good.nml'), deck.text(good))
     p = run.run('good.nml', cwd=str(tmp_path), binary=binary, timeout=120)
     assert p.returncode == 0 and 'finished at step 0' in p.stdout
+    # eight spheres, their positions and velocities given exactly: a group far longer than a line
+    spheres = {'number': 8, 'motion': 'frozen'}
+    for i in range(8):
+        spheres['position(:,%d)' % (i + 1)] = [2 + 4 * (i & 1) + 1 / 3, 2 + 2 * (i >> 1 & 1) * 2 + 1 / 7, 2 + 4 * (i >> 2) + 1 / 9]
+        spheres['velocity(:,%d)' % (i + 1)] = [1 / 3, -1 / 7, 1 / 11]
+    deck.write(str(tmp_path / 'long.nml'), deck.text(good + [('particles', spheres)]))
+    assert len(deck.group('particles', spheres).replace('\n', '')) > 1024
+    p = run.run('long.nml', cwd=str(tmp_path), binary=binary, timeout=120)
+    assert p.returncode == 0 and 'finished at step 0' in p.stdout and '8 rigid spheres' in p.stdout, p.stderr
     bad = [(good[0][0], dict(good[0][1], no_such_key=1))] + good[1:]
     deck.write(str(tmp_path / 'bad.nml'), deck.text(bad))
     p = run.run('bad.nml', cwd=str(tmp_path), binary=binary, timeout=120)
