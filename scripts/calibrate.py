@@ -43,7 +43,7 @@ import argparse, math, os, shutil, subprocess, sys, time
 import numpy as np
 import h5py
 import _fdsusp_path  # noqa: F401,E402  (this checkout's python/ on sys.path)
-from fdsusp import deck as fdeck  # noqa: E402
+from fdsusp import deck as fdeck, series  # noqa: E402
 from fdsusp.run import program  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -106,10 +106,12 @@ def aitken(x):
 
 
 def steady(out):
-    with h5py.File(os.path.join(out, 'series.h5'), 'r') as f:
-        F = aitken(f['particles/force_hydro'][:])
-        T = aitken(f['particles/torque_hydro'][:])
-        S = aitken(f['particles/stresslet_hydro'][:])
+    """Force, torque and deviatoric stresslet of each sphere at pseudo-time infinity (aitken) from
+    the run's series (fdsusp.series)."""
+    cols = series.read(out, ['particles/force_hydro', 'particles/torque_hydro', 'particles/stresslet_hydro'])[0]
+    F = aitken(cols['particles/force_hydro'])
+    T = aitken(cols['particles/torque_hydro'])
+    S = aitken(cols['particles/stresslet_hydro'])
     S = np.asarray(S)
     tr = np.trace(S, axis1=-2, axis2=-1)
     Sdev = S - tr[..., None, None] * np.eye(3) / 3.0
