@@ -2,7 +2,8 @@
 #   make            build bin/fdsusp, bin/fdsusp-pack, bin/pairtraj and the unit-test programs (optimised)
 #   make debug      the same in bin/debug/ with bounds checks and floating-point traps
 #   make check      build and run the whole test suite; last line "N passed, N failed"
-#   make install    programs, lubrication tables, decks and docs under PREFIX (default /usr/local)
+#   make install    programs, lubrication tables, decks, docs and the Python package under PREFIX
+#                   (default /usr/local)
 #   make run        run input/demo.nml on 2 ranks
 #   make bench      timings recorded in doc/BENCHMARKS.md
 #   make extremes   the extreme scenes of input/extremes in full (doc/VALIDATION.md §6)
@@ -142,16 +143,24 @@ run: all
 
 # make install PREFIX=/path (default /usr/local): the programs in PREFIX/bin, the lubrication
 # tables in PREFIX/share/fdsusp/lubrication (found there by the installed fdsusp, beside its bin/),
-# the shipped decks in PREFIX/share/fdsusp/input and the documentation in PREFIX/share/doc/fdsusp.
+# the shipped decks in PREFIX/share/fdsusp/input and the documentation in PREFIX/share/doc/fdsusp;
+# the Python package in PREFIX/share/fdsusp/python/fdsusp (PYTHONPATH=PREFIX/share/fdsusp/python;
+# it finds the programs in PREFIX/bin) with the scripts that need only a run's output,
+# PREFIX/share/fdsusp/scripts/rheology.py and series.py. (pip install -e . in a checkout instead.)
 # FDSUSP_BIN=PREFIX/bin make check tests the installed programs.
 PREFIX ?= /usr/local
+PY_PACKAGE := $(wildcard python/fdsusp/*.py)
+PY_INSTALLED_SCRIPTS := scripts/rheology.py scripts/series.py
 install: all
 	install -d $(PREFIX)/bin $(PREFIX)/share/fdsusp/lubrication $(PREFIX)/share/fdsusp/input \
-	    $(PREFIX)/share/doc/fdsusp
+	    $(PREFIX)/share/doc/fdsusp $(PREFIX)/share/fdsusp/python/fdsusp $(PREFIX)/share/fdsusp/scripts
 	install -m 755 $(PROGRAMS) $(PREFIX)/bin
 	install -m 644 input/lubrication/*.h5 $(PREFIX)/share/fdsusp/lubrication
 	install -m 644 input/*.nml $(PREFIX)/share/fdsusp/input
 	install -m 644 README.md doc/*.md $(PREFIX)/share/doc/fdsusp
+	install -m 644 $(PY_PACKAGE) $(PREFIX)/share/fdsusp/python/fdsusp
+	install -m 755 $(PY_INSTALLED_SCRIPTS) $(PREFIX)/share/fdsusp/scripts
+	install -m 644 scripts/_fdsusp_path.py $(PREFIX)/share/fdsusp/scripts
 
 # TESTS=pattern runs only the tests whose path contains pattern.
 check: all

@@ -42,6 +42,9 @@ torques about e2 = d x e1 and rotation about e1 forces along e2.
 import argparse, math, os, shutil, subprocess, sys, time
 import numpy as np
 import h5py
+import _fdsusp_path  # noqa: F401,E402  (this checkout's python/ on sys.path)
+from fdsusp import deck as fdeck, series  # noqa: E402
+from fdsusp.run import program  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 GAPS = [0.001, 0.01, 0.05, 0.1, 0.2, 0.35, 0.6, 1.0]
@@ -73,22 +76,21 @@ def with_flow(x, height):
 def deck(path, out, box, walls, shear, spheres, h, model='none', vtol=1e-6, ptol=1e-8, motion='resistance'):
     """spheres: list of (position, velocity, omega); motion: 'resistance' (the velocities imposed)
     or 'frozen' (the velocities force-free, scripts/frozen_pair.py); model: the lubrication model (calibration
-    measures the resolved part alone, so 'none'); vtol, ptol: the solver tolerances."""
-    lines = [f"&domain box = {box[0]}, {box[1]}, {box[2]}, cells_per_radius = {round(1 / h)},",
-             f"  y_boundary = '{'walls' if walls else 'periodic'}', shear_rate = {shear} /",
-             f"&fluid reynolds = {REYNOLDS}, viscous_theta = 1.0, initial_flow = 'shear',",
-             f"  velocity_tolerance = {vtol:g}, pressure_tolerance = {ptol:g} /",
-             f"&time dt = {REYNOLDS / BETA!r}, steps = {STEPS} /",
-             f"&output directory = '{out}', progress_every = {STEPS}, series_every = {EVERY} /",
-             f"&lubrication model = '{model}' /",
-             f"&particles number = {len(spheres)}, motion = '{motion}'"]
+    measures the resolved part alone, so 'none'); vtol, ptol: the solver tolerances. Written by
+    fdsusp.deck (floats exactly)."""
+    particles = {'number': len(spheres), 'motion': motion}
     for i, (x, u, w) in enumerate(spheres, 1):
-        lines.append(f"  position(:,{i}) = {x[0]!r}, {x[1]!r}, {x[2]!r}")
-        lines.append(f"  velocity(:,{i}) = {u[0]!r}, {u[1]!r}, {u[2]!r}")
-        lines.append(f"  omega(:,{i}) = {w[0]!r}, {w[1]!r}, {w[2]!r}")
-    lines.append("/")
-    with open(path, 'w') as f:
-        f.write("\n".join(lines) + "\n")
+        particles.update({'position(:,%d)' % i: [float(c) for c in x], 'velocity(:,%d)' % i: [float(c) for c in u],
+                          'omega(:,%d)' % i: [float(c) for c in w]})
+    fdeck.write(path, fdeck.text([
+        ('domain', {'box': list(box), 'cells_per_radius': round(1 / h),
+                    'y_boundary': 'walls' if walls else 'periodic', 'shear_rate': shear}),
+        ('fluid', {'reynolds': REYNOLDS, 'viscous_theta': 1.0, 'initial_flow': 'shear',
+                   'velocity_tolerance': vtol, 'pressure_tolerance': ptol}),
+        ('time', {'dt': REYNOLDS / BETA, 'steps': STEPS}),
+        ('output', {'directory': out, 'progress_every': STEPS, 'series_every': EVERY}),
+        ('lubrication', {'model': model}),
+        ('particles', particles)]))
 
 
 def aitken(x):
@@ -104,10 +106,12 @@ def aitken(x):
 
 
 def steady(out):
-    with h5py.File(os.path.join(out, 'series.h5'), 'r') as f:
-        F = aitken(f['particles/force_hydro'][:])
-        T = aitken(f['particles/torque_hydro'][:])
-        S = aitken(f['particles/stresslet_hydro'][:])
+    """Force, torque and deviatoric stresslet of each sphere at pseudo-time infinity (aitken) from
+    the run's series (fdsusp.series)."""
+    cols = series.read(out, ['particles/force_hydro', 'particles/torque_hydro', 'particles/stresslet_hydro'])[0]
+    F = aitken(cols['particles/force_hydro'])
+    T = aitken(cols['particles/torque_hydro'])
+    S = aitken(cols['particles/stresslet_hydro'])
     S = np.asarray(S)
     tr = np.trace(S, axis1=-2, axis2=-1)
     Sdev = S - tr[..., None, None] * np.eye(3) / 3.0
@@ -174,7 +178,7 @@ class Runner:
         self.binary = os.path.join(work, 'fdsusp')
         if os.path.exists(self.binary):
             os.remove(self.binary)
-        shutil.copy2(os.path.join(os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin')), 'fdsusp'), self.binary)
+        shutil.copy2(program('fdsusp'), self.binary)
 
     def add(self, name, **kw):
         out = os.path.join(self.work, name)
@@ -271,7 +275,6 @@ def main():
     recip = []
     wall = np.zeros((args.samples, len(WALL_GAPS), 5))
     one_body = []
-    sys.path.insert(0, os.path.join(ROOT, 'scripts'))
     from resistance_exact import pair_scalars, wall_excess
     for s, (off, d, e1, e2, t, dc) in enumerate(samples):
         o = {}

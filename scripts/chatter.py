@@ -15,22 +15,23 @@ contacts"): for each output directory, from its series.h5,
     scripts/chatter.py OUTDIR [OUTDIR ...] [--from 0.025] [--window 8]
 """
 import argparse
-import os
 
-import h5py
 import numpy as np
+
+import _fdsusp_path  # noqa: F401  (this checkout's python/ on sys.path)
+from fdsusp import series
 
 
 def analyse(outdir, start, window):
-    with h5py.File(os.path.join(outdir, 'series.h5'), 'r') as f:
-        t = f['time'][()]
-        h = f['core/stress_hydro'][()][:, :4]
-        c = f['core/stress_contact'][()][:, :4]
-        g = f['core/shear_rate'][()]
-        pairs, sliding = f['contacts_pair'][()], f['contacts_sliding'][()]
-        overlap = f['contact_max_overlap'][()] / f.attrs['roughness'] if 'roughness' in f.attrs else None
-        if overlap is None:
-            overlap = f['contact_overlap_over_roughness'][()]
+    f, attrs = series.read(outdir)       # series.h5 and the records still in series.parts/
+    t = f['time']
+    h = f['core/stress_hydro'][:, :4]
+    c = f['core/stress_contact'][:, :4]
+    g = f['core/shear_rate']
+    pairs, sliding = f['contacts_pair'], f['contacts_sliding']
+    overlap = f['contact_max_overlap'] / attrs['roughness'] if 'roughness' in attrs else None
+    if overlap is None:
+        overlap = f['contact_overlap_over_roughness']
     late = t > t[-1] / 2 + 1e-12
     tau = np.mean(g[late] + h[late, 3] + c[late, 3])
     inner = t[1:-1] >= start - 1e-12

@@ -16,18 +16,23 @@ import json
 import os
 import subprocess
 import sys
+import _fdsusp_path  # noqa: F401,E402  (this checkout's python/ on sys.path)
+from fdsusp import deck  # noqa: E402
+from fdsusp.run import ENV, program, run_all  # noqa: E402
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from jobpool import ENV, run_all  # noqa: E402
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
-DECK = """&domain box = {box}, cells_per_radius = {cells}, shear_rate = 1 /
-&fluid reynolds = 0.01, initial_flow = 'shear', viscous_theta = 1 /
-&time dt = 5e-3 /
-&output directory = 'out', progress_every = 50 /
-&particles solid_fraction = {phi}, seed = {seed}, motion = 'frozen' /
-&rheology discard_strain = {discard}, average_strain = 0.25, blocks = 5 /
-"""
+
+
+def deck_text(box, cells, phi, seed, discard):
+    """The deck of one case (fdsusp.deck): frozen spheres in shear, 5 blocks over the last 0.25 strain."""
+    return deck.text([
+        ('domain', {'box': box, 'cells_per_radius': cells, 'shear_rate': 1}),
+        ('fluid', {'reynolds': 0.01, 'initial_flow': 'shear', 'viscous_theta': 1}),
+        ('time', {'dt': 5e-3}),
+        ('output', {'directory': 'out', 'progress_every': 50}),
+        ('particles', {'solid_fraction': phi, 'seed': seed, 'motion': 'frozen'}),
+        ('rheology', {'discard_strain': discard, 'average_strain': 0.25, 'blocks': 5})])
 
 
 def main():
@@ -50,11 +55,9 @@ def main():
     def start(case):
         d = case_dir(case)
         os.makedirs(d, exist_ok=True)
-        with open(os.path.join(d, 'deck.nml'), 'w') as f:
-            f.write(DECK.format(box=', '.join('%g' % b for b in args.box), cells=args.cells, phi=case[0],
-                                seed=case[1], discard=discard))
+        deck.write(os.path.join(d, 'deck.nml'), deck_text(args.box, args.cells, case[0], case[1], discard))
         log = open(os.path.join(d, 'log'), 'w')
-        return subprocess.Popen([os.path.join(os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin')), 'fdsusp'), 'deck.nml'], cwd=d, env=ENV, stdout=log,
+        return subprocess.Popen([program('fdsusp'), 'deck.nml'], cwd=d, env=ENV, stdout=log,
                                 stderr=subprocess.STDOUT)
 
     if not args.table_only:

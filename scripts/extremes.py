@@ -21,9 +21,10 @@ import subprocess
 import sys
 
 import numpy as np
+import _fdsusp_path  # noqa: F401,E402  (this checkout's python/ on sys.path)
+from fdsusp import series  # noqa: E402
+from fdsusp.run import ENV, program, run_all  # noqa: E402
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from jobpool import ENV, run_all  # noqa: E402
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
 SCENES = os.path.join(ROOT, 'input', 'extremes')
@@ -69,11 +70,12 @@ def verdict(name, d, status, requested, dt):
     record['strain'] = done * dt
     m = re.search(r"largest overlap \|delta'\| over this run\s+([0-9.eE+-]+) h_r", log)
     record['overlap_over_hr'] = float(m.group(1)) if m else 0.0
-    import h5py
-    with h5py.File(os.path.join(d, 'out', 'series.h5'), 'r') as f:
-        finite = all(np.isfinite(f[k][:]).all() for k in
-                     ('particles/stresslet_hydro', 'particles/stresslet_contact', 'particles/velocity')
-                     if k in f)
+    out = os.path.join(d, 'out')
+    present = series.names(out)
+    wanted = [k for k in ('particles/stresslet_hydro', 'particles/stresslet_contact', 'particles/velocity')
+              if k in present]
+    columns = series.read(out, wanted)[0]       # series.h5 and the records still in series.parts/
+    finite = all(np.isfinite(columns[k]).all() for k in wanted)
     record['finite'] = bool(finite)
     reasons = []
     if done != requested:
@@ -102,7 +104,7 @@ def main():
     args.work = os.path.abspath(args.work)
     os.makedirs(args.work, exist_ok=True)
     binary = os.path.join(args.work, 'fdsusp')
-    shutil.copy2(os.path.join(os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin')), 'fdsusp'), binary)
+    shutil.copy2(program('fdsusp'), binary)
     waiting, records = list(names), []
     if args.table_only:
         waiting = []

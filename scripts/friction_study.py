@@ -10,11 +10,11 @@ the paper's own set-up (Gallier et al. 2014 §4).
 CASE names a row of ROWS (default: every row of the sensitivity study, in the order of ROWS), run
 at every --mu, or ROW:MU for that one run (e.g. dt5e-4:0.5).
 How runs are made, resumed and recorded (doc/data/friction_phi04/<row>_mu<mu>/: deck.nml and
-summary.json with "run" and "contacts" objects): scripts/study.py. --rerecord writes the records
+summary.json with "run" and "contacts" objects): fdsusp.study. --rerecord writes the records
 of every finished run again. --table prints, from the records, the rows of the sensitivity table: the friction
 ratio eta_r(0.5)/eta_r(0), the relative change of |N1|/tau and |N2|/tau, N2/N1 at both mu_d,
 each with its error propagated from the block errors.
---extend STRAIN (scripts/study.py) continues finished runs to STRAIN; --table then also prints,
+--extend STRAIN (fdsusp.study) continues finished runs to STRAIN; --table then also prints,
 for each extension recorded, its first window against the later one and the slopes of eta_r and
 phi_core over 2-strain windows (drift_table).
 """
@@ -23,8 +23,10 @@ import math
 import os
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from study import BASE, ROOT, Study, ratio, split_run_name  # noqa: E402
+import _fdsusp_path  # noqa: F401  (this checkout's python/ on sys.path)
+from fdsusp.study import BASE, Study, ratio, split_run_name  # noqa: E402
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), '..'))
 
 # The base (study.BASE): the §5.4 set-up (8a x 20a x 8a Couette cell, a/Delta = 4, bulk phi 0.40
 # (seed 1), eps_r 5e-3, full lubrication, dt 2e-3, 2 strains discarded and 20 averaged in 5 blocks)
@@ -105,7 +107,7 @@ def table(study, rows):
 
 
 def drift_table(study):
-    """The extended runs (records <row>_mu<mu>_to<strain>, scripts/study.py --extend): the first
+    """The extended runs (records <row>_mu<mu>_to<strain>, fdsusp.study --extend): the first
     window against the later one, and the slope of eta_r and phi_core over the 2-strain windows
     after the first discard (least squares, its standard error from the scatter about the line)."""
     import glob

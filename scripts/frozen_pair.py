@@ -9,18 +9,24 @@ sensitive, 2.7 times the relative error of XG/XA at gap 0.1, 25 times at 0.01) a
 part as 1 - B, each against exact. The 10a cube confines the pair by ~1-2 % in 1 - A (an 8a box by
 16 % at gap 0.03; measured at a/Delta 4 against a 20a cube, VALIDATION §4.4).
     scripts/frozen_pair.py 4,5,6      (work in out/frozen_pair; ~5 min on 2 cores)"""
+import argparse
 import os
-import sys
-import h5py
+
 import numpy as np
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import calibrate as C
+
+import _fdsusp_path  # noqa: F401  (this checkout's python/ on sys.path)
+import calibrate as C                           # siblings in scripts/
+from fdsusp import series
 from resistance_exact import shear_functions
+
+ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+ap.add_argument('cells', help='the resolutions a/Delta, comma-separated (e.g. 4,5,6)')
+args = ap.parse_args()
 
 GAPS = [0.01, 0.1, 0.3]
 L = 10.0
 d = np.array([0.6, -0.6, 0.53]); d /= np.linalg.norm(d)     # d.E.d and the tangential E.d both nonzero
-cells = [int(c) for c in sys.argv[1].split(',')]
+cells = [int(c) for c in args.cells.split(',')]
 work = os.path.join(C.ROOT, 'out', 'frozen_pair')
 os.makedirs(work, exist_ok=True)
 runner = C.Runner(work, 2)
@@ -39,8 +45,7 @@ print('| a/Delta | gap | 1 - A exact | DNS | error | 1 - B exact | DNS | error |
 print('|---|---|---|---|---|---|---|---|')
 for n in cells:
     for g in GAPS:
-        with h5py.File(os.path.join(work, f'a{n}_g{g}', 'series.h5'), 'r') as f:
-            V = C.aitken(f['particles/velocity'][:])
+        V = C.aitken(series.read(os.path.join(work, f'a{n}_g{g}'), ['particles/velocity'])[0]['particles/velocity'])
         dv = V[1] - V[0]                       # dr/dt; Om x r has no radial part, its t part is removed
         s = 2 + g
         one_a = (dv @ d) / (s * ded)

@@ -3,14 +3,16 @@
 gap, the pair part the grid resolves, its scatter over the calibration samples, and the exact
 value, for the combinations that carry the lubrication singularities (doc/LUBRICATION.md).
     scripts/lubrication_table.py [TABLE ...]"""
+import argparse
 import glob
 import os
-import sys
+
 import h5py
 import numpy as np
+
+from resistance_exact import pair_scalars, wall_excess, NAMES   # a sibling in scripts/
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.join(ROOT, 'scripts'))
-from resistance_exact import pair_scalars, wall_excess, NAMES
 
 I = {n: k for k, n in enumerate(NAMES)}
 COMBOS = [('XA11-XA12', lambda f: f[I['XA11']] - f[I['XA12']]),
@@ -19,7 +21,10 @@ COMBOS = [('XA11-XA12', lambda f: f[I['XA11']] - f[I['XA12']]),
           ('XC11', lambda f: f[I['XC11']]), ('YC11', lambda f: f[I['YC11']]),
           ('XM', lambda f: f[I['XM11']] + f[I['XM12']]), ('YM', lambda f: f[I['YM11']] + f[I['YM12']]),
           ('ZM', lambda f: f[I['ZM11']] + f[I['ZM12']])]
-for path in sys.argv[1:] or sorted(glob.glob(os.path.join(ROOT, 'input', 'lubrication', 'resolved_a*.h5'))):
+ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+ap.add_argument('tables', nargs='*', metavar='TABLE', help='default: the shipped input/lubrication/resolved_a*.h5')
+args = ap.parse_args()
+for path in args.tables or sorted(glob.glob(os.path.join(ROOT, 'input', 'lubrication', 'resolved_a*.h5'))):
     with h5py.File(path, 'r') as h:
         n = h.attrs['cells_per_radius']
         pair, scat = h['pair/resolved'][:], h['pair/scatter'][:]

@@ -9,7 +9,7 @@ the same packings (the in-run packing of the same seed in the same box), run wit
     scripts/model_trade.py --figure doc/figures/model_trade.png
 
 CASE names a row of ROWS (default: every row but the paper-scale ones), run at every --mu, or
-ROW:MU for one run. Runs are made, resumed and recorded as by scripts/study.py
+ROW:MU for one run. Runs are made, resumed and recorded as by fdsusp.study
 (doc/data/model_trade/<row>_mu<mu>/deck.nml and summary.json, with the CPU seconds per strain).
 The DNS of the §5.4 set-up at phi 0.4 and of the paper's set-up are the friction study's records
 (doc/data/friction_phi04, rows base and paperdt2): the same decks with the fluid resolved.
@@ -21,8 +21,10 @@ import math
 import os
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from study import BASE, ROOT, Study, load, run_name  # noqa: E402
+import _fdsusp_path  # noqa: F401  (this checkout's python/ on sys.path)
+from fdsusp.study import BASE, Study, load, run_name  # noqa: E402
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), '..'))
 
 LD = dict(model='none')
 ROWS = {

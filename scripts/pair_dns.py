@@ -42,12 +42,12 @@ import subprocess
 import sys
 
 import numpy as np
+import _fdsusp_path  # noqa: F401,E402  (this checkout's python/ on sys.path)
+from fdsusp import deck as fdeck, series  # noqa: E402
+from fdsusp.run import ENV, MPIEXEC, copy_program, program, run_all  # noqa: E402
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from jobpool import ENV, run_all  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BIN = os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin'))
 S_INF = 20.0 / 3.0 * math.pi
 # case: (pairtraj deck under input/ used as the template, eps_r, mu_d)
 CASES = {'eps0': ('pair_eps0', 0.0, 0.0),
@@ -68,17 +68,22 @@ EXTEND = 0.1      # a DNS that has not crossed by its last step goes on by this 
 
 # Smooth spheres (eps_r = 0) get no &contact group: lubrication alone keeps them apart, as in
 # pairtraj, whose smooth pair never touches (its closest gap from y = 0.5a is 8.7e-5 a).
-DNS_DECK = """! pair test in the DNS, written by scripts/pair_dns.py (case {case})
-&domain box = {box}, {box}, {box}, cells_per_radius = {cells}, y_boundary = 'walls', shear_rate = 1 /
-&fluid reynolds = {reynolds}, viscous_theta = {theta}, initial_flow = 'shear' /
-&time dt = {dt}, steps = {steps} /
-&output directory = 'out', progress_every = {progress}, series_every = {every}, checkpoint_every = {checkpoint} /
-&run title = 'pair test {case}', max_wall_hours = {hours} /
-&particles number = 2,
-  position(:,1) = {x1:.12g}, {y1:.12g}, {c:.12g},
-  position(:,2) = {x2:.12g}, {y2:.12g}, {c:.12g} /
-&lubrication model = 'full' /
-{contact}"""
+def dns_deck(case, box, cells, reynolds, theta, dt, steps, hours, x1, y1, x2, y2, c, contact):
+    """The DNS deck of a case (fdsusp.deck; numbers to 12 digits, as this study always wrote them);
+    contact: the &contact settings, None for smooth spheres."""
+    every = record_every(dt)
+    groups = [('domain', {'box': (box, box, box), 'cells_per_radius': cells, 'y_boundary': 'walls', 'shear_rate': 1}),
+              ('fluid', {'reynolds': reynolds, 'viscous_theta': theta, 'initial_flow': 'shear'}),
+              ('time', {'dt': dt, 'steps': steps}),
+              ('output', {'directory': 'out', 'progress_every': max(1, steps // 20), 'series_every': every,
+                          'checkpoint_every': max(1, steps // 10)}),
+              ('run', {'title': 'pair test %s' % case, 'max_wall_hours': hours}),
+              ('particles', {'number': 2, 'position(:,1)': (x1, y1, c), 'position(:,2)': (x2, y2, c)}),
+              ('lubrication', {'model': 'full'})]
+    if contact is not None:
+        groups.append(('contact', contact))
+    return fdeck.text(groups, comment='pair test in the DNS, written by scripts/pair_dns.py (case %s)' % case,
+                      float_format='%.12g')
 
 
 def override(text, **values):
@@ -99,7 +104,7 @@ def pairtraj(case, d, start, eps_bar):
     with open(deck, 'w') as f:
         f.write(override(text, start='%r, %r, 0.0' % (start, Y0), x_end=repr(-start),
                          eps_bar=repr(eps_bar), csv_file="'pairtraj.csv'", dt_out='0.01'))
-    subprocess.run([os.path.join(BIN, 'pairtraj'), 'pairtraj.nml'], cwd=d, check=True,
+    subprocess.run([program('pairtraj'), 'pairtraj.nml'], cwd=d, check=True,
                    stdout=subprocess.DEVNULL)
     return read_pairtraj(d)
 
@@ -125,16 +130,14 @@ def prepare(case, d, box, cells, dt, start, eps_bar=0.05, reynolds=0.01, theta=0
         if os.path.exists(os.path.join(d, 'deck.nml')):
             steps = max(steps, deck_steps(d))                # a continued case keeps its extension
     c = box / 2.0
-    contact = '' if eps_r == 0 else '&contact roughness = %r, eps_bar = %r, friction = %r /\n' % (eps_r, eps_bar, mu_d)
-    every = record_every(dt)
-    with open(os.path.join(d, 'deck.nml'), 'w') as f:
-        f.write(DNS_DECK.format(case=case, box=box, cells=cells, reynolds=reynolds, theta=theta, dt=dt, steps=steps,
-                                progress=max(1, steps // 20), every=every, checkpoint=max(1, steps // 10),
-                                hours=hours, x1=c - start / 2, y1=c - Y0 / 2, x2=c + start / 2,
-                                y2=c + Y0 / 2, c=c, contact=contact))
+    # smooth spheres (eps_r = 0) get no &contact group (above)
+    contact = None if eps_r == 0 else {'roughness': eps_r, 'eps_bar': eps_bar, 'friction': mu_d}
+    fdeck.write(os.path.join(d, 'deck.nml'),
+                dns_deck(case, box, cells, reynolds, theta, dt, steps, hours, x1=c - start / 2, y1=c - Y0 / 2,
+                         x2=c + start / 2, y2=c + Y0 / 2, c=c, contact=contact))
     binary = os.path.join(d, 'fdsusp')          # a copy: a rebuild cannot change a study half-way
     if not os.path.exists(binary):
-        shutil.copy2(os.path.join(BIN, 'fdsusp'), binary)
+        copy_program(binary)
     command = [binary, 'deck.nml']
     if os.path.exists(os.path.join(d, 'out', 'checkpoint.h5')):
         command += ['-restart', 'out/checkpoint.h5']
@@ -143,7 +146,7 @@ def prepare(case, d, box, cells, dt, start, eps_bar=0.05, reynolds=0.01, theta=0
 
 def start_dns(d, command, ranks):
     if ranks > 1:
-        command = ['mpiexec', '--oversubscribe', '-n', str(ranks)] + command
+        command = MPIEXEC + ['-n', str(ranks)] + command
     log = open(os.path.join(d, 'log'), 'a')
     log.write('\n# %s\n' % ' '.join(command))
     log.flush()
@@ -151,13 +154,12 @@ def start_dns(d, command, ranks):
 
 
 def series_steps(d):
-    """The steps of the records a case's series holds (empty before its first flush)."""
-    import h5py
-    path = os.path.join(d, 'out', 'series.h5')
-    if not os.path.exists(path):
+    """The steps of the records a case's series holds, series.parts/ included (empty before its
+    first flush)."""
+    out = os.path.join(d, 'out')
+    if not series.files(out):
         return np.zeros(0, dtype=int)
-    with h5py.File(path, 'r') as f:
-        return f['step'][:]
+    return series.read(out, ['step'])[0]['step']
 
 
 def deck_steps(d):
@@ -176,10 +178,8 @@ def trunk_steps(refs, dt):
 def check_trunk(trunk, box):
     """A trunk may serve as the shared approach only if no contact force acted in it and its pair
     stayed well clear of every roughness (the cases differ in nothing else before they touch)."""
-    import h5py
     dns = load_dns(trunk, box)
-    with h5py.File(os.path.join(trunk, 'out', 'series.h5'), 'r') as f:
-        touched = np.abs(f['particles/force_contact'][:]).max()
+    touched = np.abs(series.read(os.path.join(trunk, 'out'), ['particles/force_contact'])[0]['particles/force_contact']).max()
     if touched > 0 or dns['gap'].min() < BRANCH_GAP / 2:
         raise SystemExit('pair_dns.py: the trunk %s cannot be shared: largest contact force %.3g, closest gap %.4f '
                          '(needs none and >= %g); run without --branch' % (trunk, touched, dns['gap'].min(),
@@ -203,12 +203,14 @@ def branch(trunk, d, case):
 def load_dns(d, box):
     """The DNS pair: time, relative position r = x2 - x1 (minimum image in x and z), theta, and N1*,
     N2* of one sphere (the mean of the two, equal by symmetry), with their contact parts."""
-    import h5py
-    with h5py.File(os.path.join(d, 'out', 'series.h5'), 'r') as f:
-        t = f['time'][:]
-        x = f['particles/position'][:]
-        s = f['particles/stresslet_hydro'][:]
-        sc = f['particles/stresslet_contact'][:] if 'particles/stresslet_contact' in f else np.zeros_like(s)
+    out = os.path.join(d, 'out')
+    contact = 'particles/stresslet_contact' in series.names(out)
+    f = series.read(out, ['time', 'particles/position', 'particles/stresslet_hydro']
+                    + (['particles/stresslet_contact'] if contact else []))[0]
+    t = f['time']
+    x = f['particles/position']
+    s = f['particles/stresslet_hydro']
+    sc = f['particles/stresslet_contact'] if contact else np.zeros_like(s)
     r = x[:, 1] - x[:, 0]
     for k in (0, 2):
         r[:, k] -= box * np.round(r[:, k] / box)
@@ -327,14 +329,15 @@ def mobility(d, box):
     times as sensitive at gap 0.1, 25 times at 0.01), so it shows where the trajectory goes wrong:
     in the approach (d.E.d < 0) or the separation (d.E.d > 0). Returns, per phase and gap of
     MOBILITY_GAPS, the relative errors (radial, tangential) at the record nearest that gap."""
-    import h5py
     from resistance_exact import shear_functions
-    with h5py.File(os.path.join(d, 'out', 'series.h5'), 'r') as f:
-        x = f['particles/position'][:]
-        v = f['particles/velocity'][:]
-        contact = np.abs(f['particles/force_contact'][:]).sum(axis=(1, 2)) if 'particles/force_contact' in f \
-            else np.zeros(len(x))
-        dt = (f['time'][1] - f['time'][0]) / (f['step'][1] - f['step'][0])
+    out = os.path.join(d, 'out')
+    touching = 'particles/force_contact' in series.names(out)
+    f = series.read(out, ['step', 'time', 'particles/position', 'particles/velocity']
+                    + (['particles/force_contact'] if touching else []))[0]
+    x = f['particles/position']
+    v = f['particles/velocity']
+    contact = np.abs(f['particles/force_contact']).sum(axis=(1, 2)) if touching else np.zeros(len(x))
+    dt = (f['time'][1] - f['time'][0]) / (f['step'][1] - f['step'][0])
     dv = v[:, 1] - v[:, 0]
     # a record holds X^{n+1} and the velocity of X^n: step back, or the pair's rotation (omega dt)
     # turns v_t omega dt of tangential velocity into a spurious radial one (2.3e-3 at dt 2.5e-3)

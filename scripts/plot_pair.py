@@ -23,6 +23,8 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import _fdsusp_path  # noqa: F401,E402  (this checkout's python/ on sys.path)
+from fdsusp.run import program  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CASES = [("pair_eps0", r"$\epsilon_r = 0$", "k", "-"),
@@ -47,7 +49,7 @@ def load(case, csv_dir, run):
     path = os.path.join(csv_dir, case + ".csv")
     if run or not os.path.exists(path):
         deck = os.path.join(ROOT, "input", case + ".nml")
-        binary = os.path.join(os.environ.get("FDSUSP_BIN", os.path.join(ROOT, "bin")), "pairtraj")
+        binary = program('pairtraj')
         print("running", binary, deck)
         subprocess.run([binary, deck], check=True, cwd=ROOT, stdout=subprocess.DEVNULL)
         path = os.path.join(ROOT, "out", case + ".csv")

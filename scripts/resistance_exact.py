@@ -2,6 +2,8 @@
 import os
 import subprocess
 import numpy as np
+import _fdsusp_path  # noqa: F401,E402  (this checkout's python/ on sys.path)
+from fdsusp.run import program  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 NAMES = ["XA11", "YA11", "YB11", "XC11", "YC11", "XG11", "YG11", "YH11", "XM11", "YM11", "ZM11",
@@ -9,7 +11,7 @@ NAMES = ["XA11", "YA11", "YB11", "XC11", "YC11", "XG11", "YG11", "YH11", "XM11",
 
 
 def _table(kind, gaps):
-    out = subprocess.run([os.path.join(os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin')), 'fdsusp-resistance'), kind] + ['%.17g' % g for g in gaps],
+    out = subprocess.run([program('fdsusp-resistance'), kind] + ['%.17g' % g for g in gaps],
                          check=True, capture_output=True, text=True).stdout
     return np.array([[float(v) for v in line.split()] for line in out.splitlines() if not line.startswith('#')])
 

@@ -43,9 +43,10 @@ import re
 import shutil
 import subprocess
 import sys
+import _fdsusp_path  # noqa: F401,E402  (this checkout's python/ on sys.path)
+from fdsusp import deck  # noqa: E402
+from fdsusp.run import ENV, program, run_all  # noqa: E402
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from jobpool import ENV, run_all  # noqa: E402
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
 BASE = {'cells': 4, 'dt': 1e-3, 'vtol': 1e-8, 'ptol': 1e-10, 'lub': 'full', 'model': 'resolved'}
@@ -55,16 +56,21 @@ BASE = {'cells': 4, 'dt': 1e-3, 'vtol': 1e-8, 'ptol': 1e-10, 'lub': 'full', 'mod
 DEFAULTS = {'a/D 5 full', 'dt 0.001', 'tol 1e-06 (default)', 'full', 'DNS (resolved fluid)'}
 DEFAULT_RUN = 'a5_dt0.001_tol1e-08-1e-10_full'
 BASE_RUN = 'a4_dt0.001_tol1e-08-1e-10_full'
-DECK = """&domain box = 7, 10, 7, cells_per_radius = {cells}, y_boundary = 'walls', shear_rate = 1 /
-&fluid model = '{model}', reynolds = 0.01, initial_flow = 'shear', velocity_tolerance = {vtol:g}, pressure_tolerance = {ptol:g} /
-&time dt = {dt:g} /
-&output directory = 'out', progress_every = 250, series_every = 1 /
-&particles solid_fraction = 0.3, seed = 1 /
-&contact roughness = 5e-3, eps_bar = 0.1, friction = 0.5 /
-&lubrication model = '{lub}' /
-&rheology discard_strain = 0.2, average_strain = {average:g}, blocks = 4 /
-&run title = 'tradeoff: {name}' /
-"""
+
+
+def deck_text(p, average, name):
+    """The deck of one run (fdsusp.deck; settings rounded to 6 digits, '%g', as this study always did)."""
+    return deck.text([
+        ('domain', {'box': (7, 10, 7), 'cells_per_radius': p['cells'], 'y_boundary': 'walls', 'shear_rate': 1}),
+        ('fluid', {'model': p['model'], 'reynolds': 0.01, 'initial_flow': 'shear', 'velocity_tolerance': p['vtol'],
+                   'pressure_tolerance': p['ptol']}),
+        ('time', {'dt': p['dt']}),
+        ('output', {'directory': 'out', 'progress_every': 250, 'series_every': 1}),
+        ('particles', {'solid_fraction': 0.3, 'seed': 1}),
+        ('contact', {'roughness': 5e-3, 'eps_bar': 0.1, 'friction': 0.5}),
+        ('lubrication', {'model': p['lub']}),
+        ('rheology', {'discard_strain': 0.2, 'average_strain': average, 'blocks': 4}),
+        ('run', {'title': 'tradeoff: %s' % name})], float_format='%g')
 
 
 def tabled_grids():
@@ -113,8 +119,7 @@ def start(work, name, p, strain):
     if os.path.exists(d):
         shutil.rmtree(d)
     os.makedirs(d)
-    with open(os.path.join(d, 'deck.nml'), 'w') as f:
-        f.write(DECK.format(average=strain - 0.2, name=name, **p))
+    deck.write(os.path.join(d, 'deck.nml'), deck_text(p, strain - 0.2, name))
     log = open(os.path.join(d, 'log'), 'w')
     # the tolerance knob measures the Krylov path (-fluid_solver krylov); the default direct
     # solves are exact and ignore the tolerances
@@ -248,7 +253,7 @@ def main():
         params.setdefault(r['name'], r['parameters'])
     if not args.table_only:
         os.makedirs(args.work, exist_ok=True)
-        shutil.copy2(os.path.join(os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin')), 'fdsusp'), os.path.join(args.work, 'fdsusp'))
+        shutil.copy2(program('fdsusp'), os.path.join(args.work, 'fdsusp'))
 
         def report(name, status, seconds):
             cpu[name] = seconds

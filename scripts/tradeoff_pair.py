@@ -39,13 +39,13 @@ import subprocess
 import sys
 
 import numpy as np
-import h5py
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from jobpool import ENV, run_all  # noqa: E402
-import calibrate as C  # noqa: E402
+import _fdsusp_path  # noqa: F401,E402  (this checkout's python/ on sys.path)
+import calibrate as C  # noqa: E402  (siblings in scripts/)
 from resistance_exact import pair_scalars, NAMES  # noqa: E402
 from tradeoff import plot_front, tabled_grids  # noqa: E402
+from fdsusp import series  # noqa: E402
+from fdsusp.run import ENV, program, run_all  # noqa: E402
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
 PI = math.pi
@@ -116,8 +116,8 @@ def start(work, run, kw):
 def steady(work, run):
     """Force and torque on sphere 1 at pseudo-time infinity, and the Aitken estimate's own change
     when the last sample is left out (how far from steady the run ended)."""
-    with h5py.File(os.path.join(work, run, 'out', 'series.h5'), 'r') as f:
-        F, Tq = f['particles/force_hydro'][:, 0], f['particles/torque_hydro'][:, 0]
+    cols = series.read(os.path.join(work, run, 'out'), ['particles/force_hydro', 'particles/torque_hydro'])[0]
+    F, Tq = cols['particles/force_hydro'][:, 0], cols['particles/torque_hydro'][:, 0]
     now = np.concatenate([C.aitken(F), C.aitken(Tq)])
     before = np.concatenate([C.aitken(F[:-1]), C.aitken(Tq[:-1])])
     return now[:3], now[3:], np.abs(now - before).max() / max(np.abs(now).max(), 1e-30)
@@ -176,7 +176,7 @@ def main():
             cpu = json.load(f)
     if not args.table_only:
         os.makedirs(args.work, exist_ok=True)
-        shutil.copy2(os.path.join(os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin')), 'fdsusp'), os.path.join(args.work, 'fdsusp'))
+        shutil.copy2(program('fdsusp'), os.path.join(args.work, 'fdsusp'))
         status = {}
 
         def report(run, st, seconds):

@@ -23,21 +23,12 @@ import argparse
 import json
 import os
 import sys
+import _fdsusp_path  # noqa: F401,E402  (this checkout's python/ on sys.path)
+from fdsusp import deck  # noqa: E402
+from fdsusp.run import run_all, start_resumable  # noqa: E402
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from jobpool import run_all, start_resumable  # noqa: E402
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
-DECK = """&domain box = {box}, cells_per_radius = {cells}, y_boundary = 'walls', shear_rate = 1 /
-&fluid reynolds = 0.01, initial_flow = 'shear' /
-&time dt = {dt} /
-&output directory = 'out', progress_every = 500, series_every = 5, checkpoint_every = 2500 /
-&particles solid_fraction = {phi}, seed = 1 /
-&contact roughness = 5e-3, eps_bar = {eps_bar}, friction = {mu} /
-&lubrication model = 'full' /
-&rheology discard_strain = {discard}, average_strain = {average}, blocks = 5 /
-&run title = 'trend: phi = {phi}, mu_d = {mu}', max_wall_hours = {hours} /
-"""
 SHOWN = ['eta_r', 'eta_h', 'eta_c', 'N1/tau', 'N2/tau', 'Pi/tau', 'phi_core',
          'gamma_dot_core']
 
@@ -47,9 +38,21 @@ def case_dir(work, phi, mu):
 
 
 def start(d, args, phi, mu):
-    deck = DECK.format(box=', '.join('%g' % b for b in args.box), cells=args.cells, dt=args.dt, phi=phi, mu=mu,
-                       eps_bar=args.eps_bar, discard=args.discard, average=args.average, hours=args.hours)
-    return start_resumable(d, deck)[0]
+    return start_resumable(d, deck_text(args, phi, mu))[0]
+
+
+def deck_text(args, phi, mu):
+    """The deck of one case (fdsusp.deck)."""
+    return deck.text([
+        ('domain', {'box': args.box, 'cells_per_radius': args.cells, 'y_boundary': 'walls', 'shear_rate': 1}),
+        ('fluid', {'reynolds': 0.01, 'initial_flow': 'shear'}),
+        ('time', {'dt': args.dt}),
+        ('output', {'directory': 'out', 'progress_every': 500, 'series_every': 5, 'checkpoint_every': 2500}),
+        ('particles', {'solid_fraction': phi, 'seed': 1}),
+        ('contact', {'roughness': 5e-3, 'eps_bar': args.eps_bar, 'friction': mu}),
+        ('lubrication', {'model': 'full'}),
+        ('rheology', {'discard_strain': args.discard, 'average_strain': args.average, 'blocks': 5}),
+        ('run', {'title': 'trend: phi = %s, mu_d = %s' % (phi, mu), 'max_wall_hours': args.hours})])
 
 
 def summary(d):

@@ -18,11 +18,12 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from checks import check, finish, failures  # noqa: E402,F401
 
 ROOT = os.environ.get('FDSUSP_ROOT', os.path.abspath(os.path.join(os.path.dirname(__file__), '..')))
-BIN = os.environ.get('FDSUSP_BIN', os.path.join(ROOT, 'bin'))
-# the one reader of a run's series (series.h5 and series.parts/), from this checkout's scripts
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'scripts'))
-import series as series_reader  # noqa: E402
-FDSUSP = os.path.join(BIN, 'fdsusp')
+# the package of this checkout (python/fdsusp): the one reader of a run's series (series.h5 and
+# series.parts/) and the one way to find the programs ($FDSUSP_BIN, else this checkout's bin/)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'python'))
+from fdsusp import deck as fdsusp_deck, run as fdsusp_run, series as series_reader  # noqa: E402
+BIN = fdsusp_run.bin_dir()
+FDSUSP = fdsusp_run.program('fdsusp')
 
 ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT='1', OMPI_ALLOW_RUN_AS_ROOT_CONFIRM='1',
            OMPI_MCA_rmaps_base_oversubscribe='1')
@@ -36,17 +37,12 @@ def scratch(name):
 
 
 def write_deck(directory, name, text):
-    path = os.path.join(directory, name)
-    with open(path, 'w') as f:
-        f.write(text)
-    return path
+    """Write a deck (its text, or groups for fdsusp.deck.text) as directory/name; returns the path."""
+    return fdsusp_deck.write(os.path.join(directory, name), text if isinstance(text, str) else fdsusp_deck.text(text))
 
 
 def command(deck, np_ranks=1, args=()):
-    cmd = [FDSUSP, deck] + list(args)
-    if np_ranks > 1:
-        cmd = ['mpiexec', '--oversubscribe', '-n', str(np_ranks)] + cmd
-    return cmd
+    return fdsusp_run.command(deck, np_ranks, args, binary=FDSUSP)
 
 
 def run(deck, cwd, np_ranks=1, args=(), expect_ok=True, timeout=600):
@@ -95,7 +91,7 @@ def h5_attr(path, name):
 
 def series(outdir):
     """Every dataset of the run's series by its path ('time', 'particles/velocity', ...): series.h5
-    and the records still in series.parts/ (scripts/series.py)."""
+    and the records still in series.parts/ (fdsusp.series)."""
     return series_reader.read(outdir)[0]
 
 

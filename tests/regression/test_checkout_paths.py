@@ -1,7 +1,7 @@
 """Invariant: every test finds the programs and inputs relative to the checkout it belongs to
 (or through FDSUSP_ROOT / FDSUSP_BIN, which tests/run_tests.sh exports), never through a path of
 one particular machine.
- 1. static: no file under tests/ or scripts/, nor the Makefile, names the absolute path of this
+ 1. static: no file under tests/, scripts/ or python/ (the package), nor the Makefile, names the absolute path of this
     checkout or that of the machine where the project was first developed;
  2. dynamic: tests/physics/pairtraj_lib.py and tests/physics/test_pairtraj_deck_errors.sh,
     copied into a scratch checkout whose bin/pairtraj is a stand-in that records its calls, and
@@ -23,7 +23,7 @@ FORBIDDEN = sorted({ROOT, '/work' + '/main'})      # spelled apart so that this 
 # 1. static scan
 offenders = []
 files = [os.path.join(ROOT, 'Makefile')]
-for top in ('tests', 'scripts'):
+for top in ('tests', 'scripts', 'python'):
     for dirpath, _, names in os.walk(os.path.join(ROOT, top)):
         files += [os.path.join(dirpath, n) for n in names]
 for path in files:
@@ -36,7 +36,7 @@ for path in files:
         for k, line in enumerate(text.splitlines(), 1):
             if bad in line:
                 offenders.append('%s:%d (%s)' % (os.path.relpath(path, ROOT), k, bad))
-T.check(len(files) > 20 and not offenders, 'none of %d files under tests/, scripts/ and the Makefile names %s%s'
+T.check(len(files) > 20 and not offenders, 'none of %d files under tests/, scripts/, python/ and the Makefile names %s%s'
         % (len(files), ' or '.join(FORBIDDEN), (': ' + ', '.join(offenders[:5])) if offenders else ''))
 
 # 2. a scratch checkout with a stand-in pairtraj that records its calls

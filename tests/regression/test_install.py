@@ -8,8 +8,13 @@ is where it looks instead. Checked by the path the run log names and by a run th
      scratch directory, logs 'lubrication table: PREFIX/bin/../share/fdsusp/lubrication/...' and
      finishes;
   3. with FDSUSP_TABLE_DIR pointing at an empty directory the same run is refused, naming that
-     directory (the variable wins), before any step.
+     directory (the variable wins), before any step;
+  4. the Python package: PREFIX/share/fdsusp/python/fdsusp holds every module of python/fdsusp;
+     imported from there (PYTHONPATH, from a scratch directory, FDSUSP_BIN unset) it is that copy,
+     it finds the installed programs (PREFIX/bin/fdsusp) and its series reader reads the run of 2;
+     the installed PREFIX/share/fdsusp/scripts/series.py (no PYTHONPATH) prints that run's records.
 """
+import glob
 import os
 import subprocess
 import sys
@@ -56,4 +61,29 @@ messages = [l for l in p.stderr.splitlines() if l.startswith('fdsusp:')]
 T.check(p.returncode != 0 and len(messages) == 1 and empty in messages[0] and 'step ' not in p.stdout,
         'FDSUSP_TABLE_DIR wins: an empty one is refused by name before any step (status %d, %s)'
         % (p.returncode, messages[:1]))
+
+# 4. the Python package, installed beside the programs
+package = os.path.join(prefix, 'share', 'fdsusp', 'python')
+modules = sorted(os.path.basename(m) for m in glob.glob(os.path.join(T.ROOT, 'python', 'fdsusp', '*.py')))
+missing = [m for m in modules if not os.path.exists(os.path.join(package, 'fdsusp', m))]
+T.check(len(modules) >= 7 and not missing, 'the installed package holds the %d modules of python/fdsusp (missing: %s)'
+        % (len(modules), missing))
+env = dict(T.ENV, PYTHONPATH=package)
+env.pop('FDSUSP_BIN', None)
+code = ('import fdsusp, fdsusp.run, fdsusp.series, fdsusp.rheology, fdsusp.deck; print(fdsusp.__file__); '
+        'print(fdsusp.run.program("fdsusp")); print(len(fdsusp.series.read(%r)[0]["step"]))' % os.path.join(d, 'out'))
+p = subprocess.run([sys.executable, '-c', code], cwd=empty, env=env, capture_output=True, text=True, timeout=120)
+lines = p.stdout.split()
+T.check(p.returncode == 0 and len(lines) == 3 and lines[0].startswith(os.path.join(package, 'fdsusp') + os.sep),
+        'import fdsusp from PREFIX/share/fdsusp/python is the installed copy (%s %s)' % (lines[:1], p.stderr[-300:]))
+T.check(p.returncode == 0 and len(lines) == 3 and lines[1] == os.path.join(prefix, 'bin', 'fdsusp'),
+        'the installed package finds the installed fdsusp: %s' % lines[1:2])
+T.check(p.returncode == 0 and len(lines) == 3 and int(lines[2]) > 0,
+        'the installed fdsusp.series reads the installed program\'s run (%s records)' % lines[2:3])
+script = os.path.join(prefix, 'share', 'fdsusp', 'scripts', 'series.py')
+env.pop('PYTHONPATH')       # the installed scripts find the installed package by themselves
+p = subprocess.run([sys.executable, script, os.path.join(d, 'out')], cwd=empty, env=env, capture_output=True,
+                   text=True, timeout=120)
+T.check(p.returncode == 0 and 'records, steps' in p.stdout,
+        'the installed scripts/series.py runs on it, without PYTHONPATH (%s)' % (p.stdout.splitlines()[:1] or p.stderr[-200:]))
 T.finish()

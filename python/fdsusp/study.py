@@ -1,5 +1,6 @@
 """A resumable study of sheared suspensions in a Couette cell (or a Lees-Edwards box): the machinery
-shared by scripts/friction_study.py (issue 28) and scripts/model_trade.py (issue 30).
+shared by scripts/friction_study.py (issue 28) and scripts/model_trade.py (issue 30), each a table
+of rows and its own Study(...).main().
 
 A study is a base set-up (BASE below, overridden per study) and rows, each a name, a sentence and
 the settings it changes; each row runs at one or more mu_d. Each (row, mu_d) run is a directory
@@ -14,7 +15,7 @@ in git). The CPU seconds of every call are added up in <run>/cpu_seconds.
 <work>/<row>_mu<mu>_to<STRAIN> of its own (the finished run stays as it was), with a deck that
 averages the new strains alone (discard_strain = the finished run's end), so the program starts
 its statistics afresh there (doc/INPUT.md &rheology). The record <record>/<row>_mu<mu>_to<STRAIN>/
-holds that later window, recomputed by scripts/rheology.py from series.h5 (which the extension
+holds that later window, recomputed by fdsusp.rheology from series.h5 (which the extension
 carries on from the start), and "by_strain": eta_r, N1/tau, N2/tau and phi_core over successive
 2-strain windows of the whole run, which shows whether the first window had reached steady state.
 
@@ -32,9 +33,11 @@ import re
 import shutil
 import subprocess
 
-from jobpool import run_all, start_resumable
+from . import deck, rheology
+from .run import checkout, run_all, start_resumable
 
-ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
+# the checkout (its git commit names a run's program when no pinned build is used); None when installed
+ROOT = checkout()
 
 # The doc/VALIDATION.md §5.4 set-up with the paper's eps_bar 0.05: 8a x 20a x 8a Couette cell,
 # a/Delta = 4, bulk phi 0.40 (seed 1), eps_r 5e-3, implicit contacts, full lubrication, dt 2e-3,
@@ -43,19 +46,6 @@ ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
 BASE = dict(box=(8, 20, 8), cells=4, phi=0.40, seed=1, eps_r=5e-3, eps_bar=0.05, dt=2e-3,
             discard=2.0, average=20.0, blocks=5, min_gap=None, implicit=True,
             model='resolved', boundary='walls', cutoff=None)
-
-DECK = """! {study}, row '{row}': {what}; mu_d = {mu}
-&domain box = {box}, cells_per_radius = {cells}, y_boundary = '{boundary}', shear_rate = 1 /
-&fluid {model}reynolds = 0.01, initial_flow = 'shear' /
-&time dt = {dt} /
-&output directory = 'out', progress_every = 500, series_every = 5, checkpoint_every = 2500 /
-&particles solid_fraction = {phi}, seed = {seed}{packing} /
-&contact roughness = {eps_r}, eps_bar = {eps_bar}, friction = {mu}{implicit} /
-&lubrication model = 'full'{cutoff} /
-&rheology discard_strain = {discard}, average_strain = {average}, blocks = {blocks} /
-&run title = '{title} {row}: mu_d = {mu}', max_wall_hours = {hours} /
-"""
-
 
 def run_name(row, mu):
     return '%s_mu%g' % (row, mu)
@@ -94,28 +84,13 @@ def commit_of_binary():
     pinned = os.path.join(os.environ.get('FDSUSP_BIN', ''), 'VERSION')
     if os.environ.get('FDSUSP_BIN') and os.path.exists(pinned):
         return open(pinned).read().strip()
+    if ROOT is None:
+        return 'unknown'
     try:
         return subprocess.run(['git', 'describe', '--always', '--dirty'], cwd=ROOT, capture_output=True,
                               text=True, check=True).stdout.strip()
     except (OSError, subprocess.CalledProcessError):
         return 'unknown'
-
-
-def contact_statistics(series_path, discard_strain):
-    """Means over the averaged records (strain > discard) of the contact columns of series.h5:
-    contacts between spheres and with the walls, the fraction of them sliding (at the Coulomb
-    limit), and the largest overlap of each record in units of h_r."""
-    import h5py
-    import numpy as np
-    with h5py.File(series_path, 'r') as f:
-        strain = f['time'][()] * abs(float(np.ravel(f.attrs['shear_rate'])[0]))
-        keep = strain > discard_strain
-        pair, wall, sliding = (f[k][()][keep] for k in ('contacts_pair', 'contacts_wall', 'contacts_sliding'))
-        overlap = f['contact_overlap_over_roughness'][()][keep]
-    total = pair + wall
-    return {'records': int(keep.sum()), 'pair_contacts': float(pair.mean()), 'wall_contacts': float(wall.mean()),
-            'sliding_fraction': float(sliding.sum() / total.sum()) if total.sum() > 0 else 0.0,
-            'largest_overlap_over_h_r_mean': float(overlap.mean()), 'largest_overlap_over_h_r_max': float(overlap.max())}
 
 
 class Study:
@@ -133,20 +108,24 @@ class Study:
         return s
 
     def deck_text(self, row, mu, hours, window=None):
-        """The deck of a run; window = (discard, average) strains replaces the row's."""
+        """The deck of a run (fdsusp.deck); window = (discard, average) strains replaces the row's."""
         s = self.settings(row)
         if window is not None:
             s['discard'], s['average'] = window
-        packing = '' if s['min_gap'] is None else ', packing_min_gap = %g' % s['min_gap']
-        return DECK.format(study=self.title, title=self.title, row=row, what=self.rows[row][0], mu=mu,
-                           box=', '.join('%g' % b for b in s['box']), cells=s['cells'],
-                           boundary=s['boundary'],
-                           cutoff='' if s['cutoff'] is None else ', outer_cutoff = %g' % s['cutoff'],
-                           model='' if s['model'] == 'resolved' else "model = '%s', " % s['model'],
-                           dt=s['dt'], phi=s['phi'], seed=s['seed'], packing=packing,
-                           eps_r=s['eps_r'], eps_bar=s['eps_bar'], discard=s['discard'],
-                           average=s['average'], blocks=s['blocks'], hours=hours,
-                           implicit='' if s['implicit'] else ', implicit = .false.')
+        return deck.text([
+            ('domain', {'box': s['box'], 'cells_per_radius': s['cells'], 'y_boundary': s['boundary'],
+                        'shear_rate': 1}),
+            ('fluid', {'model': None if s['model'] == 'resolved' else s['model'], 'reynolds': 0.01,
+                       'initial_flow': 'shear'}),
+            ('time', {'dt': s['dt']}),
+            ('output', {'directory': 'out', 'progress_every': 500, 'series_every': 5, 'checkpoint_every': 2500}),
+            ('particles', {'solid_fraction': s['phi'], 'seed': s['seed'], 'packing_min_gap': s['min_gap']}),
+            ('contact', {'roughness': s['eps_r'], 'eps_bar': s['eps_bar'], 'friction': mu,
+                         'implicit': None if s['implicit'] else False}),
+            ('lubrication', {'model': 'full', 'outer_cutoff': s['cutoff']}),
+            ('rheology', {'discard_strain': s['discard'], 'average_strain': s['average'], 'blocks': s['blocks']}),
+            ('run', {'title': '%s %s: mu_d = %s' % (self.title, row, mu), 'max_wall_hours': hours}),
+        ], comment="%s, row '%s': %s; mu_d = %s" % (self.title, row, self.rows[row][0], mu))
 
     def load_record(self, row, mu):
         return load(os.path.join(self.record_dir, run_name(row, mu), 'summary.json'))
@@ -179,7 +158,6 @@ class Study:
         """Record an extension: its later window and the whole run's 2-strain windows, both
         recomputed from series.h5 (the program's own summary.json is not used: a program older
         than the restart rule of 2026-11-26 mixes the finished run's accumulators into it)."""
-        import rheology
         st = self.settings(row)
         end = self.end_strain(row)
         a, series = rheology.load(os.path.join(d, 'out'))
@@ -189,7 +167,7 @@ class Study:
         s['run']['continues'] = run_name(row, mu)
         if s['run']['cpu_seconds']:     # the extension's own cost, over the strains it ran
             s['run']['cpu_seconds_per_strain'] = s['run']['cpu_seconds'] / (strain - end)
-        s['contacts'] = contact_statistics(os.path.join(d, 'out', 'series.h5'), end)
+        s['contacts'] = rheology.contact_statistics(os.path.join(d, 'out'), end)
         s['by_strain'] = rheology.strain_windows(a, series, 2.0, ['eta_r', 'eta_h', 'eta_c', 'N1/tau', 'N2/tau', 'phi_core'])
         self.write_record(d, target, s)
 
@@ -205,7 +183,7 @@ class Study:
         s = load(os.path.join(d, 'out', 'summary.json'))
         st = self.settings(row)
         s['run'] = self.run_object(d, row, mu, ranks, st['discard'], st['average'])
-        s['contacts'] = contact_statistics(os.path.join(d, 'out', 'series.h5'), st['discard'])
+        s['contacts'] = rheology.contact_statistics(os.path.join(d, 'out'), st['discard'])
         self.write_record(d, target, s)
 
     def run_object(self, d, row, mu, ranks, discard, average):

@@ -1,0 +1,15 @@
+"""fdsusp: the Python side of fdsusp (doc/DESIGN.md "The Python package").
+
+    fdsusp.series       the one reader of a run's series (series.h5 and series.parts/)
+    fdsusp.deck         the one writer of namelist decks (and a small reader for checks)
+    fdsusp.run          where the programs are (FDSUSP_BIN, the checkout, the install, PATH),
+                        running fdsusp, the job pool of the studies
+    fdsusp.rheology     the statistics of a run's core region (src/kernels/rheology.F90 redone)
+    fdsusp.references   the literature fits the paper compares with
+    fdsusp.plots        the matplotlib figures (imports matplotlib; nothing else does)
+    fdsusp.study        the resumable studies of scripts/friction_study.py and scripts/model_trade.py
+
+The command-line entry points are scripts/*.py (each has --help). From a checkout without
+installing: `import sys; sys.path.insert(0, '<checkout>/python')`; or `pip install -e .` in the
+checkout; `make install` puts the package in PREFIX/share/fdsusp/python.
+"""

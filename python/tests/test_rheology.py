@@ -1,0 +1,127 @@
+"""fdsusp.rheology on a synthetic series whose block means are known."""
+import json
+import math
+import os
+
+import numpy as np
+import pytest
+
+from conftest import write_series
+from fdsusp import rheology
+
+NB, NANG = 4, 8
+ATTRS = dict(shear_rate=1.0, dt=0.01, series_every=2, blocks=5, discard_step=10, block_steps=10,
+             box_y=10.0, radius=1.0, pair_radius=2.5, contact_radius=2.05, core_lo=2.0, core_hi=8.0)
+
+
+def synthetic(outdir, last_step=60, attrs=ATTRS):
+    """Records at every step 1..last_step: on the grid (even steps) after discard_step, the shear
+    stress of block b is 1 + b (hydrodynamic) and 0.5 (contact), the shear rate 1; records before
+    the discard and off the grid carry values that must not count."""
+    step = np.arange(1, last_step + 1)
+    n = len(step)
+    block = (step - 10 - 1) // 10
+    counted = (step > 10) & (step % 2 == 0)
+    sh = np.zeros((n, 5))
+    sc = np.zeros((n, 5))
+    sh[:, 3] = np.where(counted, 1.0 + block, 1e3)
+    sc[:, 3] = np.where(counted, 0.5, -1e3)
+    sc[:, 1] = -2.0                      # contact pressure along y: p = 2
+    fit = np.tile([3.0, 3.0, 3.0, 5.0, 5.0], (n, 1))   # points (0,0), (1,1), (2,2): slope 1
+    cols = {'step': step, 'time': step * attrs['dt'], 'core/stress_hydro': sh, 'core/stress_contact': sc,
+            'core/solid_fraction': np.full(n, 0.4), 'core/velocity_fit': fit, 'core/flow_fit': fit,
+            'core/shear_rate': np.ones(n), 'pairs/references': np.full(n, 10.0),
+            'pairs/shell': np.ones((n, NANG)), 'pairs/contact': np.ones((n, NANG)),
+            'profiles/solid_fraction': np.full((n, NB), 0.4), 'profiles/momentum': np.full((n, NB), 0.2)}
+    write_series(os.path.join(outdir, 'series.h5'), cols, attrs)
+    return outdir
+
+
+def test_block_means(tmp_path):
+    a, s = rheology.load(synthetic(str(tmp_path)))
+    summ = rheology.summarise(a, s)
+    assert summ['blocks_complete'] == 5 and summ['last_step'] == 60
+    assert summ['records_per_block'] == [5.0] * 5
+    q = summ['quantities']
+    # eta_r = 1 + (sigma_h + sigma_c)_xy / gamma_dot over block means 2.5 .. 6.5
+    assert q['eta_r']['value'] == pytest.approx(4.5, rel=1e-14)
+    assert q['eta_r']['error'] == pytest.approx(math.sqrt(2.5 / 5), rel=1e-12)
+    assert q['eta_h']['value'] == pytest.approx(4.0, rel=1e-14)
+    assert q['eta_c']['value'] == pytest.approx(0.5, rel=1e-14) and q['eta_c']['error'] == pytest.approx(0, abs=1e-14)
+    assert q['phi_core']['value'] == pytest.approx(0.4)
+    assert q['gamma_dot_core']['value'] == pytest.approx(1.0)
+    assert q['mu']['value'] == pytest.approx(4.5 / 2.0)       # tau / p
+    assert q['I_v']['value'] == pytest.approx(0.5)             # gamma_dot / p
+    assert np.allclose(summ['profiles']['velocity'], 0.5)
+    assert np.allclose(summ['profiles']['y'], (np.arange(NB) + 0.5) * 10 / NB)
+
+
+def test_incomplete_block_and_window(tmp_path):
+    a, s = rheology.load(synthetic(str(tmp_path), last_step=58))
+    summ = rheology.summarise(a, s)
+    assert summ['blocks_complete'] == 4
+    assert summ['quantities']['eta_r']['value'] == pytest.approx(1 + np.mean([1.5, 2.5, 3.5, 4.5]))
+    w = rheology.with_window(a, 0.1, 0.4, 2)       # strains: 10 steps discarded, 2 blocks of 20
+    assert (w['discard_step'], w['block_steps'], w['blocks']) == (10, 20, 2)
+    summ = rheology.summarise(w, s)
+    assert summ['blocks_complete'] == 2
+    assert summ['quantities']['eta_r']['value'] == pytest.approx(1 + np.mean([2.0, 4.0]))   # blocks of 2
+    with pytest.raises(ValueError):
+        rheology.with_window(a, 0.1, 0.001, 2)
+
+
+def test_strain_windows(tmp_path):
+    a, s = rheology.load(synthetic(str(tmp_path)))
+    b = rheology.strain_windows(a, s, 0.1, ['eta_h', 'eta_c'])
+    # every window of the run from strain 0, discarded records included (the first: 1 + 1e3)
+    assert b['strain_start'] == pytest.approx([0.0, 0.1, 0.2, 0.3, 0.4, 0.5])
+    assert b['eta_h'] == pytest.approx([1001.0, 2.0, 3.0, 4.0, 5.0, 6.0])
+    assert b['eta_c'][1:] == pytest.approx([0.5] * 5)
+
+
+def test_json_compare_and_contacts(tmp_path):
+    d = synthetic(str(tmp_path))
+    a, s = rheology.load(d)
+    summ = rheology.summarise(a, s)
+    with open(os.path.join(d, 'summary.json'), 'w') as f:
+        json.dump(rheology.as_json(a, summ), f)
+    assert rheology.compare(summ, os.path.join(d, 'summary.json')) == []
+    summ['quantities']['eta_r']['value'] *= 1 + 1e-9
+    assert rheology.compare(summ, os.path.join(d, 'summary.json'))[0].startswith('eta_r value')
+    assert rheology.differs(None, float('nan')) is False
+    lines = rheology.summary_lines(d, summ)
+    assert lines[0].endswith('5 of 5 blocks complete (last step 60)') and len(lines) == 1 + len(rheology.NAMES)
+
+
+def test_no_rheology(tmp_path):
+    write_series(str(tmp_path / 'series.h5'), {'step': [1], 'time': [0.1]})
+    with pytest.raises(rheology.NoRheology):
+        rheology.load(str(tmp_path))
+
+
+def test_contact_statistics(tmp_path):
+    n = 10
+    write_series(str(tmp_path / 'series.h5'),
+                 {'step': np.arange(n), 'time': np.arange(n) * 0.5, 'contacts_pair': np.full(n, 4),
+                  'contacts_wall': np.full(n, 1), 'contacts_sliding': np.where(np.arange(n) > 5, 5, 0),
+                  'contact_overlap_over_roughness': np.arange(n) * 0.1}, {'shear_rate': -2.0})
+    c = rheology.contact_statistics(str(tmp_path), 5.0)        # strain = time * 2 > 5: records 6..9
+    assert c['records'] == 4 and c['pair_contacts'] == 4 and c['wall_contacts'] == 1
+    assert c['sliding_fraction'] == 1.0
+    assert c['largest_overlap_over_h_r_max'] == pytest.approx(0.9)
+
+
+def test_records_helpers(tmp_path):
+    run = dict(friction=0.5, dt=2e-3, eps_bar=0.05, roughness=5e-3, box=[8, 20, 8], cells_per_radius=4,
+               solid_fraction_bulk=0.4, seed=1)
+    assert rheology.stick_number(run) == pytest.approx(2e-3 / (3.5 * 0.5 * 0.05 * 5e-3))
+    assert rheology.stick_number(dict(run, friction=0)) == 0.0
+    assert rheology.setup_key(run) == ((8, 20, 8), 4, 0.4, 1, 0.05, 5e-3)
+    p = tmp_path / 'r1' / 'summary.json'
+    p.parent.mkdir()
+    p.write_text(json.dumps({'complete': True, 'run': run, 'quantities': {'eta_r': {'value': 2, 'error': 0.1}}}))
+    q = tmp_path / 'r2' / 'summary.json'
+    q.parent.mkdir()
+    q.write_text(json.dumps({'complete': True}))
+    recs = rheology.load_records([str(p), str(q)])
+    assert [r[0] for r in recs] == ['r1']
