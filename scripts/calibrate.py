@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Measure the resolved two-sphere and sphere-wall resistance of fdsusp at one resolution and write
-the lubrication table input/lubrication/resolved_a<N>.h5 (method.md §2.4; doc/LUBRICATION.md).
+the lubrication table input/lubrication/resolved_a<N>.h5 (doc/METHOD.md §5.4; doc/LUBRICATION.md).
 
     scripts/calibrate.py CELLS_PER_RADIUS [--samples S] [--jobs J] [--work DIR]
 
@@ -24,7 +24,7 @@ accelerates) and, with a balancing pressure gradient, feels the periodic images 
 8a they shifted XA12 by 14 % at gap 1 (measured). Relative (squeeze, sliding) motions exert no
 net force, so their images are force dipoles, O((a/L)^3). The co-moving combinations (XA11 + XA12,
 YA11 + YA12, YB11 + YB12, XG11 + XG12, YG11 + YG12) are regular at contact (their singular terms
-cancel, method.md §3.1) and resolved by the grid; the
+cancel, doc/METHOD.md §5.2) and resolved by the grid; the
 table gives them their exact values, i.e. the correction leaves them alone. For the relative
 combinations the resolved one-body part is taken as exact (the hydrodynamic radius is 0.995-1.000a
 at a/Delta = 5, doc/VALIDATION.md §2.1). The table holds, per gap, the
@@ -35,7 +35,7 @@ Sphere-wall (walls at rest, Ly = 10a): mode W1 (translate and spin along the nor
 the cell; the resolved single-wall part is num(gap) - num(centre) corrected by the superposed
 single-wall theory (bin/fdsusp-resistance) for the walls' far-field effects (doc/LUBRICATION.md).
 
-Modes are separable because the cross terms land on other components (method.md §2.1 tensor
+Modes are separable because the cross terms land on other components (doc/METHOD.md §5.1 tensor
 forms): translation along d gives no torque, rotation about d no force; translation along e1
 torques about e2 = d x e1 and rotation about e1 forces along e2.
 """
@@ -58,7 +58,7 @@ WALL_NAMES = ["lambda_perp", "f_tt", "f_tr", "f_rr", "x_w"]
 # mobility amplifies (doc/VALIDATION.md §4.1, §4.4); the others keep 2
 SAMPLES = {5: 4}
 REYNOLDS = 0.01
-BETA = 30.0          # rho/dt: the steady state does not depend on it (method.md §1.5b); 30 converges fastest
+BETA = 30.0          # rho/dt: the steady state does not depend on it (doc/METHOD.md §3.3); 30 converges fastest
 STEPS = 100
 EVERY = 20
 PI = math.pi

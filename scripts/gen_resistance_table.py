@@ -21,7 +21,7 @@ implements those recurrences (in the form corrected and completed by Townsend 20
 arXiv:1802.08226, eqs 5-8 and 18, whose corrections matter for YH, YM and ZM) at lambda = 1 and
 writes G_m = 4^-m f_m(1), so that a scalar is  sigma * sum_m G_m t^m  over the even or the odd m,
 with t = 2/s = 1/(1 + xi/2) (mod_pair_resistance documents sigma and the parity of each scalar).
-Checked: the first ten coefficients of every family equal method.md section 3.2 (libstokes), and
+Checked: the first ten coefficients of every family equal doc/METHOD.md §5.2 (libstokes), and
 the ZM coefficients equal libstokes' independently generated ZM.c to all printed digits.
 """
 import argparse

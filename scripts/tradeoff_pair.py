@@ -23,7 +23,7 @@ Knobs around the base (a/Delta = 4, solver tolerances 1e-8 / 1e-10, lubrication 
                  then the base's 1e-8 / 1e-10 (the default before this study)
   lubrication    none, simple, full at a/Delta = 4
 The time step has no knob here: a resistance run is a steady Stokes problem reached in
-pseudo-time, whose answer does not depend on dt (method.md §1.5b); the suspension scene measures
+pseudo-time, whose answer does not depend on dt (doc/METHOD.md §3.3); the suspension scene measures
 it. Cost: CPU seconds of one resistance run (its own rusage, start-up included, 100 pseudo-time
 steps), the mean over the setting's four runs.
 

@@ -1,7 +1,7 @@
 """Invariant: a sphere dragged at constant velocity across the grid feels a force that does not
 depend on where its centre sits in a cell (translation invariance of Stokes flow in a box that is
 periodic along the motion). The solid fraction varies continuously with the position and the
-relaxed constraint of method.md §1.5b keeps the effective sphere position-independent, so the
+relaxed constraint of doc/METHOD.md §3.3 keeps the effective sphere position-independent, so the
 drag's ripple as the centre crosses cells must stay small: issue 9 asks for at most 2 % of the
 mean peak to peak. Set-up: prescribed U = 2 along x in a 6.4a cube, walls at rest in y (they
 take the momentum, so the flow reaches a steady state), a/Delta = 5, Re = 0.01, dt = 1e-3: the
@@ -10,7 +10,7 @@ centre crosses one cell every 100 steps. After 200 steps of start-up the drag is
 sphere sits at mid-height, so the walls push no lift; |F_y|, |F_z| < 1e-6 |F_x|) and the torque
 is zero to the same level.
 Second run, the same sphere at dt = 1e-2 (0.1 cells per step, 100 steps): the scheme's steady
-state does not depend on dt (method.md §1.5b), so only the lag of the incremental lambda behind
+state does not depend on dt (doc/METHOD.md §3.3), so only the lag of the incremental lambda behind
 the moving body can change the drag. Lambda is carried with the sphere (fictitious_domain_follow); measured:
 mean drag over the last 50 steps -3.5 % from the dt = 1e-3 value, ripple 0.84 %. Without carrying
 (-fd_carry_lambda 0): -8.0 % and 4.3 %. Asserted: within 5 % and ripple <= 2 % (issue 9's bound),

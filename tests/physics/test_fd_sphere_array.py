@@ -10,9 +10,9 @@ References (independent of the code; tests/physics/sphere_array_reference.py):
    the reference is the series scaled by that ratio (uncertainty ~0.5 %).
 Asserted (issue 9): |K/K_ref - 1| <= 3 % for phi <= 0.13 and <= 5 % at phi = 0.19. The discrete
 sphere's drag is very sensitive to its effective hydrodynamic radius (1 % in radius moves K by
-3-5 % at these fractions), so this test pins the radius correction of method.md §1.5b
+3-5 % at these fractions), so this test pins the radius correction of doc/METHOD.md §3.3
 (alpha radius a + 0.38 Delta). The test also reports the hydrodynamic radius the drag implies.
-Steady state: the drag relaxes in ~40 steps at Re = 0.01, dt = 1e-3 (method.md §1.5b); K is read
+Steady state: the drag relaxes in ~40 steps at Re = 0.01, dt = 1e-3 (doc/METHOD.md §3.3); K is read
 as the mean of steps 61-80, and the change over those steps is checked to be < 0.2 %."""
 import math
 import os

@@ -5,7 +5,7 @@ make check: a 10a x 20a x 10a Couette cell at a/Delta = 4 (40 x 80 x 40 cells), 
 started from the linear profile. The sphere's disturbance must diffuse across the channel, which
 takes ~Re Ly^2/pi^2 = 0.4 strain, so the test steps dt = 5e-3 with backward Euler (theta = 1,
 which damps the transient fastest; the steady state of the scheme does not depend on dt or
-theta, method.md §1.5b) for 200 steps = 1 strain. Measured: Omega_z then changes by 1e-4 and
+theta, doc/METHOD.md §3.3) for 200 steps = 1 strain. Measured: Omega_z then changes by 1e-4 and
 S_xy by 0.2 % over the last 50 steps, both still approaching the exact values, so the remaining
 transient cannot carry them out of tolerance. Finer grids and the 20a cube of issue 9 are in
 doc/VALIDATION.md (bench).

@@ -1,6 +1,6 @@
 """Invariant: with the full lubrication correction, taken implicitly in the particle problem, the
 production step dt = 1e-3 (Re = 0.01) stays stable and accurate while two smooth spheres are
-driven together down to a gap of 1e-4 a (issue 5; method.md §1.5: an explicit correction would be
+driven together down to a gap of 1e-4 a (doc/LUBRICATION.md; doc/METHOD.md §3.2: an explicit correction would be
 unstable above dt R/(rho V) = 2, i.e. ~110 at this gap and Re). Two free spheres in a periodic
 7.2a cube, a/Delta = 5, pushed along their line of centres by external forces +-F, F = 60 pi
 (ten times the eps_bar force scale, so the gap closes from 0.02 to 1e-4 in ~150 steps).

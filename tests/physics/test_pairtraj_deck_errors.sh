@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# pairtraj: bad deck input (design.md "Errors and bad input"; issue 3).
+# pairtraj: bad deck input (doc/DESIGN.md, doc/PAIRTRAJ_INPUT.md).
 # Invariant: every malformed deck stops pairtraj before any work with a non-zero exit status and
 # ONE message line on stderr that names the deck file, the namelist group and the variable, and
 # no CSV is written. Cases: unknown variable, value out of range, unreadable value, integer

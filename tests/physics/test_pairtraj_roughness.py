@@ -5,7 +5,7 @@ Invariants:
      on a streamline further out than it came in, the more so the larger the roughness:
      y_out(0) = 0.5 < y_out(1e-3) < y_out(1e-2), each step by more than 0.05 (measured
      0.21 and 0.35; a missing or attractive contact gives a difference of 0).
-  2. Hard-contact limit (DaCunha & Hinch 1996; method.md 4.3): with a rigid roughness the pair
+  2. Hard-contact limit (DaCunha & Hinch 1996; doc/METHOD.md §9.3): with a rigid roughness the pair
      leaves contact at theta = pi/2, rho = 2 + eps_r, and then follows the level set of the
      Batchelor-Green first integral through that point. Evaluating that first integral by
      quadrature of A(rho), B(rho) (an independent route: no time integration, no contact law)

@@ -1,6 +1,6 @@
 """pairtraj: fore-aft symmetry of the smooth pair, and its breaking by roughness (issue 3).
 
-Invariants (Batchelor & Green 1972; method.md 4.4):
+Invariants (Batchelor & Green 1972; doc/METHOD.md §9.4):
   1. smooth pair: the trajectory is symmetric about x = 0, y(x) = y(-x), for x in [-6, 6];
      tolerance 1e-5: output every 0.002 strain (cubic Hermite dense output) and linear
      interpolation in x (spacing dx <= 0.012) give an interpolation error (dx)^2 |y''|/8 of a

@@ -1,5 +1,5 @@
 """Invariant: a run that goes wrong stops with a diagnostic and never destroys its last good
-checkpoint (design.md "Errors", issue 8 runtime guards). The velocity is poisoned with NaN at
+checkpoint (doc/DESIGN.md "Errors": runtime guards). The velocity is poisoned with NaN at
 step 12 through the test-only option -fault_nan_step (a stand-in for any blow-up); the guard
 checks the fluid velocity, pressure and the particle state after every step. Asserted, on 2
 ranks with one particle: non-zero exit status 5 at step 12, one message naming the step and the
