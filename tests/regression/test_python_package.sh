@@ -13,6 +13,7 @@ if ! "$PYTHON" -c 'import pytest' 2>/dev/null; then
 fi
 base=$root/build/test-work/pytest
 rm -rf "$base"
+mkdir -p "$(dirname "$base")"
 out=$("$PYTHON" -m pytest -q -p no:cacheprovider --basetemp="$base" "$root/python/tests" 2>&1)
 status=$?
 echo "$out"
