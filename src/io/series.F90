@@ -17,7 +17,9 @@
 ! at the end of a run, and when a run starts from a checkpoint: then it keeps only the records up to
 ! the checkpoint's step, so that the continued run writes exactly the records an uninterrupted one
 ! would. Every write is checked: a failure stops the run (abort_run) naming the file and the cause.
+#include <petsc/finclude/petscsys.h>
 module mod_series
+  use petscsys
   use hdf5
   use mod_kinds, only: dp
   use mod_columns, only: column_t
@@ -56,7 +58,7 @@ module mod_series
   end interface series_column
 
   integer(HSIZE_T), parameter :: chunk = 1024
-  ! a part holds at most this many bytes of records: the bound of rank 0's buffer
+  ! a part holds at most this many bytes of records: the bound of rank 0's buffer (-series_part_mb)
   real(dp), parameter :: part_bytes = 64.0_dp * 1048576.0_dp
   ! series.h5 is consolidated at every flush while it is this small (it stays current for readers)
   real(dp), parameter :: small_series_bytes = 64.0_dp * 1048576.0_dp
@@ -159,6 +161,9 @@ contains
     character(len=*), intent(in) :: outdir
     integer, intent(in) :: restart_step, records_to_come
     integer :: c, record_length, err
+    PetscReal :: part_megabytes
+    PetscBool :: set
+    PetscErrorCode :: ierr
 
     if (.not. allocated(s%names)) call abort_run('series.h5: no columns declared')
     if (s%names(1) /= 'step') call abort_run('series.h5: the first column must be the step')
@@ -169,7 +174,10 @@ contains
       s%first(c + 1) = s%first(c) + product(max(1, s%shapes(:, c)))
     end do
     record_length = s%first(size(s%names) + 1) - 1
-    s%max_records = max(1, int(part_bytes / (8.0_dp * record_length)))
+    ! -series_part_mb: the bound of a part, and so of the buffer, in MiB
+    part_megabytes = part_bytes / 1048576.0_dp
+    call PetscOptionsGetReal(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-series_part_mb', part_megabytes, set, ierr)
+    s%max_records = max(1, int(min(part_megabytes * 1048576.0_dp / (8.0_dp * record_length), 1.0e9_dp)))
     allocate(s%buffer(record_length, min(256, s%max_records)), s%row(record_length))
     s%nbuf = 0
     s%filled = 0

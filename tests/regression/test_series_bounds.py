@@ -1,0 +1,53 @@
+"""Invariants of the series' growth (doc/DESIGN.md "series.h5: immutable parts, atomic
+consolidation"):
+  1. rank 0's buffer of records is bounded: a run that writes no progress line and no checkpoint
+     (progress_every 1e8, checkpoint_every 0) still publishes its records whenever a part's worth
+     is buffered (-series_part_mb, 64 MiB by default; 0.1 MiB here, 13 records of this scene). A
+     SIGKILL at the entry of its 7th rename (series.h5, checkpoint of step 0, then part,
+     consolidation, part, consolidation) leaves a series of two whole parts: steps 1..2k once each,
+     k >= 10. Before 2026-11-27 the records stayed in memory to the end (259 MB for 4000 steps of
+     the demo), and such a kill left none.
+  2. the size the series will reach is on the log before the first step, with a warning naming the
+     free space when the disk cannot hold it: 10^9 steps of this scene project ~7.9 TB (before: not a
+     word). The run is stopped by SIGTERM after its first step (status 0, a checkpoint).
+Scene: lubrication dynamics, 18 rough frictional spheres in an 8a Lees-Edwards cube with the
+rheology on. Needs strace (scripts/install-deps)."""
+import os
+import re
+import subprocess
+import sys
+import numpy as np
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
+import fdsusp_testlib as T
+
+DECK = """&domain box = 8, 8, 8, y_boundary = 'lees-edwards', shear_rate = 1 /
+&fluid model = 'none' /
+&time dt = 5e-3, steps = {steps} /
+&output directory = 'out', progress_every = {progress}, checkpoint_every = 0, particles_every = 100000000 /
+&particles solid_fraction = 0.15, seed = 3 /
+&contact roughness = 5e-3, friction = 0.5 /
+&rheology discard_strain = 0.05, average_strain = 0.25, blocks = 5 /
+"""
+
+# 1. the bounded buffer
+d = T.scratch('series_bounds')
+deck = T.write_deck(d, 'b.nml', DECK.format(steps=300, progress=100000000))
+cmd = ['strace', '-o', '/dev/null', '-e', 'trace=rename', '-e', 'inject=rename:signal=KILL:when=7',
+       T.FDSUSP, deck, '-series_part_mb', '0.1']
+p = subprocess.run(cmd, cwd=d, env=T.ENV, capture_output=True, text=True, timeout=300)
+T.check(p.returncode != 0, 'the run was killed at its 7th rename (status %d)' % p.returncode)
+steps = T.series(os.path.join(d, 'out'))['step']
+k = len(steps) // 2
+T.check(k >= 10 and len(steps) == 2 * k and np.array_equal(steps, np.arange(1, 2 * k + 1)),
+        'without progress lines or checkpoints, two parts reached the disk: steps 1..%d once each '
+        '(%d records a part)' % (len(steps), k))
+
+# 2. the projected size
+e = T.scratch('series_projection')
+status, out = T.run_until_then_signal(T.write_deck(e, 'p.nml', DECK.format(steps=1000000000, progress=1)), e, 1)
+m = re.search(r'series\.h5: about ([0-9.]+) GB at the end of this run \(([0-9.]+) GB free', out)
+T.check(status == 0 and m is not None and float(m.group(1)) > 1.0e3,
+        'the log projects the series: %s' % (m.group(0) if m else out[-300:]))
+T.check('fdsusp: warning: series.h5 will need about' in out and 'GB are free in out' in out,
+        'a warning says the disk cannot hold it and how much is free')
+T.finish()
