@@ -192,7 +192,7 @@ contains
     if (restart_step >= 0) then
       call consolidate(s, restart_step)
     else
-      call remove_parts(s)
+      call remove_in_parts(s, '.h5')   ! an earlier run's
       call start_empty(s)
     end if
     call project_size(s, outdir, 8.0_dp * record_length * max(records_to_come, 0))
@@ -375,21 +375,16 @@ contains
     integer, intent(in) :: limit
     character(len=*), intent(out) :: problem
     integer, intent(out) :: last
-    integer(HID_T) :: dset, space
-    integer(HSIZE_T) :: dims(4), maxdims(4)
+    integer(HID_T) :: dset
+    integer(HSIZE_T) :: dims(4)
     integer, allocatable :: steps(:)
-    integer :: err, c, rank, keep, k
+    integer :: err, e, c, rank, keep, k
     last = -huge(1)
     call read_steps(s, file, steps, problem)
     if (len_trim(problem) > 0) return
     keep = size(steps)
     do c = 1, size(s%names)
-      call h5dopen_f(file, trim(s%names(c)), dset, err)
-      call h5dget_space_f(dset, space, err)
-      call h5sget_simple_extent_ndims_f(space, rank, err)
-      call h5sget_simple_extent_dims_f(space, dims(1:rank), maxdims(1:rank), err)
-      call h5sclose_f(space, err)
-      call h5dclose_f(dset, err)
+      call column_extent(s, file, c, rank, dims, err)
       if (err /= 0 .or. rank /= column_rank(s%shapes(:, c)) .or. &
           any(dims(1:rank - 1) /= s%shapes(1:rank - 1, c))) then
         problem = 'its column '//trim(s%names(c))//' has another shape than this run''s'
@@ -407,17 +402,16 @@ contains
     if (keep < size(steps)) call log_line('series.h5: records after step '//trim(step_text(steps, keep))// &
          ' are not kept (beyond the checkpoint, or an unfinished write)')
     do c = 1, size(s%names)
-      call h5dopen_f(file, trim(s%names(c)), dset, err)
-      call h5dget_space_f(dset, space, err)
-      call h5sget_simple_extent_ndims_f(space, rank, err)
-      call h5sget_simple_extent_dims_f(space, dims(1:rank), maxdims(1:rank), err)
-      call h5sclose_f(space, err)
+      call column_extent(s, file, c, rank, dims, err)
       if (dims(rank) /= keep) then
         dims(rank) = keep
-        call h5dset_extent_f(dset, dims(1:rank), err)
-        if (err /= 0) call write_failed(s, trim(s%path)//'.tmp', 'column '//trim(s%names(c))//' cannot be cut back')
+        call h5dopen_f(file, trim(s%names(c)), dset, err)
+        call h5dset_extent_f(dset, dims(1:rank), e)
+        err = max(err, abs(e))
+        call h5dclose_f(dset, e)
+        if (max(err, abs(e)) /= 0) call write_failed(s, trim(s%path)//'.tmp', 'column '//trim(s%names(c))// &
+                                                     ' cannot be cut back')
       end if
-      call h5dclose_f(dset, err)
     end do
     if (keep > 0) last = steps(keep)
   end subroutine sound_prefix
@@ -574,28 +568,45 @@ contains
   ! Partial files of a killed write: series.h5.tmp and the .tmp files of series.parts.
   subroutine remove_partial_writes(s)
     type(series_t), intent(in) :: s
-    character(len=256), allocatable :: names(:)
-    integer :: k, err
+    integer :: err
     err = remove_file(trim(s%path)//'.tmp')
     if (err /= 0) call abort_run('cannot remove '//trim(s%path)//'.tmp: '//errno_text(err))
-    call list_directory(s%parts_dir, '.tmp', names, err)
-    do k = 1, size(names)
-      err = remove_file(trim(s%parts_dir)//'/'//trim(names(k)))
-      if (err /= 0) call abort_run('cannot remove '//trim(s%parts_dir)//'/'//trim(names(k))//': '//errno_text(err))
-    end do
+    call remove_in_parts(s, '.tmp')
   end subroutine remove_partial_writes
 
-  ! A run from the start: the parts of an earlier run in this directory go.
-  subroutine remove_parts(s)
+  ! Remove the files of series.parts whose names end in suffix ('.h5': the parts).
+  subroutine remove_in_parts(s, suffix)
     type(series_t), intent(in) :: s
+    character(len=*), intent(in) :: suffix
     character(len=256), allocatable :: names(:)
     integer :: k, err
-    call list_directory(s%parts_dir, '.h5', names, err)
+    call list_directory(s%parts_dir, suffix, names, err)
     do k = 1, size(names)
       err = remove_file(trim(s%parts_dir)//'/'//trim(names(k)))
       if (err /= 0) call abort_run('cannot remove '//trim(s%parts_dir)//'/'//trim(names(k))//': '//errno_text(err))
     end do
-  end subroutine remove_parts
+  end subroutine remove_in_parts
+
+  ! The per-record rank + 1 and the dimensions (records last) of column c in an open file.
+  subroutine column_extent(s, file, c, rank, dims, err)
+    type(series_t), intent(in) :: s
+    integer(HID_T), intent(in) :: file
+    integer, intent(in) :: c
+    integer, intent(out) :: rank, err
+    integer(HSIZE_T), intent(out) :: dims(4)
+    integer(HID_T) :: dset, space
+    integer(HSIZE_T) :: maxdims(4)
+    integer :: e
+    dims = 0
+    rank = 0
+    call h5dopen_f(file, trim(s%names(c)), dset, err)
+    if (err /= 0) return
+    call h5dget_space_f(dset, space, err)
+    call h5sget_simple_extent_ndims_f(space, rank, e)
+    if (rank >= 1 .and. rank <= 4) call h5sget_simple_extent_dims_f(space, dims(1:rank), maxdims(1:rank), e)
+    call h5sclose_f(space, e)
+    call h5dclose_f(dset, e)
+  end subroutine column_extent
 
   ! Rank of a column's dataset: its per-record dimensions (those > 0) plus records.
   pure integer function column_rank(shape)
