@@ -8,9 +8,9 @@
 module mod_lubrication_io
   use hdf5
   use petscsys
-  use mod_kinds, only: dp, pi
+  use mod_kinds, only: dp
   use mod_params, only: config_t
-  use mod_lubrication, only: lubrication_t, lub_setup, model_code, LUB_FULL, LUB_NONE, LUB_EXACT, n_wall_scalars
+  use mod_lubrication, only: lubrication_t, lub_setup, lub_wall_floor, model_code, LUB_FULL, LUB_NONE, LUB_EXACT, n_wall_scalars
   use mod_pair_resistance, only: n_pair_scalars
   use mod_h5util, only: read_attribute, read_dataset, dataset_dims, has_attribute
   use mod_errors, only: is_root, input_error, file_error_from_root, log_line
@@ -110,8 +110,7 @@ contains
       lub%wall_resolved = transpose(wall(2:, :))
     end if
     call lub_setup(lub, model, cfg%radius, 1.0_dp, cfg%cells_per_radius, cfg%outer_cutoff, cfg%inner_cutoff)
-    ! a quarter of (rho/dt) J, J = (2/5) a^2 (4/3) pi a^3 the smallest eigenvalue of M_p (rho = Re)
-    lub%wall_floor = -0.25_dp * (cfg%reynolds / cfg%dt) * 0.4_dp * cfg%radius**2 * (4.0_dp / 3.0_dp) * pi * cfg%radius**3
+    lub%wall_floor = lub_wall_floor(cfg%reynolds, cfg%dt, cfg%radius)
   end subroutine lubrication_load
 
   subroutine read_table(path, cfg, pair, wall, message)

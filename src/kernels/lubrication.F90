@@ -42,7 +42,7 @@ module mod_lubrication
        pair_stresslets, wall_resistance_block
   implicit none
   private
-  public :: lubrication_t, lub_setup, lub_pair_scalars, lub_wall_scalars, lub_pair_link, lub_wall_link, &
+  public :: lubrication_t, lub_setup, lub_wall_floor, lub_pair_scalars, lub_wall_scalars, lub_pair_link, lub_wall_link, &
             lub_pair_stresslets, lub_wall_stresslet, clip_to_psd, lub_taper, model_code, grains3d_cutoff
   integer, parameter, public :: LUB_NONE = 0, LUB_SIMPLE = 1, LUB_FULL = 2, LUB_EXACT = 3
   ! outer cut-off of the exact model when the deck gives none [a]
@@ -345,5 +345,13 @@ contains
       b(k + 1:n, k) = b(k, k + 1:n)
     end do
   end function clip_to_psd
+
+  !> The floor of a wall block's eigenvalues in the resolved DNS: a quarter of the smallest
+  !> eigenvalue of the fictitious-fluid mass (rho/dt) J, J = (2/5) a^2 (4/3) pi a^3 the moment of
+  !> inertia of a sphere of radius a (rho = Re in fdsusp's units; doc/METHOD.md §5.8).
+  pure real(dp) function lub_wall_floor(reynolds, dt, radius)
+    real(dp), intent(in) :: reynolds, dt, radius
+    lub_wall_floor = -0.25_dp * (reynolds / dt) * 0.4_dp * radius**2 * (4.0_dp / 3.0_dp) * pi * radius**3
+  end function lub_wall_floor
 
 end module mod_lubrication
