@@ -545,19 +545,24 @@ contains
          '; the records published before, and the last checkpoint, are kept')
   end subroutine write_failed
 
-  ! Move a file the series cannot use aside (NAME.damaged, .damaged-2, ...) with a warning.
+  ! Move a file the series cannot use aside with a warning: NAME.damaged (.damaged-2, ...) when it
+  ! cannot be read, NAME.other-columns when it is another run's or holds other quantities (the
+  ! problems that say so name 'this run').
   subroutine keep_aside(name, problem)
     character(len=*), intent(in) :: name, problem
     character(len=1100) :: aside
+    character(len=:), allocatable :: suffix
     integer :: k, err
     logical :: exists
-    aside = trim(name)//'.damaged'
+    suffix = '.damaged'
+    if (index(problem, 'this run') > 0) suffix = '.other-columns'
+    aside = trim(name)//suffix
     k = 1
     do
       inquire(file=trim(aside), exist=exists)
       if (.not. exists) exit
       k = k + 1
-      write(aside, '(a,i0)') trim(name)//'.damaged-', k
+      write(aside, '(a,i0)') trim(name)//suffix//'-', k
     end do
     err = rename_file(name, aside)
     if (err /= 0) call abort_run('cannot move '//trim(name)//' aside to '//trim(aside)//': '//errno_text(err))
