@@ -49,6 +49,8 @@ module mod_series
     integer :: parts = 0                     ! parts published since the last consolidation
     real(dp) :: parts_bytes = 0.0_dp         ! their size
     real(dp) :: consolidated_bytes = 0.0_dp  ! the size of series.h5
+    real(dp) :: flush_seconds = 5.0_dp        ! progress lines flush at most this often (wall time)
+    integer(kind=8) :: last_flush = 0         ! system_clock count of the last flush
   end type series_t
 
   ! One column: its value, a scalar or an array whose shape is the column's per-record shape
@@ -174,6 +176,12 @@ contains
       s%first(c + 1) = s%first(c) + product(max(1, s%shapes(:, c)))
     end do
     record_length = s%first(size(s%names) + 1) - 1
+    ! -series_flush_seconds: how often at most progress lines publish the records (checkpoints, a
+    ! full buffer and the end always do): a part and, while series.h5 is small, its copy per flush
+    ! would cost more than the step itself in a run with a progress line every step
+    call PetscOptionsGetReal(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-series_flush_seconds', s%flush_seconds, &
+                             set, ierr)
+    call system_clock(s%last_flush)
     ! -series_part_mb: the bound of a part, and so of the buffer, in MiB
     part_megabytes = part_bytes / 1048576.0_dp
     call PetscOptionsGetReal(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-series_part_mb', part_megabytes, set, ierr)
@@ -237,14 +245,22 @@ contains
     if (s%nbuf == s%max_records) call series_flush(s)
   end subroutine series_record
 
-  ! Publish the buffered records as a part; consolidate series.h5 when that is due.
-  subroutine series_flush(s)
+  ! Publish the buffered records as a part; consolidate series.h5 when that is due. progress,
+  ! optional: the flush of a progress line, done only when -series_flush_seconds have passed since
+  ! the last one.
+  subroutine series_flush(s, progress)
     type(series_t), intent(inout) :: s
+    logical, intent(in), optional :: progress
     character(len=1100) :: part
     integer(HID_T) :: file
     integer :: err
-    integer(kind=8) :: bytes
+    integer(kind=8) :: bytes, now, rate
     if (.not. is_root() .or. s%nbuf == 0) return
+    call system_clock(now, rate)
+    if (present(progress)) then
+      if (progress .and. real(now - s%last_flush, dp) < s%flush_seconds * rate) return
+    end if
+    s%last_flush = now
     write(part, '(a,i10.10,a)') trim(s%parts_dir)//'/', nint(s%buffer(1, 1)), '.h5'
     call create_file(s, trim(part)//'.tmp', file)
     call append_records(s, file, trim(part)//'.tmp', s%buffer(:, 1:s%nbuf))

@@ -283,7 +283,7 @@ program fdsusp
       else
         call progress_line(step, cfg%steps, time, wall_now, wall_per_step)
       end if
-      call series_flush(series)
+      call series_flush(series, progress=.true.)
     end if
     if (cfg%fields_every > 0 .and. cfg%resolved) then
       if (mod(step, cfg%fields_every) == 0) then

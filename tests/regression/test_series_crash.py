@@ -8,7 +8,8 @@ consolidated file are written as .tmp, flushed and renamed; a part is removed on
 series.h5 holds its records; a continuation consolidates up to its checkpoint's step.
 
 Two phases are attacked:
-  A. a run from the start, 60 steps, a part every 5 steps (progress lines) and a checkpoint every
+  A. a run from the start, 60 steps, a part every 5 steps (progress lines, with
+     -series_flush_seconds 0 so that each one publishes) and a checkpoint every
      20: kills spread over its HDF5 writes (pwrite64), its other writes (the log, the copies of
      consolidation), every rename and unlink;
   B. a continuation that must cut the series back: series.h5 holds steps 1..60, the checkpoint is
@@ -37,12 +38,13 @@ DECK = """&domain box = 8, 8, 8, y_boundary = 'lees-edwards', shear_rate = 1 /
 &rheology discard_strain = 0.05, average_strain = 0.25, blocks = 5 /
 """
 STEPS = 60
+FLUSH = ['-series_flush_seconds', '0']     # every progress line publishes a part
 
 
 def strace_run(deck, cwd, syscall, when):
     """Run `fdsusp DECK -continue` under strace, killed at the entry of its when-th `syscall`."""
     cmd = ['strace', '-o', '/dev/null', '-e', 'trace=' + syscall,
-           '-e', 'inject=%s:signal=KILL:when=%d' % (syscall, when), T.FDSUSP, deck, '-continue']
+           '-e', 'inject=%s:signal=KILL:when=%d' % (syscall, when), T.FDSUSP, deck, '-continue'] + FLUSH
     p = subprocess.run(cmd, cwd=cwd, env=T.ENV, capture_output=True, text=True, timeout=120)
     return p.returncode
 
@@ -50,7 +52,7 @@ def strace_run(deck, cwd, syscall, when):
 def count_calls(deck, cwd, syscalls):
     """How many of each syscall a `fdsusp DECK -continue` makes (strace's trace, one run)."""
     trace = os.path.join(cwd, 'trace.txt')
-    subprocess.run(['strace', '-o', trace, '-e', 'trace=' + ','.join(syscalls), T.FDSUSP, deck, '-continue'],
+    subprocess.run(['strace', '-o', trace, '-e', 'trace=' + ','.join(syscalls), T.FDSUSP, deck, '-continue'] + FLUSH,
                    cwd=cwd, env=T.ENV, capture_output=True, text=True, timeout=120, check=True)
     counts = {s: 0 for s in syscalls}
     with open(trace) as f:
@@ -136,7 +138,7 @@ for phase in ('A', 'B'):
             trials += 1
             if status == 0:
                 continue      # the run ended before that call: nothing was killed
-            rc, so, se = T.run(deck, work, args=['-continue'], expect_ok=False)
+            rc, so, se = T.run(deck, work, args=['-continue'] + FLUSH, expect_ok=False)
             problem = 'continuation failed (%d): %s' % (rc, se.strip()[-300:]) if rc != 0 else \
                 series_problem(out, want)
             if problem:
