@@ -433,10 +433,16 @@ contains
   function fluid_columns(fl) result(c)
     type(fluid_t), intent(in) :: fl
     type(column_t), allocatable :: c(:)
-    c = [column('tau_wall_bottom', fl%tau_bottom), column('tau_wall_top', fl%tau_top), &
-         column('divergence', fl%divergence), column('rate_of_change', fl%max_rate), &
-         column('iterations_u', fl%solver(1)%iterations), column('iterations_v', fl%solver(2)%iterations), &
-         column('iterations_w', fl%solver(3)%iterations), column('iterations_p', fl%solver(4)%iterations)]
+    ! element by element: an array constructor of column_t leaks their values (gfortran 12)
+    allocate(c(8))
+    c(1) = column('tau_wall_bottom', fl%tau_bottom)
+    c(2) = column('tau_wall_top', fl%tau_top)
+    c(3) = column('divergence', fl%divergence)
+    c(4) = column('rate_of_change', fl%max_rate)
+    c(5) = column('iterations_u', fl%solver(1)%iterations)
+    c(6) = column('iterations_v', fl%solver(2)%iterations)
+    c(7) = column('iterations_w', fl%solver(3)%iterations)
+    c(8) = column('iterations_p', fl%solver(4)%iterations)
   end function fluid_columns
 
 end module mod_fluid

@@ -309,7 +309,7 @@ contains
     character(len=1100) :: tmp, part
     character(len=400) :: problem
     integer(HID_T) :: file, source
-    integer :: err, k, last, n_source, i0, i1
+    integer :: err, k, last, n_source, i0, i1, first
     integer, allocatable :: steps(:)
     integer(kind=8) :: bytes
     real(dp), allocatable :: block(:, :)
@@ -358,11 +358,14 @@ contains
       i0 = findloc(steps > last, .true., 1)
       i1 = count(steps <= limit)
       if (i0 > 0 .and. i1 >= i0) then
-        n_source = i1 - i0 + 1
-        allocate(block(size(s%row), n_source))
-        call read_records(s, source, part, i0, block)
-        call append_records(s, file, tmp, block)
-        deallocate(block)
+        ! in slices of at most 256 records: the copy holds little memory whatever the part's size
+        do first = i0, i1, 256
+          n_source = min(256, i1 - first + 1)
+          allocate(block(size(s%row), n_source))
+          call read_records(s, source, part, first, block)
+          call append_records(s, file, tmp, block)
+          deallocate(block)
+        end do
         last = steps(i1)
       end if
       call h5fclose_f(source, err)

@@ -85,7 +85,9 @@ contains
   function le_columns(le) result(c)
     type(lees_edwards_t), intent(in) :: le
     type(column_t), allocatable :: c(:)
-    c = [column('lees_edwards_offset', le%offset)]
+    ! element by element: an array constructor of column_t leaks their values (gfortran 12)
+    allocate(c(1))
+    c(1) = column('lees_edwards_offset', le%offset)
   end function le_columns
 
 end module mod_lees_edwards

@@ -233,10 +233,15 @@ contains
   function particle_contacts_columns(pc) result(c)
     type(particle_contacts_t), intent(in) :: pc
     type(column_t), allocatable :: c(:)
-    c = [column('contacts_pair', pc%stats%pair_contacts), column('contacts_wall', pc%stats%wall_contacts), &
-         column('contacts_sliding', pc%stats%sliding), column('contact_max_overlap', pc%max_overlap), &
-         column('particles/force_contact', pc%force), column('particles/torque_contact', pc%torque), &
-         column('particles/stresslet_contact', pc%stresslet)]
+    ! element by element: an array constructor of column_t leaks their values (gfortran 12)
+    allocate(c(7))
+    c(1) = column('contacts_pair', pc%stats%pair_contacts)
+    c(2) = column('contacts_wall', pc%stats%wall_contacts)
+    c(3) = column('contacts_sliding', pc%stats%sliding)
+    c(4) = column('contact_max_overlap', pc%max_overlap)
+    c(5) = column('particles/force_contact', pc%force)
+    c(6) = column('particles/torque_contact', pc%torque)
+    c(7) = column('particles/stresslet_contact', pc%stresslet)
   end function particle_contacts_columns
 
 end module mod_particle_contacts

@@ -371,8 +371,13 @@ contains
   function particle_lubrication_columns(pl) result(c)
     type(particle_lubrication_t), intent(in) :: pl
     type(column_t), allocatable :: c(:)
-    c = [column('lubrication_pairs', pl%npairs), column('lubrication_walls', pl%nwalls), column('min_gap', pl%min_gap), &
-         column('particles/force_lubrication', pl%force), column('particles/torque_lubrication', pl%torque)]
+    ! element by element: an array constructor of column_t leaks their values (gfortran 12)
+    allocate(c(5))
+    c(1) = column('lubrication_pairs', pl%npairs)
+    c(2) = column('lubrication_walls', pl%nwalls)
+    c(3) = column('min_gap', pl%min_gap)
+    c(4) = column('particles/force_lubrication', pl%force)
+    c(5) = column('particles/torque_lubrication', pl%torque)
   end function particle_lubrication_columns
 
 end module mod_particle_lubrication

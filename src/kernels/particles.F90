@@ -186,9 +186,14 @@ contains
   function particles_columns(p) result(c)
     type(particles_t), intent(in) :: p
     type(column_t), allocatable :: c(:)
-    c = [column('particles/position', p%position), column('particles/velocity', p%velocity), &
-         column('particles/omega', p%omega), column('particles/force_hydro', p%force_hydro), &
-         column('particles/torque_hydro', p%torque_hydro), column('particles/stresslet_hydro', p%stresslet_hydro)]
+    ! element by element: an array constructor of column_t leaks their values (gfortran 12)
+    allocate(c(6))
+    c(1) = column('particles/position', p%position)
+    c(2) = column('particles/velocity', p%velocity)
+    c(3) = column('particles/omega', p%omega)
+    c(4) = column('particles/force_hydro', p%force_hydro)
+    c(5) = column('particles/torque_hydro', p%torque_hydro)
+    c(6) = column('particles/stresslet_hydro', p%stresslet_hydro)
   end function particles_columns
 
 end module mod_particles

@@ -396,12 +396,20 @@ contains
   function rheo_columns(r) result(c)
     type(rheology_t), intent(in) :: r
     type(column_t), allocatable :: c(:)
-    c = [column('core/stress_hydro', r%values(1:5)), column('core/stress_contact', r%values(6:10)), &
-         column('core/solid_fraction', r%values(11)), column('core/velocity_fit', r%values(12:16)), &
-         column('core/flow_fit', r%values(17:21)), column('core/shear_rate', r%shear_rate_core), &
-         column('min_pair_gap', r%min_pair_gap), column('pairs/references', r%references), &
-         column('pairs/shell', r%angles(:, 1)), column('pairs/contact', r%angles(:, 2)), &
-         column('profiles/solid_fraction', r%profile(:, 1)), column('profiles/momentum', r%profile(:, 2))]
+    ! element by element: an array constructor of column_t leaks their values (gfortran 12)
+    allocate(c(12))
+    c(1) = column('core/stress_hydro', r%values(1:5))
+    c(2) = column('core/stress_contact', r%values(6:10))
+    c(3) = column('core/solid_fraction', r%values(11))
+    c(4) = column('core/velocity_fit', r%values(12:16))
+    c(5) = column('core/flow_fit', r%values(17:21))
+    c(6) = column('core/shear_rate', r%shear_rate_core)
+    c(7) = column('min_pair_gap', r%min_pair_gap)
+    c(8) = column('pairs/references', r%references)
+    c(9) = column('pairs/shell', r%angles(:, 1))
+    c(10) = column('pairs/contact', r%angles(:, 2))
+    c(11) = column('profiles/solid_fraction', r%profile(:, 1))
+    c(12) = column('profiles/momentum', r%profile(:, 2))
   end function rheo_columns
 
 end module mod_rheology
