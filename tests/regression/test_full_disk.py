@@ -46,7 +46,9 @@ def on_small_disk(deck_text, size, name, np_ranks):
     os.makedirs(mnt)
     os.makedirs(left)
     T.write_deck(d, 'deck.nml', deck_text)
-    run = ' '.join(T.command('deck.nml', np_ranks))
+    # every progress line publishes its records (else a run this short publishes none before the
+    # disk is full: the default is at most one part every 5 s)
+    run = ' '.join(T.command('deck.nml', np_ranks, ['-series_flush_seconds', '0']))
     script = ('mount -t tmpfs -o size=%s tmpfs %s && cp %s/deck.nml %s && cd %s && '
               '{ timeout 120 %s > %s/stdout 2> %s/stderr; echo $? > %s/status; }; cp -a %s/. %s/'
               % (size, mnt, d, mnt, mnt, run, d, d, d, mnt, left))
