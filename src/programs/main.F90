@@ -419,7 +419,7 @@ contains
   subroutine continue_from_directory()
     integer :: found
     found = 0
-    if (is_rank0()) then
+    if (is_root()) then
       inquire(file=trim(cfg%output_directory)//'/checkpoint.h5', exist=restarting)
       found = merge(1, 0, restarting)
     end if
@@ -447,7 +447,7 @@ contains
     dir = trim(cfg%output_directory)
     state = 0
     holder = ''
-    if (is_rank0()) then
+    if (is_root()) then
       state(1) = make_directory(dir)
       if (state(1) == 0) then
         state(2) = lock_directory(dir, holder)
@@ -481,13 +481,6 @@ contains
     if (state(3) == 1) call log_line('output directory '//dir//': removed checkpoint.h5.tmp, the partial '// &
          'write of a killed run (checkpoint.h5, if there, is the last whole checkpoint)')
   end subroutine prepare_output_directory
-
-  logical function is_rank0()
-    PetscMPIInt :: rank
-    PetscErrorCode :: ierr
-    call MPI_Comm_rank(PETSC_COMM_WORLD, rank, ierr)
-    is_rank0 = (rank == 0)
-  end function is_rank0
 
   ! One record of series.h5, and the statistics' share of it.
   subroutine record()
