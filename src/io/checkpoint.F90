@@ -44,7 +44,7 @@ module mod_checkpoint
   use mod_h5util, only: write_attribute, read_attribute, write_string_attribute, has_object, dataset_dims, &
                         write_dataset, read_dataset, has_attribute
   use mod_os_services, only: publish_file
-  use mod_file_services, only: require_free_space, write_failure_cause, errno_text, remove_file
+  use mod_file_services, only: require_free_space, write_failure_cause, errno_text, remove_file, directory_of
   use mod_errors, only: is_root, abort_run, file_error_from_root, input_error, log_line
   use mod_restart_deck, only: deck_record, deck_compare
   use mod_particles, only: particles_t
@@ -87,16 +87,13 @@ contains
     logical :: failed
     character(len=400) :: item, message
     character(len=1100) :: tmp, dir
-    integer :: slash
     PetscInt :: length
     real(dp) :: bytes
     Vec, allocatable :: fields(:)
     real(dp), allocatable :: statistics(:)
 
     tmp = trim(path)//'.tmp'
-    slash = index(path, '/', back=.true.)
-    dir = path(1:max(slash - 1, 1))
-    if (slash == 0) dir = '.'
+    dir = directory_of(path)
     stars = 0
     if (associated(state%fl)) then
       fields = field_vectors(state, .true.)

@@ -10,7 +10,7 @@ module mod_output
   use mod_fluid, only: fluid_t
   use mod_errors, only: is_root, abort_run, abort_if_any
   use mod_os_services, only: publish_file
-  use mod_file_services, only: errno_text, write_failure_cause, require_free_space
+  use mod_file_services, only: errno_text, write_failure_cause, require_free_space, directory_of
   implicit none
   private
   public :: write_fields, progress_line
@@ -109,7 +109,7 @@ contains
     character(len=200) :: line
     character(len=:), allocatable :: doc
     character(len=1) :: nl
-    integer :: unit, s, f, err, slash
+    integer :: unit, s, f, err
     write(nodes, '(3(i0,1x))') grid%n(3) + 1, grid%n(2) + 1, grid%n(1) + 1
     write(cells, '(3(i0,1x))') grid%n(3), grid%n(2), grid%n(1)
     nl = new_line('a')
@@ -141,8 +141,7 @@ contains
     close(unit, iostat=s)
     if (err == 0) err = s
     if (err == 0) err = publish_file(path//'.tmp', path)
-    slash = index(path, '/', back=.true.)
-    if (err /= 0) call abort_run(path//' cannot be written: '//write_failure_cause(path(1:max(slash - 1, 1)), 0.0_dp))
+    if (err /= 0) call abort_run(path//' cannot be written: '//write_failure_cause(directory_of(path), 0.0_dp))
   end subroutine write_xdmf
 
   ! step, strain, wall time, estimated time left, iterations of each solver, divergence (fl

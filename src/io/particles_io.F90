@@ -13,7 +13,7 @@ module mod_particles_io
   use mod_h5util, only: write_attribute, read_attribute, has_object, write_dataset, read_dataset, dataset_dims
   use mod_errors, only: is_root, input_error, file_error, file_error_from_root, abort_run
   use mod_os_services, only: publish_file
-  use mod_file_services, only: errno_text, write_failure_cause
+  use mod_file_services, only: errno_text, write_failure_cause, directory_of
   implicit none
   private
   public :: particles_load, particles_write, particles_read_state, particles_snapshot
@@ -220,23 +220,19 @@ contains
     integer :: err
     character(len=1024) :: file
     integer(SIZE_T) :: length
-    integer :: slash
     call write_dataset(group, name, values, err)
     if (err /= 0) then
       file = ''
       call h5fget_name_f(group, file, length, err)
-      slash = index(file, '/', back=.true.)
       call abort_run(trim(file)//' cannot take /particles/'//name//': '// &
-                     write_failure_cause(file(1:max(slash - 1, 1)), 8.0_dp * size(values)))
+                     write_failure_cause(directory_of(file), 8.0_dp * size(values)))
     end if
   end subroutine write_matrix
 
   ! A write of a particle file failed: stop the run naming the file and the cause.
   subroutine write_failed(path, what)
     character(len=*), intent(in) :: path, what
-    integer :: slash
-    slash = index(path, '/', back=.true.)
-    call abort_run(trim(path)//' '//what//': '//write_failure_cause(path(1:max(slash - 1, 1)), 0.0_dp))
+    call abort_run(trim(path)//' '//what//': '//write_failure_cause(directory_of(path), 0.0_dp))
   end subroutine write_failed
 
   ! Restart: positions, velocities and history from a checkpoint (collective). The particle count

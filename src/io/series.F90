@@ -27,7 +27,7 @@ module mod_series
   use mod_errors, only: is_root, warn_line, log_line, abort_run
   use mod_os_services, only: publish_file, make_directory
   use mod_file_services, only: list_directory, copy_file, remove_file, rename_file, errno_text, write_failure_cause, &
-                               free_bytes
+                               free_bytes, directory_of
   implicit none
   private
   public :: series_t, series_column, series_add, series_open, series_record, series_flush, series_close, series_attributes
@@ -553,14 +553,13 @@ contains
   subroutine write_failed(s, name, what)
     type(series_t), intent(in) :: s
     character(len=*), intent(in) :: name, what
-    integer :: slash, err
+    integer :: err
     real(dp) :: needed
-    slash = index(s%path, '/', back=.true.)
     ! a partial .tmp would only hold space the user needs back; what it was to replace is whole
     if (index(name, '.tmp', back=.true.) == len_trim(name) - 3) err = remove_file(name)
     needed = 0.0_dp
     if (allocated(s%buffer)) needed = 8.0_dp * size(s%buffer, 1) * max(1, s%nbuf)
-    call abort_run(trim(name)//' '//what//': '//write_failure_cause(s%path(1:max(slash - 1, 1)), needed)// &
+    call abort_run(trim(name)//' '//what//': '//write_failure_cause(directory_of(s%path), needed)// &
          '; the records published before, and the last checkpoint, are kept')
   end subroutine write_failed
 

@@ -11,7 +11,7 @@ module mod_file_services
   implicit none
   private
   public :: list_directory, copy_file, remove_file, rename_file, free_bytes, errno_text, write_failure_cause, &
-            require_free_space
+            require_free_space, directory_of
 
   interface
     integer(c_int) function fdsusp_list_directory(dir, suffix, buf, len) bind(C, name='fdsusp_list_directory')
@@ -116,6 +116,19 @@ contains
       text = text//buf(k)
     end do
   end function errno_text
+
+  ! The directory holding the file PATH ('.' for a bare name).
+  function directory_of(path) result(dir)
+    character(len=*), intent(in) :: path
+    character(len=:), allocatable :: dir
+    integer :: slash
+    slash = index(trim(path), '/', back=.true.)
+    if (slash == 0) then
+      dir = '.'
+    else
+      dir = path(1:max(slash - 1, 1))
+    end if
+  end function directory_of
 
   ! Why a write into directory DIR failed, for a message: a full disk is named as such (the
   ! libraries that wrote, HDF5 or PETSc, report no errno), else an I/O error. NEEDED: the bytes
