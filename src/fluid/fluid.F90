@@ -64,9 +64,9 @@ contains
     real(dp) :: tol, floor, u_ref, cells
     PetscBool :: found
 
-    fl%reynolds = cfg%reynolds
-    fl%dt = cfg%dt
-    fl%theta = cfg%viscous_theta
+    fl%reynolds = cfg%fluid%reynolds
+    fl%dt = cfg%time%dt
+    fl%theta = cfg%fluid%viscous_theta
     fl%wall_speed = cfg%wall_speed
     do c = 1, 3
       PetscCall(DMCreateGlobalVector(grid%da(c), fl%vel(c), ierr))
@@ -96,7 +96,7 @@ contains
     ! -fluid_extrapolate 0: the warm start from u^n (for the comparison of doc/BENCHMARKS.md §10)
     PetscCall(PetscOptionsGetBool(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-fluid_extrapolate', fl%extrapolate, found, ierr))
     PetscCall(set_forcing(cfg, grid, fl, ierr))
-    if (cfg%initial_flow == 'shear' .and. grid%walls) then
+    if (cfg%fluid%initial_flow == 'shear' .and. grid%walls) then
       PetscCall(set_linear_shear(grid, fl, ierr))
     end if
 
@@ -110,10 +110,10 @@ contains
     u_ref = max(abs(fl%wall_speed), 1.0_dp)
     cells = real(grid%n(1), dp) * real(grid%n(2), dp) * real(grid%n(3), dp)
     do c = 1, 4
-      tol = cfg%velocity_tolerance
+      tol = cfg%fluid%velocity_tolerance
       floor = 1.0e2_dp * epsilon(1.0_dp) * (fl%reynolds / fl%dt) * u_ref * sqrt(cells)
       if (c == FIELD_P) then
-        tol = cfg%pressure_tolerance
+        tol = cfg%fluid%pressure_tolerance
         floor = floor / grid%h
       end if
       PetscCall(solver_create(grid, c, tol, floor, fl%solver(c), ierr))
@@ -129,10 +129,10 @@ contains
     PetscScalar, pointer :: f(:,:,:)
     integer :: c, i, j, k
 
-    fl%has_forcing = cfg%manufactured_solution .or. any(cfg%body_force /= 0.0_dp)
+    fl%has_forcing = cfg%verification%manufactured_solution .or. any(cfg%fluid%body_force /= 0.0_dp)
     do c = 1, 3
-      PetscCall(VecSet(fl%forcing(c), cfg%body_force(c), ierr))
-      if (.not. cfg%manufactured_solution) cycle
+      PetscCall(VecSet(fl%forcing(c), cfg%fluid%body_force(c), ierr))
+      if (.not. cfg%verification%manufactured_solution) cycle
       PetscCall(DMDAVecGetArrayF90(grid%da(c), fl%forcing(c), f, ierr))
       do k = grid%lo(3), grid%hi(3)
         do j = grid%lo(2), grid%hi(2)

@@ -71,7 +71,7 @@ contains
 
     grid%n = cfg%cells
     grid%h = cfg%h
-    grid%box = cfg%box
+    grid%box = cfg%domain%box
     grid%walls = cfg%walls
 
     ! Let PETSc choose the process grid, then align each rank's share to the coarsest

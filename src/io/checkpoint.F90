@@ -131,11 +131,11 @@ contains
       call put_int('step', [step])
       call put_real('time', [time])
       call put_int('cells', cfg%cells)
-      call put_real('box', cfg%box)
+      call put_real('box', cfg%domain%box)
       call put_int('walls', [merge(1, 0, cfg%walls)])
-      call put_real('reynolds', [cfg%reynolds])
-      call put_real('dt', [cfg%dt])
-      call put_real('shear_rate', [cfg%shear_rate])
+      call put_real('reynolds', [cfg%fluid%reynolds])
+      call put_real('dt', [cfg%time%dt])
+      call put_real('shear_rate', [cfg%domain%shear_rate])
       call write_string_attribute(file, 'program', 'fdsusp', err)
       failed = failed .or. err /= 0
       call put_int('star_history', [stars])
@@ -148,14 +148,14 @@ contains
       end if
       failed = failed .or. err /= 0
       if (associated(state%parts)) then
-        call particles_write(file, state%parts, cfg%box, .true.)
+        call particles_write(file, state%parts, cfg%domain%box, .true.)
         if (associated(state%history)) call contacts_write(file, state%history, state%parts%n)
       end if
       if (associated(state%rh)) then
         call put_int('rheology_window', [state%rh%discard_step, state%rh%block_steps])
         call put_real('rheology_core', state%rh%core)
         call put_real('rheology_shells', [state%rh%r_outer, state%rh%r_contact])
-        call put_int('rheology_sampling', [cfg%series_every])
+        call put_int('rheology_sampling', [cfg%output%series_every])
         statistics = rheo_state(state%rh)
         call h5gcreate_f(file, 'rheology', group, err)
         if (err == 0) call write_dataset(group, 'accumulators', reshape(statistics, [size(statistics), 1]), err)
@@ -314,9 +314,9 @@ contains
       call read_attribute(file, 'box', box, err)
       if (err /= 0) then
         item = 'box'; message = 'missing'
-      else if (any(abs(box - cfg%box) > 1.0e-12_dp * cfg%box)) then
+      else if (any(abs(box - cfg%domain%box) > 1.0e-12_dp * cfg%domain%box)) then
         item = 'box'
-        write(message, '(a,3f10.4,a,3f10.4)') 'the checkpoint box is', box, ', the deck asks for', cfg%box
+        write(message, '(a,3f10.4,a,3f10.4)') 'the checkpoint box is', box, ', the deck asks for', cfg%domain%box
       end if
     end if
     if (len_trim(message) == 0) then
@@ -394,7 +394,7 @@ contains
     end if
     ! the statistics: the deck's window against the checkpoint's accumulators
     if (len_trim(message) == 0 .and. present(rh)) then
-      call rheology_verdict(file, rh, cfg%series_every, message, group, variable, afresh)
+      call rheology_verdict(file, rh, cfg%output%series_every, message, group, variable, afresh)
       if (len_trim(message) > 0 .and. len_trim(group) == 0) item = 'rheology/accumulators'
     else if (len_trim(message) == 0) then
       if (has_object(file, 'rheology')) &

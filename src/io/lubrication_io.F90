@@ -71,23 +71,23 @@ contains
     real(dp), allocatable :: pair(:, :), wall(:, :)
     logical :: exists
 
-    model = model_code(trim(cfg%lubrication_model))
+    model = model_code(trim(cfg%lubrication%model))
     if (.not. needed) model = LUB_NONE
     ! lubrication dynamics (&fluid model = 'none'): nothing is resolved, so 'full' is the exact
     ! two-body functions themselves and needs no table (mod_lubrication_dynamics)
     if (.not. cfg%resolved .and. model == LUB_FULL) then
       model = LUB_EXACT
-      if (len_trim(cfg%lubrication_table) > 0) &
+      if (len_trim(cfg%lubrication%table) > 0) &
         call log_line('lubrication: &lubrication table is not used with &fluid model = ''none'' (exact functions)')
     end if
     if (model == LUB_FULL) then
-      path = trim(cfg%lubrication_table)
+      path = trim(cfg%lubrication%table)
       if (len(path) == 0) then
-        path = default_table_path(cfg%cells_per_radius)
+        path = default_table_path(cfg%domain%cells_per_radius)
         inquire(file=path, exist=exists)
-        if (abs(cfg%cells_per_radius - nint(cfg%cells_per_radius)) > 1.0e-9_dp .or. .not. exists) &
+        if (abs(cfg%domain%cells_per_radius - nint(cfg%domain%cells_per_radius)) > 1.0e-9_dp .or. .not. exists) &
           call input_error(cfg%deck_file, 'lubrication', 'model', 'the full model has no table for '// &
-               'cells_per_radius = '//trim(number(cfg%cells_per_radius))//' ('//path//' is missing): '// &
+               'cells_per_radius = '//trim(number(cfg%domain%cells_per_radius))//' ('//path//' is missing): '// &
                'calibrate it (make calibrate CELLS_PER_RADIUS=n), use a calibrated resolution, '// &
                'or model = ''simple''')
       else
@@ -109,8 +109,8 @@ contains
       lub%wall_gap = wall(1, :)
       lub%wall_resolved = transpose(wall(2:, :))
     end if
-    call lub_setup(lub, model, cfg%radius, 1.0_dp, cfg%cells_per_radius, cfg%outer_cutoff, cfg%inner_cutoff)
-    lub%wall_floor = lub_wall_floor(cfg%reynolds, cfg%dt, cfg%radius)
+    call lub_setup(lub, model, cfg%particles%radius, 1.0_dp, cfg%domain%cells_per_radius, cfg%lubrication%outer_cutoff, cfg%lubrication%inner_cutoff)
+    lub%wall_floor = lub_wall_floor(cfg%fluid%reynolds, cfg%time%dt, cfg%particles%radius)
   end subroutine lubrication_load
 
   subroutine read_table(path, cfg, pair, wall, message)
@@ -132,7 +132,7 @@ contains
                                                   'slip_kappa']
       real(dp) :: expected(3)
       integer :: k
-      expected = [cfg%cells_per_radius, cfg%radius_offset, cfg%slip_kappa]
+      expected = [cfg%domain%cells_per_radius, cfg%particles%radius_offset, cfg%particles%slip_kappa]
       do k = 1, 3
         if (.not. has_attribute(file, trim(names(k)))) then
           message = 'attribute '//trim(names(k))//' missing'

@@ -31,15 +31,15 @@ contains
     integer :: n, culprit, ierr
     character(len=32) :: item
 
-    if (len_trim(cfg%position_file) == 0) then
-      n = cfg%particle_number
-      call particles_init(parts, n, cfg%radius, motion_code(cfg%motion))
-      parts%position = cfg%particle_position(:, 1:n)
-      parts%prescribed_velocity = cfg%particle_velocity(:, 1:n)
-      parts%prescribed_omega = cfg%particle_omega(:, 1:n)
-      parts%external_force = cfg%external_force(:, 1:n)
-      parts%external_torque = cfg%external_torque(:, 1:n)
-      message = configuration_fault(parts%position, parts%radius, cfg%box, cfg%walls, culprit, start_gap_roughness(cfg))
+    if (len_trim(cfg%particles%position_file) == 0) then
+      n = cfg%particles%number
+      call particles_init(parts, n, cfg%particles%radius, motion_code(cfg%particles%motion))
+      parts%position = cfg%particles%position(:, 1:n)
+      parts%prescribed_velocity = cfg%particles%velocity(:, 1:n)
+      parts%prescribed_omega = cfg%particles%omega(:, 1:n)
+      parts%external_force = cfg%particles%external_force(:, 1:n)
+      parts%external_torque = cfg%particles%external_torque(:, 1:n)
+      message = configuration_fault(parts%position, parts%radius, cfg%domain%box, cfg%walls, culprit, start_gap_roughness(cfg))
       if (len_trim(message) > 0) then
         write(item, '(a,i0,a)') 'position(:,', culprit, ')'
         call input_error(cfg%deck_file, 'particles', trim(item), trim(message))
@@ -49,23 +49,23 @@ contains
 
     message = ''
     n = 0
-    if (is_root()) call read_positions(trim(cfg%position_file), position, message)
-    call file_error_from_root(trim(cfg%position_file), 'particles/position', message)
+    if (is_root()) call read_positions(trim(cfg%particles%position_file), position, message)
+    call file_error_from_root(trim(cfg%particles%position_file), 'particles/position', message)
     if (is_root()) n = size(position, 2)
     call MPI_Bcast(n, 1, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
     if (.not. is_root()) allocate(position(3, n))
     call MPI_Bcast(position, 3 * n, MPI_DOUBLE_PRECISION, 0, PETSC_COMM_WORLD, ierr)
-    call particles_init(parts, n, cfg%radius, motion_code(cfg%motion))
+    call particles_init(parts, n, cfg%particles%radius, motion_code(cfg%particles%motion))
     parts%position = position
-    message = configuration_fault(parts%position, parts%radius, cfg%box, cfg%walls, culprit, start_gap_roughness(cfg))
-    if (len_trim(message) > 0) call file_error(trim(cfg%position_file), 'particles/position', trim(message))
+    message = configuration_fault(parts%position, parts%radius, cfg%domain%box, cfg%walls, culprit, start_gap_roughness(cfg))
+    if (len_trim(message) > 0) call file_error(trim(cfg%particles%position_file), 'particles/position', trim(message))
   end subroutine particles_load
 
   ! h_r when the run has rough contacts (their start-gap rule), else 0.
   pure real(dp) function start_gap_roughness(cfg) result(h_r)
     type(config_t), intent(in) :: cfg
     h_r = 0.0_dp
-    if (cfg%contact_group) h_r = cfg%roughness * cfg%radius
+    if (cfg%contact_group) h_r = cfg%contact%roughness * cfg%particles%radius
   end function start_gap_roughness
 
   subroutine read_positions(path, position, message)

@@ -52,64 +52,64 @@ contains
     logical :: contacts
     n = 0
     contacts = particles > 0 .and. cfg%contact_group
-    call text_item('domain', 'y_boundary', MUST_MATCH, cfg%y_boundary)
-    call real_item('domain', 'shear_rate', MUST_MATCH, [cfg%shear_rate], legacy='shear_rate')
+    call text_item('domain', 'y_boundary', MUST_MATCH, cfg%domain%y_boundary)
+    call real_item('domain', 'shear_rate', MUST_MATCH, [cfg%domain%shear_rate], legacy='shear_rate')
     if (cfg%resolved) then
-      call real_item('fluid', 'reynolds', MUST_MATCH, [cfg%reynolds], legacy='reynolds')
-      call real_item('fluid', 'body_force', MUST_MATCH, cfg%body_force)
-      call real_item('fluid', 'viscous_theta', MUST_MATCH, [cfg%viscous_theta])
-      call real_item('fluid', 'velocity_tolerance', MAY_CHANGE, [cfg%velocity_tolerance])
-      call real_item('fluid', 'pressure_tolerance', MAY_CHANGE, [cfg%pressure_tolerance])
+      call real_item('fluid', 'reynolds', MUST_MATCH, [cfg%fluid%reynolds], legacy='reynolds')
+      call real_item('fluid', 'body_force', MUST_MATCH, cfg%fluid%body_force)
+      call real_item('fluid', 'viscous_theta', MUST_MATCH, [cfg%fluid%viscous_theta])
+      call real_item('fluid', 'velocity_tolerance', MAY_CHANGE, [cfg%fluid%velocity_tolerance])
+      call real_item('fluid', 'pressure_tolerance', MAY_CHANGE, [cfg%fluid%pressure_tolerance])
       call real_item('verification', 'manufactured_solution', MUST_MATCH, [merge(1.0_dp, 0.0_dp, &
-                     cfg%manufactured_solution)])
+                     cfg%verification%manufactured_solution)])
     end if
-    call real_item('time', 'dt', MUST_MATCH, [cfg%dt], legacy='dt')
-    call real_item('time', 'steps', MAY_CHANGE, [real(cfg%steps, dp)])
-    call real_item('time', 'steady_tolerance', MAY_CHANGE, [cfg%steady_tolerance])
-    call text_item('output', 'directory', MAY_CHANGE, cfg%output_directory)
-    call real_item('output', 'progress_every', MAY_CHANGE, [real(cfg%progress_every, dp)])
+    call real_item('time', 'dt', MUST_MATCH, [cfg%time%dt], legacy='dt')
+    call real_item('time', 'steps', MAY_CHANGE, [real(cfg%time%steps, dp)])
+    call real_item('time', 'steady_tolerance', MAY_CHANGE, [cfg%time%steady_tolerance])
+    call text_item('output', 'directory', MAY_CHANGE, cfg%output%directory)
+    call real_item('output', 'progress_every', MAY_CHANGE, [real(cfg%output%progress_every, dp)])
     ! with &rheology series_every also sets the records the statistics take: mod_checkpoint checks
     ! it against the checkpoint's window
-    call real_item('output', 'series_every', MAY_CHANGE, [real(cfg%series_every, dp)])
-    call real_item('output', 'fields_every', MAY_CHANGE, [real(cfg%fields_every, dp)])
-    call real_item('output', 'checkpoint_every', MAY_CHANGE, [real(cfg%checkpoint_every, dp)])
-    call real_item('output', 'particles_every', MAY_CHANGE, [real(cfg%particles_every, dp)])
-    call text_item('run', 'title', MAY_CHANGE, cfg%title)
-    call real_item('run', 'max_wall_hours', MAY_CHANGE, [cfg%max_wall_hours])
+    call real_item('output', 'series_every', MAY_CHANGE, [real(cfg%output%series_every, dp)])
+    call real_item('output', 'fields_every', MAY_CHANGE, [real(cfg%output%fields_every, dp)])
+    call real_item('output', 'checkpoint_every', MAY_CHANGE, [real(cfg%output%checkpoint_every, dp)])
+    call real_item('output', 'particles_every', MAY_CHANGE, [real(cfg%output%particles_every, dp)])
+    call text_item('run', 'title', MAY_CHANGE, cfg%run%title)
+    call real_item('run', 'max_wall_hours', MAY_CHANGE, [cfg%run%max_wall_hours])
     if (particles > 0) then
-      call real_item('particles', 'radius', MUST_MATCH, [cfg%radius])
-      call text_item('particles', 'motion', MUST_MATCH, cfg%motion)
+      call real_item('particles', 'radius', MUST_MATCH, [cfg%particles%radius])
+      call text_item('particles', 'motion', MUST_MATCH, cfg%particles%motion)
       if (cfg%resolved) then
-        call real_item('particles', 'radius_offset', MUST_MATCH, [cfg%radius_offset])
-        call real_item('particles', 'slip_kappa', MUST_MATCH, [cfg%slip_kappa])
+        call real_item('particles', 'radius_offset', MUST_MATCH, [cfg%particles%radius_offset])
+        call real_item('particles', 'slip_kappa', MUST_MATCH, [cfg%particles%slip_kappa])
       end if
       ! the imposed velocities (prescribed motion) or the external loads (free motion) of the
       ! inline particles
-      if (cfg%motion == 'prescribed' .or. cfg%motion == 'resistance') then
-        call real_item('particles', 'velocity', MUST_MATCH, reshape(cfg%particle_velocity, [size(cfg%particle_velocity)]), &
+      if (cfg%particles%motion == 'prescribed' .or. cfg%particles%motion == 'resistance') then
+        call real_item('particles', 'velocity', MUST_MATCH, reshape(cfg%particles%velocity, [size(cfg%particles%velocity)]), &
                        per=3)
-        call real_item('particles', 'omega', MUST_MATCH, reshape(cfg%particle_omega, [size(cfg%particle_omega)]), per=3)
-      else if (cfg%motion == 'free') then
-        call real_item('particles', 'external_force', MUST_MATCH, reshape(cfg%external_force, &
-                       [size(cfg%external_force)]), per=3)
-        call real_item('particles', 'external_torque', MUST_MATCH, reshape(cfg%external_torque, &
-                       [size(cfg%external_torque)]), per=3)
+        call real_item('particles', 'omega', MUST_MATCH, reshape(cfg%particles%omega, [size(cfg%particles%omega)]), per=3)
+      else if (cfg%particles%motion == 'free') then
+        call real_item('particles', 'external_force', MUST_MATCH, reshape(cfg%particles%external_force, &
+                       [size(cfg%particles%external_force)]), per=3)
+        call real_item('particles', 'external_torque', MUST_MATCH, reshape(cfg%particles%external_torque, &
+                       [size(cfg%particles%external_torque)]), per=3)
       end if
-      call text_item('lubrication', 'model', MUST_MATCH, cfg%lubrication_model)
-      call real_item('lubrication', 'outer_cutoff', MUST_MATCH, [cfg%outer_cutoff])
-      call real_item('lubrication', 'inner_cutoff', MUST_MATCH, [cfg%inner_cutoff])
-      call real_item('lubrication', 'skin', MAY_CHANGE, [cfg%lubrication_skin])
+      call text_item('lubrication', 'model', MUST_MATCH, cfg%lubrication%model)
+      call real_item('lubrication', 'outer_cutoff', MUST_MATCH, [cfg%lubrication%outer_cutoff])
+      call real_item('lubrication', 'inner_cutoff', MUST_MATCH, [cfg%lubrication%inner_cutoff])
+      call real_item('lubrication', 'skin', MAY_CHANGE, [cfg%lubrication%skin])
       ! the table's path (its content is checked against the deck by mod_lubrication_io)
-      if (cfg%resolved) call text_item('lubrication', 'table', MAY_CHANGE, cfg%lubrication_table)
+      if (cfg%resolved) call text_item('lubrication', 'table', MAY_CHANGE, cfg%lubrication%table)
     end if
     if (contacts) then
-      call real_item('contact', 'roughness', MUST_MATCH, [cfg%roughness])
-      call real_item('contact', 'normal_stiffness', MUST_MATCH, [cfg%normal_stiffness])
+      call real_item('contact', 'roughness', MUST_MATCH, [cfg%contact%roughness])
+      call real_item('contact', 'normal_stiffness', MUST_MATCH, [cfg%contact%normal_stiffness])
       ! eps_bar sets k_n only when normal_stiffness is 0 (doc/CONTACT.md)
-      if (cfg%normal_stiffness <= 0.0_dp) call real_item('contact', 'eps_bar', MUST_MATCH, [cfg%eps_bar])
-      call real_item('contact', 'friction', MUST_MATCH, [cfg%friction])
-      call real_item('contact', 'implicit', MUST_MATCH, [merge(1.0_dp, 0.0_dp, cfg%contact_implicit)])
-      call real_item('contact', 'neighbour_skin', MAY_CHANGE, [cfg%neighbour_skin])
+      if (cfg%contact%normal_stiffness <= 0.0_dp) call real_item('contact', 'eps_bar', MUST_MATCH, [cfg%contact%eps_bar])
+      call real_item('contact', 'friction', MUST_MATCH, [cfg%contact%friction])
+      call real_item('contact', 'implicit', MUST_MATCH, [merge(1.0_dp, 0.0_dp, cfg%contact%implicit)])
+      call real_item('contact', 'neighbour_skin', MAY_CHANGE, [cfg%contact%neighbour_skin])
     end if
     allocate(list(n))
     list(1:n) = found(1:n)

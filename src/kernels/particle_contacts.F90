@@ -27,8 +27,18 @@ module mod_particle_contacts
   use mod_columns, only: column_t, column
   implicit none
   private
-  public :: particle_contacts_t, particle_contacts_create, particle_contacts_step
+  public :: contact_settings_t, particle_contacts_t, particle_contacts_create, particle_contacts_step
   public :: particle_contacts_add_stiffness, particle_contacts_implicit_update, particle_contacts_columns
+
+  ! The deck's &contact (doc/INPUT.md): its variables, named as in the deck, with their defaults.
+  type :: contact_settings_t
+    real(dp) :: roughness = 0.0_dp         ! eps_r = h_r/a [-]
+    real(dp) :: eps_bar = 0.05_dp          ! roughness deformation under 6 pi eta gamma_dot a^2 [-]
+    real(dp) :: friction = 0.0_dp          ! mu_d [-]
+    real(dp) :: normal_stiffness = 0.0_dp  ! k_n [eta gamma_dot a^(1/2)] (0: from eps_bar)
+    real(dp) :: neighbour_skin = 0.2_dp    ! neighbour-list skin [a]
+    logical :: implicit = .true.           ! linearised contact stiffness in the particle solve
+  end type contact_settings_t
 
   type :: particle_contacts_t
     type(contact_params_t) :: params
@@ -56,25 +66,25 @@ module mod_particle_contacts
 
 contains
 
-  !> Set up for np spheres of radius a. eps_r, mu_d, eps_bar, k_n_prescribed: the &contact
-  !> values (doc/INPUT.md); skin: neighbour-list skin [a]; eta: viscosity; shear_rate: imposed
+  !> Set up for np spheres of radius a with the deck's &contact settings; shear_rate: imposed
   !> shear rate (walls at -+ shear_rate Ly/2 when walls); box, walls: the domain; dt: time step.
   !> info: 0 ok, else msg says what is wrong (contact_setup or nlist_init refused).
-  !> implicit, optional: the contact stiffness enters the particle solve (default .true.).
   !> le, optional: Lees-Edwards boundaries in y (walls must then be .false.).
-  subroutine particle_contacts_create(pc, np, a, eps_r, mu_d, eps_bar, k_n_prescribed, skin, eta, &
-                              shear_rate, box, walls, dt, info, msg, implicit, le)
+  subroutine particle_contacts_create(pc, np, a, settings, shear_rate, box, walls, dt, info, msg, le)
     type(particle_contacts_t), intent(out) :: pc
     integer, intent(in) :: np
-    real(dp), intent(in) :: a, eps_r, mu_d, eps_bar, k_n_prescribed, skin, eta, shear_rate, box(3), dt
+    real(dp), intent(in) :: a, shear_rate, box(3), dt
+    type(contact_settings_t), intent(in) :: settings
     logical, intent(in) :: walls
     integer, intent(out) :: info
     character(len=*), intent(out) :: msg
-    logical, intent(in), optional :: implicit
     type(lees_edwards_t), intent(in), optional :: le
-    call contact_setup(pc%params, a, eps_r, mu_d, eps_bar, k_n_prescribed, eta, shear_rate, info, msg)
+    ! the viscosity is the unit of stress (doc/METHOD.md §0.2)
+    real(dp), parameter :: eta = 1.0_dp
+    call contact_setup(pc%params, a, settings%roughness, settings%friction, settings%eps_bar, &
+                       settings%normal_stiffness, eta, shear_rate, info, msg)
     if (info /= 0) return
-    if (present(implicit)) pc%implicit = implicit
+    pc%implicit = settings%implicit
     pc%np = np
     pc%box = box
     pc%dt = dt
@@ -88,8 +98,8 @@ contains
     pc%overlap_limit = pc%params%h_r
     if (pc%overlap_limit <= 0) pc%overlap_limit = 0.05_dp * a
     if (present(le)) pc%le = le
-    call nlist_init(pc%nlist, np, box, pc%periodic, 2 * a + pc%params%h_r + skin, &
-                    a + pc%params%h_r + skin, skin, info, pc%le)
+    call nlist_init(pc%nlist, np, box, pc%periodic, 2 * a + pc%params%h_r + settings%neighbour_skin, &
+                    a + pc%params%h_r + settings%neighbour_skin, settings%neighbour_skin, info, pc%le)
     if (info /= 0) then
       msg = 'contacts: the neighbour search refuses this box (a periodic length below 2 x cutoff)'
       return

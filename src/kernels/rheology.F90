@@ -33,7 +33,7 @@ module mod_rheology
   use mod_columns, only: column_t, column
   implicit none
   private
-  public :: rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, rheo_quantities, rheo_block_of, &
+  public :: rheology_settings_t, rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, rheo_quantities, rheo_block_of, &
             rheo_state, rheo_restore, rheo_summarise, rheo_columns, NQ, NSUMMARY, summary_names, slab_volume
 
   ! per-record values that are block-averaged: stress_hydro(5), stress_contact(5), phi_core,
@@ -48,6 +48,20 @@ module mod_rheology
        'lambda_2', 'lambda_3', 'lambda_2_c', 'lambda_3_c', 'eta_n', 'eta_n_c', &
        'I_v', 'mu', 'mu_h', 'mu_c', 'phi_core', 'gamma_dot_core', 'tau', &
        'Sigma_xy/tau', 'Sigma_xy_c/tau', 'Pi_h/tau', 'N1_h/tau', 'gamma_dot_flow']
+
+  ! The deck's &rheology (doc/INPUT.md, doc/RHEOLOGY.md): its variables, named as in the deck, with
+  ! their defaults. The step counts of the window follow from them and &time dt (rheo_create's
+  ! discard_step, block_steps).
+  type :: rheology_settings_t
+    real(dp) :: discard_strain = 5.0_dp       ! strain discarded before averaging [-]
+    real(dp) :: average_strain = 20.0_dp      ! strain averaged over [-]
+    integer :: blocks = 5                     ! averaging blocks [-]
+    real(dp) :: core(2) = [0.25_dp, 0.75_dp]  ! core region y/Ly [-] (paper eq. (4.10))
+    integer :: profile_bins = 0               ! bins across y (0: 4 per radius)
+    integer :: angle_bins = 36                ! bins of g(theta) over [0, 2 pi)
+    real(dp) :: pair_shell = 2.1_dp           ! g(theta) counts pairs at r < pair_shell [a]
+    real(dp) :: contact_shell = 0.0_dp        ! g_c(theta): r < 2a + contact_shell [a] (0: h_r or 0.005)
+  end type rheology_settings_t
 
   type :: rheology_t
     real(dp) :: box(3) = 0, radius = 1, shear_rate = 1
@@ -79,15 +93,16 @@ module mod_rheology
 
 contains
 
-  !> Set up. contact_shell: h_c of the contact shell [a]; steps are counted from the start of the
-  !> simulation. info: 0 ok; 1 a periodic length below twice the pair search range.
-  !> le, optional: Lees-Edwards boundaries in y (core_fraction is then [0, 1]: the whole box).
-  subroutine rheo_create(r, n, box, radius, shear_rate, core_fraction, nbins, nangles, r_outer, contact_shell, &
-                         blocks, discard_step, block_steps, info, le)
+  !> Set up for n spheres with the deck's &rheology settings (profile_bins and contact_shell as
+  !> resolved by the deck reader: non-zero); steps are counted from the start of the simulation.
+  !> info: 0 ok; 1 a periodic length below twice the pair search range.
+  !> le, optional: Lees-Edwards boundaries in y (the core is then the whole box).
+  subroutine rheo_create(r, n, box, radius, shear_rate, settings, discard_step, block_steps, info, le)
     type(rheology_t), intent(out) :: r
     integer, intent(in) :: n                ! number of spheres
-    real(dp), intent(in) :: box(3), radius, shear_rate, core_fraction(2), r_outer, contact_shell
-    integer, intent(in) :: nbins, nangles, blocks, discard_step, block_steps
+    real(dp), intent(in) :: box(3), radius, shear_rate
+    type(rheology_settings_t), intent(in) :: settings
+    integer, intent(in) :: discard_step, block_steps
     integer, intent(out) :: info
     type(lees_edwards_t), intent(in), optional :: le
     real(dp), parameter :: skin = 0.3_dp
@@ -95,18 +110,18 @@ contains
     r%box = box
     r%radius = radius
     r%shear_rate = shear_rate
-    r%core = core_fraction * box(2)
+    r%core = settings%core * box(2)
     if (r%le%active) r%core = [0.0_dp, box(2)]
-    r%nbins = nbins
-    r%nangles = nangles
-    r%r_outer = r_outer * radius
-    r%r_contact = (2.0_dp + contact_shell) * radius
-    r%blocks = blocks
+    r%nbins = settings%profile_bins
+    r%nangles = settings%angle_bins
+    r%r_outer = settings%pair_shell * radius
+    r%r_contact = (2.0_dp + settings%contact_shell) * radius
+    r%blocks = settings%blocks
     r%discard_step = discard_step
     r%block_steps = block_steps
-    allocate(r%profile(nbins, 2), r%angles(nangles, 2))
-    allocate(r%block_sums(NQ, blocks), r%block_profile(nbins, 2, blocks), r%block_angles(nangles, 2, blocks), &
-             r%block_references(blocks), r%block_records(blocks))
+    allocate(r%profile(r%nbins, 2), r%angles(r%nangles, 2))
+    allocate(r%block_sums(NQ, r%blocks), r%block_profile(r%nbins, 2, r%blocks), r%block_angles(r%nangles, 2, r%blocks), &
+             r%block_references(r%blocks), r%block_records(r%blocks))
     r%profile = 0; r%angles = 0
     r%block_sums = 0; r%block_profile = 0; r%block_angles = 0; r%block_references = 0; r%block_records = 0
     call nlist_init(r%nl, n, box, [.true., r%le%active, .true.], max(r%r_outer, r%r_contact) + skin, &

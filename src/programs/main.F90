@@ -89,11 +89,11 @@ program fdsusp
   ! ---- everything is checked before any work ----
   call command_line(deck, restart, restarting, continuing)
   call read_deck(deck, cfg)
-  call log_line('fdsusp: '//trim(cfg%title))
+  call log_line('fdsusp: '//trim(cfg%run%title))
   call echo_deck(cfg)
   call prepare_output_directory(cfg)
   if (continuing) call continue_from_directory()
-  if (cfg%solid_fraction > 0.0_dp) then
+  if (cfg%particles%solid_fraction > 0.0_dp) then
     call initial_packing_make(cfg, parts)        ! a random packing made now
   else
     call particles_load(cfg, parts)              ! the deck's or the position file's
@@ -102,8 +102,8 @@ program fdsusp
   ! lubrication dynamics moves spheres and nothing else: a file or packing that yields none leaves
   ! nothing to compute (the deck itself is checked in mod_params::validate_particles)
   if (.not. cfg%resolved .and. .not. has_particles) then
-    if (len_trim(cfg%position_file) > 0) then
-      call input_error(cfg%deck_file, 'particles', 'position_file', '"'//trim(cfg%position_file)// &
+    if (len_trim(cfg%particles%position_file) > 0) then
+      call input_error(cfg%deck_file, 'particles', 'position_file', '"'//trim(cfg%particles%position_file)// &
            '" holds no particles: &fluid model = ''none'' (lubrication dynamics) has nothing to compute')
     else
       call input_error(cfg%deck_file, 'particles', 'solid_fraction', 'packs no particles in this box: '// &
@@ -112,13 +112,12 @@ program fdsusp
   end if
   ! sliding periodic boundaries in y (lubrication dynamics): the offset starts at 0, a restart
   ! reads it from the checkpoint
-  if (cfg%lees_edwards) le = le_create(cfg%box, cfg%shear_rate, 0.0_dp)
+  if (cfg%lees_edwards) le = le_create(cfg%domain%box, cfg%domain%shear_rate, 0.0_dp)
   ! contacts: the deck has &contact and the run has particles (doc/CONTACT.md)
   has_contacts = has_particles .and. cfg%contact_group
   if (has_contacts) then
-    call particle_contacts_create(pc, parts%n, parts%radius, cfg%roughness, cfg%friction, cfg%eps_bar, &
-         cfg%normal_stiffness, cfg%neighbour_skin, 1.0_dp, cfg%shear_rate, cfg%box, cfg%walls, cfg%dt, &
-         info, text, cfg%contact_implicit, le)
+    call particle_contacts_create(pc, parts%n, parts%radius, cfg%contact, cfg%domain%shear_rate, cfg%domain%box, &
+         cfg%walls, cfg%time%dt, info, text, le)
     if (info /= 0) call input_error(cfg%deck_file, 'contact', '', trim(text))
   end if
   ! lubrication: pairs or walls to lubricate (doc/LUBRICATION.md); the table is read and checked now
@@ -126,35 +125,35 @@ program fdsusp
   has_lubrication = lub%model /= LUB_NONE
   if (has_lubrication) then
     allocate(pl)
-    call particle_lubrication_create(pl, lub, parts%n, cfg%box, cfg%walls, cfg%shear_rate, cfg%lubrication_skin, info, text, le)
+    call particle_lubrication_create(pl, lub, parts%n, cfg%domain%box, cfg%walls, cfg%domain%shear_rate, cfg%lubrication%skin, info, text, le)
     if (info /= 0) call input_error(cfg%deck_file, 'lubrication', 'skin', trim(text))
   end if
   ! rough contacts: the limits of doc/CONTACT.md and doc/VALIDATION.md §6, before any work
   if (has_contacts .and. (has_lubrication .or. .not. cfg%resolved)) then
-    solid_fraction = parts%n * (4.0_dp / 3.0_dp) * pi * parts%radius**3 / product(cfg%box)
-    call report(contact_limits(pc%params, cfg%dt, pc%implicit, cfg%walls .or. cfg%lees_edwards, solid_fraction, &
-                               cfg%eps_bar, cfg%normal_stiffness > 0.0_dp))
+    solid_fraction = parts%n * (4.0_dp / 3.0_dp) * pi * parts%radius**3 / product(cfg%domain%box)
+    call report(contact_limits(pc%params, cfg%time%dt, pc%implicit, cfg%walls .or. cfg%lees_edwards, solid_fraction, &
+                               cfg%contact%eps_bar, cfg%contact%normal_stiffness > 0.0_dp))
   end if
   ! statistics of the core region (doc/RHEOLOGY.md)
   if (cfg%rheology_group) then
     allocate(rh)
-    call rheo_create(rh, parts%n, cfg%box, parts%radius, cfg%shear_rate, cfg%core, cfg%profile_bins, &
-         cfg%angle_bins, cfg%pair_shell, cfg%contact_shell, cfg%blocks, cfg%discard_step, cfg%block_steps, info, le)
+    call rheo_create(rh, parts%n, cfg%domain%box, parts%radius, cfg%domain%shear_rate, cfg%rheology, cfg%discard_step, &
+         cfg%block_steps, info, le)
     if (info /= 0) call input_error(cfg%deck_file, 'domain', 'box', &
          'with &rheology every periodic length must be >= 2 (pair_shell + 0.3) a')
-    write(text, '(a,i0,a,i0,a,i0,a,i0)') 'statistics: discard ', cfg%discard_step, ' steps, then ', cfg%blocks, &
-         ' blocks of ', cfg%block_steps, ' steps, ending at step ', cfg%discard_step + cfg%blocks * cfg%block_steps
+    write(text, '(a,i0,a,i0,a,i0,a,i0)') 'statistics: discard ', cfg%discard_step, ' steps, then ', cfg%rheology%blocks, &
+         ' blocks of ', cfg%block_steps, ' steps, ending at step ', cfg%discard_step + cfg%rheology%blocks * cfg%block_steps
     call log_line(text)
     ! spheres at the edge of the core must not outrun their Lambda (mod_fictitious_domain)
-    core_edge_speed = abs(cfg%shear_rate) * max(rh%core(2) - 0.5_dp * cfg%box(2), 0.5_dp * cfg%box(2) - rh%core(1))
-    if (cfg%resolved) call report(fictitious_domain_stresslet_lag_limit(core_edge_speed, cfg%dt, cfg%h))
-    if (cfg%steps < cfg%discard_step + cfg%blocks * cfg%block_steps) then
-      write(text, '(a,i0,a)') '&time steps = ', cfg%steps, ' ends before the averaging window: the summary '// &
+    core_edge_speed = abs(cfg%domain%shear_rate) * max(rh%core(2) - 0.5_dp * cfg%domain%box(2), 0.5_dp * cfg%domain%box(2) - rh%core(1))
+    if (cfg%resolved) call report(fictitious_domain_stresslet_lag_limit(core_edge_speed, cfg%time%dt, cfg%h))
+    if (cfg%time%steps < cfg%discard_step + cfg%rheology%blocks * cfg%block_steps) then
+      write(text, '(a,i0,a)') '&time steps = ', cfg%time%steps, ' ends before the averaging window: the summary '// &
            'will hold the blocks complete by then (restart with more steps to finish)'
       call warn_line(text)
     end if
   end if
-  checkpoint_path = trim(cfg%output_directory)//'/checkpoint.h5'
+  checkpoint_path = trim(cfg%output%directory)//'/checkpoint.h5'
   step = 0
   time = 0.0_dp
   if (restarting) then
@@ -170,12 +169,12 @@ program fdsusp
     PetscCallA(grid_create(cfg, grid, ierr))
     PetscCallA(fluid_create(cfg, grid, fl, ierr))
     if (has_particles) then
-      PetscCallA(fictitious_domain_create(grid, cfg%reynolds, cfg%dt, cfg%slip_kappa, cfg%radius_offset, fd, ierr))
+      PetscCallA(fictitious_domain_create(grid, cfg%fluid%reynolds, cfg%time%dt, cfg%particles%slip_kappa, cfg%particles%radius_offset, fd, ierr))
     end if
   else
     ! lubrication dynamics: no grid, no fluid; the imposed shear comes from the walls or the
     ! sliding boundaries (mod_lubrication_dynamics)
-    call lubrication_dynamics_create(ld, parts%radius, 1.0_dp, cfg%shear_rate, cfg%box, cfg%walls .or. cfg%lees_edwards)
+    call lubrication_dynamics_create(ld, parts%radius, 1.0_dp, cfg%domain%shear_rate, cfg%domain%box, cfg%walls .or. cfg%lees_edwards)
     PetscCallA(particle_solver_create(ld_solver, ierr))
   end if
   ! the state the checkpoints hold and a restart restores: the pieces this run has
@@ -196,24 +195,24 @@ program fdsusp
     ! what scripts/rheology.py needs to repeat the statistics from series.h5 alone
     call series_attributes(series, [character(len=32) :: 'box_x', 'box_y', 'box_z', 'radius', 'shear_rate', &
          'dt', 'core_lo', 'core_hi', 'pair_radius', 'contact_radius', 'blocks', 'discard_step', 'block_steps', &
-         'series_every', 'friction', 'roughness'], [cfg%box, parts%radius, cfg%shear_rate, cfg%dt, rh%core, &
-         rh%r_outer, rh%r_contact, real([cfg%blocks, cfg%discard_step, cfg%block_steps, cfg%series_every], dp), &
-         merge(cfg%friction, 0.0_dp, has_contacts), merge(cfg%roughness, 0.0_dp, has_contacts)])
+         'series_every', 'friction', 'roughness'], [cfg%domain%box, parts%radius, cfg%domain%shear_rate, cfg%time%dt, rh%core, &
+         rh%r_outer, rh%r_contact, real([cfg%rheology%blocks, cfg%discard_step, cfg%block_steps, cfg%output%series_every], dp), &
+         merge(cfg%contact%friction, 0.0_dp, has_contacts), merge(cfg%contact%roughness, 0.0_dp, has_contacts)])
   end if
   ! from the start: an empty series; from a checkpoint: its records up to the checkpoint's step
-  call series_open(series, cfg%output_directory, merge(step, -1, restarting), (cfg%steps - step) / cfg%series_every)
+  call series_open(series, cfg%output%directory, merge(step, -1, restarting), (cfg%time%steps - step) / cfg%output%series_every)
   PetscCallA(stage_pop(ierr))
   ! free lubricated pairs must not separate faster than their Lambda relaxes (mod_fictitious_domain)
   if (cfg%resolved .and. has_particles .and. has_lubrication .and. parts%motion == MOTION_FREE) &
-    call report(fictitious_domain_pair_lag_limit(cfg%dt, cfg%reynolds, cfg%h))
+    call report(fictitious_domain_pair_lag_limit(cfg%time%dt, cfg%fluid%reynolds, cfg%h))
   if (.not. cfg%resolved) then
     write(text, '(a,i0,a)') 'models: lubrication dynamics, no fluid (one-body Stokes drag in the imposed flow, '// &
          trim(merge('Lees-Edwards boundaries', 'walls in y             ', cfg%lees_edwards))//'); ', parts%n, &
-         ' rigid spheres (motion '''//trim(cfg%motion)//'''); '//trim(contact_models())//'; '//trim(lubrication_models())
+         ' rigid spheres (motion '''//trim(cfg%particles%motion)//'''); '//trim(contact_models())//'; '//trim(lubrication_models())
     call log_line(text)
   else if (has_particles) then
     write(text, '(a,i0,a)') 'models: fluid (unsteady Stokes, projection); ', parts%n, &
-         ' rigid spheres (fictitious domain, motion '''//trim(cfg%motion)//'''); '//trim(contact_models())// &
+         ' rigid spheres (fictitious domain, motion '''//trim(cfg%particles%motion)//'''); '//trim(contact_models())// &
          '; '//trim(lubrication_models())
     call log_line(text)
   else
@@ -239,7 +238,7 @@ program fdsusp
   ! a run from the start publishes its initial state as checkpoint.h5 before the first step, so the
   ! directory holds a whole checkpoint whatever kills the run later (a kill during a write leaves
   ! the previous one; doc/DESIGN.md "Files, restart and signals")
-  if (.not. restarting .and. step < cfg%steps) then
+  if (.not. restarting .and. step < cfg%time%steps) then
     PetscCallA(stage_push(STAGE_OUTPUT, ierr))
     call checkpoint()
     PetscCallA(stage_pop(ierr))
@@ -250,7 +249,7 @@ program fdsusp
   ! ---- time loop ----
   first_step = step
   stop_reason = RUNNING
-  if (step >= cfg%steps) stop_reason = DONE
+  if (step >= cfg%time%steps) stop_reason = DONE
   ! the step of this run, its variant chosen once (mod_time_step); -fd_carry_lambda 0 leaves Lambda
   ! on the faces of X^n (the scheme before 2026-11-23; for the comparison of doc/VALIDATION.md §5.3)
   carry_lambda = .true.
@@ -271,30 +270,30 @@ program fdsusp
     if (cfg%resolved) iterations_sum = iterations_sum + [fl%solver(1)%iterations, fl%solver(2)%iterations, &
                                                          fl%solver(3)%iterations, fl%solver(4)%iterations]
     step = step + 1
-    time = time + cfg%dt
+    time = time + cfg%time%dt
 
     PetscCallA(stage_push(STAGE_OUTPUT, ierr))
     wall_now = MPI_Wtime() - wall_start
-    if (mod(step, cfg%series_every) == 0) call record()
-    if (mod(step, cfg%progress_every) == 0) then
+    if (mod(step, cfg%output%series_every) == 0) call record()
+    if (mod(step, cfg%output%progress_every) == 0) then
       wall_per_step = wall_now / (step - first_step)
       if (cfg%resolved) then
-        call progress_line(step, cfg%steps, time, wall_now, wall_per_step, fl)
+        call progress_line(step, cfg%time%steps, time, wall_now, wall_per_step, fl)
       else
-        call progress_line(step, cfg%steps, time, wall_now, wall_per_step)
+        call progress_line(step, cfg%time%steps, time, wall_now, wall_per_step)
       end if
       call series_flush(series, progress=.true.)
     end if
-    if (cfg%fields_every > 0 .and. cfg%resolved) then
-      if (mod(step, cfg%fields_every) == 0) then
-        PetscCallA(write_fields(cfg%output_directory, grid, fl, step, time, ierr))
+    if (cfg%output%fields_every > 0 .and. cfg%resolved) then
+      if (mod(step, cfg%output%fields_every) == 0) then
+        PetscCallA(write_fields(cfg%output%directory, grid, fl, step, time, ierr))
       end if
     end if
-    if (cfg%particles_every > 0 .and. has_particles) then
-      if (mod(step, cfg%particles_every) == 0) call particles_snapshot(cfg%output_directory, parts, cfg%box, step, time)
+    if (cfg%output%particles_every > 0 .and. has_particles) then
+      if (mod(step, cfg%output%particles_every) == 0) call particles_snapshot(cfg%output%directory, parts, cfg%domain%box, step, time)
     end if
-    if (cfg%checkpoint_every > 0) then
-      if (mod(step, cfg%checkpoint_every) == 0) call checkpoint()
+    if (cfg%output%checkpoint_every > 0) then
+      if (mod(step, cfg%output%checkpoint_every) == 0) call checkpoint()
     end if
     PetscCallA(stage_pop(ierr))
 
@@ -339,13 +338,13 @@ program fdsusp
     end if
   end if
   PetscCallA(stage_push(STAGE_OUTPUT, ierr))
-  if (step > first_step .and. mod(step, cfg%series_every) /= 0) call record()
+  if (step > first_step .and. mod(step, cfg%output%series_every) /= 0) call record()
   call series_close(series)
   if (step > first_step) then
     if (cfg%resolved) then
-      PetscCallA(write_fields(cfg%output_directory, grid, fl, step, time, ierr))
+      PetscCallA(write_fields(cfg%output%directory, grid, fl, step, time, ierr))
     end if
-    if (has_particles) call particles_snapshot(cfg%output_directory, parts, cfg%box, step, time)
+    if (has_particles) call particles_snapshot(cfg%output%directory, parts, cfg%domain%box, step, time)
     call checkpoint()
   end if
   if (allocated(rh)) call summary()
@@ -363,8 +362,8 @@ program fdsusp
     write(text, '(a,i0)') 'finished at step ', step
   end select
   call log_line(text)
-  if (cfg%manufactured_solution .and. cfg%resolved) then
-    PetscCallA(fluid_errors_vs_manufactured(grid, fl, cfg%shear_rate, err_vel, err_p_max, err_p_rms, ierr))
+  if (cfg%verification%manufactured_solution .and. cfg%resolved) then
+    PetscCallA(fluid_errors_vs_manufactured(grid, fl, cfg%domain%shear_rate, err_vel, err_p_max, err_p_rms, ierr))
     write(text, '(a,3es14.6)') 'manufactured solution errors (velocity max, pressure max, pressure rms):', &
          err_vel, err_p_max, err_p_rms
     call log_line(text)
@@ -420,16 +419,16 @@ contains
     integer :: found
     found = 0
     if (is_root()) then
-      inquire(file=trim(cfg%output_directory)//'/checkpoint.h5', exist=restarting)
+      inquire(file=trim(cfg%output%directory)//'/checkpoint.h5', exist=restarting)
       found = merge(1, 0, restarting)
     end if
     call MPI_Bcast(found, 1, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
     restarting = found == 1
     if (restarting) then
-      restart = trim(cfg%output_directory)//'/checkpoint.h5'
+      restart = trim(cfg%output%directory)//'/checkpoint.h5'
       call log_line('-continue: continuing from '//trim(restart))
     else
-      call log_line('-continue: no checkpoint in '//trim(cfg%output_directory)//' yet: starting from the beginning')
+      call log_line('-continue: no checkpoint in '//trim(cfg%output%directory)//' yet: starting from the beginning')
     end if
   end subroutine continue_from_directory
 
@@ -444,7 +443,7 @@ contains
     character(len=16) :: code
     character(len=400) :: holder
     character(len=:), allocatable :: dir
-    dir = trim(cfg%output_directory)
+    dir = trim(cfg%output%directory)
     state = 0
     holder = ''
     if (is_root()) then
@@ -489,7 +488,7 @@ contains
     ! only the records on the series_every grid enter the statistics (a restart then adds
     ! exactly the records an uninterrupted run would)
     if (has_particles .and. allocated(rh)) then
-      if (mod(step, cfg%series_every) == 0) call rheo_accumulate(rh, step)
+      if (mod(step, cfg%output%series_every) == 0) call rheo_accumulate(rh, step)
     end if
   end subroutine record
 
@@ -504,8 +503,8 @@ contains
     ! the verification's
     if (cfg%resolved) call series_add(series, fluid_columns(fl))
     if (cfg%lees_edwards) call series_add(series, le_columns(le))
-    if (cfg%manufactured_solution) then
-      PetscCallA(fluid_errors_vs_manufactured(grid, fl, cfg%shear_rate, err_vel, err_p_max, err_p_rms, ierr))
+    if (cfg%verification%manufactured_solution) then
+      PetscCallA(fluid_errors_vs_manufactured(grid, fl, cfg%domain%shear_rate, err_vel, err_p_max, err_p_rms, ierr))
       call series_column(series, 'mms_error_velocity_max', err_vel)
       call series_column(series, 'mms_error_pressure_max', err_p_max)
       call series_column(series, 'mms_error_pressure_rms', err_p_rms)
@@ -535,12 +534,12 @@ contains
     if (allocated(rh)) rheology => rh
     ! (disassociated pointers are absent arguments)
     if (cfg%resolved .and. has_particles) then
-      call time_step_create(ts, cfg%dt, cfg%box, cfg%walls, le, carry_lambda, ierr, grid=grid, fluid=fl, fd=fd, &
+      call time_step_create(ts, cfg%time%dt, cfg%domain%box, cfg%walls, le, carry_lambda, ierr, grid=grid, fluid=fl, fd=fd, &
                             parts=parts, contacts=contacts, lubrication=lubrication, rheology=rheology)
     else if (cfg%resolved) then
-      call time_step_create(ts, cfg%dt, cfg%box, cfg%walls, le, carry_lambda, ierr, grid=grid, fluid=fl)
+      call time_step_create(ts, cfg%time%dt, cfg%domain%box, cfg%walls, le, carry_lambda, ierr, grid=grid, fluid=fl)
     else
-      call time_step_create(ts, cfg%dt, cfg%box, cfg%walls, le, carry_lambda, ierr, parts=parts, ld=ld, &
+      call time_step_create(ts, cfg%time%dt, cfg%domain%box, cfg%walls, le, carry_lambda, ierr, parts=parts, ld=ld, &
                             ld_solver=ld_solver, contacts=contacts, lubrication=lubrication, rheology=rheology)
     end if
     CHKERRQ(ierr)
@@ -560,11 +559,11 @@ contains
     character(len=20), parameter :: shown(14) = [character(len=20) :: 'eta_r', 'eta_h', 'eta_c', 'N1/tau', &
          'N2/tau', 'Pi/tau', 'lambda_2', 'lambda_3', 'eta_n', 'I_v', 'mu', 'phi_core', 'gamma_dot_core', 'tau']
     if (.not. is_root()) return
-    path = trim(cfg%output_directory)//'/summary.json'
+    path = trim(cfg%output%directory)//'/summary.json'
     call rheo_summarise(rh, step, complete, value, error, profile, angles)
     call summary_write(rh, path, step, complete, value, error, profile, angles, err)
-    if (err /= 0) call abort_run(trim(path)//' cannot be written: '//write_failure_cause(cfg%output_directory, 0.0_dp))
-    write(text, '(a,i0,a,i0,a)') 'rheology of the core region (', complete, ' of ', cfg%blocks, &
+    if (err /= 0) call abort_run(trim(path)//' cannot be written: '//write_failure_cause(cfg%output%directory, 0.0_dp))
+    write(text, '(a,i0,a,i0,a)') 'rheology of the core region (', complete, ' of ', cfg%rheology%blocks, &
          ' blocks complete; value +- standard error; doc/RHEOLOGY.md):'
     call log_line(text)
     do k = 1, size(shown)
@@ -695,9 +694,9 @@ contains
         ! a sphere half way through a wall: nothing physical holds it back any more (no wall
         ! contacts or lubrication, or a step far too large for them)
         if (cfg%walls .and. (parts%position(2, q) < 0.5_dp * parts%radius .or. &
-                             parts%position(2, q) > cfg%box(2) - 0.5_dp * parts%radius)) then
+                             parts%position(2, q) > cfg%domain%box(2) - 0.5_dp * parts%radius)) then
           write(what, '(a,i0,a,f10.5,a,f10.5,a)') 'particle ', q, ' is half way through a wall (centre y = ', &
-               parts%position(2, q), ', walls at 0 and ', cfg%box(2), &
+               parts%position(2, q), ', walls at 0 and ', cfg%domain%box(2), &
                '): add &contact, keep &lubrication on, or lower &time dt'
           exit
         end if
@@ -713,9 +712,9 @@ contains
     integer, intent(in) :: at_step
     character(len=*), intent(in) :: what
     call series_close(series)
-    PetscCallA(checkpoint_write(trim(cfg%output_directory)//'/failed_state.h5', cfg, state, step, time, ierr))
+    PetscCallA(checkpoint_write(trim(cfg%output%directory)//'/failed_state.h5', cfg, state, step, time, ierr))
     write(text, '(a,i0,a)') 'fdsusp: fatal: at step ', at_step, ': '//trim(what)// &
-         '; state written to '//trim(cfg%output_directory)//'/failed_state.h5, the last good checkpoint is kept'
+         '; state written to '//trim(cfg%output%directory)//'/failed_state.h5, the last good checkpoint is kept'
     call fatal_error(text, 5)
   end subroutine stop_with_state
 
@@ -725,18 +724,18 @@ contains
     real(dp) :: elapsed, per_step
     flags = 0
     if (stop_signal() /= 0) flags(1) = 1
-    if (cfg%max_wall_hours > 0.0_dp) then
+    if (cfg%run%max_wall_hours > 0.0_dp) then
       elapsed = MPI_Wtime() - wall_start
       per_step = elapsed / max(1, step - first_step)
       ! leave room for two more steps and the final output
-      if (elapsed + 3.0_dp * per_step > 3600.0_dp * cfg%max_wall_hours) flags(2) = 1
+      if (elapsed + 3.0_dp * per_step > 3600.0_dp * cfg%run%max_wall_hours) flags(2) = 1
     end if
-    if (cfg%resolved .and. cfg%steady_tolerance > 0.0_dp) then
-      if (fl%max_rate < cfg%steady_tolerance) flags(3) = 1
+    if (cfg%resolved .and. cfg%time%steady_tolerance > 0.0_dp) then
+      if (fl%max_rate < cfg%time%steady_tolerance) flags(3) = 1
     end if
     call MPI_Allreduce(flags, all_flags, 3, MPI_INTEGER, MPI_MAX, PETSC_COMM_WORLD, ierr)
     why_stop = RUNNING
-    if (step >= cfg%steps) why_stop = DONE
+    if (step >= cfg%time%steps) why_stop = DONE
     if (all_flags(3) == 1) why_stop = STEADY
     if (all_flags(2) == 1) why_stop = WALL_LIMIT
     if (all_flags(1) == 1) why_stop = SIGNALLED

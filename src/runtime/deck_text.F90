@@ -6,7 +6,8 @@ module mod_deck_text
   use mod_errors, only: input_error
   implicit none
   private
-  public :: deck_line_length, load_lines, group_on_line, to_lower, diagnose_group, group_reader
+  public :: deck_line_length, load_lines, group_on_line, to_lower, diagnose_group, group_reader, &
+            qualified_names, unqualified_names
 
   integer, parameter :: deck_line_length = 1024
   integer, parameter :: max_line = deck_line_length
@@ -175,5 +176,126 @@ contains
         text = 'unknown variable in this group (see doc/INPUT.md)'
     end if
   end function explain
+
+  ! The lines of a group with each variable name qualified by OBJECT ('dt = 1e-3' becomes
+  ! 'time_group%dt = 1e-3'): the reading of a namelist whose object is a derived type (mod_params)
+  ! wants the components so. A name is an identifier followed, after an optional subscript, by
+  ! '='; quoted strings, comments and the '&group' line itself are left as they are.
+  function qualified_names(lines, object) result(out)
+    character(len=*), intent(in) :: lines(:), object
+    character(len=max_line), allocatable :: out(:)
+    integer :: l
+    allocate(out(size(lines)))
+    do l = 1, size(lines)
+      out(l) = qualified_line(lines(l), object)
+    end do
+  end function qualified_names
+
+  function qualified_line(line, object) result(out)
+    character(len=*), intent(in) :: line, object
+    character(len=max_line) :: out
+    character(len=1) :: quote, c
+    integer :: i, j, n
+    out = ''
+    n = 0
+    quote = ' '
+    i = 1
+    do while (i <= len_trim(line))
+      c = line(i:i)
+      if (quote /= ' ') then
+        if (c == quote) quote = ' '
+      else if (c == '''' .or. c == '"') then
+        quote = c
+      else if (c == '!') then
+        out(n + 1:) = line(i:)
+        return
+      else if (starts_name(line, i)) then
+        j = i
+        do while (j < len_trim(line))
+          if (.not. is_name_char(line(j + 1:j + 1))) exit
+          j = j + 1
+        end do
+        if (assigned_to(line, j + 1)) then
+          out(n + 1:) = object//'%'
+          n = n + len(object) + 1
+        end if
+        out(n + 1:n + j - i + 1) = line(i:j)
+        n = n + j - i + 1
+        i = j + 1
+        cycle
+      end if
+      out(n + 1:n + 1) = c
+      n = n + 1
+      i = i + 1
+    end do
+  end function qualified_line
+
+  ! An identifier begins at position i: a letter not glued to a name or a number and not after a
+  ! '.' (logicals), a '%' or the '&' of the group line.
+  logical function starts_name(line, i)
+    character(len=*), intent(in) :: line
+    integer, intent(in) :: i
+    character(len=1) :: c
+    c = to_lower(line(i:i))
+    starts_name = c >= 'a' .and. c <= 'z'
+    if (.not. starts_name .or. i == 1) return
+    starts_name = .not. (is_name_char(line(i - 1:i - 1)) .or. scan(line(i - 1:i - 1), '.%&$') > 0)
+  end function starts_name
+
+  logical function is_name_char(c)
+    character(len=1), intent(in) :: c
+    is_name_char = scan(to_lower(c), 'abcdefghijklmnopqrstuvwxyz0123456789_') > 0
+  end function is_name_char
+
+  ! From position k on: spaces, an optional '(...)' subscript, spaces, then '='.
+  logical function assigned_to(line, k)
+    character(len=*), intent(in) :: line
+    integer, intent(in) :: k
+    integer :: i, depth
+    assigned_to = .false.
+    i = skip_spaces(line, k)
+    if (i > len_trim(line)) return
+    if (line(i:i) == '(') then
+      depth = 0
+      do while (i <= len_trim(line))
+        if (line(i:i) == '(') depth = depth + 1
+        if (line(i:i) == ')') depth = depth - 1
+        i = i + 1
+        if (depth == 0) exit
+      end do
+      i = skip_spaces(line, i)
+      if (i > len_trim(line)) return
+    end if
+    assigned_to = line(i:i) == '='
+  end function assigned_to
+
+  integer function skip_spaces(line, k) result(i)
+    character(len=*), intent(in) :: line
+    integer, intent(in) :: k
+    i = k
+    do while (i <= len_trim(line))
+      if (line(i:i) /= ' ') exit
+      i = i + 1
+    end do
+  end function skip_spaces
+
+  ! A compiler message about a qualified read with the qualifier removed: 'object%name' and
+  ! '%name' become 'name', as the deck has it.
+  function unqualified_names(msg, object) result(out)
+    character(len=*), intent(in) :: msg, object
+    character(len=len(msg)) :: out
+    integer :: p
+    out = msg
+    do
+      p = index(to_lower(out), to_lower(object)//'%')
+      if (p == 0) exit
+      out = out(1:p - 1)//out(p + len(object) + 1:)
+    end do
+    do
+      p = index(out, '%')
+      if (p == 0) exit
+      out = out(1:p - 1)//out(p + 1:)
+    end do
+  end function unqualified_names
 
 end module mod_deck_text

@@ -19,10 +19,14 @@
 program test_rheology
   use mod_kinds, only: dp, pi
   use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
-  use mod_rheology, only: rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, rheo_quantities, &
+  use mod_rheology, only: rheology_settings_t, rheology_t, rheo_create, rheo_sample, rheo_sample_flow, &
+                          rheo_accumulate, rheo_quantities, &
                           rheo_block_of, rheo_state, rheo_restore, slab_volume, NQ, NSUMMARY, summary_names
   use mod_unit_checks, only: check, finish
   implicit none
+  ! the statistics of a 48-bin, 8-angle, 3-block window (pair shell 2.1 a, contact shell 0.01 a)
+  type(rheology_settings_t), parameter :: settings = rheology_settings_t(blocks=3, profile_bins=48, angle_bins=8, &
+                                                                         contact_shell=0.01_dp)
   integer :: info, k, n
   type(rheology_t) :: r, r2
   real(dp) :: v, vp, box(3), m(NQ), q(NSUMMARY), gd, s_sum
@@ -54,7 +58,7 @@ program test_rheology
     sh(:, :, k) = reshape([1.0_dp, 2.0_dp, 0.0_dp, 2.0_dp, -3.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.5_dp], [3, 3])
     sc(:, :, k) = reshape([-1.0_dp, 0.5_dp, 0.0_dp, 0.5_dp, -2.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, -1.0_dp], [3, 3])
   end do
-  call rheo_create(r, n, box, 1.0_dp, 1.0_dp, [0.25_dp, 0.75_dp], 48, 8, 2.1_dp, 0.01_dp, 3, 10, 5, info)
+  call rheo_create(r, n, box, 1.0_dp, 1.0_dp, settings, 10, 5, info)
   call check(info == 0, 'set-up')
   call rheo_sample(r, x, u, sh, sc)
   s_sum = sum(r%profile(:, 1)) * (box(2) / 48) * box(1) * box(3)
@@ -137,7 +141,7 @@ program test_rheology
   end do
   call check(all(r%block_records == 5), 'five records per block')
   state = rheo_state(r)
-  call rheo_create(r2, n, box, 1.0_dp, 1.0_dp, [0.25_dp, 0.75_dp], 48, 8, 2.1_dp, 0.01_dp, 3, 10, 5, info)
+  call rheo_create(r2, n, box, 1.0_dp, 1.0_dp, settings, 10, 5, info)
   call rheo_restore(r2, state, info)
   call check(info == 0 .and. all(rheo_state(r2) == state), 'accumulators survive a checkpoint bit for bit')
   call rheo_restore(r2, state(2:), info)

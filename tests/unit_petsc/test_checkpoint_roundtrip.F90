@@ -78,16 +78,19 @@ program test_checkpoint_roundtrip
   ! the scene, as a deck would give it
   cfg%deck_file = 'test_checkpoint_roundtrip (no deck)'
   cfg%cells = [8, 6, 4]
-  cfg%cells_per_radius = 0.8_dp
+  cfg%domain%cells_per_radius = 0.8_dp
   cfg%h = 1.25_dp
-  cfg%box = cfg%cells * cfg%h
+  cfg%domain%box = cfg%cells * cfg%h
   cfg%walls = .true.
-  cfg%particle_number = n_particles
+  cfg%particles%number = n_particles
   cfg%contact_group = .true.
   cfg%rheology_group = .true.
   cfg%discard_step = 2
   cfg%block_steps = 10
-  cfg%blocks = 3
+  cfg%rheology%blocks = 3
+  cfg%rheology%profile_bins = 4
+  cfg%rheology%angle_bins = 8
+  cfg%rheology%contact_shell = 0.005_dp
   PetscCallA(grid_create(cfg, grid, ierr))
 
   ! the state written: random values everywhere (the same on every rank where it is not distributed)
@@ -109,7 +112,7 @@ program test_checkpoint_roundtrip
   call make_lambda(lambda, .true.)
   call particles_init(parts, n_particles, 1.0_dp, MOTION_FREE)
   call random_number(values)
-  parts%position = values(:, :, 1) * spread(cfg%box, 2, n_particles)
+  parts%position = values(:, :, 1) * spread(cfg%domain%box, 2, n_particles)
   parts%velocity = values(:, :, 2) - 0.5_dp
   parts%omega = values(:, :, 3) - 0.5_dp
   parts%velocity_prev = values(:, :, 4) - 0.5_dp
@@ -118,8 +121,8 @@ program test_checkpoint_roundtrip
   call random_number(ups)
   call history_unpack(history, n_particles, 4, ids, ups * 1.0e-3_dp, info)
   call check(info == 0, 'the contact history to write is built (history_unpack)')
-  call rheo_create(rh, n_particles, cfg%box, 1.0_dp, cfg%shear_rate, cfg%core, 4, 8, cfg%pair_shell, 0.005_dp, &
-                   cfg%blocks, cfg%discard_step, cfg%block_steps, info)
+  call rheo_create(rh, n_particles, cfg%domain%box, 1.0_dp, cfg%domain%shear_rate, cfg%rheology, cfg%discard_step, &
+                   cfg%block_steps, info)
   call check(info == 0, 'the &rheology statistics are set up (rheo_create)')
   allocate(noise(size(rheo_state(rh))))
   call random_number(noise)
@@ -137,8 +140,8 @@ program test_checkpoint_roundtrip
   PetscCallA(checkpoint_write(path, cfg, state, saved_step, saved_time, ierr))
 
   ! 1. the check a restart makes before any work
-  call rheo_create(rh2, n_particles, cfg%box, 1.0_dp, cfg%shear_rate, cfg%core, 4, 8, cfg%pair_shell, 0.005_dp, &
-                   cfg%blocks, cfg%discard_step, cfg%block_steps, info)
+  call rheo_create(rh2, n_particles, cfg%domain%box, 1.0_dp, cfg%domain%shear_rate, cfg%rheology, cfg%discard_step, &
+                   cfg%block_steps, info)
   step = -1
   time = -1.0_dp
   call checkpoint_check(path, cfg, n_particles, step, time, rh2)

@@ -68,14 +68,14 @@ program test_fluid_solvers
   do pass = 1, 2
     cfg%cells = cells
     cfg%h = h
-    cfg%box = cells * h
+    cfg%domain%box = cells * h
     cfg%walls = pass == 1
-    cfg%y_boundary = merge('walls   ', 'periodic', cfg%walls)
+    cfg%domain%y_boundary = merge('walls   ', 'periodic', cfg%walls)
     write(scene, '(i0,a,i0,a,i0,a,a,a,i0,a)') cells(1), ' x ', cells(2), ' x ', cells(3), ', ', &
-         trim(cfg%y_boundary), ', ', nranks, ' rank(s)'
+         trim(cfg%domain%y_boundary), ', ', nranks, ' rank(s)'
     if (rank == 0) print '(2a)', '# ', trim(scene)
     PetscCallA(grid_create(cfg, grid, ierr))
-    call solvers_configure(mass, diffusion, cfg%box, cfg%walls)
+    call solvers_configure(mass, diffusion, cfg%domain%box, cfg%walls)
     call test_scene(grid, trim(scene))
     PetscCallA(grid_destroy(grid, ierr))
   end do
