@@ -3,13 +3,20 @@
 ! dynamics; §7.2), chosen once by time_step_create from the pieces the run has. The step owns no
 ! physics object: it points at those main made and calls them in order, each phase in its
 ! PetscLogStage. Output, statistics' bookkeeping and the run's schedule stay with the caller.
-! A contact or lubrication failure ends the step early (time_step_t%contact_failure,
-! %lubrication_failure), the state as it was when the failure was found, for the caller to report
-! and write as failed_state.h5.
-#include <petsc/finclude/petscsys.h>
+! What can go wrong in a step is found here and described in time_step_t%failure, for the caller to
+! stop with (the state as it was, written as failed_state.h5): a contact overlap far beyond the
+! roughness or a lubrication block LAPACK cannot decompose end the step early (time_step_advance);
+! a non-finite velocity, pressure or particle quantity, or a sphere half way through a wall, is
+! found by the runtime guard after it (time_step_guard). The step also keeps the run's account of
+! itself: solver iterations, the largest contact overlap (warned past h_r/2), and time_step_report
+! logs it at the end.
+#include <petsc/finclude/petscvec.h>
 module mod_time_step
-  use petscsys
+  use petscvec
+  use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
   use mod_kinds, only: dp
+  use mod_errors, only: log_line, report_limits
+  use mod_contact, only: overlap_limit, wall_lower, wall_upper
   use mod_grid, only: grid_t
   use mod_fluid, only: fluid_t, fluid_step, fluid_mean_profile
   use mod_timers, only: stage_push, stage_pop, STAGE_FLUID, STAGE_PARTICLES, STAGE_CONTACTS, STAGE_LUBRICATION
@@ -26,7 +33,7 @@ module mod_time_step
   use mod_particle_solver, only: particle_solver_t
   implicit none
   private
-  public :: time_step_t, time_step_create, time_step_advance
+  public :: time_step_t, time_step_create, time_step_advance, time_step_guard, time_step_report
 
   ! the variants
   integer, parameter :: TIME_STEP_FLUID = 1       ! the fluid alone (no spheres)
@@ -41,10 +48,16 @@ module mod_time_step
     ! Lambda carried with the moving spheres (default); .false. recomputes the geometry at X^{n+1}
     ! and leaves Lambda on the faces of X^n (the scheme before 2026-11-23, -fd_carry_lambda 0)
     logical :: carry_lambda = .true.
-    ! why the last step ended early (0: it did not): particle_contacts_step's info, or the link
-    ! (particle, partner or 0 for a wall) whose lubrication block could not be decomposed
-    integer :: contact_failure = 0
-    integer :: lubrication_failure(2) = 0
+    ! what went wrong in the last step or the guard after it ('' when nothing did)
+    character(len=400) :: failure = ''
+    ! -fault_nan_step N: the guard poisons the state at step N (tests of the guard only; -1: never)
+    integer :: fault_nan_step = -1
+    ! the run's account: steps taken, the fluid solvers' iterations (u, v, w, p) summed over them,
+    ! the largest contact overlap |delta'| [a] and its step
+    integer :: steps_taken = 0
+    integer :: iterations_sum(4) = 0
+    real(dp) :: largest_overlap = 0.0_dp
+    integer :: largest_overlap_step = 0
     type(grid_t), pointer :: grid => null()
     type(fluid_t), pointer :: fluid => null()
     type(fictitious_domain_t), pointer :: fd => null()
@@ -64,12 +77,13 @@ contains
   ! The step of a run: fluid (grid, fluid), spheres (parts) with, when resolved, their fictitious
   ! domain fd, or, without a fluid, their lubrication dynamics (ld, ld_solver); contacts,
   ! lubrication and rheology where the run has them; le: the Lees-Edwards boundaries (offset 0
-  ! when inactive). walls: walls in y. Collective (resolved: the geometry of X^n is built here).
-  subroutine time_step_create(ts, dt, box, walls, le, carry_lambda, ierr, grid, fluid, fd, parts, ld, ld_solver, &
+  ! when inactive). walls: walls in y. Options: -fd_carry_lambda, -fault_nan_step. Collective
+  ! (resolved: the geometry of X^n is built here).
+  subroutine time_step_create(ts, dt, box, walls, le, ierr, grid, fluid, fd, parts, ld, ld_solver, &
                               contacts, lubrication, rheology)
     type(time_step_t), intent(out) :: ts
     real(dp), intent(in) :: dt, box(3)
-    logical, intent(in) :: walls, carry_lambda
+    logical, intent(in) :: walls
     type(lees_edwards_t), target, intent(in) :: le
     PetscErrorCode, intent(out) :: ierr
     type(grid_t), target, intent(in), optional :: grid
@@ -81,11 +95,16 @@ contains
     type(particle_contacts_t), target, intent(in), optional :: contacts
     type(particle_lubrication_t), target, intent(in), optional :: lubrication
     type(rheology_t), target, intent(in), optional :: rheology
+    PetscBool :: set
+    PetscInt :: fault_step
     ierr = 0
     ts%dt = dt
     ts%box = box
     ts%walls = walls
-    ts%carry_lambda = carry_lambda
+    PetscCall(PetscOptionsGetBool(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-fd_carry_lambda', ts%carry_lambda, set, ierr))
+    fault_step = -1
+    PetscCall(PetscOptionsGetInt(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-fault_nan_step', fault_step, set, ierr))
+    ts%fault_nan_step = fault_step
     ts%le => le
     if (present(grid)) ts%grid => grid
     if (present(fluid)) ts%fluid => fluid
@@ -112,19 +131,21 @@ contains
     end if
   end subroutine time_step_create
 
-  ! One step: X^n, u^n to X^{n+1}, u^{n+1} (doc/METHOD.md §7). The core statistics sample the
-  ! configuration X^n with its velocities before it moves on. Collective.
-  subroutine time_step_advance(ts, ierr)
+  ! One step: X^n, u^n to X^{n+1}, u^{n+1} (doc/METHOD.md §7), n = step. The core statistics
+  ! sample the configuration X^n with its velocities before it moves on. A failure ends it early,
+  ! described in ts%failure. Collective.
+  subroutine time_step_advance(ts, step, ierr)
     type(time_step_t), intent(inout) :: ts
+    integer, intent(in) :: step
     PetscErrorCode, intent(out) :: ierr
     integer :: info
     ierr = 0
-    ts%contact_failure = 0
-    ts%lubrication_failure = 0
+    ts%failure = ''
     if (ts%variant == TIME_STEP_FLUID) then
       PetscCall(stage_push(STAGE_FLUID, ierr))
       PetscCall(fluid_step(ts%grid, ts%fluid, ierr))
       PetscCall(stage_pop(ierr))
+      call count_step(ts, step)
       return
     end if
     associate(parts => ts%parts, le => ts%le)
@@ -134,7 +155,7 @@ contains
         call particle_contacts_step(ts%contacts, parts%position, parts%velocity, parts%omega, info, le%offset)
         PetscCall(stage_pop(ierr))
         if (info /= 0) then
-          ts%contact_failure = info
+          ts%failure = contact_failure(ts%contacts, info)
           return
         end if
       end if
@@ -144,7 +165,7 @@ contains
         PetscCall(lubrication_links_evaluate(ts%lubrication, parts%position, ierr, le%offset))
         PetscCall(stage_pop(ierr))
         if (ts%lubrication%failed_link(1) /= 0) then
-          ts%lubrication_failure = ts%lubrication%failed_link
+          ts%failure = lubrication_failure(ts%lubrication%failed_link)
           return
         end if
       end if
@@ -197,6 +218,159 @@ contains
       end if
       PetscCall(stage_pop(ierr))
     end associate
+    call count_step(ts, step)
   end subroutine time_step_advance
+
+  ! The account of a step taken: the fluid solvers' iterations, and a new largest contact overlap
+  ! of the run, warned once past h_r/2 (mod_contact::overlap_limit).
+  subroutine count_step(ts, step)
+    type(time_step_t), intent(inout) :: ts
+    integer, intent(in) :: step
+    integer :: c
+    ts%steps_taken = ts%steps_taken + 1
+    if (associated(ts%fluid)) then
+      do c = 1, 4
+        ts%iterations_sum(c) = ts%iterations_sum(c) + ts%fluid%solver(c)%iterations
+      end do
+    end if
+    if (associated(ts%contacts)) then
+      if (ts%contacts%max_overlap > ts%largest_overlap) then
+        call report_limits('', overlap_limit(ts%contacts%params, ts%largest_overlap, ts%contacts%max_overlap, step))
+        ts%largest_overlap = ts%contacts%max_overlap
+        ts%largest_overlap_step = step
+      end if
+    end if
+  end subroutine count_step
+
+  ! What a contact failure of particle_contacts_step (its info) means for the run.
+  function contact_failure(pc, info) result(what)
+    type(particle_contacts_t), intent(in) :: pc
+    integer, intent(in) :: info
+    character(len=400) :: what
+    character(len=40) :: partner
+    integer :: pair(2)
+    what = 'the contact history does not belong to this particle set'
+    if (info /= 2) return
+    pair = pc%stats%max_overlap_pair
+    select case (pair(2))
+    case (wall_lower)
+      partner = 'the lower wall'
+    case (wall_upper)
+      partner = 'the upper wall'
+    case default
+      write(partner, '(a,i0)') 'particle ', pair(2)
+    end select
+    write(what, '(a,es10.3,a,i0,a,a,es10.3,a)') 'a contact overlap |delta''| = ', pc%max_overlap, &
+         ' a between particle ', pair(1), ' and '//trim(partner), ' exceeds ', pc%overlap_limit, &
+         ' a (far beyond the roughness): lower &time dt or raise &contact normal_stiffness'
+  end function contact_failure
+
+  ! A lubrication block LAPACK could not decompose (link: the particle and its partner, 0 for a
+  ! wall): non-finite positions or resistance.
+  function lubrication_failure(link) result(what)
+    integer, intent(in) :: link(2)
+    character(len=400) :: what
+    if (link(2) == 0) then
+      write(what, '(a,i0,a)') 'the lubrication block of particle ', link(1), ' and a wall could not be '// &
+           'decomposed (LAPACK dsyev failed: non-finite position or resistance)'
+    else
+      write(what, '(a,i0,a,i0,a)') 'the lubrication block of particles ', link(1), ' and ', link(2), &
+           ' could not be decomposed (LAPACK dsyev failed: non-finite positions or resistance)'
+    end if
+  end function lubrication_failure
+
+  ! The runtime guard after step (doc/DESIGN.md "Files, restart and signals"): a non-finite
+  ! velocity, pressure or particle quantity, or a sphere half way through a wall, is described in
+  ! ts%failure. The norms are global reductions and particle data is replicated, so every rank
+  ! finds the same. At step -fault_nan_step the state is poisoned first (the guard's own test).
+  subroutine time_step_guard(ts, step, ierr)
+    type(time_step_t), intent(inout) :: ts
+    integer, intent(in) :: step
+    PetscErrorCode, intent(out) :: ierr
+    PetscReal :: norms(4)
+    integer :: c, q
+    ierr = 0
+    ts%failure = ''
+    if (step == ts%fault_nan_step) then
+      if (associated(ts%fluid)) then
+        PetscCall(VecScale(ts%fluid%vel(1), ieee_value(1.0_dp, ieee_quiet_nan), ierr))
+      else
+        ts%parts%velocity(1, 1) = ieee_value(1.0_dp, ieee_quiet_nan)
+      end if
+    end if
+    norms = 0.0_dp
+    if (associated(ts%fluid)) then
+      do c = 1, 3
+        PetscCall(VecNorm(ts%fluid%vel(c), NORM_INFINITY, norms(c), ierr))
+      end do
+      PetscCall(VecNorm(ts%fluid%pressure, NORM_INFINITY, norms(4), ierr))
+    end if
+    do c = 1, 4
+      if (.not. ieee_is_finite(norms(c))) then
+        write(ts%failure, '(a,a,a,es10.3)') 'the fluid ', trim(merge('velocity', 'pressure', c <= 3)), &
+             ' is not finite: max norm ', norms(c)
+        return
+      end if
+    end do
+    if (.not. associated(ts%parts)) return
+    associate(parts => ts%parts)
+      do q = 1, parts%n
+        if (.not. (all(ieee_is_finite(parts%velocity(:, q))) .and. all(ieee_is_finite(parts%omega(:, q))) &
+                   .and. all(ieee_is_finite(parts%position(:, q))))) then
+          write(ts%failure, '(a,i0,a,3es10.3,a,3es10.3)') 'particle ', q, ' is not finite: velocity ', &
+               parts%velocity(:, q), ' omega ', parts%omega(:, q)
+          return
+        end if
+        ! a sphere half way through a wall: nothing physical holds it back any more (no wall
+        ! contacts or lubrication, or a step far too large for them)
+        if (ts%walls .and. (parts%position(2, q) < 0.5_dp * parts%radius .or. &
+                            parts%position(2, q) > ts%box(2) - 0.5_dp * parts%radius)) then
+          write(ts%failure, '(a,i0,a,f10.5,a,f10.5,a)') 'particle ', q, ' is half way through a wall (centre y = ', &
+               parts%position(2, q), ', walls at 0 and ', ts%box(2), &
+               '): add &contact, keep &lubrication on, or lower &time dt'
+          return
+        end if
+      end do
+    end associate
+  end subroutine time_step_guard
+
+  ! The run's account of its steps, in the run log: wall time per step (seconds_per_step) and the
+  ! fluid solvers' mean iterations, the largest contact overlap, the particle solves.
+  subroutine time_step_report(ts, seconds_per_step)
+    type(time_step_t), intent(in) :: ts
+    real(dp), intent(in) :: seconds_per_step
+    character(len=200) :: text
+    integer :: solves
+    real(dp) :: seconds
+    if (ts%steps_taken == 0) return
+    if (associated(ts%fluid)) then
+      write(text, '(a,i0,a,f10.5,a,4(f6.1))') 'steps run: ', ts%steps_taken, '  wall time per step:', &
+           seconds_per_step, ' s  mean iterations u v w p:', real(ts%iterations_sum, dp) / ts%steps_taken
+    else
+      write(text, '(a,i0,a,f10.5,a)') 'steps run: ', ts%steps_taken, '  wall time per step:', seconds_per_step, ' s'
+    end if
+    call log_line(text)
+    if (.not. associated(ts%parts)) return
+    if (associated(ts%contacts)) then
+      if (ts%contacts%params%h_r > 0) then
+        ! the overlap bound of the extreme scenes (doc/VALIDATION.md §6): below h_r/2
+        write(text, '(a,f8.4,a,i0,a)') 'contacts: largest overlap |delta''| over this run ', &
+             ts%largest_overlap / ts%contacts%params%h_r, ' h_r (step ', ts%largest_overlap_step, ')'
+        call log_line(text)
+      end if
+    end if
+    if (ts%variant == TIME_STEP_RESOLVED) then
+      solves = ts%fd%solver%solves
+      seconds = ts%fd%solver%seconds
+    else
+      solves = ts%ld_solver%solves
+      seconds = ts%ld_solver%seconds
+    end if
+    if (solves > 0) then
+      write(text, '(a,i0,a,f10.3,a)') 'particle system with lubrication pairs: ', solves, &
+           ' sparse solves, mean ', 1.0e3_dp * seconds / solves, ' ms (assembly + solve)'
+      call log_line(text)
+    end if
+  end subroutine time_step_report
 
 end module mod_time_step

@@ -21,13 +21,17 @@ module mod_fluid
   use petscdmda
   use mod_kinds, only: dp
   use mod_params, only: config_t
-  use mod_grid, only: grid_t, grid_position, grid_fixed_row, field_names, FIELD_U, FIELD_V, FIELD_W, FIELD_P
-  use mod_solvers, only: solver_t, solvers_configure, solver_create, solver_solve, solver_destroy
+  use mod_grid, only: grid_t, grid_position, grid_fixed_row, field_names, FIELD_U, FIELD_V, FIELD_W, FIELD_P, &
+                      direct_solves_wanted
+  use mod_solvers, only: solver_t, solvers_configure, solver_create, solver_solve, solver_destroy, solver_cold_solve, &
+                         fft_planner_flags
+  use mod_errors, only: log_line
   use mod_manufactured, only: mms_forcing
   use mod_columns, only: column_t, column
   implicit none
   private
   public :: fluid_t, fluid_create, fluid_step, fluid_destroy, fluid_mean_profile, fluid_columns
+  public :: fluid_options_check, fluid_bench_cold_poisson
   integer, parameter :: STAR_HISTORY_FULL = 2   ! u*^n and u*^{n-1} known: extrapolate
 
   type :: fluid_t
@@ -444,5 +448,37 @@ contains
     c(7) = column('iterations_w', fl%solver(3)%iterations)
     c(8) = column('iterations_p', fl%solver(4)%iterations)
   end function fluid_columns
+
+  ! The fluid solvers' command-line options, checked before any work (each wrong one stops with
+  ! one message): -fluid_solver, and with the transforms -fft_planner.
+  subroutine fluid_options_check()
+    integer :: plan
+    if (direct_solves_wanted()) plan = fft_planner_flags()
+  end subroutine fluid_options_check
+
+  ! -bench_cold_poisson: time one pressure solve from a zero guess to 1e-8 (doc/BENCHMARKS.md),
+  ! logged. The yardstick is the multigrid solve whatever solves the steps (-fluid_solver fft
+  ! needs no KSP: one is made for it).
+  subroutine fluid_bench_cold_poisson(grid, fl, ierr)
+    type(grid_t), intent(in) :: grid
+    type(fluid_t), intent(inout) :: fl
+    PetscErrorCode, intent(out) :: ierr
+    type(solver_t) :: yardstick
+    PetscBool :: wanted
+    real(dp) :: seconds
+    integer :: iterations
+    character(len=120) :: text
+    PetscCall(PetscOptionsHasName(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-bench_cold_poisson', wanted, ierr))
+    if (.not. wanted) return
+    if (fl%solver(FIELD_P)%direct) then
+      PetscCall(solver_create(grid, FIELD_P, 1.0e-8_dp, 0.0_dp, yardstick, ierr, krylov=.true.))
+      PetscCall(solver_cold_solve(yardstick, 1.0e-8_dp, seconds, iterations, ierr))
+      PetscCall(solver_destroy(yardstick, ierr))
+    else
+      PetscCall(solver_cold_solve(fl%solver(FIELD_P), 1.0e-8_dp, seconds, iterations, ierr))
+    end if
+    write(text, '(a,f10.5,a,i0,a)') 'bench: cold Poisson solve to 1e-8:', seconds, ' s, ', iterations, ' iterations'
+    call log_line(text)
+  end subroutine fluid_bench_cold_poisson
 
 end module mod_fluid

@@ -42,7 +42,7 @@ module mod_lubrication
        pair_stresslets, wall_resistance_block
   implicit none
   private
-  public :: lubrication_t, lub_setup, lub_wall_floor, lub_pair_scalars, lub_wall_scalars, lub_pair_link, lub_wall_link, &
+  public :: lubrication_t, lub_description, lub_setup, lub_wall_floor, lub_pair_scalars, lub_wall_scalars, lub_pair_link, lub_wall_link, &
             lub_pair_stresslets, lub_wall_stresslet, clip_to_psd, lub_taper, model_code, grains3d_cutoff
   integer, parameter, public :: LUB_NONE = 0, LUB_SIMPLE = 1, LUB_FULL = 2, LUB_EXACT = 3
   ! outer cut-off of the exact model when the deck gives none [a]
@@ -71,6 +71,27 @@ module mod_lubrication
   integer, parameter :: one_body_scalars(7) = [i_xa11, i_ya11, i_xc11, i_yc11, i_xm11, i_ym11, i_zm11]
 
 contains
+
+  ! The lubrication part of the run log's 'models:' line; resolved: the fluid is resolved (else
+  ! the model is lubrication dynamics' pair hydrodynamics).
+  function lub_description(lub, resolved) result(line)
+    type(lubrication_t), intent(in) :: lub
+    logical, intent(in) :: resolved
+    character(len=200) :: line
+    select case (lub%model)
+    case (LUB_NONE)
+      line = 'no lubrication correction'
+      if (.not. resolved) line = 'no pair hydrodynamics (one-body drag only)'
+    case (LUB_EXACT)
+      write(line, '(a,f7.3,a)') 'exact two-body pair and wall resistance minus one-body (outer cut-off ', &
+           lub%outer_cutoff, ' a)'
+    case (LUB_SIMPLE)
+      write(line, '(a,f6.3,a)') 'lubrication simple (singular terms, outer cut-off ', lub%outer_cutoff, ' a)'
+    case default
+      write(line, '(a,f6.3,a,i0,a)') 'lubrication full (calibrated, outer cut-off ', lub%outer_cutoff, &
+           ' a, ', size(lub%pair_gap), ' tabulated gaps)'
+    end select
+  end function lub_description
 
   integer function model_code(name)
     character(len=*), intent(in) :: name

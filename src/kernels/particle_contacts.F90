@@ -27,7 +27,8 @@ module mod_particle_contacts
   use mod_columns, only: column_t, column
   implicit none
   private
-  public :: contact_settings_t, particle_contacts_t, particle_contacts_create, particle_contacts_step
+  public :: contact_settings_t, particle_contacts_t, particle_contacts_create, particle_contacts_step, &
+            particle_contacts_description
   public :: particle_contacts_add_stiffness, particle_contacts_implicit_update, particle_contacts_columns
 
   ! The deck's &contact (doc/INPUT.md): its variables, named as in the deck, with their defaults.
@@ -65,6 +66,19 @@ module mod_particle_contacts
   end type particle_contacts_t
 
 contains
+
+  ! The contact part of the run log's 'models:' line (pc absent: a run without contacts).
+  function particle_contacts_description(pc) result(line)
+    type(particle_contacts_t), intent(in), optional :: pc
+    character(len=200) :: line
+    character(len=32) :: friction
+    line = 'no contacts'
+    if (.not. present(pc)) return
+    friction = 'friction off'
+    if (pc%params%mu_d > 0) write(friction, '(a,f5.3,a)') 'friction on (mu_d = ', pc%params%mu_d, ')'
+    write(line, '(a,es10.3,a,es10.3,a)') 'contacts on (Hertz, h_r = ', pc%params%h_r, ' a, k_n = ', &
+         pc%params%k_n, '), '//trim(friction)
+  end function particle_contacts_description
 
   !> Set up for np spheres of radius a with the deck's &contact settings; shear_rate: imposed
   !> shear rate (walls at -+ shear_rate Ly/2 when walls); box, walls: the domain; dt: time step.

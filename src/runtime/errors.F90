@@ -6,10 +6,11 @@
 module mod_errors
   use petscsys
   use mod_os_services, only: release_directory
+  use mod_limits, only: limit_finding_t, LIMIT_REFUSE
   implicit none
   private
   public :: input_error, file_error, file_error_from_root, fatal_error, abort_run, abort_if_any, is_root, log_line, &
-            warn_line
+            warn_line, report_limits
 
 contains
 
@@ -46,6 +47,21 @@ contains
     if (len_trim(variable) > 0) where = where//', variable '//trim(variable)
     call fatal_error(where//': '//trim(message), 2)
   end subroutine input_error
+
+  ! The findings of a limit check (mod_limits) on the deck FILE, in their order: warnings, and the
+  ! refusal of the deck item named, which stops the run. Collective: every rank finds the same.
+  subroutine report_limits(file, findings)
+    character(len=*), intent(in) :: file
+    type(limit_finding_t), intent(in) :: findings(:)
+    integer :: k
+    do k = 1, size(findings)
+      if (findings(k)%level == LIMIT_REFUSE) then
+        call input_error(file, trim(findings(k)%group), trim(findings(k)%key), trim(findings(k)%text))
+      else
+        call warn_line(findings(k)%text)
+      end if
+    end do
+  end subroutine report_limits
 
   ! A file the run reads (checkpoint, particle file, table) is unusable. Collective.
   subroutine file_error(file, item, message)
