@@ -20,9 +20,8 @@ import sys
 import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, '..'))
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(HERE)), 'scripts'))
 import fdsusp_testlib as T
-from resistance_exact import pair_scalars, NAMES
+from fdsusp.resistance import pair_scalars, NAMES
 
 F = 60 * math.pi
 GAP0 = 0.02
