@@ -152,17 +152,20 @@ def check_trunk(trunk, box):
 
 
 def branch(trunk, d, case):
-    """Start case d from the trunk's output: its checkpoint and its series, without the contact
-    columns when the case has no contacts (its restart extends only the columns it writes)."""
+    """Start case d from the trunk's output: its checkpoint and its series up to the checkpoint's
+    step, without the contact columns when the case has no contacts (its restart extends only the
+    columns it writes, and sets aside a series.h5 that lacks one). The series is read as fdsusp
+    leaves it, series.h5 and series.parts/ (a trunk stopped by --hours or a kill has records in
+    parts), and written whole by fdsusp.series.consolidate, so the copy holds no parts whose
+    columns or steps disagree with its series.h5 (doc/DESIGN.md "series.h5: immutable parts,
+    atomic consolidation")."""
     import h5py
-    shutil.copytree(os.path.join(trunk, 'out'), os.path.join(d, 'out'))
-    if CASES[case][1] == 0:
-        with h5py.File(os.path.join(d, 'out', 'series.h5'), 'a') as f:
-            names = []
-            f.visit(lambda name: names.append(name) if 'contact' in name and isinstance(f[name], h5py.Dataset)
-                    else None)
-            for name in names:
-                del f[name]
+    out = os.path.join(d, 'out')
+    shutil.copytree(os.path.join(trunk, 'out'), out)
+    with h5py.File(os.path.join(out, 'checkpoint.h5'), 'r') as f:
+        step = int(np.ravel(f.attrs['step'])[0])
+    drop = [n for n in series.names(out) if 'contact' in n] if CASES[case][1] == 0 else []
+    series.consolidate(out, drop=drop, last_step=step)
 
 
 def load_dns(d, box):
