@@ -12,7 +12,8 @@
                         their measurement by fdsusp in resistance mode (scripts/calibrate.py, ...)
     fdsusp.pair         the paper's pair test in the DNS against pairtraj (scripts/pair_dns.py)
 
-The command-line entry points are scripts/*.py (each has --help). From a checkout without
-installing: `import sys; sys.path.insert(0, '<checkout>/python')`; or `pip install -e .` in the
-checkout; `make install` puts the package in PREFIX/share/fdsusp/python.
+The command-line entry points are scripts/*.py (each has --help; they find this package through
+scripts/_fdsusp_path.py). Elsewhere, from a checkout without installing: PYTHONPATH=<checkout>/python
+(as tests/run_tests.sh sets it); or `pip install -e .` in the checkout; `make install` puts the
+package in PREFIX/share/fdsusp/python.
 """

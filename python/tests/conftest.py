@@ -1,7 +1,8 @@
 """The pytest suite of the package fdsusp (python/fdsusp), on small synthetic files: run by
-`make check` (tests/regression/test_python_package.sh) or `python3 -m pytest python/tests`."""
+`make check` (tests/regression/test_python_package.sh) or `python3 -m pytest python/tests`. The
+package imported is this checkout's, also when another copy is installed: pyproject.toml's
+[tool.pytest.ini_options] pythonpath puts python/ first."""
 import os
-import sys
 
 import h5py
 import numpy as np
@@ -9,8 +10,6 @@ import pytest
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
-# the package of this checkout, also when another copy is installed
-sys.path.insert(0, os.path.join(ROOT, 'python'))
 
 
 def write_series(path, columns, attributes=None):

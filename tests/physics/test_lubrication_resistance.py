@@ -38,8 +38,6 @@ import math
 import os
 import sys
 import numpy as np
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, '..'))
 import fdsusp_testlib as T
 from fdsusp import resistance as R
 from fdsusp.resistance import pair_scalars, wall_scalars, wall_excess, NAMES

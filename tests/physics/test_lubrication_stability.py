@@ -16,10 +16,7 @@ within a few steps at a speed ~ F / (6 pi R~) with R~ the saturated resolved res
 a gap h a step must then be below h / V, i.e. ~5e-5 for h = 1e-4."""
 import math
 import os
-import sys
 import numpy as np
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, '..'))
 import fdsusp_testlib as T
 from fdsusp.resistance import pair_scalars, NAMES
 

@@ -30,11 +30,9 @@ Tolerances, from the differences between the two models rather than from measure
     the same force: gap = h_r - |delta'|).
 """
 import os
-import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T  # noqa: E402
 
 from fdsusp import pair as P  # noqa: E402
