@@ -8,6 +8,7 @@ import h5py
 import numpy as np
 import pytest
 
+from conftest import write_series
 from fdsusp import deck, pair, run, series
 
 CONTACT = ('particles/force_contact', 'particles/stresslet_contact')
@@ -22,23 +23,13 @@ def columns(steps):
             'particles/stresslet_contact': np.ones((n, 2, 3, 3))}
 
 
-def write_like_fdsusp(path, cols, attributes=None):
-    """A series file in fdsusp's layout (src/io/series.F90 create_column): records extendable."""
-    os.makedirs(os.path.dirname(path), exist_ok=True)
-    with h5py.File(path, 'w') as f:
-        for k, v in (attributes or {}).items():
-            f.attrs[k] = v
-        for n, v in cols.items():
-            f.create_dataset(n, data=v, maxshape=(None,) + v.shape[1:], chunks=True)
-
-
 def trunk_with_parts(root):
     """A trunk killed after its checkpoint at step 80: series.h5 to step 50, a stale part (its
     records already in series.h5: a kill between publishing and removing), parts to step 90."""
     out = os.path.join(root, 'trunk', 'out')
-    write_like_fdsusp(os.path.join(out, 'series.h5'), columns([10, 20, 30, 40, 50]), {'dt': 1e-3, 'shear_rate': 1.0})
+    write_series(os.path.join(out, 'series.h5'), columns([10, 20, 30, 40, 50]), {'dt': 1e-3, 'shear_rate': 1.0})
     for first, steps in ((40, [40, 50]), (60, [60, 70]), (80, [80, 90])):
-        write_like_fdsusp(os.path.join(out, 'series.parts', '%010d.h5' % first), columns(steps))
+        write_series(os.path.join(out, 'series.parts', '%010d.h5' % first), columns(steps))
     with h5py.File(os.path.join(out, 'checkpoint.h5'), 'w') as f:
         f.attrs['step'] = np.array([80], dtype=np.int32)
     return os.path.dirname(out)
@@ -72,24 +63,19 @@ def test_branch_folds_the_parts(tmp_path, case):
 def test_consolidate_without_series_h5(tmp_path):
     """Parts alone (a run killed before its first consolidation) make a series.h5."""
     out = str(tmp_path)
-    write_like_fdsusp(os.path.join(out, 'series.parts', '%010d.h5' % 1), columns([1, 2]))
-    write_like_fdsusp(os.path.join(out, 'series.parts', '%010d.h5' % 3), columns([3]))
+    write_series(os.path.join(out, 'series.parts', '%010d.h5' % 1), columns([1, 2]))
+    write_series(os.path.join(out, 'series.parts', '%010d.h5' % 3), columns([3]))
     assert series.consolidate(out) == 3
     assert series.files(out) == [os.path.join(out, 'series.h5')]
     assert list(series.read(out, ['step'])[0]['step']) == [1, 2, 3]
 
 
-def test_fdsusp_continues_a_branch_with_parts(tmp_path):
+def test_fdsusp_continues_a_branch_with_parts(tmp_path, fdsusp_binary):
     """The trunk run by fdsusp (its series split into series.h5 and parts as a kill leaves it),
     branched and continued by fdsusp from the checkpoint: the continuation keeps every record,
     warns of nothing and sets nothing aside. The branch is the trunk's own case: the program
     refuses a restart whose &contact differs from the checkpoint's (src/io/restart_deck.F90)."""
-    try:
-        binary = run.program('fdsusp')
-    except FileNotFoundError:
-        binary = None
-    if binary is None or not os.access(binary, os.X_OK):
-        pytest.skip('bin/fdsusp is not built')
+    binary = fdsusp_binary
     dt, steps = 2.5e-3, 24         # a record every 4 steps (pair.record_every), a checkpoint every 2
 
     def write(d, case, n, contact):
@@ -110,7 +96,7 @@ def test_fdsusp_continues_a_branch_with_parts(tmp_path):
     series.consolidate(out, last_step=12)
     for first in (16, 24):
         sel = later & (whole['step'] >= first) & (whole['step'] < first + 8)
-        write_like_fdsusp(os.path.join(out, 'series.parts', '%010d.h5' % first), {n: v[sel] for n, v in whole.items()})
+        write_series(os.path.join(out, 'series.parts', '%010d.h5' % first), {n: v[sel] for n, v in whole.items()})
     assert series.pending_parts(out) == 2
 
     d = str(tmp_path / pair.TRUNK_CASE)
