@@ -6,7 +6,7 @@ the lubrication table input/lubrication/resolved_a<N>.h5 (doc/METHOD.md §5.4; d
 
 Every measurement is a run of bin/fdsusp in resistance mode (velocities imposed, configuration
 held, no lubrication correction): the steady resolved force, torque and stresslet of each sphere
-are read from series.h5 and extrapolated to pseudo-time infinity (Aitken, below). For each gap
+are read from series.h5 and extrapolated to pseudo-time infinity (Aitken; fdsusp.resistance). For each gap
 and each of S samples (a random sub-cell offset of the pair centre and a random direction d of
 the line of centres):
   mode A (periodic 8a cube): the spheres translate at +-d (squeeze), sphere 1 spins about d
@@ -15,7 +15,7 @@ the line of centres):
          spins about e1 -> YA11 - YA12, YB11 - YB12 (torque; the forces from the spin check
          reciprocity), YG11 - YG12, YC11, YC12, YH11, YH12
   mode C (Couette cell, shear rate 1): both spheres move with the undisturbed flow, along a line
-         of centres where the strain fit is well conditioned (STRAIN_CONDITION below)
+         of centres where the strain fit is well conditioned (STRAIN_CONDITION, fdsusp.resistance)
          -> the sums XM11+XM12, YM11+YM12, ZM11+ZM12 (least squares over the stresslet)
 and, per sample, the same three modes for one sphere alone (the one-body part, subtracted from
 the rotation and strain functions so that only the pair interaction is corrected).
@@ -39,117 +39,22 @@ Modes are separable because the cross terms land on other components (doc/METHOD
 forms): translation along d gives no torque, rotation about d no force; translation along e1
 torques about e2 = d x e1 and rotation about e1 forces along e2.
 """
-import argparse, math, os, shutil, subprocess, sys, time
+import argparse, math, os
 import numpy as np
 import h5py
 import _fdsusp_path  # noqa: F401,E402  (this checkout's python/ on sys.path)
-from fdsusp import deck as fdeck, series  # noqa: E402
-from fdsusp.run import program  # noqa: E402
+from fdsusp.resistance import (NAMES, WALL_NAMES, SHEAR_E, STRAIN_CONDITION, Runner, m_fit,  # noqa: E402
+                               pair_scalars, steady, strain_conditioning, wall_excess, with_flow)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 GAPS = [0.001, 0.01, 0.05, 0.1, 0.2, 0.35, 0.6, 1.0]
 WALL_GAPS = [0.001, 0.01, 0.05, 0.1, 0.2, 0.35, 0.6, 1.0]
-NAMES = ["XA11", "YA11", "YB11", "XC11", "YC11", "XG11", "YG11", "YH11", "XM11", "YM11", "ZM11",
-         "XA12", "YA12", "YB12", "XC12", "YC12", "XG12", "YG12", "YH12", "XM12", "YM12", "ZM12"]
 IDX = {n: i for i, n in enumerate(NAMES)}
-WALL_NAMES = ["lambda_perp", "f_tt", "f_tr", "f_rr", "x_w"]
 # samples per gap of the shipped tables: a/Delta = 5 takes 4 because its first two samples both sat
 # at the top of the +-3 % direction spread of the resolved XG11 - XG12, which a free pair's radial
 # mobility amplifies (doc/VALIDATION.md §4.1, §4.4); the others keep 2
 SAMPLES = {5: 4}
-REYNOLDS = 0.01
-BETA = 30.0          # rho/dt: the steady state does not depend on it (doc/METHOD.md §3.3); 30 converges fastest
-STEPS = 100
-EVERY = 20
 PI = math.pi
-ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT='1', OMPI_ALLOW_RUN_AS_ROOT_CONFIRM='1')
-# The Couette cell at shear rate 1 (u_x = y - Ly/2 about its mid-plane): strain rate and rotation
-SHEAR_E = np.array([[0.0, 0.5, 0.0], [0.5, 0.0, 0.0], [0.0, 0.0, 0.0]])
-SHEAR_OMEGA = np.array([0.0, 0.0, -0.5])
-
-
-def with_flow(x, height):
-    """A sphere at x moving and spinning with the undisturbed flow of a Couette cell this high."""
-    return (x, np.array([x[1] - height / 2, 0.0, 0.0]), SHEAR_OMEGA)
-
-
-def deck(path, out, box, walls, shear, spheres, h, model='none', vtol=1e-6, ptol=1e-8, motion='resistance'):
-    """spheres: list of (position, velocity, omega); motion: 'resistance' (the velocities imposed)
-    or 'frozen' (the velocities force-free, scripts/frozen_pair.py); model: the lubrication model (calibration
-    measures the resolved part alone, so 'none'); vtol, ptol: the solver tolerances. Written by
-    fdsusp.deck (floats exactly)."""
-    particles = {'number': len(spheres), 'motion': motion}
-    for i, (x, u, w) in enumerate(spheres, 1):
-        particles.update({'position(:,%d)' % i: [float(c) for c in x], 'velocity(:,%d)' % i: [float(c) for c in u],
-                          'omega(:,%d)' % i: [float(c) for c in w]})
-    fdeck.write(path, fdeck.text([
-        ('domain', {'box': list(box), 'cells_per_radius': round(1 / h),
-                    'y_boundary': 'walls' if walls else 'periodic', 'shear_rate': shear}),
-        ('fluid', {'reynolds': REYNOLDS, 'viscous_theta': 1.0, 'initial_flow': 'shear',
-                   'velocity_tolerance': vtol, 'pressure_tolerance': ptol}),
-        ('time', {'dt': REYNOLDS / BETA, 'steps': STEPS}),
-        ('output', {'directory': out, 'progress_every': STEPS, 'series_every': EVERY}),
-        ('lubrication', {'model': model}),
-        ('particles', particles)]))
-
-
-def aitken(x):
-    """Steady value of a geometrically converging sequence from its last three samples."""
-    a, b, c = x[-3], x[-2], x[-1]
-    d1, d2 = b - a, c - b
-    den = d2 - d1
-    with np.errstate(divide='ignore', invalid='ignore'):
-        ratio = np.where(d1 != 0, d2 / d1, 0.0)
-        est = np.where((np.abs(den) > 1e-14 * (np.abs(c) + 1)) & (ratio > 0) & (ratio < 0.95),
-                       c - d2 * d2 / den, c)
-    return est
-
-
-def steady(out):
-    """Force, torque and deviatoric stresslet of each sphere at pseudo-time infinity (aitken) from
-    the run's series (fdsusp.series)."""
-    cols = series.read(out, ['particles/force_hydro', 'particles/torque_hydro', 'particles/stresslet_hydro'])[0]
-    F = aitken(cols['particles/force_hydro'])
-    T = aitken(cols['particles/torque_hydro'])
-    S = aitken(cols['particles/stresslet_hydro'])
-    S = np.asarray(S)
-    tr = np.trace(S, axis1=-2, axis2=-1)
-    Sdev = S - tr[..., None, None] * np.eye(3) / 3.0
-    return np.asarray(F), np.asarray(T), Sdev
-
-
-def strain_basis(d, E):
-    ed = E @ d
-    ded = d @ ed
-    I = np.eye(3)
-    dd = np.outer(d, d)
-    d0 = 1.5 * (dd - I / 3) * ded
-    d1 = np.outer(d, ed) + np.outer(ed, d) - 2 * dd * ded
-    d2 = E + 0.5 * (I + dd) * ded - np.outer(d, ed) - np.outer(ed, d)
-    return d0, d1, d2
-
-
-def m_fit(S, d, E):
-    """(XM, YM, ZM) such that S = (20/3) pi sum_k M_k D_k(d, E), least squares."""
-    if strain_conditioning(d, E) < STRAIN_CONDITION:
-        sys.exit('calibrate: the strain fit along d = %s is ill-conditioned' % d)
-    basis = np.array([b.ravel() for b in strain_basis(d, E)]).T * (20.0 / 3.0 * PI)
-    coef, *_ = np.linalg.lstsq(basis, S.ravel(), rcond=None)
-    return coef
-
-
-# Smallest singular value of the strain basis (9 x 3) below which the fit of (XM, YM, ZM) is refused:
-# it is 0.41 at best (d along (1, 1, 1)), ~0 when d.E.d or E.d - (d.E.d) d vanishes (d in the
-# x-z or y-z plane, or along an eigenvector of E), where the fit divides noise by ~0. The a/Delta = 4
-# table of 2026-11-23 drew d = (0.002, -0.339, 0.941) (0.001) and its XM11 came out 0.50 at gap
-# 0.35 between 1.46 (0.2) and 0.67 (0.6), scatter 0.47. 0.25 keeps ~35 % of random directions and
-# amplifies the stresslet noise at most 1.6 times more than the best direction.
-STRAIN_CONDITION = 0.25
-
-
-def strain_conditioning(d, E):
-    basis = np.array([b.ravel() for b in strain_basis(d, E)]).T
-    return np.linalg.svd(basis, compute_uv=False).min()
 
 
 def strain_direction(d, E, seed):
@@ -169,52 +74,6 @@ def frame(rng):
     e1 = np.cross(d, rng.normal(size=3))
     e1 /= np.linalg.norm(e1)
     return d, e1, np.cross(d, e1)
-
-
-class Runner:
-    def __init__(self, work, jobs):
-        self.work, self.jobs, self.queue, self.count = work, jobs, [], 0
-        # one binary for the whole set of runs, even if bin/ is rebuilt meanwhile
-        self.binary = os.path.join(work, 'fdsusp')
-        if os.path.exists(self.binary):
-            os.remove(self.binary)
-        shutil.copy2(program('fdsusp'), self.binary)
-
-    def add(self, name, **kw):
-        out = os.path.join(self.work, name)
-        path = out + '.nml'
-        deck(path, out, **kw)
-        self.queue.append((name, path, out))
-        return out
-
-    def run(self):
-        pending = list(self.queue)
-        running = []
-        t0 = time.time()
-        done = 0
-        while pending or running:
-            while pending and len(running) < self.jobs:
-                name, path, out = pending.pop(0)
-                if os.path.exists(os.path.join(out, 'done')):
-                    done += 1
-                    continue
-                log = open(out + '.log', 'w')
-                p = subprocess.Popen(['mpiexec', '--oversubscribe', '-n', '1', self.binary, path],
-                                     stdout=log, stderr=subprocess.STDOUT, env=ENV)
-                running.append((p, out, log))
-            time.sleep(0.2)
-            for item in list(running):
-                p, out, log = item
-                if p.poll() is not None:
-                    log.close()
-                    running.remove(item)
-                    if p.returncode != 0:
-                        sys.exit(f'calibrate: run {out} failed (status {p.returncode}), see {out}.log')
-                    open(os.path.join(out, 'done'), 'w').close()
-                    done += 1
-                    if done % 10 == 0:
-                        print(f'calibrate: {done}/{len(self.queue)} runs, {time.time() - t0:.0f} s', flush=True)
-        self.queue = []
 
 
 def main():
@@ -275,7 +134,6 @@ def main():
     recip = []
     wall = np.zeros((args.samples, len(WALL_GAPS), 5))
     one_body = []
-    from resistance_exact import pair_scalars, wall_excess
     for s, (off, d, e1, e2, t, dc) in enumerate(samples):
         o = {}
         F, T, S = steady(os.path.join(work, f's{s}_one_A'))

@@ -10,7 +10,8 @@ import os
 import h5py
 import numpy as np
 
-from resistance_exact import pair_scalars, wall_excess, NAMES   # a sibling in scripts/
+import _fdsusp_path  # noqa: F401  (this checkout's python/ on sys.path)
+from fdsusp.resistance import pair_scalars, wall_excess, NAMES
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 

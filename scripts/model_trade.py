@@ -142,12 +142,12 @@ def print_ld_rows(study, title, rows):
 def figure(study, path):
     """eta_r, eta_h, eta_c, N1/tau, N2/tau and Pi/tau against phi_core, DNS (filled) and lubrication
     dynamics (open), mu_d 0 (blue) and 0.5 (red), with the Zarraga et al. (2000) viscosity and the
-    Dai et al. (2013) normal-stress fits (scripts/rheology.py)."""
+    Dai et al. (2013) normal-stress fits (fdsusp.references)."""
     import matplotlib
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt
     import numpy as np
-    from rheology import dai_normal, zarraga_eta
+    from fdsusp.references import dai_normal, zarraga_eta
     names = ('eta_r', 'eta_h', 'eta_c', 'N1/tau', 'N2/tau', 'Pi/tau')
     fig, axes = plt.subplots(2, 3, figsize=(12, 7))
     phi = np.linspace(0.28, 0.47, 50)

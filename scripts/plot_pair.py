@@ -24,6 +24,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import _fdsusp_path  # noqa: F401,E402  (this checkout's python/ on sys.path)
+from fdsusp.plots import theta_axes  # noqa: E402
 from fdsusp.run import program  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -31,18 +32,6 @@ CASES = [("pair_eps0", r"$\epsilon_r = 0$", "k", "-"),
          ("pair_eps1e-3", r"$\epsilon_r = 10^{-3}$", "tab:blue", "-"),
          ("pair_eps1e-2", r"$\epsilon_r = 10^{-2}$", "tab:red", "-"),
          ("pair_eps1e-2_mu03", r"$\epsilon_r = 10^{-2}$, $\mu_d = 0.3$", "tab:orange", "--")]
-
-
-def theta_axes(axes, fontsize):
-    """Frame the N1*, N2* against theta panels (the line theta = pi/2 splits compression from
-    extension)."""
-    for ax, q in zip(axes, ("N_1^*", "N_2^*")):
-        ax.axhline(0, color="0.6", lw=0.5)
-        ax.axvline(np.pi / 2, color="0.6", lw=0.5, ls=":")
-        ax.set_xlim(0, np.pi)
-        ax.set_xlabel(r"$\theta$ (rad, from $+x$)")
-        ax.set_ylabel("$%s$" % q)
-        ax.legend(fontsize=fontsize)
 
 
 def load(case, csv_dir, run):

@@ -35,16 +35,14 @@ Writes a markdown table (doc/BENCHMARKS.md §9), out/tradeoff/tradeoff.json and 
 plot with its Pareto front (doc/figures/tradeoff.png by default).
 """
 import argparse
-import glob
 import json
-import math
 import os
-import re
 import shutil
 import subprocess
 import sys
 import _fdsusp_path  # noqa: F401,E402  (this checkout's python/ on sys.path)
 from fdsusp import deck  # noqa: E402
+from fdsusp.resistance import tabled_grids  # noqa: E402
 from fdsusp.run import ENV, program, run_all  # noqa: E402
 
 
@@ -73,20 +71,10 @@ def deck_text(p, average, name):
         ('run', {'title': 'tradeoff: %s' % name})], float_format='%g')
 
 
-def tabled_grids():
-    """a/Delta of the shipped full-model tables."""
-    found = []
-    for path in glob.glob(os.path.join(ROOT, 'input', 'lubrication', 'resolved_a*.h5')):
-        m = re.search(r'resolved_a(\d+)\.h5$', path)
-        if m:
-            found.append(int(m.group(1)))
-    return sorted(found)
-
-
 def settings(knobs):
     """Every run as a dict: name (its directory; identical parameter sets share one run), knob,
     label, parameters and finest (the label of the knob's finest setting). The reference first."""
-    grids = tabled_grids()
+    grids = tabled_grids(ROOT)
     series = {'reference': [('a/D %d, dt 5e-4, full' % grids[-1], dict(BASE, cells=grids[-1], dt=5e-4))]}
     if 'grid' in knobs:
         series['grid (full)'] = [('a/D %d full' % n, dict(BASE, cells=n)) for n in grids]
@@ -144,90 +132,6 @@ def result(work, name):
         # the message up to its advice, without the '|' of |delta'| (the table is markdown)
         why = errors[0][len('fdsusp: '):].split(';')[0].replace('|', '').strip() if errors else 'unfinished'
     return None, why
-
-
-def pareto(points):
-    """Indices of the points no other point beats in both cost and error."""
-    front = []
-    for i, (c, e) in enumerate(points):
-        if not any((c2 <= c and e2 <= e) and (c2 < c or e2 < e) for c2, e2 in points):
-            front.append(i)
-    return sorted(front, key=lambda i: points[i][0])
-
-
-def plot_front(rows, path, cost, markers, xlabel, title, floor=1e-5, default_run=None, base_run=None, base_label=None,
-               ylabel=None, reference_title=None):
-    """Two panels of error against cost, one marker and colour per knob. Left: each knob's settings
-    against that knob's finest (error_knob), each labelled, the finest itself left out (its error is
-    0 by construction). Right: every setting against the reference (error), the Pareto front over
-    the distinct configurations, and only the front's points labelled, each run once (base_run, which
-    several knobs share, as base_label). Each knob's default setting is ringed on the left, the run
-    of the default configuration (default_run) on the right; errors below floor are drawn at floor
-    (log axis). Rows without error_knob (the pair test, whose every error is against exact theory)
-    get the right panel alone, with ylabel and reference_title."""
-    import matplotlib
-    matplotlib.use('Agg')
-    import matplotlib.pyplot as plt
-    per_knob = all('error_knob' in r for r in rows)
-    fig, axes = plt.subplots(1, 2 if per_knob else 1, figsize=(14.5 if per_knob else 9, 5.5), sharey=True,
-                             squeeze=False)
-    axes = axes[0]
-    colours = dict(zip(markers, ['C%d' % i for i in range(len(markers))]))
-
-    def draw(ax, key, labelled, ringed):
-        placed = []                     # the labels so far, (x, y) of their points
-        for knob, marker in markers.items():
-            pts = [r for r in rows if r['knob'] == knob and r[key] is not None
-                   and not (key == 'error_knob' and r['label'] == r['finest'])]
-            for i, r in enumerate(pts):
-                x, y = r[cost], max(r[key], floor)
-                ax.scatter([x], [y], marker=marker, color=colours[knob], s=45,
-                           label=knob if i == 0 else None, zorder=3)
-                if ringed(r):
-                    ax.scatter([x], [y], marker='o', s=220, facecolors='none', edgecolors='k', lw=1, zorder=2)
-                text = labelled(r)
-                if text:
-                    # above its point, or below when a label already sits near it (within ~15 % in
-                    # cost and a factor 1.6 in error), so that neighbours do not overlap
-                    near = any(abs(math.log(x / px)) < 0.15 and abs(math.log(y / py)) < 0.5 for px, py in placed) \
-                        or r['name'] == base_run          # (its long label would cross the default's ring)
-                    placed.append((x, y))
-                    ax.annotate(text, (x, y), fontsize=7, color=colours[knob],
-                                xytext=(5, -11 if near else 6), textcoords='offset points')
-        ax.set_xscale('log')
-        ax.set_yscale('log')
-        ax.set_xlabel(xlabel)
-        ax.grid(True, which='major', lw=0.3)
-
-    if per_knob:
-        draw(axes[0], 'error_knob', lambda r: r['label'], lambda r: r['label'] in DEFAULTS)
-        axes[0].set_ylabel('|eta_r - eta_r(finest)| / eta_r(finest)')
-        axes[0].set_title("each knob against its own finest setting", fontsize=10)
-    else:
-        axes[0].set_ylabel(ylabel or 'error')
-    pts = list({r['name']: r for r in rows if r['knob'] in markers and r['error'] is not None}.values())
-    front = pareto([(r[cost], max(r['error'], floor)) for r in pts])
-    on_front = {pts[i]['name'] for i in front}
-    # one label per distinct run on the front (the base is shared by the grid, dt, lubrication and
-    # model knobs: labelled once as such)
-    named = set()
-
-    def front_label(r):
-        if r['name'] not in on_front or r['name'] in named:
-            return None
-        named.add(r['name'])
-        return base_label if r['name'] == base_run and base_label else r['label']
-    draw(axes[-1], 'error', front_label, lambda r: r['name'] == default_run)
-    axes[-1].plot([pts[i][cost] for i in front], [max(pts[i]['error'], floor) for i in front], 'k--', lw=1,
-                 label='Pareto front')
-    axes[-1].set_title(reference_title or 'total error against the reference (finest grid, dt, tolerance)',
-                       fontsize=10)
-    axes[-1].scatter([], [], marker='o', s=220, facecolors='none', edgecolors='k', label="the code's default")
-    axes[-1].legend(fontsize=8, loc='center left', bbox_to_anchor=(1.01, 0.5))
-    fig.suptitle(title, fontsize=11)
-    fig.tight_layout()
-    os.makedirs(os.path.dirname(path), exist_ok=True)
-    fig.savefig(path, dpi=120)
 
 
 def main():
@@ -292,12 +196,14 @@ def main():
         print('| %s | %s | %.4f (%.3f) | %s | %s | %.0f |' % (r['knob'], r['label'], r['eta_r'], r['eta_r_error'],
                                                            e(r['error_knob']), e(r['error']), r['cpu_per_strain']))
     if any(r['error'] is not None and r['knob'] != 'reference' for r in rows):
+        from fdsusp.plots import plot_front     # matplotlib only when there is something to draw
         plot_front(rows, args.plot, 'cpu_per_strain',
                    {'grid (full)': 'o', 'grid (simple)': 'v', 'dt': 's', 'tolerance': '^', 'lubrication': 'D',
                     'model': 'P'},
                    'cost: CPU seconds per unit strain (1 rank)',
                    'fdsusp speed against accuracy (phi = 0.3, 7a x 10a x 7a, mu_d = 0.5)',
-                   default_run=DEFAULT_RUN, base_run=BASE_RUN, base_label='base: a/D 4, dt 1e-3, full, DNS')
+                   default_run=DEFAULT_RUN, base_run=BASE_RUN, base_label='base: a/D 4, dt 1e-3, full, DNS',
+                   defaults=DEFAULTS)
         print('plot: %s' % os.path.relpath(args.plot, ROOT))
     return 0
 

@@ -41,10 +41,9 @@ import sys
 import numpy as np
 
 import _fdsusp_path  # noqa: F401,E402  (this checkout's python/ on sys.path)
-import calibrate as C  # noqa: E402  (siblings in scripts/)
-from resistance_exact import pair_scalars, NAMES  # noqa: E402
-from tradeoff import plot_front, tabled_grids  # noqa: E402
-from fdsusp import series  # noqa: E402
+from fdsusp import resistance as R, series  # noqa: E402
+from fdsusp.plots import plot_front  # noqa: E402
+from fdsusp.resistance import pair_scalars, tabled_grids, NAMES  # noqa: E402
 from fdsusp.run import ENV, program, run_all  # noqa: E402
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
@@ -64,7 +63,7 @@ FUNCTIONS = ('XA11-XA12', 'XC11', 'YA11-YA12', 'YB11-YB12', 'YC11')
 def settings():
     """Every setting as a dict: name (shared by identical parameter sets), knob, label, parameters."""
     series = {
-        'grid (full)': [('a/D %d full' % n, dict(BASE, cells=n)) for n in tabled_grids()],
+        'grid (full)': [('a/D %d full' % n, dict(BASE, cells=n)) for n in tabled_grids(ROOT)],
         'grid (simple)': [('a/D %d simple' % n, dict(BASE, cells=n, lub='simple')) for n in (4, 5, 6, 8)],
         'grid (none)': [('a/D %d none' % n, dict(BASE, cells=n, lub='none')) for n in (4, 5, 6, 8)],
         'tolerance': [('tol %g%s' % (t, ' (default)' * (t == 1e-6)), dict(BASE, tol=t, krylov=True))
@@ -83,7 +82,7 @@ def settings():
 
 
 def runs_of(name, p):
-    """The four resistance runs of a setting: (run name, calibrate.deck keywords)."""
+    """The four resistance runs of a setting: (run name, fdsusp.resistance.deck keywords)."""
     h = 1.0 / p['cells']
     c = np.full(3, L / 2) + OFFSET * h
     vtol, ptol = DEFAULT_TOL if p['tol'] is None else (p['tol'], p['tol'])
@@ -107,7 +106,7 @@ def start(work, run, kw):
     # the tolerance knob measures the Krylov path (-fluid_solver krylov); the default direct
     # solves are exact and ignore the tolerances
     args = ['-fluid_solver', 'krylov'] if kw.pop('krylov', False) else []
-    C.deck(os.path.join(d, 'deck.nml'), 'out', **kw)
+    R.deck(os.path.join(d, 'deck.nml'), 'out', **kw)
     log = open(os.path.join(d, 'log'), 'w')
     return subprocess.Popen([os.path.join(work, 'fdsusp'), 'deck.nml'] + args, cwd=d, env=ENV,
                             stdout=log, stderr=subprocess.STDOUT)
@@ -118,8 +117,8 @@ def steady(work, run):
     when the last sample is left out (how far from steady the run ended)."""
     cols = series.read(os.path.join(work, run, 'out'), ['particles/force_hydro', 'particles/torque_hydro'])[0]
     F, Tq = cols['particles/force_hydro'][:, 0], cols['particles/torque_hydro'][:, 0]
-    now = np.concatenate([C.aitken(F), C.aitken(Tq)])
-    before = np.concatenate([C.aitken(F[:-1]), C.aitken(Tq[:-1])])
+    now = np.concatenate([R.aitken(F), R.aitken(Tq)])
+    before = np.concatenate([R.aitken(F[:-1]), R.aitken(Tq[:-1])])
     return now[:3], now[3:], np.abs(now - before).max() / max(np.abs(now).max(), 1e-30)
 
 

@@ -1,27 +1,26 @@
 """Helpers shared by the fdsusp test scripts: run bin/fdsusp on a deck in a scratch directory
-and read what it wrote. Needs Debian's python3 with numpy and h5py."""
+and read what it wrote. Needs Debian's python3 with numpy and h5py. tests/run_tests.sh puts tests/
+(this library, checks.py) and the checkout's python/ (the package fdsusp) on PYTHONPATH: the one
+way the tests find them (doc/DESIGN.md "Tests")."""
 import os
 import shutil
 import signal
 import subprocess
-import sys
 import tempfile
 import time
 
 import h5py
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 # the verdict (shared with tests/physics/pairtraj_lib.py): check() records one assertion, finish()
 # exits 1 unless at least one check was made and none failed; a test ending without finish() gets
 # the same verdict at exit (tests/checks.py)
-from checks import check, finish, failures  # noqa: E402,F401
+from checks import check, finish, failures  # noqa: F401
 
 ROOT = os.environ.get('FDSUSP_ROOT', os.path.abspath(os.path.join(os.path.dirname(__file__), '..')))
 # the package of this checkout (python/fdsusp): the one reader of a run's series (series.h5 and
 # series.parts/) and the one way to find the programs ($FDSUSP_BIN, else this checkout's bin/)
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'python'))
-from fdsusp import deck as fdsusp_deck, run as fdsusp_run, series as series_reader  # noqa: E402
+from fdsusp import deck as fdsusp_deck, run as fdsusp_run, series as series_reader
 BIN = fdsusp_run.bin_dir()
 FDSUSP = fdsusp_run.program('fdsusp')
 

@@ -17,6 +17,9 @@ export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 export OMPI_MCA_rmaps_base_oversubscribe=1
 export FDSUSP_ROOT=$root
 export FDSUSP_BIN=${FDSUSP_BIN:-$root/bin}
+# the one way the Python tests find their library (tests/: fdsusp_testlib, checks) and this
+# checkout's package fdsusp (python/), ahead of any installed copy (no test sets its own path)
+export PYTHONPATH=$root/tests:$root/python${PYTHONPATH:+:$PYTHONPATH}
 # the unit-test programs and, one level up, the objects and modules they link (tests that build a
 # program against mod_unit_checks)
 export FDSUSP_UNIT_DIR=$(cd "$unit_dir" 2>/dev/null && pwd)

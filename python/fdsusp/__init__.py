@@ -8,8 +8,12 @@
     fdsusp.references   the literature fits the paper compares with
     fdsusp.plots        the matplotlib figures (imports matplotlib; nothing else does)
     fdsusp.study        the resumable studies of scripts/friction_study.py and scripts/model_trade.py
+    fdsusp.resistance   the exact two-sphere and sphere-wall functions (bin/fdsusp-resistance) and
+                        their measurement by fdsusp in resistance mode (scripts/calibrate.py, ...)
+    fdsusp.pair         the paper's pair test in the DNS against pairtraj (scripts/pair_dns.py)
 
-The command-line entry points are scripts/*.py (each has --help). From a checkout without
-installing: `import sys; sys.path.insert(0, '<checkout>/python')`; or `pip install -e .` in the
-checkout; `make install` puts the package in PREFIX/share/fdsusp/python.
+The command-line entry points are scripts/*.py (each has --help; they find this package through
+scripts/_fdsusp_path.py). Elsewhere, from a checkout without installing: PYTHONPATH=<checkout>/python
+(as tests/run_tests.sh sets it); or `pip install -e .` in the checkout; `make install` puts the
+package in PREFIX/share/fdsusp/python.
 """

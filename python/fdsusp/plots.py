@@ -1,9 +1,13 @@
-"""The figures of fdsusp's rheology (matplotlib, Agg backend): per run and across runs from
-summaries recomputed by fdsusp.rheology, and the paper's comparisons from recorded summaries.
+"""The figures of fdsusp (matplotlib, Agg backend): the rheology per run and across runs from
+summaries recomputed by fdsusp.rheology, the paper's comparisons from recorded summaries, and the
+pieces the speed-accuracy and pair scripts draw with.
 
     run_figures(runs, directory)        runs: [(outdir, a, s, summ)] (fdsusp.rheology load, summarise)
     record_figures(records, directory)  records: fdsusp.rheology.load_records(paths)
     strain_figure(paths, directory)     the "by_strain" windows of recorded extensions
+    plot_front(rows, path, ...)         error against cost with the Pareto front (scripts/tradeoff.py,
+                                        tradeoff_pair.py)
+    theta_axes(axes, fontsize)          the frame of the pair's N1*, N2* against theta panels
 """
 import json
 import math
@@ -229,3 +233,99 @@ def record_figures(records, directory):
     fig.savefig(os.path.join(directory, 'paper_fig20_22.png'), dpi=110)
     plt.close(fig)
 
+
+def pareto(points):
+    """Indices of the points no other point beats in both cost and error."""
+    front = []
+    for i, (c, e) in enumerate(points):
+        if not any((c2 <= c and e2 <= e) and (c2 < c or e2 < e) for c2, e2 in points):
+            front.append(i)
+    return sorted(front, key=lambda i: points[i][0])
+
+
+def plot_front(rows, path, cost, markers, xlabel, title, floor=1e-5, default_run=None, base_run=None, base_label=None,
+               ylabel=None, reference_title=None, defaults=()):
+    """Two panels of error against cost, one marker and colour per knob. Left: each knob's settings
+    against that knob's finest (error_knob), each labelled, the finest itself left out (its error is
+    0 by construction). Right: every setting against the reference (error), the Pareto front over
+    the distinct configurations, and only the front's points labelled, each run once (base_run, which
+    several knobs share, as base_label). Each knob's default setting is ringed on the left, the run
+    of the default configuration (default_run) on the right (defaults: the labels of the knobs'
+    default settings, each ringed on the left); errors below floor are drawn at floor
+    (log axis). Rows without error_knob (the pair test, whose every error is against exact theory)
+    get the right panel alone, with ylabel and reference_title."""
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    per_knob = all('error_knob' in r for r in rows)
+    fig, axes = plt.subplots(1, 2 if per_knob else 1, figsize=(14.5 if per_knob else 9, 5.5), sharey=True,
+                             squeeze=False)
+    axes = axes[0]
+    colours = dict(zip(markers, ['C%d' % i for i in range(len(markers))]))
+
+    def draw(ax, key, labelled, ringed):
+        placed = []                     # the labels so far, (x, y) of their points
+        for knob, marker in markers.items():
+            pts = [r for r in rows if r['knob'] == knob and r[key] is not None
+                   and not (key == 'error_knob' and r['label'] == r['finest'])]
+            for i, r in enumerate(pts):
+                x, y = r[cost], max(r[key], floor)
+                ax.scatter([x], [y], marker=marker, color=colours[knob], s=45,
+                           label=knob if i == 0 else None, zorder=3)
+                if ringed(r):
+                    ax.scatter([x], [y], marker='o', s=220, facecolors='none', edgecolors='k', lw=1, zorder=2)
+                text = labelled(r)
+                if text:
+                    # above its point, or below when a label already sits near it (within ~15 % in
+                    # cost and a factor 1.6 in error), so that neighbours do not overlap
+                    near = any(abs(math.log(x / px)) < 0.15 and abs(math.log(y / py)) < 0.5 for px, py in placed) \
+                        or r['name'] == base_run          # (its long label would cross the default's ring)
+                    placed.append((x, y))
+                    ax.annotate(text, (x, y), fontsize=7, color=colours[knob],
+                                xytext=(5, -11 if near else 6), textcoords='offset points')
+        ax.set_xscale('log')
+        ax.set_yscale('log')
+        ax.set_xlabel(xlabel)
+        ax.grid(True, which='major', lw=0.3)
+
+    if per_knob:
+        draw(axes[0], 'error_knob', lambda r: r['label'], lambda r: r['label'] in defaults)
+        axes[0].set_ylabel('|eta_r - eta_r(finest)| / eta_r(finest)')
+        axes[0].set_title("each knob against its own finest setting", fontsize=10)
+    else:
+        axes[0].set_ylabel(ylabel or 'error')
+    pts = list({r['name']: r for r in rows if r['knob'] in markers and r['error'] is not None}.values())
+    front = pareto([(r[cost], max(r['error'], floor)) for r in pts])
+    on_front = {pts[i]['name'] for i in front}
+    # one label per distinct run on the front (the base is shared by the grid, dt, lubrication and
+    # model knobs: labelled once as such)
+    named = set()
+
+    def front_label(r):
+        if r['name'] not in on_front or r['name'] in named:
+            return None
+        named.add(r['name'])
+        return base_label if r['name'] == base_run and base_label else r['label']
+    draw(axes[-1], 'error', front_label, lambda r: r['name'] == default_run)
+    axes[-1].plot([pts[i][cost] for i in front], [max(pts[i]['error'], floor) for i in front], 'k--', lw=1,
+                 label='Pareto front')
+    axes[-1].set_title(reference_title or 'total error against the reference (finest grid, dt, tolerance)',
+                       fontsize=10)
+    axes[-1].scatter([], [], marker='o', s=220, facecolors='none', edgecolors='k', label="the code's default")
+    axes[-1].legend(fontsize=8, loc='center left', bbox_to_anchor=(1.01, 0.5))
+    fig.suptitle(title, fontsize=11)
+    fig.tight_layout()
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    fig.savefig(path, dpi=120)
+
+
+def theta_axes(axes, fontsize):
+    """Frame the N1*, N2* against theta panels of the pair figures (scripts/plot_pair.py,
+    scripts/pair_dns.py): the line theta = pi/2 splits compression from extension."""
+    for ax, q in zip(axes, ("N_1^*", "N_2^*")):
+        ax.axhline(0, color="0.6", lw=0.5)
+        ax.axvline(np.pi / 2, color="0.6", lw=0.5, ls=":")
+        ax.set_xlim(0, np.pi)
+        ax.set_xlabel(r"$\theta$ (rad, from $+x$)")
+        ax.set_ylabel("$%s$" % q)
+        ax.legend(fontsize=fontsize)

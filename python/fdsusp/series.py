@@ -9,6 +9,9 @@ after consolidating: series.h5's records, then each part's records after the las
 
     from fdsusp import series
     columns, attributes = series.read('out/demo', ['step', 'core/stress_hydro'])
+
+consolidate() is the one writer of a series outside the program: it folds the parts into series.h5
+as fdsusp does (for a run branched from another's output, fdsusp.pair.branch).
 """
 import os
 
@@ -80,6 +83,39 @@ def read(outdir, names=None):
     if names is not None and 'step' not in names:
         del columns['step']
     return columns, attributes
+
+
+def consolidate(outdir, drop=(), last_step=None):
+    """Fold series.parts/ into series.h5 the way fdsusp does (src/io/series.F90): the records read()
+    gives, up to last_step when given, without the columns named in drop, written to series.h5.tmp,
+    renamed over series.h5, and only then the parts removed, so that a kill at any point leaves a
+    series fdsusp continues correctly (leftover parts hold records series.h5 already has, which the
+    next consolidation skips; a leftover .tmp it removes). Each column keeps fdsusp's layout:
+    extendable along the records, chunks of about 1024 values, its type (the step as integers), so
+    that a run continuing here (-restart) appends to it. Returns the number of records kept."""
+    columns, attributes = read(outdir)
+    keep = np.ones(len(columns['step']), bool) if last_step is None else columns['step'] <= last_step
+    main = os.path.join(outdir, 'series.h5')
+    tmp = main + '.tmp'
+    with h5py.File(tmp, 'w') as f:
+        for k, v in attributes.items():
+            f.attrs[k] = v
+        for n, v in columns.items():
+            if n in drop:
+                continue
+            per_record = v.shape[1:]
+            chunk = max(1, 1024 // int(np.prod(per_record, dtype=int)))
+            f.create_dataset(n, data=v[keep], maxshape=(None,) + per_record, chunks=(chunk,) + per_record)
+    fd = os.open(tmp, os.O_RDONLY)
+    try:
+        os.fsync(fd)                    # the data on disk before the name points at it
+    finally:
+        os.close(fd)
+    parts = files(outdir)[1:] if os.path.exists(main) else files(outdir)
+    os.replace(tmp, main)
+    for part in parts:
+        os.remove(part)
+    return int(keep.sum())
 
 
 def settings(attributes):

@@ -34,7 +34,7 @@ import shutil
 import subprocess
 
 from . import deck, rheology
-from .run import checkout, run_all, start_resumable
+from .run import bin_dir, checkout, run_all, start_resumable
 
 # the checkout (its git commit names a run's program when no pinned build is used); None when installed
 ROOT = checkout()
@@ -81,8 +81,9 @@ def commit_of_binary():
     """The commit the copied program was built from: the file VERSION beside it when the study runs
     a pinned build ($FDSUSP_BIN, so that work in the checkout cannot reach a study half-way),
     else the checkout's."""
-    pinned = os.path.join(os.environ.get('FDSUSP_BIN', ''), 'VERSION')
-    if os.environ.get('FDSUSP_BIN') and os.path.exists(pinned):
+    programs = bin_dir()                # where program('fdsusp') took the copy from (fdsusp.run)
+    pinned = os.path.join(programs, 'VERSION') if programs else ''
+    if pinned and os.path.exists(pinned):
         return open(pinned).read().strip()
     if ROOT is None:
         return 'unknown'

@@ -75,18 +75,8 @@ def test_parse_shipped_decks(root):
         assert deck.parse(deck.text(groups)) == groups, p
 
 
-def _fdsusp():
-    try:
-        path = run.program('fdsusp')
-    except FileNotFoundError:
-        path = None
-    if path is None or not os.access(path, os.X_OK):
-        pytest.skip('bin/fdsusp is not built')
-    return path
-
-
-def test_fdsusp_accepts_and_refuses(tmp_path):
-    binary = _fdsusp()
+def test_fdsusp_accepts_and_refuses(tmp_path, fdsusp_binary):
+    binary = fdsusp_binary
     good = [('domain', {'box': (8, 8, 8), 'cells_per_radius': 4}), ('time', {'dt': 1e-3, 'steps': 0}),
             ('output', {'directory': 'out'})]
     deck.write(str(tmp_path / 'good.nml'), deck.text(good))

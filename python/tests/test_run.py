@@ -52,3 +52,11 @@ def test_start_resumable(tmp_path, monkeypatch):
     log = open(os.path.join(d, 'log')).read()
     assert 'args: deck.nml\n' in log and 'args: deck.nml -restart out/checkpoint.h5' in log
     assert open(os.path.join(d, 'deck.nml')).read() == '&time dt = 2 /\n'
+
+
+def test_pinned_build_names_its_commit(tmp_path, monkeypatch):
+    """A study records the VERSION beside the programs fdsusp.run finds ($FDSUSP_BIN here)."""
+    from fdsusp import study
+    (tmp_path / 'VERSION').write_text('abc1234\n')
+    monkeypatch.setenv('FDSUSP_BIN', str(tmp_path))
+    assert study.commit_of_binary() == 'abc1234'

@@ -1,7 +1,7 @@
-"""Helpers shared by the tests/physics/test_pairtraj_*.py tests (Python standard library only).
+"""Helpers shared by the tests/physics/test_pairtraj_*.py tests (the standard library and fdsusp.run).
 
-run_deck() runs bin/pairtraj ($FDSUSP_BIN, default the bin/ of the checkout holding this file) on
-a copy of a project deck
+run_deck() runs bin/pairtraj (found by fdsusp.run.program: $FDSUSP_BIN, else the bin/ of the
+checkout) on a copy of a project deck
 with some variables overridden and the CSV redirected to a temporary directory, and returns the
 summary printed on stdout and the CSV rows.
 """
@@ -13,13 +13,12 @@ import subprocess
 import sys
 import tempfile
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-import checks  # noqa: E402  (tests/checks.py: the verdict shared by the Python tests)
+import checks  # tests/checks.py: the verdict shared by the Python tests
+from fdsusp.run import program
 
 # the checkout: $FDSUSP_ROOT (tests/run_tests.sh exports it), else the one holding this file
 ROOT = os.environ.get("FDSUSP_ROOT", os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..")))
-BIN = os.environ.get("FDSUSP_BIN", os.path.join(ROOT, "bin"))
-PAIRTRAJ = os.path.join(BIN, "pairtraj")
+PAIRTRAJ = program("pairtraj")
 TMP = tempfile.mkdtemp(prefix="pairtraj_test_")
 
 

@@ -27,7 +27,6 @@ must fail (it does: the proof that the test sees the chatter)."""
 import os
 import sys
 import numpy as np
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 EXPLICIT = '--explicit' in sys.argv[1:]

@@ -22,9 +22,7 @@ default 0.38 the balance stalls 2 % short; measured). Measured convergence: the 
 contact force (and no table is calibrated for radius_offset = 0)."""
 import math
 import os
-import sys
 import numpy as np
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 F = 6 * math.pi

@@ -14,9 +14,7 @@ Asserted:
  - the flow is divergence-free (1e-10)."""
 import math
 import os
-import sys
 import numpy as np
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 LY, RE = 20.0, 0.1

@@ -12,7 +12,6 @@ import json
 import os
 import subprocess
 import sys
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 EXPECTED = {

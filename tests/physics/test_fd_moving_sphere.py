@@ -45,9 +45,7 @@ one by more than ~0.3 %, far inside what a broken radius correction does (radius
 import glob
 import math
 import os
-import sys
 import numpy as np
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 from sphere_array_reference import k_reference  # noqa: E402
 

@@ -16,8 +16,6 @@ Steady state: the drag relaxes in ~40 steps at Re = 0.01, dt = 1e-3 (doc/METHOD.
 as the mean of steps 61-80, and the change over those steps is checked to be < 0.2 %."""
 import math
 import os
-import sys
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 from sphere_array_reference import k_reference  # noqa: E402
 

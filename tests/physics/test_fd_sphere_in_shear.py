@@ -20,9 +20,7 @@ domain alone (&lubrication model = 'none'): the sphere stays >= 6a from the wall
 lubrication cut-off."""
 import math
 import os
-import sys
 import numpy as np
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 DECK = """&domain box = 10, 20, 10, cells_per_radius = 4, y_boundary = 'walls', shear_rate = 1 /

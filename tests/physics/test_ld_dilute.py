@@ -12,8 +12,6 @@ that is the tolerance |eta_r - 1 - 2.5 phi| within [-3 sigma, 10 phi^2 + 3 sigma
 2.5 phi = 50 c2 units) and for pair blocks of the wrong sign."""
 import json
 import os
-import sys
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 DECK = """&domain box = 16, 16, 16, y_boundary = 'lees-edwards', shear_rate = 1 /

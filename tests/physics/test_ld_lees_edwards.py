@@ -19,9 +19,7 @@ dynamics):
    (bitwise in practice), as tests/regression/test_restart.py asks of the DNS."""
 import os
 import shutil
-import sys
 import numpy as np
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 PAIR = """&domain box = 12, 12, 12, y_boundary = 'lees-edwards', shear_rate = 1 /

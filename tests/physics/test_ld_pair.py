@@ -12,10 +12,7 @@ C1 taper of the cut-off over gaps 7-10a; measured 1e-5 (smooth) and 2e-5 (rough)
 1 %. A wrong factor anywhere in the pair blocks moves the rough offset by more: without the
 pair hydrodynamics (&lubrication model = 'none') it is off by 50 %."""
 import os
-import sys
 import numpy as np
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
-sys.path.insert(0, os.path.dirname(__file__))
 import fdsusp_testlib as T
 import pairtraj_lib as P
 

@@ -10,9 +10,7 @@ continues from the image below with the velocity of its new height, U_x = gamma_
 through the crossing, and its rotation and stresslet do not change."""
 import math
 import os
-import sys
 import numpy as np
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 DECK = """&domain box = 10, 20, 10, y_boundary = '{boundary}', shear_rate = 1 /

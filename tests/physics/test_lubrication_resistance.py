@@ -20,7 +20,7 @@ conditioned; the force on sphere 1 is the strain coupling R_FE:E, least-squares 
 4 pi [(XG11 - XG12)(ds.E.ds) ds + 2 (YG11 - YG12)(E.ds - (ds.E.ds) ds)] (the sign and form were
 checked on the uncorrected runs against the table's G functions, which calibrate.py measures
 through the stresslet due to translation: reciprocity holds to ~3 %), and the stresslet gives
-the sums XM, YM, ZM (calibrate.m_fit). This is the coupling that drives a pair together in a
+the sums XM, YM, ZM (fdsusp.resistance.m_fit). This is the coupling that drives a pair together in a
 sheared suspension, and the stresslet its rheology.
 Wall (walls at rest, box 8 x 8 x 8): mode W1 translates and spins along the normal (lambda_perp),
 W2 along a tangent t (f_tt; f_tr from the torque about b = n x t; f_rr). The cell's other wall and
@@ -38,13 +38,9 @@ import math
 import os
 import sys
 import numpy as np
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(os.path.dirname(HERE))
-sys.path.insert(0, os.path.join(HERE, '..'))
-sys.path.insert(0, os.path.join(ROOT, 'scripts'))
 import fdsusp_testlib as T
-import calibrate as C
-from resistance_exact import pair_scalars, wall_scalars, wall_excess, NAMES
+from fdsusp import resistance as R
+from fdsusp.resistance import pair_scalars, wall_scalars, wall_excess, NAMES
 import h5py
 
 PI = math.pi
@@ -53,7 +49,7 @@ h = 1.0 / CELLS
 GAPS = [0.001, 0.01, 0.1, 0.5]
 L = 8.0
 work = T.scratch('lubrication_resistance' + ('' if CELLS == 5 else f'_a{CELLS}'))
-runner = C.Runner(work, 2)
+runner = R.Runner(work, 2)
 off = np.array([0.37, 0.61, 0.13]) * h
 d = np.array([0.3, -0.5, 0.81]); d /= np.linalg.norm(d)
 e1 = np.cross(d, [0.0, 0.0, 1.0]); e1 /= np.linalg.norm(e1)
@@ -74,21 +70,21 @@ for g in GAPS + ['centre']:
     x = np.array([L / 2 + off[0], y, L / 2 + off[2]])
     add(f'w{g}_W1', box=(L, LW, L), walls=True, shear=0.0, spheres=[(x, n, n)])
     add(f'w{g}_W2', box=(L, LW, L), walls=True, shear=0.0, spheres=[(x, t, t)])
-E = C.SHEAR_E
+E = R.SHEAR_E
 ds = np.array([0.6, -0.6, 0.53]); ds /= np.linalg.norm(ds)       # conditioning 0.32 (>= 0.25)
 LS = 10.0
 cs = np.array([L / 2, LS / 2, L / 2]) + off
 for g in GAPS:
     x1, x2 = cs - (1 + g / 2) * ds, cs + (1 + g / 2) * ds
-    add(f'g{g}_S', box=(L, LS, L), walls=True, shear=1.0, spheres=[C.with_flow(x1, LS), C.with_flow(x2, LS)])
+    add(f'g{g}_S', box=(L, LS, L), walls=True, shear=1.0, spheres=[R.with_flow(x1, LS), R.with_flow(x2, LS)])
 runner.run()
 
 
 def steady(name):
     """Total and lubrication force/torque, extrapolated to steady state."""
     with h5py.File(os.path.join(work, name, 'series.h5'), 'r') as f:
-        out = [C.aitken(f[k][:]) for k in ('particles/force_hydro', 'particles/torque_hydro')]
-        lub = [C.aitken(f[k][:]) if k in f else np.zeros_like(out[0])
+        out = [R.aitken(f[k][:]) for k in ('particles/force_hydro', 'particles/torque_hydro')]
+        lub = [R.aitken(f[k][:]) if k in f else np.zeros_like(out[0])
                for k in ('particles/force_lubrication', 'particles/torque_lubrication')]
     return out[0], out[1], lub[0], lub[1]
 
@@ -121,8 +117,8 @@ for g in GAPS:
     F, Tq, Fl, Tl = steady(f'g{g}_S')
     g_dns = np.linalg.lstsq(basis, F[0], rcond=None)[0]
     g_raw = np.linalg.lstsq(basis, F[0] - Fl[0], rcond=None)[0]
-    S = C.steady(os.path.join(work, f'g{g}_S'))[2]       # deviatoric stresslets
-    m_dns = 0.5 * (C.m_fit(S[0], ds, E) + C.m_fit(S[1], ds, E))
+    S = R.steady(os.path.join(work, f'g{g}_S'))[2]       # deviatoric stresslets
+    m_dns = 0.5 * (R.m_fit(S[0], ds, E) + R.m_fit(S[1], ds, E))
     values = [('XG11-XG12', ex['XG11'] - ex['XG12'], g_dns[0], g_raw[0], None),
               ('YG11-YG12', ex['YG11'] - ex['YG12'], g_dns[1], g_raw[1], ex['XG11'] - ex['XG12'])]
     values += [(m, ex[m + '11'] + ex[m + '12'], m_dns[k], float('nan'), None if k == 0 else ex['XM11'] + ex['XM12'])

@@ -16,13 +16,9 @@ within a few steps at a speed ~ F / (6 pi R~) with R~ the saturated resolved res
 a gap h a step must then be below h / V, i.e. ~5e-5 for h = 1e-4."""
 import math
 import os
-import sys
 import numpy as np
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, '..'))
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(HERE)), 'scripts'))
 import fdsusp_testlib as T
-from resistance_exact import pair_scalars, NAMES
+from fdsusp.resistance import pair_scalars, NAMES
 
 F = 60 * math.pi
 GAP0 = 0.02

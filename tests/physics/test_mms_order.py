@@ -11,8 +11,6 @@ solution as Crank-Nicolson's, reached in ~30 steps instead of hundreds.
 Prints the table recorded in doc/VALIDATION.md."""
 import math
 import os
-import sys
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 DECK = """&domain box = 3.2, 3.2, 3.2, cells_per_radius = {cpr}, y_boundary = '{yb}', shear_rate = {shear} /

@@ -30,16 +30,13 @@ Tolerances, from the differences between the two models rather than from measure
     the same force: gap = h_r - |delta'|).
 """
 import os
-import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T  # noqa: E402
 
-sys.path.insert(0, os.path.join(T.ROOT, 'scripts'))
-import pair_dns as P  # noqa: E402
-from fdsusp.run import run_all  # noqa: E402  (tests/fdsusp_testlib.py put python/ on sys.path)
+from fdsusp import pair as P  # noqa: E402
+from fdsusp.run import run_all  # noqa: E402
 
 BOX, CELLS, DT, START, EPS_BAR = 10.0, 4, 2.5e-3, -2.5, 0.1
 work = T.scratch('pair_dns')

@@ -34,9 +34,7 @@ Runs two at a time on one rank each (~3 min on 2 cores)."""
 import json
 import os
 import subprocess
-import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 DECK = """&domain box = 8, 20, 8, cells_per_radius = 4, shear_rate = 1 /

@@ -7,8 +7,6 @@ A run refused at input checking leaves nothing it created: an output directory (
 made by the refused run is removed again when it holds nothing but the lock file, so a fresh
 &output directory does not exist after the refusal (exact check, no tolerance)."""
 import os
-import sys
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 GOOD = """&domain box = 3.2, 3.2, 3.2, cells_per_radius = 5 /

@@ -28,13 +28,11 @@ solves (issue 31) this scene takes 2-4 ms per step (with 100 steps, job 1 had fi
 import os
 import signal
 import subprocess
-import sys
 import time
 
 import h5py
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 STEPS = 3000

@@ -3,18 +3,18 @@
 one particular machine.
  1. static: no file under tests/, scripts/ or python/ (the package), nor the Makefile, names the absolute path of this
     checkout or that of the machine where the project was first developed;
- 2. dynamic: tests/physics/pairtraj_lib.py and tests/physics/test_pairtraj_deck_errors.sh,
-    copied into a scratch checkout whose bin/pairtraj is a stand-in that records its calls, and
-    run from another directory without FDSUSP_ROOT and FDSUSP_BIN, use that checkout: the
-    library's ROOT and PAIRTRAJ point into it and the shell test calls the stand-in (before,
-    both defaulted to that machine's bin/, and the library's ROOT to the current directory).
+ 2. dynamic: tests/physics/pairtraj_lib.py (with the package fdsusp, which finds its programs)
+    and tests/physics/test_pairtraj_deck_errors.sh, copied into a scratch checkout whose
+    bin/pairtraj is a stand-in that records its calls, and run from another directory without
+    FDSUSP_ROOT and FDSUSP_BIN (the library on PYTHONPATH as tests/run_tests.sh puts it), use that
+    checkout: the library's ROOT and PAIRTRAJ point into it and the shell test calls the stand-in
+    (before, both defaulted to that machine's bin/, and the library's ROOT to the current directory).
 Exact string and path comparisons, no tolerance."""
 import os
 import shutil
 import subprocess
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 ROOT = os.path.realpath(T.ROOT)
@@ -44,9 +44,12 @@ d = T.scratch('checkout_paths')
 other = os.path.join(d, 'checkout')
 os.makedirs(os.path.join(other, 'tests', 'physics'))
 os.makedirs(os.path.join(other, 'bin'))
+os.makedirs(os.path.join(other, 'src', 'programs'))        # what fdsusp.run.checkout() knows a checkout by
 for name in ('physics/pairtraj_lib.py', 'physics/test_pairtraj_deck_errors.sh', 'checks.py', 'checks.sh'):
     if os.path.exists(os.path.join(ROOT, 'tests', name)):
         shutil.copy(os.path.join(ROOT, 'tests', name), os.path.join(other, 'tests', name))
+shutil.copytree(os.path.join(ROOT, 'python', 'fdsusp'), os.path.join(other, 'python', 'fdsusp'),
+                ignore=shutil.ignore_patterns('__pycache__'))
 calls = os.path.join(d, 'calls.txt')
 stand_in = os.path.join(other, 'bin', 'pairtraj')
 with open(stand_in, 'w') as f:
@@ -59,7 +62,9 @@ os.makedirs(elsewhere)
 # (the probe makes one check: a script that imports the harness and checks nothing fails)
 probe = 'import pairtraj_lib as L; print("ROOT=" + L.ROOT); print("BIN=" + L.PAIRTRAJ); L.checks.check(True, "probe")'
 p = subprocess.run([sys.executable, '-c', probe], cwd=elsewhere,
-                   env=dict(env, PYTHONPATH=os.path.join(other, 'tests', 'physics')), capture_output=True, text=True)
+                   env=dict(env, PYTHONPATH=os.pathsep.join(os.path.join(other, *sub) for sub in
+                                                            (('tests', 'physics'), ('tests',), ('python',)))),
+                   capture_output=True, text=True)
 lines = [l.split('=', 1)[1] for l in p.stdout.splitlines() if l.startswith(('ROOT=', 'BIN='))]
 T.check(p.returncode == 0 and len(lines) == 2 and os.path.realpath(lines[0]) == os.path.realpath(other),
         'pairtraj_lib: ROOT is the checkout holding it (%s)' % (lines[:1] or p.stderr[-300:]))

@@ -12,8 +12,6 @@ deck's output directory, which differs by construction, excepted). A checkpoint 
 could not be verified. Exact checks otherwise (bytes, message text, exit status)."""
 import os
 import shutil
-import sys
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 DNS = """&domain box = 3.2, 3.2, 3.2, cells_per_radius = 5, shear_rate = 1 /

@@ -14,10 +14,8 @@ these contacts exist at every step of both runs and that the checkpoint at step 
 springs, so the history really is exercised; and that the checkpoint's springs at step 20 agree
 too. 2 ranks: the contact state is replicated and must be identical on both."""
 import os
-import sys
 import h5py
 import numpy as np
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 DECK = """&domain box = 6.4, 6.4, 6.4, cells_per_radius = 5, y_boundary = 'walls', shear_rate = 1 /

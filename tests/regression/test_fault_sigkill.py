@@ -15,11 +15,9 @@ from the start publishes before its first step."""
 import os
 import signal
 import subprocess
-import sys
 import time
 import h5py
 import numpy as np
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 DECK = """&domain box = 12.8, 6.4, 12.8, cells_per_radius = 5, y_boundary = 'walls', shear_rate = 1 /

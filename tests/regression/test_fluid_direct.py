@@ -17,11 +17,9 @@ Tolerance: velocities and pressure after 10 steps agree to 1e-9 of their scale (
 boundary kind, eigenvalue or normalisation gives differences of order 1.
 """
 import os
-import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T  # noqa: E402
 
 DECK = """&domain box = 6.4, 6.4, 6.4, cells_per_radius = 5, y_boundary = '{boundary}', shear_rate = {shear} /

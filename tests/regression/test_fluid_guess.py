@@ -21,11 +21,9 @@ Tolerances (observed in brackets, 2026-11-25):
 """
 import os
 import re
-import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T  # noqa: E402
 
 DECK = """&domain box = 8.0, 8.0, 8.0, cells_per_radius = 4, y_boundary = 'walls', shear_rate = 1 /

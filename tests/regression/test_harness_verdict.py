@@ -18,7 +18,6 @@ import shutil
 import subprocess
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 TESTS = os.path.join(T.ROOT, 'tests')
@@ -33,8 +32,12 @@ def status_of(cmd, what, want, env=None):
 
 
 def python_test(name, body, want, what):
-    path = T.write_deck(d, name + '.py', 'import sys\nsys.path.insert(0, %r)\n%s\n' % (TESTS, body))
-    status_of([sys.executable, path], 'Python, ' + what, want)
+    """A test script in the scratch directory, run as tests/run_tests.sh runs one (its PYTHONPATH:
+    tests/ and python/), and tests/physics for pairtraj_lib."""
+    path = T.write_deck(d, name + '.py', 'import sys\n%s\n' % body)
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([os.path.join(TESTS, 'physics'), TESTS,
+                                                        os.path.join(T.ROOT, 'python')]))
+    status_of([sys.executable, path], 'Python, ' + what, want, env=env)
 
 
 python_test('none_finish', 'import fdsusp_testlib as T\nT.finish()', 1, 'no check, finish()')
@@ -43,10 +46,9 @@ python_test('fail_nofinish', 'import fdsusp_testlib as T\nT.check(False, "does n
             'a failed check, no finish()')
 python_test('none_exit0', 'import fdsusp_testlib as T\nsys.exit(0)', 1, 'no check, sys.exit(0)')
 python_test('one_nofinish', 'import fdsusp_testlib as T\nT.check(True, "holds")', 0, 'a passing check, no finish()')
-python_test('checker_none', 'sys.path.insert(0, %r)\nfrom pairtraj_lib import Checker\nChecker().done()'
-            % os.path.join(TESTS, 'physics'), 1, "pairtraj_lib's Checker, done() without a check")
-python_test('checker_one', 'sys.path.insert(0, %r)\nfrom pairtraj_lib import Checker\nc = Checker()\n'
-            'c.check("holds", True)\nc.done()' % os.path.join(TESTS, 'physics'), 0,
+python_test('checker_none', 'from pairtraj_lib import Checker\nChecker().done()', 1,
+            "pairtraj_lib's Checker, done() without a check")
+python_test('checker_one', 'from pairtraj_lib import Checker\nc = Checker()\nc.check("holds", True)\nc.done()', 0,
             "pairtraj_lib's Checker, one passing check")
 
 

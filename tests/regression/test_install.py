@@ -19,7 +19,6 @@ import os
 import subprocess
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T  # noqa: E402
 
 prefix = T.scratch('install_prefix')

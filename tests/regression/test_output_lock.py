@@ -14,14 +14,12 @@ Exact checks on statuses, messages and step numbers; no tolerance."""
 import os
 import signal
 import subprocess
-import sys
 import time
 
 import atexit
 
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 DECK = """&domain box = 3.2, 3.2, 3.2, cells_per_radius = 5, y_boundary = 'walls', shear_rate = 1 /

@@ -14,9 +14,7 @@
 import os
 import shutil
 import subprocess
-import sys
 import time
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 import h5py
 import numpy as np

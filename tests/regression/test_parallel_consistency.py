@@ -4,9 +4,7 @@ must give the same u, v, w, p to 1e-10. The solvers run to a relative tolerance 
 multigrid smoothers (SOR) differ between decompositions, so results agree only to the solver
 tolerance times the condition of the step (O(1e3) here): 1e-10 absolute on O(1) fields."""
 import os
-import sys
 import numpy as np
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 DECK = """&domain box = 3.2, 3.2, 3.2, cells_per_radius = 5, y_boundary = 'walls', shear_rate = 1 /

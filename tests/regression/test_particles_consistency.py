@@ -12,9 +12,7 @@
 Three free spheres in a small Couette cell (one close to a periodic boundary, so its faces wrap
 and, on 2 ranks, fall on both sides of the processor boundary)."""
 import os
-import sys
 import numpy as np
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 POS = [(1.3, 3.0, 3.1), (4.1, 4.6, 3.5), (3.2, 1.9, 5.9)]

@@ -18,9 +18,7 @@ are never filled, 2 ranks differed by 3.7e-5 (velocity) and 2.0e-4 (omega), 8 ra
 and 7.0e-3 (doc/VALIDATION.md §2.6). About 8 s on 2 cores."""
 import os
 import re
-import sys
 import numpy as np
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 # Lx = Lz: the restart refuses a checkpoint of a grid with n1 /= n3 ('dataset of the wrong shape

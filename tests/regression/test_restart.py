@@ -12,10 +12,8 @@ import os
 import shutil
 import signal
 import subprocess
-import sys
 import time
 import numpy as np
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 DECK = """&domain box = 3.2, 3.2, 2.4, cells_per_radius = 5, y_boundary = 'walls', shear_rate = 1 /

@@ -14,8 +14,6 @@ dt, reynolds and shear_rate are still checked. Exact checks (message text, bytes
 the values compared are the doubles the decks were read into, so no tolerance applies."""
 import os
 import shutil
-import sys
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 DNS = """&domain box = 3.2, 3.2, 3.2, cells_per_radius = 5, shear_rate = 1 /

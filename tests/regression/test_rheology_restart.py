@@ -38,7 +38,6 @@ import sys
 import h5py
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 DECK = """&domain box = 8, 20, 8, cells_per_radius = 4, shear_rate = 1 /

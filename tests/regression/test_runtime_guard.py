@@ -21,9 +21,7 @@ lubrication, and with that solve capped at one iteration (-particles_ksp_max_it 
 solve that fails) the run stops (status 4) with one message naming the solve and its KSP reason,
 and no checkpoint is written over the good one."""
 import os
-import sys
 import numpy as np
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 DECK = """&domain box = 3.2, 6.4, 3.2, cells_per_radius = 5, y_boundary = 'walls', shear_rate = 1 /

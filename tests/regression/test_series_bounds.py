@@ -19,9 +19,7 @@ rheology on. Needs strace (scripts/install-deps)."""
 import os
 import re
 import subprocess
-import sys
 import numpy as np
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 DECK = """&domain box = 8, 8, 8, y_boundary = 'lees-edwards', shear_rate = 1 /

@@ -23,10 +23,8 @@ Needs strace (scripts/install-deps installs it)."""
 import os
 import shutil
 import subprocess
-import sys
 import h5py
 import numpy as np
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 DECK = """&domain box = 8, 8, 8, y_boundary = 'lees-edwards', shear_rate = 1 /

@@ -17,7 +17,6 @@ import subprocess
 import sys
 import tempfile
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..'))
 from checks import check, finish
 
 ROOT = os.environ.get('FDSUSP_ROOT') or os.path.abspath(os.path.join(os.path.dirname(__file__), '..', '..'))
