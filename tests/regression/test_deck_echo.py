@@ -11,8 +11,6 @@ Exact checks: the echo prints every double with 17 significant digits, which rea
 same double, so no tolerance applies."""
 import os
 import re
-import sys
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..'))
 import fdsusp_testlib as T
 
 DECK = """! lubrication dynamics, no grid: the reader is what is tested, not the flow
