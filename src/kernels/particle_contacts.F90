@@ -27,19 +27,19 @@ module mod_particle_contacts
   use mod_columns, only: column_t, column
   implicit none
   private
-  public :: contact_settings_t, particle_contacts_t, particle_contacts_create, particle_contacts_step, &
+  public :: particle_contacts_settings_t, particle_contacts_t, particle_contacts_create, particle_contacts_step, &
             particle_contacts_description
   public :: particle_contacts_add_stiffness, particle_contacts_implicit_update, particle_contacts_columns
 
   ! The deck's &contact (doc/INPUT.md): its variables, named as in the deck, with their defaults.
-  type :: contact_settings_t
+  type :: particle_contacts_settings_t
     real(dp) :: roughness = 0.0_dp         ! eps_r = h_r/a [-]
     real(dp) :: eps_bar = 0.05_dp          ! roughness deformation under 6 pi eta gamma_dot a^2 [-]
     real(dp) :: friction = 0.0_dp          ! mu_d [-]
     real(dp) :: normal_stiffness = 0.0_dp  ! k_n [eta gamma_dot a^(1/2)] (0: from eps_bar)
     real(dp) :: neighbour_skin = 0.2_dp    ! neighbour-list skin [a]
     logical :: implicit = .true.           ! linearised contact stiffness in the particle solve
-  end type contact_settings_t
+  end type particle_contacts_settings_t
 
   type :: particle_contacts_t
     type(contact_params_t) :: params
@@ -88,7 +88,7 @@ contains
     type(particle_contacts_t), intent(out) :: pc
     integer, intent(in) :: np
     real(dp), intent(in) :: a, shear_rate, box(3), dt
-    type(contact_settings_t), intent(in) :: settings
+    type(particle_contacts_settings_t), intent(in) :: settings
     logical, intent(in) :: walls
     integer, intent(out) :: info
     character(len=*), intent(out) :: msg

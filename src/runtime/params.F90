@@ -21,7 +21,7 @@ module mod_params
   use mod_deck_text, only: deck_line_length, load_lines, group_on_line, to_lower, diagnose_group, &
                            qualified_names, unqualified_names
   use mod_packing_geometry, only: phi_max
-  use mod_particle_contacts, only: contact_settings_t
+  use mod_particle_contacts, only: particle_contacts_settings_t
   use mod_rheology, only: rheology_settings_t
   implicit none
   private
@@ -122,7 +122,7 @@ module mod_params
     type(run_settings_t) :: run
     type(verification_settings_t) :: verification
     type(particles_settings_t) :: particles
-    type(contact_settings_t) :: contact                 ! active when the group is present and the run has particles
+    type(particle_contacts_settings_t) :: contact       ! active when the group is present and the run has particles
     type(lubrication_settings_t) :: lubrication
     type(rheology_settings_t) :: rheology               ! statistics on when the group is present
     ! derived, not read
@@ -236,7 +236,7 @@ contains
     type(run_settings_t) :: run_group
     type(verification_settings_t) :: verification_group
     type(particles_settings_t) :: particles_group
-    type(contact_settings_t) :: contact_group
+    type(particle_contacts_settings_t) :: contact_group
     type(lubrication_settings_t) :: lubrication_group
     type(rheology_settings_t) :: rheology_group
     namelist /domain/ domain_group

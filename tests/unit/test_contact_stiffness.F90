@@ -45,7 +45,7 @@ program test_contact_stiffness
   use mod_kinds, only: dp, pi
   use mod_vector, only: cross
   use mod_contact, only: contact_params_t, contact_setup, contact_pair, contact_stiffness
-  use mod_particle_contacts, only: contact_settings_t, particle_contacts_t, particle_contacts_create, particle_contacts_step, &
+  use mod_particle_contacts, only: particle_contacts_settings_t, particle_contacts_t, particle_contacts_create, particle_contacts_step, &
                                    particle_contacts_add_stiffness, particle_contacts_implicit_update
   use mod_particle_system, only: particle_system_t, particle_system_reset, particle_system_add_diagonal, &
                                  particle_system_solve
@@ -267,7 +267,7 @@ contains
     integer :: step, its, c, info
     logical :: ok, have_prev
     character(len=200) :: msg
-    call particle_contacts_create(pc, 2, 1.0_dp, contact_settings_t(roughness=5.0e-3_dp, implicit=implicit_mode), &
+    call particle_contacts_create(pc, 2, 1.0_dp, particle_contacts_settings_t(roughness=5.0e-3_dp, implicit=implicit_mode), &
                           1.0_dp, [20.0_dp, 20.0_dp, 20.0_dp], .true., dt, info, msg)
     d6 = 0
     do c = 1, 6
@@ -313,7 +313,7 @@ contains
     logical :: ok, have_prev, stuck
     character(len=200) :: msg
     ! the lower wall moves at -shear_rate Ly/2: shear_rate = -2 v_wall / Ly gives +v_wall
-    call particle_contacts_create(pc, 1, 1.0_dp, contact_settings_t(roughness=5.0e-3_dp, friction=0.5_dp, &
+    call particle_contacts_create(pc, 1, 1.0_dp, particle_contacts_settings_t(roughness=5.0e-3_dp, friction=0.5_dp, &
                           normal_stiffness=p%k_n), -2 * v_wall / 20.0_dp, [20.0_dp, 20.0_dp, 20.0_dp], .true., dt, &
                           info, msg)
     call check(info == 0 .and. abs(pc%wall_velocity(1, 1) - v_wall) < 1e-15_dp, '7. wall at +0.01 e_x')
