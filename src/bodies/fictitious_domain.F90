@@ -32,7 +32,7 @@ module mod_fictitious_domain
   use petscdmda
   use petscksp
   use mod_kinds, only: dp
-  use mod_grid, only: grid_t, grid_create_box_layout, FIELD_U, FIELD_V, FIELD_W, FIELD_P
+  use mod_grid, only: grid_t, grid_create_box_layout, FIELD_P
   use mod_particles, only: particles_t, MOTION_FREE, MOTION_FROZEN, impose_motion
   use mod_particle_system, only: particle_system_reset, particle_system_add_diagonal
   use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_corrections, &
@@ -42,7 +42,8 @@ module mod_fictitious_domain
                                    particle_contacts_implicit_update
   use mod_particle_solver, only: particle_solver_t, particle_solver_create, particle_solver_solve, &
                                  particle_solver_destroy
-  use mod_solid_fraction, only: cube_fraction
+  use mod_sphere_faces, only: mac_block_t, face_list_t, field_view_t, faces_build, faces_carry, faces_moments, &
+                              faces_new_lambda, faces_update
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates, min_image
   use mod_errors, only: fatal_error
   use mod_limits, only: limit_finding_t, add_finding, LIMIT_WARN
@@ -64,13 +65,8 @@ module mod_fictitious_domain
     ! The layout of the faces with edge and corner ghosts (box stencil, mod_grid): the trilinear
     ! carry of fictitious_domain_follow reads them; the fields' own DMDAs (star) never fill them.
     DM :: carry_layout
-    ! the covered faces and cells of this rank, in runs of one sphere and one component
-    integer :: nf = 0
-    integer, allocatable :: f_ijk(:, :)
-    real(dp), allocatable :: f_r(:, :), f_alpha(:), f_relax(:)   ! r, alpha, 1/(1+gamma)
-    integer :: nruns = 0
-    integer, allocatable :: run_start(:)   ! run r (one sphere, one component) is run_start(r) .. run_start(r+1)-1
-    integer, allocatable :: run_comp(:), run_part(:)   ! its component and its sphere
+    ! the covered faces and cells of this rank, in runs of one sphere and one component (mod_sphere_faces)
+    type(face_list_t) :: faces
     real(dp), allocatable :: rigid_matrix(:, :, :)               ! M_p (6, 6, n), summed over ranks
     ! The rivals of each sphere: the spheres whose control-volume reach meets its own (centres
     ! closer than twice the reach). Only they can contest a face; elsewhere a sphere owns what it
@@ -88,14 +84,6 @@ module mod_fictitious_domain
     real(dp), allocatable :: moments(:, :)   ! (12, n): b(u~) and m(Lambda^n) of the step (fictitious_domain_moments)
     type(particle_solver_t) :: solver     ! the 6N system of the particle step and its solution
   end type fictitious_domain_t
-
-  type :: field_pointer
-    PetscScalar, pointer :: ptr(:, :, :) => null()
-  end type field_pointer
-
-  ! position of unknown c inside its cell, in cells: u on x-faces, v on y-faces, ...
-  real(dp), parameter :: stagger(3, 4) = reshape([0.0_dp, 0.5_dp, 0.5_dp, 0.5_dp, 0.0_dp, 0.5_dp, &
-       0.5_dp, 0.5_dp, 0.0_dp, 0.5_dp, 0.5_dp, 0.5_dp], [3, 4])
 
 contains
 
@@ -152,25 +140,22 @@ contains
     end do
     PetscCall(grid_create_box_layout(grid, fd%carry_layout, ierr))
     PetscCall(particle_solver_create(fd%solver, ierr))
-    allocate(fd%f_ijk(3, 1024), fd%f_r(3, 1024), fd%f_alpha(1024), fd%f_relax(1024))
-    allocate(fd%run_start(1), fd%run_comp(0), fd%run_part(0))
   end subroutine fictitious_domain_create
 
   ! The geometry at the current positions: face ownership, alpha, the face list and M_p.
   ! Collective (M_p is summed over ranks).
-  ! Each sphere visits the unknowns its control volumes can meet and computes alpha once. An
-  ! unknown no rival can reach is its own outright. Where rivals reach (15 % of the faces of the
-  ! paper scene), the sphere computes their alphas there itself, with the very arithmetic each
-  ! rival's own visit uses (the same unwrapped index, the same expressions), so every sphere
-  ! takes the same decision: the largest alpha owns the unknown (ties to the lower index) with
-  ! weight alpha - the runner-up's. No grid-sized ownership arrays, no second pass (before 2026-11-26 the
-  ! geometry was half of the paper scene's step).
+  ! Each sphere visits the unknowns of this rank's block its control volumes can meet and
+  ! computes alpha once (mod_sphere_faces' faces_build). Where rivals reach (15 % of the faces of
+  ! the paper scene), the sphere computes their alphas there itself, so every sphere takes the same
+  ! decision without grid-sized ownership arrays or a second pass (before 2026-11-26 the geometry
+  ! was half of the paper scene's step).
   subroutine fictitious_domain_geometry(grid, fd, parts)
     type(grid_t), intent(in) :: grid
     type(fictitious_domain_t), intent(inout) :: fd
     type(particles_t), intent(in) :: parts
-    integer :: q, c, ierr, f0
-    real(dp) :: radius
+    integer :: ierr
+    real(dp) :: radius, h
+    type(mac_block_t) :: block
 
     PetscCallA(event_begin(EVENT_GEOMETRY, ierr))
     radius = parts%radius + fd%radius_offset * grid%h
@@ -181,200 +166,15 @@ contains
     end if
     if (.not. allocated(fd%rigid_matrix)) allocate(fd%rigid_matrix(6, 6, parts%n))
     fd%rigid_matrix = 0.0_dp
-    fd%nf = 0
-    fd%nruns = 0
-    if (size(fd%run_start) < 4 * parts%n + 1) then
-      deallocate(fd%run_start, fd%run_comp, fd%run_part)
-      allocate(fd%run_start(4 * parts%n + 1), fd%run_comp(4 * parts%n), fd%run_part(4 * parts%n))
-    end if
-    do q = 1, parts%n
-      do c = 1, 4
-        f0 = fd%nf + 1
-        call visit(grid, fd, parts, q, c, radius)
-        if (fd%nf >= f0) then
-          fd%nruns = fd%nruns + 1
-          fd%run_start(fd%nruns) = f0
-          fd%run_comp(fd%nruns) = c
-          fd%run_part(fd%nruns) = q
-        end if
-      end do
-    end do
-    fd%run_start(fd%nruns + 1) = fd%nf + 1
+    h = grid%h
+    block = mac_block_t(h=h, box=grid%box, n=grid%n, walls=grid%walls, lo=grid%lo, hi=grid%hi)
+    ! the unit of gamma = kappa (1 - alpha) beta h^2 / eta (doc/METHOD.md §3.3)
+    call faces_build(block, parts%position, radius, fd%kappa * fd%beta * h**2 / fd%eta, fd%rival_start, &
+                     fd%rival_part, fd%rival_offset, fd%faces, fd%rigid_matrix)
     call MPI_Allreduce(MPI_IN_PLACE, fd%rigid_matrix, 36 * parts%n, MPI_DOUBLE_PRECISION, MPI_SUM, &
                        PETSC_COMM_WORLD, ierr)
     PetscCallA(event_end(EVENT_GEOMETRY, ierr))
   end subroutine fictitious_domain_geometry
-
-  ! The unknowns of component c (1..4, 4 = cell centres) that particle q owns, listed with their
-  ! owned (wrapped) index, their offset r from the centre (unwrapped, so no image logic), their
-  ! weight and relaxation; M_p of q accumulated (sum_f w g g^T dV over the non-zeros of g).
-  subroutine visit(grid, fd, parts, q, c, radius)
-    type(grid_t), intent(in) :: grid
-    type(fictitious_domain_t), intent(inout) :: fd
-    type(particles_t), intent(in) :: parts
-    integer, intent(in) :: q, c
-    real(dp), intent(in) :: radius
-    ! indices per axis: at most 2R/h + 2 (the box below), with one to spare for round-off
-    integer :: wrapped(ceiling(2.0_dp * radius / grid%h) + 3, 3)
-    logical :: mine(ceiling(2.0_dp * radius / grid%h) + 3, 3)
-    integer :: lo(3), hi(3), i, j, k, d, m, ilo, ihi, iw, jw, kw, f, nrow, idx(3), arm(2)
-    real(dp) :: centre(3), r(3), a, h, reach2, inside2, rest2, chord, gamma_unit, rival2, second, rival_alpha
-    real(dp) :: w, dv, sgn(2), block3(3, 3), sums6(6), v2, v3
-    logical :: owned
-    ! the rivals that reach the current row, and what is left of the reach there
-    integer :: row_rival(max(1, fd%rival_start(q + 1) - fd%rival_start(q)))
-    real(dp) :: row_rest2(max(1, fd%rival_start(q + 1) - fd%rival_start(q)))
-    h = grid%h
-    dv = h**3
-    centre = parts%position(:, q)
-    ! The control volume of unknown i spans (i + stagger +- 1/2) h, so only |(i + stagger) h - x_d|
-    ! < R + h/2 can meet the sphere: the box below is that range, no wider (doc/BENCHMARKS.md §8: the loops are
-    ! most of the geometry's cost). Each index is wrapped and tested for ownership once per axis.
-    do d = 1, 3
-      lo(d) = floor((centre(d) - radius) / h - stagger(d, c) - 0.5_dp)
-      hi(d) = min(ceiling((centre(d) + radius) / h - stagger(d, c) + 0.5_dp), lo(d) + size(mine, 1) - 1)
-      do m = 1, hi(d) - lo(d) + 1
-        i = lo(d) + m - 1
-        if (d == 2 .and. grid%walls) then
-          wrapped(m, d) = i
-          ! outside the walls there is no fluid; on the wall itself v = 0 stays (no constraint)
-          mine(m, d) = i >= 0 .and. i < grid%n(2) .and. .not. (c == FIELD_V .and. i == 0)
-        else
-          wrapped(m, d) = modulo(i, grid%n(d))
-          mine(m, d) = .true.
-        end if
-        mine(m, d) = mine(m, d) .and. wrapped(m, d) >= grid%lo(d) .and. wrapped(m, d) <= grid%hi(d)
-      end do
-    end do
-    ! beyond this distance from the centre a control volume lies wholly outside (its half-diagonal)
-    reach2 = (radius + 0.5_dp * sqrt(3.0_dp) * h)**2
-    ! within this distance it lies wholly inside (alpha = 1)
-    inside2 = -1.0_dp
-    if (radius > 0.5_dp * sqrt(3.0_dp) * h) inside2 = (radius - 0.5_dp * sqrt(3.0_dp) * h)**2
-    ! room for every unknown of the box, once, so that the loop below stores without checks
-    call reserve_faces(fd, fd%nf + product(hi - lo + 1))
-    ! gamma = kappa (1 - alpha) beta h^2 / eta (relaxation_gamma, doc/METHOD.md §3.3), written out
-    gamma_unit = 0.0_dp
-    sums6 = 0.0_dp
-    if (c /= FIELD_P) then
-      gamma_unit = fd%kappa * fd%beta * h**2 / fd%eta
-      call torque_arm(c, idx, arm, sgn)
-    end if
-    do k = lo(3), hi(3)
-      if (.not. mine(k - lo(3) + 1, 3)) cycle
-      kw = wrapped(k - lo(3) + 1, 3)
-      r(3) = (k + stagger(3, c)) * h - centre(3)
-      do j = lo(2), hi(2)
-        if (.not. mine(j - lo(2) + 1, 2)) cycle
-        jw = wrapped(j - lo(2) + 1, 2)
-        r(2) = (j + stagger(2, c)) * h - centre(2)
-        rest2 = reach2 - r(2)**2 - r(3)**2
-        if (rest2 <= 0.0_dp) cycle
-        ! the row's chord, widened by a cell for round-off; the test below decides
-        chord = sqrt(rest2)
-        ilo = max(lo(1), floor((centre(1) - chord) / h - stagger(1, c)) - 1)
-        ihi = min(hi(1), ceiling((centre(1) + chord) / h - stagger(1, c)) + 1)
-        ! the rivals whose reach meets this row at all: only they can contest its unknowns (a
-        ! margin of 1e-12 keeps the test on the safe side of round-off: contested if in doubt)
-        nrow = 0
-        do m = fd%rival_start(q), fd%rival_start(q + 1) - 1
-          rival2 = (r(2) - fd%rival_offset(2, m))**2 + (r(3) - fd%rival_offset(3, m))**2
-          if (rival2 >= reach2 * (1.0_dp + 1.0e-12_dp)) cycle
-          nrow = nrow + 1
-          row_rival(nrow) = m
-          row_rest2(nrow) = reach2 * (1.0_dp + 1.0e-12_dp) - rival2
-        end do
-        do i = ilo, ihi
-          if (.not. mine(i - lo(1) + 1, 1)) cycle
-          r(1) = (i + stagger(1, c)) * h - centre(1)
-          a = alpha_at(r)
-          if (a <= 0.0_dp) cycle
-          iw = wrapped(i - lo(1) + 1, 1)
-          ! the rivals that reach this unknown: the largest alpha owns it, the runner-up's is taken off
-          second = 0.0_dp
-          owned = .true.
-          do m = 1, nrow
-            if ((r(1) - fd%rival_offset(1, row_rival(m)))**2 >= row_rest2(m)) cycle
-            rival_alpha = alpha_of_rival(fd%rival_part(row_rival(m)), [iw, jw, kw])
-            if (rival_alpha > a .or. (rival_alpha == a .and. fd%rival_part(row_rival(m)) < q)) then
-              owned = .false.
-              exit
-            end if
-            second = max(second, rival_alpha)
-          end do
-          if (.not. owned) cycle
-          a = a - second
-          if (a <= 0.0_dp) cycle
-          f = fd%nf + 1
-          fd%nf = f
-          fd%f_ijk(:, f) = [iw, jw, kw]
-          fd%f_r(:, f) = r
-          fd%f_alpha(f) = a
-          if (a == 1.0_dp) then
-            fd%f_relax(f) = 1.0_dp       ! a covered face does not relax (gamma = 0)
-          else
-            fd%f_relax(f) = 1.0_dp / (1.0_dp + gamma_unit * (1.0_dp - a))
-          end if
-          if (c == FIELD_P) cycle
-          ! w g g^T on the non-zeros (1, v2, v3) of g: six distinct sums
-          v2 = sgn(1) * r(arm(1))
-          v3 = sgn(2) * r(arm(2))
-          w = fd%f_alpha(f) * fd%f_relax(f) * dv
-          sums6 = sums6 + [w, w * v2, w * v3, w * v2 * v2, w * v2 * v3, w * v3 * v3]
-        end do
-      end do
-    end do
-    ! M_p gains w g g^T on the three non-zeros of g
-    if (c /= FIELD_P) then
-      block3 = reshape([sums6(1), sums6(2), sums6(3), sums6(2), sums6(4), sums6(5), sums6(3), sums6(5), sums6(6)], &
-                       [3, 3])
-      fd%rigid_matrix(idx, idx, q) = fd%rigid_matrix(idx, idx, q) + block3
-    end if
-  contains
-    ! The cover of the control volume at offset x from a centre (0 beyond the reach).
-    real(dp) function alpha_at(x)
-      real(dp), intent(in) :: x(3)
-      real(dp) :: d2
-      d2 = x(1)**2 + x(2)**2 + x(3)**2
-      if (d2 >= reach2) then
-        alpha_at = 0.0_dp
-      else if (d2 <= inside2) then
-        alpha_at = 1.0_dp      ! the whole control volume is inside (cube_fraction's first test)
-      else
-        alpha_at = cube_fraction(x, radius, h)
-      end if
-    end function alpha_at
-
-    ! Rival p's alpha of the unknown with wrapped index ijk, computed as p's own visit does: from
-    ! the image of the unknown nearest to p's centre (the one p's box holds).
-    real(dp) function alpha_of_rival(p, ijk)
-      integer, intent(in) :: p, ijk(3)
-      integer :: d, unwrapped
-      real(dp) :: x(3)
-      do d = 1, 3
-        unwrapped = ijk(d)
-        if (.not. (d == 2 .and. grid%walls)) unwrapped = ijk(d) + grid%n(d) * &
-             nint((parts%position(d, p) - (ijk(d) + stagger(d, c)) * h) / grid%box(d))
-        x(d) = (unwrapped + stagger(d, c)) * h - parts%position(d, p)
-      end do
-      alpha_of_rival = alpha_at(x)
-    end function alpha_of_rival
-  end subroutine visit
-
-  ! Room for n faces in the face list (its arrays grow by doubling, kept between steps).
-  subroutine reserve_faces(fd, n)
-    type(fictitious_domain_t), intent(inout) :: fd
-    integer, intent(in) :: n
-    integer :: m
-    integer, allocatable :: t3(:, :)
-    real(dp), allocatable :: tr(:), tr3(:, :)
-    if (n <= size(fd%f_alpha)) return
-    m = max(n, 2 * size(fd%f_alpha))
-    allocate(t3(3, m)); t3(:, 1:fd%nf) = fd%f_ijk(:, 1:fd%nf); call move_alloc(t3, fd%f_ijk)
-    allocate(tr3(3, m)); tr3(:, 1:fd%nf) = fd%f_r(:, 1:fd%nf); call move_alloc(tr3, fd%f_r)
-    allocate(tr(m)); tr(1:fd%nf) = fd%f_alpha(1:fd%nf); call move_alloc(tr, fd%f_alpha)
-    allocate(tr(m)); tr(1:fd%nf) = fd%f_relax(1:fd%nf); call move_alloc(tr, fd%f_relax)
-  end subroutine reserve_faces
 
   ! The rivals of each sphere: the spheres whose centres are closer than twice the reach
   ! R + sqrt(3) h/2, so that some control volume may meet both (mod_neighbours' cell lists, with a
@@ -475,9 +275,8 @@ contains
     real(dp), intent(in) :: displacement(:, :)
     PetscErrorCode, intent(out) :: ierr
     Vec :: old(3)
-    type(field_pointer) :: lam_old(3), lam(3)
-    real(dp) :: t(3), w(3), weight(8)
-    integer :: run, f0, f1, c, q, o(3), a, b, e, m, corner(3, 8)
+    type(field_view_t) :: lam_old(3), lam(3)
+    integer :: c
     character(len=200) :: text
 
     call fictitious_domain_geometry(grid, fd, parts)
@@ -492,41 +291,16 @@ contains
       PetscCall(DMGlobalToLocalBegin(fd%carry_layout, fd%lambda(c), INSERT_VALUES, old(c), ierr))
       PetscCall(DMGlobalToLocalEnd(fd%carry_layout, fd%lambda(c), INSERT_VALUES, old(c), ierr))
       PetscCall(VecSet(fd%lambda(c), 0.0_dp, ierr))
-      PetscCall(DMDAVecGetArrayReadF90(fd%carry_layout, old(c), lam_old(c)%ptr, ierr))
-      PetscCall(DMDAVecGetArrayF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
+      PetscCall(DMDAVecGetArrayReadF90(fd%carry_layout, old(c), lam_old(c)%v, ierr))
+      PetscCall(DMDAVecGetArrayF90(grid%da(c), fd%lambda(c), lam(c)%v, ierr))
     end do
-    ! The list comes in runs of one sphere and one component: the eight corner offsets and
-    ! weights are set once per run, and each run is carried by a kernel on plain arrays.
-    do run = 1, fd%nruns
-      f0 = fd%run_start(run)
-      f1 = fd%run_start(run + 1) - 1
-      c = fd%run_comp(run)
-      q = fd%run_part(run)
-      if (c /= FIELD_P) then
-        ! x_f - dX in cells from the face itself: offsets o and o + 1 in {-1, 0, 1}, weights w of o + 1
-        t = -displacement(:, q) / grid%h
-        o = floor(t)
-        w = t - o
-        m = 0
-        do e = 0, 1
-          do b = 0, 1
-            do a = 0, 1
-              m = m + 1
-              corner(:, m) = o + [a, b, e]
-              weight(m) = merge(w(1), 1.0_dp - w(1), a == 1) * merge(w(2), 1.0_dp - w(2), b == 1) &
-                        * merge(w(3), 1.0_dp - w(3), e == 1)
-            end do
-          end do
-        end do
-        call carry_run(lam_old(c)%ptr, lam(c)%ptr, grid%glo, grid%ghi, grid%lo, grid%hi, f1 - f0 + 1, &
-                       fd%f_ijk(:, f0:f1), corner, weight, any(displacement(:, q) /= 0.0_dp), &
-                       grid%walls, grid%n(2))
-      end if
-    end do
+    ! run by run: the eight corner offsets and weights set once per run (mod_sphere_faces)
+    call faces_carry(fd%faces, lam_old, lam, grid%glo, grid%ghi, grid%lo, grid%hi, displacement, grid%h, &
+                     grid%walls, grid%n(2))
     fd%lambda_listed = .true.
     do c = 1, 3
-      PetscCall(DMDAVecRestoreArrayF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
-      PetscCall(DMDAVecRestoreArrayReadF90(fd%carry_layout, old(c), lam_old(c)%ptr, ierr))
+      PetscCall(DMDAVecRestoreArrayF90(grid%da(c), fd%lambda(c), lam(c)%v, ierr))
+      PetscCall(DMDAVecRestoreArrayReadF90(fd%carry_layout, old(c), lam_old(c)%v, ierr))
       PetscCall(DMRestoreLocalVector(fd%carry_layout, old(c), ierr))
     end do
     PetscCall(event_end(EVENT_CARRY, ierr))
@@ -547,9 +321,9 @@ contains
     Vec, intent(in) :: vel(3)
     integer, intent(in) :: n
     PetscErrorCode, intent(out) :: ierr
-    type(field_pointer) :: u(3), lam(3)
+    type(field_view_t) :: u(3), lam(3)
     real(dp) :: dv
-    integer :: run, f0, f1, c, q
+    integer :: c
 
     PetscCall(event_begin(EVENT_MOMENTS, ierr))
     dv = grid%h**3
@@ -559,20 +333,13 @@ contains
     if (.not. allocated(fd%moments)) allocate(fd%moments(12, n))
     fd%moments = 0.0_dp
     do c = 1, 3
-      PetscCall(DMDAVecGetArrayReadF90(grid%da(c), vel(c), u(c)%ptr, ierr))
-      PetscCall(DMDAVecGetArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
+      PetscCall(DMDAVecGetArrayReadF90(grid%da(c), vel(c), u(c)%v, ierr))
+      PetscCall(DMDAVecGetArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%v, ierr))
     end do
-    do run = 1, fd%nruns
-      f0 = fd%run_start(run)
-      f1 = fd%run_start(run + 1) - 1
-      c = fd%run_comp(run)
-      q = fd%run_part(run)
-      if (c /= FIELD_P) call moments_run(c, u(c)%ptr, lam(c)%ptr, grid%lo, grid%hi, f1 - f0 + 1, fd%f_ijk(:, f0:f1), &
-                                         fd%f_r(:, f0:f1), fd%f_alpha(f0:f1), fd%f_relax(f0:f1), dv, fd%moments(:, q))
-    end do
+    call faces_moments(fd%faces, u, lam, grid%lo, grid%hi, dv, fd%moments)
     do c = 1, 3
-      PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
-      PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), vel(c), u(c)%ptr, ierr))
+      PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%v, ierr))
+      PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), vel(c), u(c)%v, ierr))
     end do
     call MPI_Allreduce(MPI_IN_PLACE, fd%moments, 12 * n, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
     PetscCall(event_end(EVENT_MOMENTS, ierr))
@@ -638,10 +405,9 @@ contains
     PetscErrorCode, intent(out) :: ierr
     type(particle_lubrication_t), intent(inout), optional :: lubrication
     real(dp), allocatable :: sums(:, :)
-    type(field_pointer) :: u(3), lam(3)
-    PetscScalar, pointer :: p(:,:,:)
+    type(field_view_t) :: u(3), lam(3), p
     real(dp) :: dv, integral
-    integer :: run, f0, f1, c, q, n
+    integer :: c, q, n
     logical :: removed
 
     PetscCall(event_begin(EVENT_UPDATE, ierr))
@@ -656,56 +422,37 @@ contains
     removed = .not. fd%lambda_listed
     if (removed) then
       if (allocated(fd%lambda_new)) then
-        if (size(fd%lambda_new) < fd%nf) deallocate(fd%lambda_new)
+        if (size(fd%lambda_new) < fd%faces%nf) deallocate(fd%lambda_new)
       end if
-      if (.not. allocated(fd%lambda_new)) allocate(fd%lambda_new(size(fd%f_alpha)))
+      if (.not. allocated(fd%lambda_new)) allocate(fd%lambda_new(size(fd%faces%alpha)))
       do c = 1, 3
-        PetscCall(DMDAVecGetArrayReadF90(grid%da(c), vel(c), u(c)%ptr, ierr))
-        PetscCall(DMDAVecGetArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
+        PetscCall(DMDAVecGetArrayReadF90(grid%da(c), vel(c), u(c)%v, ierr))
+        PetscCall(DMDAVecGetArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%v, ierr))
       end do
-      do run = 1, fd%nruns
-        f0 = fd%run_start(run)
-        f1 = fd%run_start(run + 1) - 1
-        c = fd%run_comp(run)
-        q = fd%run_part(run)
-        if (c /= FIELD_P) call new_lambda_run(c, u(c)%ptr, lam(c)%ptr, grid%lo, grid%hi, f1 - f0 + 1, &
-             fd%f_ijk(:, f0:f1), fd%f_r(:, f0:f1), fd%f_alpha(f0:f1), fd%f_relax(f0:f1), fd%beta, &
-             parts%velocity(:, q), parts%omega(:, q), fd%lambda_new(f0:f1))
-      end do
+      call faces_new_lambda(fd%faces, u, lam, grid%lo, grid%hi, fd%beta, parts%velocity, parts%omega, fd%lambda_new)
       do c = 1, 3
-        PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
-        PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), vel(c), u(c)%ptr, ierr))
+        PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%v, ierr))
+        PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), vel(c), u(c)%v, ierr))
         PetscCall(VecAXPY(vel(c), -1.0_dp / fd%beta, fd%lambda(c), ierr))
         PetscCall(VecSet(fd%lambda(c), 0.0_dp, ierr))
       end do
     end if
     do c = 1, 3
-      PetscCall(DMDAVecGetArrayF90(grid%da(c), vel(c), u(c)%ptr, ierr))
-      PetscCall(DMDAVecGetArrayF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
+      PetscCall(DMDAVecGetArrayF90(grid%da(c), vel(c), u(c)%v, ierr))
+      PetscCall(DMDAVecGetArrayF90(grid%da(c), fd%lambda(c), lam(c)%v, ierr))
     end do
-    PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_P), pressure, p, ierr))
-    do run = 1, fd%nruns
-      f0 = fd%run_start(run)
-      f1 = fd%run_start(run + 1) - 1
-      c = fd%run_comp(run)
-      q = fd%run_part(run)
-      if (c == FIELD_P) then
-        ! the interior pressure of doc/METHOD.md §3.7
-        call pressure_run(p, grid%lo, grid%hi, f1 - f0 + 1, fd%f_ijk(:, f0:f1), fd%f_alpha(f0:f1), dv, sums(16, q))
-      else if (removed) then
-        call update_run(c, u(c)%ptr, lam(c)%ptr, grid%lo, grid%hi, f1 - f0 + 1, fd%f_ijk(:, f0:f1), &
-             fd%f_r(:, f0:f1), fd%f_alpha(f0:f1), fd%f_relax(f0:f1), fd%beta, dv, parts%velocity(:, q), &
-             parts%omega(:, q), sums(:, q), fd%lambda_new(f0:f1))
-      else
-        call update_run(c, u(c)%ptr, lam(c)%ptr, grid%lo, grid%hi, f1 - f0 + 1, fd%f_ijk(:, f0:f1), &
-             fd%f_r(:, f0:f1), fd%f_alpha(f0:f1), fd%f_relax(f0:f1), fd%beta, dv, parts%velocity(:, q), &
-             parts%omega(:, q), sums(:, q))
-      end if
-    end do
-    PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_P), pressure, p, ierr))
+    PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_P), pressure, p%v, ierr))
+    ! with the interior pressure of doc/METHOD.md §3.7 from the runs of cell centres
+    if (removed) then
+      call faces_update(fd%faces, u, lam, p, grid%lo, grid%hi, fd%beta, dv, parts%velocity, parts%omega, sums, &
+                        fd%lambda_new)
+    else
+      call faces_update(fd%faces, u, lam, p, grid%lo, grid%hi, fd%beta, dv, parts%velocity, parts%omega, sums)
+    end if
+    PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_P), pressure, p%v, ierr))
     do c = 1, 3
-      PetscCall(DMDAVecRestoreArrayF90(grid%da(c), fd%lambda(c), lam(c)%ptr, ierr))
-      PetscCall(DMDAVecRestoreArrayF90(grid%da(c), vel(c), u(c)%ptr, ierr))
+      PetscCall(DMDAVecRestoreArrayF90(grid%da(c), fd%lambda(c), lam(c)%v, ierr))
+      PetscCall(DMDAVecRestoreArrayF90(grid%da(c), vel(c), u(c)%v, ierr))
     end do
     call MPI_Allreduce(MPI_IN_PLACE, sums, 16 * n, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
     if (present(lubrication)) call particle_lubrication_corrections(lubrication, parts%velocity, parts%omega)
@@ -722,152 +469,6 @@ contains
       call particle_lubrication_add_corrections(lubrication, parts%force_hydro, parts%torque_hydro, parts%stresslet_hydro)
     PetscCall(event_end(EVENT_UPDATE, ierr))
   end subroutine fictitious_domain_update
-
-
-  ! The kernels below take one run (one sphere, one velocity component c) on plain arrays with the
-  ! bounds of the rank's part of the grid, so that the compiler sees fixed strides (doc/DESIGN.md "Fictitious domain", Face runs).
-  ! g = (e_c, r x e_c) enters through its three non-zeros: 1 at idx(1), sgn(1) r(k(1)) at idx(2)
-  ! and sgn(2) r(k(2)) at idx(3) (torque_arm, once per run).
-
-  pure subroutine torque_arm(c, idx, k, sgn)
-    integer, intent(in) :: c
-    integer, intent(out) :: idx(3), k(2)
-    real(dp), intent(out) :: sgn(2)
-    select case (c)
-    case (1)
-      idx = [1, 5, 6]; k = [3, 2]; sgn = [1.0_dp, -1.0_dp]
-    case (2)
-      idx = [2, 4, 6]; k = [3, 1]; sgn = [-1.0_dp, 1.0_dp]
-    case default
-      idx = [3, 4, 5]; k = [2, 1]; sgn = [1.0_dp, -1.0_dp]
-    end select
-  end subroutine torque_arm
-
-  ! Lambda carried by the displacement: trilinear from the eight corners of x_f - dX (fictitious_domain_follow).
-  subroutine carry_run(old, new, glo, ghi, lo, hi, nfaces, ijk, corner, weight, moved, walls, ny)
-    integer, intent(in) :: glo(3), ghi(3), lo(3), hi(3), nfaces, ijk(3, nfaces), corner(3, 8), ny
-    real(dp), intent(in) :: old(glo(1):ghi(1), glo(2):ghi(2), glo(3):ghi(3)), weight(8)
-    real(dp), intent(inout) :: new(lo(1):hi(1), lo(2):hi(2), lo(3):hi(3))
-    logical, intent(in) :: moved, walls
-    integer :: f, m, i, j, k, jj, i0, j0, k0
-    real(dp) :: value
-    if (.not. moved) then
-      do f = 1, nfaces
-        new(ijk(1, f), ijk(2, f), ijk(3, f)) = old(ijk(1, f), ijk(2, f), ijk(3, f))
-      end do
-      return
-    end if
-    ! corner m = 1..8 is (o1 + a, o2 + b, o3 + e), a fastest (fictitious_domain_follow)
-    i0 = corner(1, 1); j0 = corner(2, 1); k0 = corner(3, 1)
-    do f = 1, nfaces
-      i = ijk(1, f) + i0; j = ijk(2, f) + j0; k = ijk(3, f) + k0
-      if (walls .and. (j < 0 .or. j + 1 >= ny)) then
-        ! beyond a wall there is no fluid and no Lambda (the periodic ghost would wrap)
-        value = 0.0_dp
-        do m = 1, 8
-          jj = ijk(2, f) + corner(2, m)
-          if (jj < 0 .or. jj >= ny) cycle
-          value = value + weight(m) * old(ijk(1, f) + corner(1, m), jj, ijk(3, f) + corner(3, m))
-        end do
-      else
-        value = ((((((weight(1) * old(i, j, k) + weight(2) * old(i + 1, j, k)) + weight(3) * old(i, j + 1, k)) &
-                + weight(4) * old(i + 1, j + 1, k)) + weight(5) * old(i, j, k + 1)) + weight(6) * old(i + 1, j, k + 1)) &
-                + weight(7) * old(i, j + 1, k + 1)) + weight(8) * old(i + 1, j + 1, k + 1)
-      end if
-      new(ijk(1, f), ijk(2, f), ijk(3, f)) = value
-    end do
-  end subroutine carry_run
-
-  ! moments(1:6) += sum w u~_c g dV, moments(7:12) += sum Lambda^n/(1+gamma) g dV (fictitious_domain_moments).
-  subroutine moments_run(c, u, lam, lo, hi, nfaces, ijk, r, alpha, relax, dv, moments)
-    integer, intent(in) :: c, lo(3), hi(3), nfaces, ijk(3, nfaces)
-    real(dp), intent(in) :: u(lo(1):hi(1), lo(2):hi(2), lo(3):hi(3)), lam(lo(1):hi(1), lo(2):hi(2), lo(3):hi(3))
-    real(dp), intent(in) :: r(3, nfaces), alpha(nfaces), relax(nfaces), dv
-    real(dp), intent(inout) :: moments(12)
-    integer :: f, idx(3), k(2)
-    real(dp) :: val(3), b(3), m(3), su, sl, sgn(2)
-    call torque_arm(c, idx, k, sgn)
-    b = 0.0_dp
-    m = 0.0_dp
-    do f = 1, nfaces
-      val = [1.0_dp, sgn(1) * r(k(1), f), sgn(2) * r(k(2), f)]
-      su = alpha(f) * relax(f) * u(ijk(1, f), ijk(2, f), ijk(3, f)) * dv
-      sl = lam(ijk(1, f), ijk(2, f), ijk(3, f)) * relax(f) * dv
-      b = b + su * val
-      m = m + sl * val
-    end do
-    moments(idx) = moments(idx) + b
-    moments(6 + idx) = moments(6 + idx) + m
-  end subroutine moments_run
-
-  ! Lambda^{n+1} = [Lambda^n + beta alpha (g.U - u~)]/(1 + gamma) of each face of the run.
-  subroutine new_lambda_run(c, u, lam, lo, hi, nfaces, ijk, r, alpha, relax, beta, velocity, omega, lambda_new)
-    integer, intent(in) :: c, lo(3), hi(3), nfaces, ijk(3, nfaces)
-    real(dp), intent(in) :: u(lo(1):hi(1), lo(2):hi(2), lo(3):hi(3)), lam(lo(1):hi(1), lo(2):hi(2), lo(3):hi(3))
-    real(dp), intent(in) :: r(3, nfaces), alpha(nfaces), relax(nfaces), beta, velocity(3), omega(3)
-    real(dp), intent(out) :: lambda_new(nfaces)
-    integer :: f, idx(3), k(2)
-    real(dp) :: rigid, sgn(2)
-    call torque_arm(c, idx, k, sgn)
-    do f = 1, nfaces
-      rigid = velocity(c) + sgn(1) * r(k(1), f) * omega(idx(2) - 3) + sgn(2) * r(k(2), f) * omega(idx(3) - 3)
-      lambda_new(f) = (lam(ijk(1, f), ijk(2, f), ijk(3, f)) + beta * alpha(f) &
-                       * (rigid - u(ijk(1, f), ijk(2, f), ijk(3, f)))) * relax(f)
-    end do
-  end subroutine new_lambda_run
-
-  ! One run of fictitious_domain_update: Lambda^{n+1} (from lambda_new when given, the grid then already free
-  ! of Lambda^n), u^{n+1} = u~ - Lambda^n/beta + Lambda^{n+1}/beta, and the run's force, torque
-  ! and stresslet added to sums(1:15) (the 3x3 block stored by columns in 7:15).
-  subroutine update_run(c, u, lam, lo, hi, nfaces, ijk, r, alpha, relax, beta, dv, velocity, omega, sums, lambda_new)
-    integer, intent(in) :: c, lo(3), hi(3), nfaces, ijk(3, nfaces)
-    real(dp), intent(inout) :: u(lo(1):hi(1), lo(2):hi(2), lo(3):hi(3)), lam(lo(1):hi(1), lo(2):hi(2), lo(3):hi(3))
-    real(dp), intent(in) :: r(3, nfaces), alpha(nfaces), relax(nfaces), beta, dv, velocity(3), omega(3)
-    real(dp), intent(inout) :: sums(16)
-    real(dp), intent(in), optional :: lambda_new(nfaces)
-    integer :: f, i, j, k, idx(3), arm(2), d
-    real(dp) :: val(3), rigid, b, force(3), first(3), bd, sgn(2)
-    call torque_arm(c, idx, arm, sgn)
-    force = 0.0_dp
-    first = 0.0_dp
-    do f = 1, nfaces
-      i = ijk(1, f); j = ijk(2, f); k = ijk(3, f)
-      val = [1.0_dp, sgn(1) * r(arm(1), f), sgn(2) * r(arm(2), f)]
-      if (present(lambda_new)) then
-        b = lambda_new(f)
-        u(i, j, k) = u(i, j, k) + b / beta
-      else
-        rigid = velocity(c) + val(2) * omega(idx(2) - 3) + val(3) * omega(idx(3) - 3)
-        b = (lam(i, j, k) + beta * alpha(f) * (rigid - u(i, j, k))) * relax(f)
-        u(i, j, k) = (u(i, j, k) + (-1.0_dp / beta) * lam(i, j, k)) + b / beta
-      end if
-      lam(i, j, k) = b
-      ! force -Lambda e_c dV and torque -r x (Lambda e_c) dV: -Lambda dV times g
-      bd = b * dv
-      force = force - bd * val
-      ! -1/2 Lambda dV (r e_c + e_c r): column c and row c of the 3x3 block; r_d Lambda dV summed here
-      first = first + bd * r(:, f)
-    end do
-    sums(idx) = sums(idx) + force
-    do d = 1, 3
-      sums(6 + d + 3 * (c - 1)) = sums(6 + d + 3 * (c - 1)) - 0.5_dp * first(d)
-      sums(6 + c + 3 * (d - 1)) = sums(6 + c + 3 * (d - 1)) - 0.5_dp * first(d)
-    end do
-  end subroutine update_run
-
-  ! The interior pressure sum_cells alpha p dV of one run of cell centres (doc/METHOD.md §3.7).
-  subroutine pressure_run(p, lo, hi, nfaces, ijk, alpha, dv, integral)
-    integer, intent(in) :: lo(3), hi(3), nfaces, ijk(3, nfaces)
-    real(dp), intent(in) :: p(lo(1):hi(1), lo(2):hi(2), lo(3):hi(3)), alpha(nfaces), dv
-    real(dp), intent(inout) :: integral
-    integer :: f
-    real(dp) :: total
-    total = 0.0_dp
-    do f = 1, nfaces
-      total = total + alpha(f) * p(ijk(1, f), ijk(2, f), ijk(3, f))
-    end do
-    integral = integral + total * dv
-  end subroutine pressure_run
 
 
   subroutine fictitious_domain_destroy(fd, ierr)

@@ -4,14 +4,16 @@
 ! Defaults (CG, geometric multigrid on the DMDA hierarchy, tolerances from the deck) go into the
 ! options database only where the user gave nothing, then KSPSetFromOptions runs: the command line
 ! always wins, e.g. -p_pc_type hypre or -u_ksp_rtol 1e-12. Operators are rediscretised on every
-! multigrid level by compute_operator, which knows the walls (see mod_grid for the layout).
+! multigrid level by compute_operator, which knows the walls (see mod_grid for the layout); what it
+! needs comes with each solver (operator_context_t, the callback's context), so solvers of
+! different coefficients coexist.
 #include <petsc/finclude/petscksp.h>
 module mod_solvers
   use petscksp
   use petscdmda
   use, intrinsic :: iso_c_binding, only: C_INT
   use mod_kinds, only: dp
-  use mod_grid, only: grid_t, FIELD_U, FIELD_V, FIELD_W, FIELD_P, field_names, direct_solves_wanted
+  use mod_grid, only: grid_t, FIELD_V, FIELD_P, field_names, direct_solves_wanted
   use mod_errors, only: fatal_error, log_line
   use mod_petsc_options, only: set_default_option
   use mod_fft_solver, only: fft_solver_t, fft_create, fft_solve, fft_destroy
@@ -19,6 +21,17 @@ module mod_solvers
   private
   public :: solver_t, solvers_configure, solver_create, solver_solve, solver_destroy
   public :: solver_cold_solve, fft_planner_flags
+
+  ! What compute_operator needs to assemble a solver's operator on any multigrid level: PETSc
+  ! hands it to the callback as its context (KSPSetComputeOperators), and DMCoarsen passes it on
+  ! to the coarse levels. Helmholtz: mass*I - diffusion*lap; Poisson: -lap.
+  type :: operator_context_t
+    integer :: field = 0
+    real(dp) :: mass = 0.0_dp
+    real(dp) :: diffusion = 0.0_dp
+    real(dp) :: box(3) = 1.0_dp     ! box lengths: the cell size of a level is box(1)/cells
+    logical :: walls = .true.       ! walls at y = 0 and y = Ly
+  end type operator_context_t
 
   type :: solver_t
     KSP :: ksp
@@ -29,43 +42,49 @@ module mod_solvers
     MatNullSpace :: nullspace
     logical :: direct = .false.     ! solved by fast transforms (mod_fft_solver), no KSP
     type(fft_solver_t) :: fft
+    ! the callback's context, on the heap: PETSc keeps its address, which must not move when the
+    ! solver_t is copied or its holder reallocated
+    type(operator_context_t), pointer :: context => null()
   end type solver_t
 
-  ! Operator coefficients, shared with the callback (set once by solvers_configure).
-  ! Helmholtz: mass*I - diffusion*lap; Poisson: -lap.
-  real(dp), save :: mass_coefficient = 0.0_dp
-  real(dp), save :: diffusion_coefficient = 0.0_dp
-  real(dp), save :: box_lengths(3) = 1.0_dp
-  logical, save :: has_walls = .true.
-  integer, save, target :: field_ids(4) = [FIELD_U, FIELD_V, FIELD_W, FIELD_P]
+  ! The coefficients solver_create gives the solvers it is not told otherwise (solvers_configure).
+  type(operator_context_t), save :: configured
 
 contains
 
-  ! mass = Re/dt, diffusion = theta*eta: the implicit part of the viscous step (doc/METHOD.md §2.2).
+  ! mass = Re/dt, diffusion = theta*eta: the implicit part of the viscous step (doc/METHOD.md §2.2),
+  ! for the solvers created from now on without coefficients of their own (solver_create).
   subroutine solvers_configure(mass, diffusion, box, walls)
     real(dp), intent(in) :: mass, diffusion, box(3)
     logical, intent(in) :: walls
-    mass_coefficient = mass
-    diffusion_coefficient = diffusion
-    box_lengths = box
-    has_walls = walls
+    configured%mass = mass
+    configured%diffusion = diffusion
+    configured%box = box
+    configured%walls = walls
   end subroutine solvers_configure
 
   ! rtol: relative tolerance from the deck. atol: the residual norm at which the solve stops
   ! whatever |b| is; the caller sets it at round-off level of a physically sized right-hand side,
   ! so a right-hand side that is itself round-off (a steady state) costs no iterations.
   ! krylov, optional (its value is not read): a Krylov solver whatever -fluid_solver says (the
-  ! multigrid yardstick of -bench_cold_poisson).
-  subroutine solver_create(grid, field, rtol, atol, s, ierr, krylov)
+  ! multigrid yardstick of -bench_cold_poisson). mass, diffusion, optional: this solver's Helmholtz
+  ! coefficients, else those of solvers_configure.
+  subroutine solver_create(grid, field, rtol, atol, s, ierr, krylov, mass, diffusion)
     type(grid_t), intent(in) :: grid
     integer, intent(in) :: field
     real(dp), intent(in) :: rtol, atol
     type(solver_t), intent(inout) :: s
     PetscErrorCode, intent(out) :: ierr
     logical, intent(in), optional :: krylov
+    real(dp), intent(in), optional :: mass, diffusion
     character(len=3) :: prefix
     character(len=32) :: text
 
+    if (.not. associated(s%context)) allocate(s%context)
+    s%context = configured
+    s%context%field = field
+    if (present(mass)) s%context%mass = mass
+    if (present(diffusion)) s%context%diffusion = diffusion
     s%field = field
     s%singular = (field == FIELD_P)
     s%cell_volume = grid%h**3
@@ -78,7 +97,7 @@ contains
       if (s%singular) then
         PetscCall(fft_create(grid, field, 0.0_dp, 1.0_dp, fft_planner_flags(), s%fft, ierr))
       else
-        PetscCall(fft_create(grid, field, mass_coefficient, diffusion_coefficient, fft_planner_flags(), s%fft, ierr))
+        PetscCall(fft_create(grid, field, s%context%mass, s%context%diffusion, fft_planner_flags(), s%fft, ierr))
       end if
       return
     end if
@@ -92,7 +111,7 @@ contains
     PetscCall(set_default_option(prefix//'ksp_max_it', '1000', ierr))
     ! The warm start can hold a residual far above |b| (decaying increments): no divergence test.
     PetscCall(set_default_option(prefix//'ksp_divtol', '1e100', ierr))
-    if (.not. s%singular .and. jacobi_suffices(grid%h)) then
+    if (.not. s%singular .and. jacobi_suffices(s%context, grid%h)) then
       ! A well-conditioned Helmholtz operator: point Jacobi CG beats multigrid (doc/BENCHMARKS.md §7)
       PetscCall(set_default_option(prefix//'pc_type', 'jacobi', ierr))
     else if (grid%mg_levels >= 2) then
@@ -119,11 +138,11 @@ contains
     PetscCall(KSPCreate(PETSC_COMM_WORLD, s%ksp, ierr))
     PetscCall(KSPSetOptionsPrefix(s%ksp, field_names(field)//'_', ierr))
     PetscCall(KSPSetDM(s%ksp, grid%da(field), ierr))
-    PetscCall(KSPSetComputeOperators(s%ksp, compute_operator, field_ids(field), ierr))
+    PetscCall(KSPSetComputeOperators(s%ksp, compute_operator, s%context, ierr))
     PetscCall(KSPSetInitialGuessNonzero(s%ksp, PETSC_TRUE, ierr))
     PetscCall(KSPSetFromOptions(s%ksp, ierr))
     if (field == FIELD_P) then
-      PetscCall(set_cell_centred_interpolation(s%ksp, grid%da(FIELD_P), ierr))
+      PetscCall(set_cell_centred_interpolation(s%ksp, grid%da(FIELD_P), s%context%walls, ierr))
     end if
     if (s%singular) then
       PetscCall(MatNullSpaceCreate(PETSC_COMM_WORLD, PETSC_TRUE, 0, PETSC_NULL_VEC, s%nullspace, ierr))
@@ -139,9 +158,10 @@ contains
   ! transpose, which sums the volume-scaled residuals. Cold Poisson solve on 64^3 with walls: 20
   ! iterations with the DMDA transfer, 11 fully periodic (doc/BENCHMARKS.md §8). Only when the
   ! pressure preconditioner is PCMG; -p_mg_cell_centred 0 restores the DMDA transfer.
-  subroutine set_cell_centred_interpolation(ksp, da, ierr)
+  subroutine set_cell_centred_interpolation(ksp, da, walls, ierr)
     KSP, intent(in) :: ksp
     DM, intent(in) :: da
+    logical, intent(in) :: walls
     PetscErrorCode, intent(out) :: ierr
     PC :: pc
     PCType :: pc_type
@@ -163,7 +183,7 @@ contains
     fine = da
     do l = levels - 1, 1, -1
       PetscCall(DMCoarsen(fine, PETSC_COMM_WORLD, coarse, ierr))
-      PetscCall(cell_centred_prolongation(fine, coarse, prolongation, ierr))
+      PetscCall(cell_centred_prolongation(fine, coarse, walls, prolongation, ierr))
       PetscCall(PCMGSetInterpolation(pc, l, prolongation, ierr))
       PetscCall(MatDestroy(prolongation, ierr))
       PetscCall(PCMGGetSmoother(pc, l - 1, smoother, ierr))
@@ -179,8 +199,9 @@ contains
   end subroutine set_cell_centred_interpolation
 
   ! P (fine x coarse) for cell-centred unknowns on DMDAs coarsened by 2 in every direction.
-  subroutine cell_centred_prolongation(fine, coarse, P, ierr)
+  subroutine cell_centred_prolongation(fine, coarse, walls, P, ierr)
     DM, intent(in) :: fine, coarse
+    logical, intent(in) :: walls
     Mat, intent(out) :: P
     PetscErrorCode, intent(out) :: ierr
     PetscInt :: mf(3), mc(3), procs(3), dof, sw, bt(3), st, dim
@@ -213,7 +234,7 @@ contains
             idx(2, d) = idx(1, d) + merge(-1, 1, mod(f(d), 2) == 0)
             wt(:, d) = [0.75_dp, 0.25_dp]
             if (idx(2, d) < 0 .or. idx(2, d) >= mc(d)) then
-              if (d == 2 .and. has_walls) then
+              if (d == 2 .and. walls) then
                 idx(2, d) = idx(1, d)          ! zero gradient towards the wall
               else
                 idx(2, d) = modulo(idx(2, d), mc(d))
@@ -271,11 +292,12 @@ contains
   ! needs ~sqrt(r) iterations of one product each, against ~8 V-cycles of ~10 products for
   ! multigrid. Measured on the demo grid: Jacobi is faster up to r = 48 (dt = 5e-3), by 1.6x at
   ! r = 9.6 (dt = 1e-3); the switch is set below the crossover. m = 0 (no mass) has no bound.
-  logical function jacobi_suffices(h)
+  logical function jacobi_suffices(context, h)
+    type(operator_context_t), intent(in) :: context
     real(dp), intent(in) :: h
     real(dp), parameter :: r_max = 50.0_dp
     jacobi_suffices = .false.
-    if (mass_coefficient > 0.0_dp) jacobi_suffices = 12.0_dp * diffusion_coefficient / (mass_coefficient * h**2) <= r_max
+    if (context%mass > 0.0_dp) jacobi_suffices = 12.0_dp * context%diffusion / (context%mass * h**2) <= r_max
   end function jacobi_suffices
 
   ! Solve A x = b from the guess already in x (warm start), or from zero when that guess is
@@ -395,12 +417,14 @@ contains
     PetscErrorCode, intent(out) :: ierr
     if (s%direct) then
       PetscCall(fft_destroy(s%fft, ierr))
-      return
+    else
+      PetscCall(KSPDestroy(s%ksp, ierr))
+      if (s%singular) then
+        PetscCall(MatNullSpaceDestroy(s%nullspace, ierr))
+      end if
     end if
-    PetscCall(KSPDestroy(s%ksp, ierr))
-    if (s%singular) then
-      PetscCall(MatNullSpaceDestroy(s%nullspace, ierr))
-    end if
+    ! after the KSP: it and its coarse levels' DMs hold the context's address until then
+    if (associated(s%context)) deallocate(s%context)
   end subroutine solver_destroy
 
   ! Assemble the operator of field on the DMDA of whichever multigrid level asks.
@@ -416,10 +440,11 @@ contains
   !   v with walls: j = 0 is the wall face (v = 0): identity-like row, and no row couples to it.
   ! Poisson rows (-lap, SPD form): sum over neighbours of (x_0 - x_nb)/h^2; at the walls the
   !   neighbour across is dropped (zero normal flux, v = 0 on the wall).
-  subroutine compute_operator(ksp, A, B, field, ierr)
+  ! context: the solver's operator_context_t, which PETSc passes by reference.
+  subroutine compute_operator(ksp, A, B, context, ierr)
     KSP :: ksp
     Mat :: A, B
-    integer :: field
+    type(operator_context_t) :: context
     PetscErrorCode :: ierr
     DM :: da
     PetscInt :: dim, m(3), procs(3), dof, sw, bt(3), st
@@ -434,15 +459,15 @@ contains
     PetscCall(KSPGetDM(ksp, da, ierr))
     PetscCall(DMDAGetInfo(da, dim, m(1), m(2), m(3), procs(1), procs(2), procs(3), dof, sw, bt(1), bt(2), bt(3), st, ierr))
     PetscCall(DMDAGetCorners(da, xs, ys, zs, xm, ym, zm, ierr))
-    h = box_lengths(1) / m(1)
-    poisson = (field == FIELD_P)
-    cell_centred_y = (field /= FIELD_V)
+    h = context%box(1) / m(1)
+    poisson = (context%field == FIELD_P)
+    cell_centred_y = (context%field /= FIELD_V)
     if (poisson) then
       mass = 0.0_dp
       diff = 1.0_dp
     else
-      mass = mass_coefficient
-      diff = diffusion_coefficient
+      mass = context%mass
+      diff = context%diffusion
     end if
     off = -diff / h**2 * h**3
 
@@ -452,7 +477,7 @@ contains
           row(MatStencil_i) = i; row(MatStencil_j) = j; row(MatStencil_k) = k; row(MatStencil_c) = 0
           idiag = mass
           nc = 1
-          wall_row = has_walls .and. .not. cell_centred_y .and. j == 0
+          wall_row = context%walls .and. .not. cell_centred_y .and. j == 0
           if (wall_row) then
             ! v on the wall: v = 0, scaled like the other rows.
             col(:, 1) = row
@@ -461,7 +486,7 @@ contains
             cycle
           end if
           do d = 1, 6
-            if (has_walls .and. nb(2, d) /= 0) then
+            if (context%walls .and. nb(2, d) /= 0) then
               if (cell_centred_y) then
                 ! neighbour across a wall
                 if ((j == 0 .and. nb(2, d) < 0) .or. (j == m(2) - 1 .and. nb(2, d) > 0)) then
