@@ -23,7 +23,7 @@ module mod_fluid
   use mod_params, only: config_t
   use mod_grid, only: grid_t, grid_position, grid_fixed_row, field_names, FIELD_U, FIELD_V, FIELD_W, FIELD_P, &
                       direct_solves_wanted
-  use mod_solvers, only: solver_t, solvers_configure, solver_create, solver_solve, solver_destroy, solver_cold_solve, &
+  use mod_solvers, only: solver_t, solver_create, solver_solve, solver_destroy, solver_cold_solve, &
                          fft_planner_flags
   use mod_errors, only: log_line
   use mod_manufactured, only: mms_forcing
@@ -104,7 +104,6 @@ contains
       PetscCall(set_linear_shear(grid, fl, ierr))
     end if
 
-    call solvers_configure(fl%reynolds / fl%dt, fl%theta * fl%viscosity, grid%box, grid%walls)
     ! Round-off floor of each solve: 100 machine epsilons of the right-hand side that a field of
     ! the reference speed U_ref = max(U_wall, a*gamma_dot) would give (before the h^3 row scaling),
     ! Helmholtz (Re/dt) U_ref per face, Poisson (Re/dt) U_ref/h per cell, times sqrt(cells) for
@@ -120,7 +119,7 @@ contains
         tol = cfg%fluid%pressure_tolerance
         floor = floor / grid%h
       end if
-      PetscCall(solver_create(grid, c, tol, floor, fl%solver(c), ierr))
+      PetscCall(solver_create(grid, c, tol, floor, fl%reynolds / fl%dt, fl%theta * fl%viscosity, fl%solver(c), ierr))
     end do
   end subroutine fluid_create
 
@@ -471,7 +470,7 @@ contains
     PetscCall(PetscOptionsHasName(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-bench_cold_poisson', wanted, ierr))
     if (.not. wanted) return
     if (fl%solver(FIELD_P)%direct) then
-      PetscCall(solver_create(grid, FIELD_P, 1.0e-8_dp, 0.0_dp, yardstick, ierr, krylov=.true.))
+      PetscCall(solver_create(grid, FIELD_P, 1.0e-8_dp, 0.0_dp, 0.0_dp, 1.0_dp, yardstick, ierr, krylov=.true.))
       PetscCall(solver_cold_solve(yardstick, 1.0e-8_dp, seconds, iterations, ierr))
       PetscCall(solver_destroy(yardstick, ierr))
     else

@@ -19,7 +19,7 @@ module mod_solvers
   use mod_fft_solver, only: fft_solver_t, fft_create, fft_solve, fft_destroy
   implicit none
   private
-  public :: solver_t, solvers_configure, solver_create, solver_solve, solver_destroy
+  public :: solver_t, solver_create, solver_solve, solver_destroy
   public :: solver_cold_solve, fft_planner_flags
 
   ! What compute_operator needs to assemble a solver's operator on any multigrid level: PETSc
@@ -47,44 +47,27 @@ module mod_solvers
     type(operator_context_t), pointer :: context => null()
   end type solver_t
 
-  ! The coefficients solver_create gives the solvers it is not told otherwise (solvers_configure).
-  type(operator_context_t), save :: configured
-
 contains
-
-  ! mass = Re/dt, diffusion = theta*eta: the implicit part of the viscous step (doc/METHOD.md §2.2),
-  ! for the solvers created from now on without coefficients of their own (solver_create).
-  subroutine solvers_configure(mass, diffusion, box, walls)
-    real(dp), intent(in) :: mass, diffusion, box(3)
-    logical, intent(in) :: walls
-    configured%mass = mass
-    configured%diffusion = diffusion
-    configured%box = box
-    configured%walls = walls
-  end subroutine solvers_configure
 
   ! rtol: relative tolerance from the deck. atol: the residual norm at which the solve stops
   ! whatever |b| is; the caller sets it at round-off level of a physically sized right-hand side,
   ! so a right-hand side that is itself round-off (a steady state) costs no iterations.
-  ! krylov, optional (its value is not read): a Krylov solver whatever -fluid_solver says (the
-  ! multigrid yardstick of -bench_cold_poisson). mass, diffusion, optional: this solver's Helmholtz
-  ! coefficients, else those of solvers_configure.
-  subroutine solver_create(grid, field, rtol, atol, s, ierr, krylov, mass, diffusion)
+  ! mass, diffusion: the Helmholtz operator mass*I - diffusion*lap of a velocity field (mass =
+  ! Re/dt, diffusion = theta*eta: the implicit part of the viscous step, doc/METHOD.md §2.2; the
+  ! pressure's Poisson operator does not use them). krylov, optional (its value is not read): a
+  ! Krylov solver whatever -fluid_solver says (the multigrid yardstick of -bench_cold_poisson).
+  subroutine solver_create(grid, field, rtol, atol, mass, diffusion, s, ierr, krylov)
     type(grid_t), intent(in) :: grid
     integer, intent(in) :: field
-    real(dp), intent(in) :: rtol, atol
+    real(dp), intent(in) :: rtol, atol, mass, diffusion
     type(solver_t), intent(inout) :: s
     PetscErrorCode, intent(out) :: ierr
     logical, intent(in), optional :: krylov
-    real(dp), intent(in), optional :: mass, diffusion
     character(len=3) :: prefix
     character(len=32) :: text
 
     if (.not. associated(s%context)) allocate(s%context)
-    s%context = configured
-    s%context%field = field
-    if (present(mass)) s%context%mass = mass
-    if (present(diffusion)) s%context%diffusion = diffusion
+    s%context = operator_context_t(field=field, mass=mass, diffusion=diffusion, box=grid%box, walls=grid%walls)
     s%field = field
     s%singular = (field == FIELD_P)
     s%cell_volume = grid%h**3

@@ -38,7 +38,7 @@ program test_fluid_solvers
   use mod_kinds, only: dp, pi
   use mod_params, only: config_t
   use mod_grid, only: grid_t, grid_create, grid_destroy, FIELD_U, FIELD_V, FIELD_P, field_names
-  use mod_solvers, only: solver_t, solvers_configure, solver_create, solver_solve, solver_destroy, fft_planner_flags
+  use mod_solvers, only: solver_t, solver_create, solver_solve, solver_destroy, fft_planner_flags
   use mod_fft_solver, only: fft_solver_t, fft_create, fft_solve, fft_destroy
   use mod_unit_checks, only: check, check_below, finish
   implicit none
@@ -75,7 +75,6 @@ program test_fluid_solvers
          trim(cfg%domain%y_boundary), ', ', nranks, ' rank(s)'
     if (rank == 0) print '(2a)', '# ', trim(scene)
     PetscCallA(grid_create(cfg, grid, ierr))
-    call solvers_configure(mass, diffusion, cfg%domain%box, cfg%walls)
     call test_scene(grid, trim(scene))
     PetscCallA(grid_destroy(grid, ierr))
   end do
@@ -116,7 +115,7 @@ contains
       if (rank == 0) print '(3a,es9.2)', '# ', field_names(f), ': condition number bound ', cond
 
       ! 1. the code's assembled operator is the hand stencil
-      PetscCallA(solver_create(grid, f, krylov_rtol, 0.0_dp, krylov, ierr, krylov=.true.))
+      PetscCallA(solver_create(grid, f, krylov_rtol, 0.0_dp, mass, diffusion, krylov, ierr, krylov=.true.))
       PetscCallA(KSPGetOperators(krylov%ksp, A, P, ierr))
       PetscCallA(MatMult(A, exact, work, ierr))
       PetscCallA(VecScale(work, 1.0_dp / grid%h**3, ierr))
@@ -125,7 +124,7 @@ contains
       call check_below(trim(what), relative_difference(work, rhs), tol_operator)
 
       ! 2. the direct solve
-      PetscCallA(solver_create(grid, f, krylov_rtol, 0.0_dp, direct, ierr))
+      PetscCallA(solver_create(grid, f, krylov_rtol, 0.0_dp, mass, diffusion, direct, ierr))
       call check(direct%direct, scene//', '//field_names(f)//': solver_create takes the FFT path by default')
       PetscCallA(VecCopy(rhs, work, ierr))
       PetscCallA(VecSet(x, 0.0_dp, ierr))

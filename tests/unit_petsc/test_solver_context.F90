@@ -2,13 +2,11 @@
 ! operator_context_t, the context of PETSc's compute-operators callback), on every multigrid
 ! level, while other solvers of other coefficients exist on the same grid. Two Krylov Helmholtz
 ! solvers of u (A = mass I - diffusion lap; mass 10 and 40, diffusion 0.5 and 2) are created one
-! after the other on the same DMDA of a periodic 16^3 grid, after solvers_configure gave other
-! coefficients (mass 1, diffusion 1), with the multigrid preconditioner (-u_pc_type mg on the 3
-! levels the grid allows). Then:
+! after the other on the same DMDA of a periodic 16^3 grid, with the multigrid preconditioner
+! (-u_pc_type mg on the 3 levels the grid allows). Then:
 !   1. on every level l of each solver's multigrid (fine to coarsest, h_l = L/n_l), the operator
 !      times the constant field is mass h_l^3 (the rows are scaled by the cell volume, the
-!      Laplacian of a constant is 0): each solver's own mass, not the other's nor the configured
-!      one, to 1e-13 relative (7 terms of size <= (mass + 6 diffusion/h^2) h^3 per row, a few
+!      Laplacian of a constant is 0): each solver's own mass, not the other's, to 1e-13 relative (7 terms of size <= (mass + 6 diffusion/h^2) h^3 per row, a few
 !      ulps of that against mass h^3);
 !   2. on the fine level the operator times x* = sin(2 pi x/L) is (mass + diffusion 4/h^2
 !      sin^2(pi h/L)) h^3 x* (x* is an eigenvector of the 7-point Laplacian), each solver's
@@ -22,7 +20,7 @@ program test_solver_context
   use mod_kinds, only: dp, pi
   use mod_params, only: config_t
   use mod_grid, only: grid_t, grid_create, grid_destroy, FIELD_U
-  use mod_solvers, only: solver_t, solvers_configure, solver_create, solver_destroy
+  use mod_solvers, only: solver_t, solver_create, solver_destroy
   use mod_unit_checks, only: check, check_below, finish
   implicit none
 
@@ -41,17 +39,16 @@ program test_solver_context
   if (rank /= 0) open(unit=output_unit, file='/dev/null')     ! one copy of the verdicts
   cfg%cells = n
   cfg%h = h
-  cfg%box = n * h
+  cfg%domain%box = n * h
   cfg%walls = .false.
-  cfg%y_boundary = 'periodic'
+  cfg%domain%y_boundary = 'periodic'
   PetscCallA(grid_create(cfg, grid, ierr))
   ! multigrid on the levels the grid allows (mod_solvers would pick Jacobi for these coefficients)
   PetscCallA(PetscOptionsSetValue(PETSC_NULL_OPTIONS, '-u_pc_type', 'mg', ierr))
   write(text, '(i0)') grid%mg_levels
   PetscCallA(PetscOptionsSetValue(PETSC_NULL_OPTIONS, '-u_pc_mg_levels', trim(text), ierr))
-  call solvers_configure(1.0_dp, 1.0_dp, cfg%box, cfg%walls)
   do s = 1, 2
-    PetscCallA(solver_create(grid, FIELD_U, 1.0e-10_dp, 0.0_dp, solvers(s), ierr, krylov=.true., mass=masses(s), diffusion=diffusions(s)))
+    PetscCallA(solver_create(grid, FIELD_U, 1.0e-10_dp, 0.0_dp, masses(s), diffusions(s), solvers(s), ierr, krylov=.true.))
   end do
   do s = 1, 2
     call check_levels(solvers(s), masses(s))
