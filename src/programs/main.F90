@@ -56,6 +56,14 @@ program fdsusp
   type(lubrication_dynamics_t), target :: ld        ! &fluid model = 'none': the spheres alone
   type(particle_solver_t), target :: ld_solver      ! its sparse 6N solve
   type(checkpoint_state_t) :: state                 ! what the checkpoints hold: the pieces this run has
+  ! the pieces the step and the output work on, associated when the run has them
+  type(grid_t), pointer :: grid_p => null()
+  type(fluid_t), pointer :: fluid_p => null()
+  type(particles_t), pointer :: parts_p => null()
+  type(particle_contacts_t), pointer :: contacts_p => null()
+  type(particle_lubrication_t), pointer :: lubrication_p => null()
+  type(rheology_t), pointer :: rheology_p => null()
+  type(lees_edwards_t), pointer :: le_p => null()
   type(time_step_t) :: ts                           ! the step of this run
   type(run_output_t) :: out                         ! what it writes, and when
   character(len=max_line) :: deck, restart
@@ -111,13 +119,8 @@ program fdsusp
                                      cfg%walls .or. cfg%lees_edwards)
     PetscCallA(particle_solver_create(ld_solver, ierr))
   end if
-  ! the state the checkpoints hold and a restart restores: the pieces this run has
-  if (cfg%resolved) state%fl => fl
-  if (cfg%resolved .and. has_particles) state%lambda => fd%lambda
-  if (has_particles) state%parts => parts
-  if (allocated(pc)) state%history => pc%history
-  if (allocated(rh)) state%rh => rh
-  if (cfg%lees_edwards) state%offset => le%offset
+  ! the pieces this run has, and the state the checkpoints hold and a restart restores
+  call point_at_pieces()
   if (restarting) then
     PetscCallA(checkpoint_read(restart, state, statistics_afresh, ierr))
     if (statistics_afresh) call log_line('statistics: the &rheology window begins after the checkpoint''s step; '// &
@@ -263,17 +266,7 @@ contains
   ! The output of this run over the pieces it has (disassociated pointers are absent arguments).
   subroutine make_output(ierr)
     PetscErrorCode, intent(out) :: ierr
-    type(grid_t), pointer :: grid_p
-    type(fluid_t), pointer :: fluid_p
-    type(lees_edwards_t), pointer :: le_p
-    type(particles_t), pointer :: parts_p
-    type(particle_contacts_t), pointer :: contacts_p
-    type(particle_lubrication_t), pointer :: lubrication_p
-    type(rheology_t), pointer :: rheology_p
     ierr = 0
-    call pieces(grid_p, fluid_p, parts_p, contacts_p, lubrication_p, rheology_p)
-    le_p => null()
-    if (cfg%lees_edwards) le_p => le
     call run_output_open(out, cfg, state, step, restarting, wall_start, grid_p, fluid_p, le_p, parts_p, contacts_p, &
                          lubrication_p, rheology_p)
   end subroutine make_output
@@ -281,13 +274,6 @@ contains
   ! The step of this run (mod_time_step) over the pieces it has: its variant follows from them.
   subroutine make_time_step(ierr)
     PetscErrorCode, intent(out) :: ierr
-    type(grid_t), pointer :: grid_p
-    type(fluid_t), pointer :: fluid_p
-    type(particles_t), pointer :: parts_p
-    type(particle_contacts_t), pointer :: contacts_p
-    type(particle_lubrication_t), pointer :: lubrication_p
-    type(rheology_t), pointer :: rheology_p
-    call pieces(grid_p, fluid_p, parts_p, contacts_p, lubrication_p, rheology_p)
     if (cfg%resolved) then
       call time_step_create(ts, cfg%time%dt, cfg%domain%box, cfg%walls, le, ierr, grid=grid_p, fluid=fluid_p, &
                             fd=fd, parts=parts_p, contacts=contacts_p, lubrication=lubrication_p, rheology=rheology_p)
@@ -298,29 +284,32 @@ contains
     CHKERRQ(ierr)
   end subroutine make_time_step
 
-  ! The pieces this run has, each associated when it has it.
-  subroutine pieces(grid_p, fluid_p, parts_p, contacts_p, lubrication_p, rheology_p)
-    type(grid_t), pointer, intent(out) :: grid_p
-    type(fluid_t), pointer, intent(out) :: fluid_p
-    type(particles_t), pointer, intent(out) :: parts_p
-    type(particle_contacts_t), pointer, intent(out) :: contacts_p
-    type(particle_lubrication_t), pointer, intent(out) :: lubrication_p
-    type(rheology_t), pointer, intent(out) :: rheology_p
-    grid_p => null()
-    fluid_p => null()
-    parts_p => null()
-    contacts_p => null()
-    lubrication_p => null()
-    rheology_p => null()
+  ! The pieces this run has, pointed at (and the state the checkpoints hold: the same pieces).
+  subroutine point_at_pieces()
     if (cfg%resolved) then
       grid_p => grid
       fluid_p => fl
+      state%fl => fl
     end if
-    if (has_particles) parts_p => parts
-    if (allocated(pc)) contacts_p => pc
+    if (cfg%lees_edwards) then
+      le_p => le
+      state%offset => le%offset
+    end if
+    if (has_particles) then
+      parts_p => parts
+      state%parts => parts
+      if (cfg%resolved) state%lambda => fd%lambda
+    end if
+    if (allocated(pc)) then
+      contacts_p => pc
+      state%history => pc%history
+    end if
     if (allocated(pl)) lubrication_p => pl
-    if (allocated(rh)) rheology_p => rh
-  end subroutine pieces
+    if (allocated(rh)) then
+      rheology_p => rh
+      state%rh => rh
+    end if
+  end subroutine point_at_pieces
 
   ! The run log's 'models:' line.
   function models_line() result(line)

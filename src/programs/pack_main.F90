@@ -43,18 +43,18 @@ program fdsusp_pack
     call log_line(echo(l))
   end do
   call log_line('# end of effective deck')
-  err = make_directory(cfg%directory)
-  if (err == 0) err = probe_directory(cfg%directory)
+  err = make_directory(cfg%packing%directory)
+  if (err == 0) err = probe_directory(cfg%packing%directory)
   if (err /= 0) then
     write(text, '(a,i0,a)') 'cannot be created or written (errno ', err, ')'
     call input_error(deck, 'packing', 'directory', trim(text))
   end if
-  path = trim(cfg%directory)//'/'//trim(cfg%file)
+  path = trim(cfg%packing%directory)//'/'//trim(cfg%packing%file)
 
   write(text, '(a,i0,a,3(f0.4,1x),a,a)') 'packing ', cfg%n, ' spheres of radius 1 in a box ', &
-    cfg%box, 'a, y: ', trim(cfg%y_boundary)
+    cfg%packing%box, 'a, y: ', trim(cfg%packing%y_boundary)
   call log_line(text)
-  call random_packing(cfg%n, cfg%box, cfg%periodic, 1.0_dp, cfg%min_gap, cfg%seed, cfg%mc_sweeps, &
+  call random_packing(cfg%n, cfg%packing%box, cfg%periodic, 1.0_dp, cfg%packing%min_gap, cfg%packing%seed, cfg%packing%mc_sweeps, &
                       x, info, msg, rep)
   select case (info)
   case (0)
@@ -69,7 +69,7 @@ program fdsusp_pack
   write(text, '(a,f8.6,a,i0,a,i0,a)') 'phi = ', rep%phi, ' reached in ', rep%stages, &
     ' compression stages (', rep%relax_sweeps, ' relaxation sweeps)'
   call log_line(text)
-  write(text, '(i0,a,f6.4,a,f5.3,a)') cfg%mc_sweeps, ' Monte Carlo sweeps, step ', rep%step, &
+  write(text, '(i0,a,f6.4,a,f5.3,a)') cfg%packing%mc_sweeps, ' Monte Carlo sweeps, step ', rep%step, &
     ' a, acceptance ', rep%acceptance, ' (fixed-step half)'
   call log_line(text)
   if (cfg%periodic(2)) then
@@ -102,17 +102,17 @@ contains
     call h5screate_simple_f(2, dims, space, e(2))
     call h5dcreate_f(group, 'position', H5T_NATIVE_DOUBLE, space, dset, e(3))
     call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, x, dims, e(4))
-    call write_attribute(dset, 'box', cfg%box, e(5))
+    call write_attribute(dset, 'box', cfg%packing%box, e(5))
     call h5dclose_f(dset, st)
     call h5sclose_f(space, st)
-    call write_attribute(group, 'box', cfg%box, e(6))
+    call write_attribute(group, 'box', cfg%packing%box, e(6))
     call write_attribute(group, 'radius', [1.0_dp], e(7))
     call h5gclose_f(group, st)
     call write_attribute(file, 'phi', [rep%phi], e(8))
-    call write_attribute(file, 'seed', [cfg%seed], e(9))
-    call write_string_attribute(file, 'y_boundary', trim(cfg%y_boundary), e(10))
-    call write_attribute(file, 'mc_sweeps', [cfg%mc_sweeps], st)
-    call write_attribute(file, 'min_gap', [cfg%min_gap], st)
+    call write_attribute(file, 'seed', [cfg%packing%seed], e(9))
+    call write_string_attribute(file, 'y_boundary', trim(cfg%packing%y_boundary), e(10))
+    call write_attribute(file, 'mc_sweeps', [cfg%packing%mc_sweeps], st)
+    call write_attribute(file, 'min_gap', [cfg%packing%min_gap], st)
     call write_string_attribute(file, 'generator', 'fdsusp-pack', st)
     call h5fclose_f(file, st)
     if (any(e /= 0) .or. st /= 0) call abort_run('writing '//trim(tmp)//' failed')

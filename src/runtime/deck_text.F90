@@ -7,7 +7,7 @@ module mod_deck_text
   implicit none
   private
   public :: deck_line_length, load_lines, group_on_line, to_lower, diagnose_group, group_reader, &
-            qualified_names, unqualified_names
+            qualified_names, unqualified_names, plain_echo_line
 
   integer, parameter :: deck_line_length = 1024
   integer, parameter :: max_line = deck_line_length
@@ -278,6 +278,22 @@ contains
       i = i + 1
     end do
   end function skip_spaces
+
+  ! A line of a namelist the compiler wrote for a derived-type object, as a deck has it: the
+  ! object's qualifier dropped (' TIME_GROUP%DT= 1.0' becomes ' DT= 1.0') and the padding of a
+  ! quoted character value removed.
+  function plain_echo_line(line) result(out)
+    character(len=*), intent(in) :: line
+    character(len=len(line)) :: out
+    integer :: e, p, q1, q2
+    out = line
+    e = index(out, '=')
+    p = index(out(1:max(e, 1)), '%')
+    if (out(1:1) == ' ' .and. p > 0) out = ' '//out(p + 1:)
+    q1 = index(out, '"')
+    q2 = index(out, '"', back=.true.)
+    if (q1 > 0 .and. q2 > q1) out = out(1:q1)//trim(out(q1 + 1:q2 - 1))//out(q2:)
+  end function plain_echo_line
 
   ! A compiler message about a qualified read with the qualifier removed: 'object%name' and
   ! '%name' become 'name', as the deck has it.

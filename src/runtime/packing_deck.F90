@@ -8,7 +8,8 @@
 module mod_packing_deck
   use mod_kinds, only: dp, pi
   use mod_errors, only: input_error
-  use mod_deck_text, only: deck_line_length, load_lines, group_on_line, to_lower, diagnose_group
+  use mod_deck_text, only: deck_line_length, load_lines, group_on_line, to_lower, diagnose_group, &
+                           qualified_names, unqualified_names, plain_echo_line
   use mod_packing_geometry, only: phi_max, packing_count, packing_box_for
   implicit none
   private
@@ -16,8 +17,9 @@ module mod_packing_deck
 
   integer, parameter :: max_line = deck_line_length
 
-  type :: pack_config_t
-    character(len=max_line) :: deck_file = ''
+  ! &packing: its variables, named as in the deck, with their defaults (doc/DESIGN.md "Input":
+  ! one derived type per group, the namelist's one object)
+  type :: packing_settings_t
     real(dp) :: box(3) = [20.0_dp, 20.0_dp, 20.0_dp]    ! box lengths Lx, Ly, Lz [a]
     character(len=16) :: y_boundary = 'walls'           ! 'walls' (Couette cell) or 'periodic'
     real(dp) :: phi = 0.3_dp                            ! target volume fraction [-]
@@ -26,7 +28,12 @@ module mod_packing_deck
     integer :: seed = 1                                 ! random seed [-]
     integer :: mc_sweeps = 1000                         ! Monte Carlo equilibration sweeps [-]
     character(len=max_line) :: directory = 'out'        ! output directory (created)
-    character(len=256) :: file = 'packing.h5'          ! file name inside the directory
+    character(len=256) :: file = 'packing.h5'           ! file name inside the directory
+  end type packing_settings_t
+
+  type :: pack_config_t
+    character(len=max_line) :: deck_file = ''
+    type(packing_settings_t) :: packing
     ! derived, not read
     integer :: n = 0                                    ! number of spheres
     logical :: periodic(3) = [.true., .false., .true.]
@@ -63,22 +70,24 @@ contains
     call validate(cfg)
   end subroutine read_pack_deck
 
-  !> The effective deck (defaults included) as namelist text, one line per element.
+  !> The effective deck (defaults included) as namelist text, one line per variable.
   subroutine pack_deck_lines(cfg, text)
     type(pack_config_t), intent(in) :: cfg
     character(len=max_line), allocatable, intent(out) :: text(:)
-    allocate(text(11))
-    write(text(1), '(a)') '&packing'
-    write(text(2), '(a,3(g0.10,:,", "))') '  box = ', cfg%box
-    write(text(3), '(a)') "  y_boundary = '"//trim(cfg%y_boundary)//"'"
-    write(text(4), '(a,g0.10)') '  phi = ', cfg%phi
-    write(text(5), '(a,i0)') '  n_particles = ', cfg%n_particles
-    write(text(6), '(a,g0.10)') '  min_gap = ', cfg%min_gap
-    write(text(7), '(a,i0)') '  seed = ', cfg%seed
-    write(text(8), '(a,i0)') '  mc_sweeps = ', cfg%mc_sweeps
-    write(text(9), '(a)') "  directory = '"//trim(cfg%directory)//"'"
-    write(text(10), '(a)') "  file = '"//trim(cfg%file)//"'"
-    write(text(11), '(a)') '/'
+    type(pack_config_t) :: copy
+    character(len=8192) :: line            ! a character value is written padded to its length
+    integer :: unit, ios
+    copy = cfg
+    open(newunit=unit, status='scratch', action='readwrite', recl=8192)
+    call group_io(copy, echo_unit=unit)
+    rewind(unit)
+    allocate(text(0))
+    do
+      read(unit, '(a)', iostat=ios) line
+      if (ios /= 0) exit
+      text = [character(len=max_line) :: text, plain_echo_line(line)]
+    end do
+    close(unit)
   end subroutine pack_deck_lines
 
   ! ---- reading ----------------------------------------------------------------------------
@@ -111,37 +120,29 @@ contains
     call group_io(trial, src, ios, msg)
   end subroutine read_into_copy
 
-  subroutine group_io(cfg, src, ios, msg)
+  !> &packing read from src (its lines from '&packing' on) when present, echoed to echo_unit when
+  !> present. The namelist's one object is the group's settings; the deck's names are qualified
+  !> with it for the read, the compiler's message unqualified for the diagnosis (mod_deck_text).
+  subroutine group_io(cfg, src, ios, msg, echo_unit)
     type(pack_config_t), intent(inout) :: cfg
-    character(len=*), intent(in) :: src(:)
-    integer, intent(out) :: ios
-    character(len=*), intent(inout) :: msg
-    real(dp) :: box(3), phi, min_gap
-    character(len=16) :: y_boundary
-    integer :: n_particles, seed, mc_sweeps
-    character(len=max_line) :: directory
-    character(len=256) :: file
-    namelist /packing/ box, y_boundary, phi, n_particles, min_gap, seed, mc_sweeps, directory, file
-    box = cfg%box
-    y_boundary = cfg%y_boundary
-    phi = cfg%phi
-    n_particles = cfg%n_particles
-    min_gap = cfg%min_gap
-    seed = cfg%seed
-    mc_sweeps = cfg%mc_sweeps
-    directory = cfg%directory
-    file = cfg%file
-    read(src, nml=packing, iostat=ios, iomsg=msg)
-    if (ios /= 0) return
-    cfg%box = box
-    cfg%y_boundary = to_lower(y_boundary)
-    cfg%phi = phi
-    cfg%n_particles = n_particles
-    cfg%min_gap = min_gap
-    cfg%seed = seed
-    cfg%mc_sweeps = mc_sweeps
-    cfg%directory = directory
-    cfg%file = file
+    character(len=*), intent(in), optional :: src(:)
+    integer, intent(out), optional :: ios
+    character(len=*), intent(inout), optional :: msg
+    integer, intent(in), optional :: echo_unit
+    type(packing_settings_t) :: packing_group
+    namelist /packing/ packing_group
+    character(len=max_line), allocatable :: text(:)
+    packing_group = cfg%packing
+    if (present(src)) then
+      text = qualified_names(src, 'packing_group')
+      read(text, nml=packing, iostat=ios, iomsg=msg)
+      if (ios /= 0) then
+        msg = unqualified_names(msg, 'packing_group')
+        return
+      end if
+      cfg%packing = packing_group
+    end if
+    if (present(echo_unit)) write(echo_unit, nml=packing)
   end subroutine group_io
 
 
@@ -180,42 +181,43 @@ contains
     real(dp) :: phie
     integer :: d
 
-    call check_real(cfg, 'phi', cfg%phi, 0.0_dp, phi_max, .true.)
-    call check_int(cfg, 'n_particles', cfg%n_particles, 0, 10000000)
-    call check_real(cfg, 'min_gap', cfg%min_gap, 0.0_dp, 0.5_dp, .false.)
-    call check_int(cfg, 'seed', cfg%seed, 0, huge(1))
-    call check_int(cfg, 'mc_sweeps', cfg%mc_sweeps, 0, 10000000)
-    if (cfg%y_boundary /= 'walls' .and. cfg%y_boundary /= 'periodic') &
+    cfg%packing%y_boundary = to_lower(cfg%packing%y_boundary)
+    call check_real(cfg, 'phi', cfg%packing%phi, 0.0_dp, phi_max, .true.)
+    call check_int(cfg, 'n_particles', cfg%packing%n_particles, 0, 10000000)
+    call check_real(cfg, 'min_gap', cfg%packing%min_gap, 0.0_dp, 0.5_dp, .false.)
+    call check_int(cfg, 'seed', cfg%packing%seed, 0, huge(1))
+    call check_int(cfg, 'mc_sweeps', cfg%packing%mc_sweeps, 0, 10000000)
+    if (cfg%packing%y_boundary /= 'walls' .and. cfg%packing%y_boundary /= 'periodic') &
       call input_error(cfg%deck_file, 'packing', 'y_boundary', &
-           'must be ''walls'' or ''periodic'', not '''//trim(cfg%y_boundary)//'''')
-    cfg%periodic = [.true., cfg%y_boundary == 'periodic', .true.]
+           'must be ''walls'' or ''periodic'', not '''//trim(cfg%packing%y_boundary)//'''')
+    cfg%periodic = [.true., cfg%packing%y_boundary == 'periodic', .true.]
     do d = 1, 3
-      call check_real(cfg, 'box('//xyz(d:d)//')', cfg%box(d), 0.0_dp, 1.0e4_dp, .true.)
+      call check_real(cfg, 'box('//xyz(d:d)//')', cfg%packing%box(d), 0.0_dp, 1.0e4_dp, .true.)
     end do
-    if (cfg%n_particles > 0) then
-      cfg%box = packing_box_for(cfg%n_particles, cfg%phi, cfg%box, 1.0_dp)
-      cfg%n = cfg%n_particles
+    if (cfg%packing%n_particles > 0) then
+      cfg%packing%box = packing_box_for(cfg%packing%n_particles, cfg%packing%phi, cfg%packing%box, 1.0_dp)
+      cfg%n = cfg%packing%n_particles
     else
-      cfg%n = packing_count(cfg%phi, cfg%box, 1.0_dp)
+      cfg%n = packing_count(cfg%packing%phi, cfg%packing%box, 1.0_dp)
       if (cfg%n < 1) call input_error(cfg%deck_file, 'packing', 'phi', &
            'gives no sphere in this box (set a larger phi or box, or n_particles)')
     end if
     do d = 1, 3
-      if (cfg%box(d) < 4 * (1 + cfg%min_gap)) then
+      if (cfg%packing%box(d) < 4 * (1 + cfg%packing%min_gap)) then
         write(text, '(a,f0.4,a)') 'every box length must be at least 4 (a + min_gap) (it is ', &
-          cfg%box(d), ' a)'
+          cfg%packing%box(d), ' a)'
         call input_error(cfg%deck_file, 'packing', 'box('//xyz(d:d)//')', trim(text))
       end if
     end do
-    phie = (cfg%n - 1) * (4 * pi / 3) * (1 + cfg%min_gap / 2)**3 / product(cfg%box)
-    if (cfg%min_gap > 0 .and. phie > phi_max * (1 + 1.0e-12_dp)) then
+    phie = (cfg%n - 1) * (4 * pi / 3) * (1 + cfg%packing%min_gap / 2)**3 / product(cfg%packing%box)
+    if (cfg%packing%min_gap > 0 .and. phie > phi_max * (1 + 1.0e-12_dp)) then
       write(text, '(a,f6.4,a,f4.2)') 'with this minimum gap the spheres fill phi = ', phie, &
         ', above the supported ', phi_max
       call input_error(cfg%deck_file, 'packing', 'min_gap', trim(text))
     end if
-    if (len_trim(cfg%directory) == 0) call input_error(cfg%deck_file, 'packing', 'directory', &
+    if (len_trim(cfg%packing%directory) == 0) call input_error(cfg%deck_file, 'packing', 'directory', &
          'must not be empty')
-    if (len_trim(cfg%file) == 0 .or. index(cfg%file, '/') > 0) call input_error(cfg%deck_file, &
+    if (len_trim(cfg%packing%file) == 0 .or. index(cfg%packing%file, '/') > 0) call input_error(cfg%deck_file, &
          'packing', 'file', 'must be a plain file name (no directory part)')
   end subroutine validate
 

@@ -19,7 +19,7 @@ module mod_params
   use mod_kinds, only: dp
   use mod_errors, only: input_error, log_line, is_root
   use mod_deck_text, only: deck_line_length, load_lines, group_on_line, to_lower, diagnose_group, &
-                           qualified_names, unqualified_names
+                           qualified_names, unqualified_names, plain_echo_line
   use mod_packing_geometry, only: phi_max
   use mod_particle_contacts, only: particle_contacts_settings_t
   use mod_rheology, only: rheology_settings_t
@@ -331,7 +331,7 @@ contains
     character(len=8192) :: line
     character(len=32) :: item
     character(len=64) :: group
-    integer :: g, unit, ios, q1, q2, e, p
+    integer :: g, unit, ios, e, p
     logical :: inline_array
     character(len=16), parameter :: inline_arrays(5) = [character(len=16) :: 'position', 'velocity', 'omega', &
                                                          'external_force', 'external_torque']
@@ -357,16 +357,11 @@ contains
       else if (line(1:1) == ' ' .and. p > 0) then
         item = to_lower(line(p + 1:e - 1))
         inline_array = group == 'particles' .and. any(inline_arrays == item)
-        line = ' '//line(p + 1:)
       else if (adjustl(line) == '/') then
         if (group == 'particles') call echo_inline_particles(cfg%particles)
         inline_array = .false.
       end if
-      if (inline_array) cycle
-      q1 = index(line, '"')
-      q2 = index(line, '"', back=.true.)
-      if (q1 > 0 .and. q2 > q1) line = line(1:q1)//trim(line(q1 + 1:q2 - 1))//line(q2:)
-      write(*, '(a)') trim(line)
+      if (.not. inline_array) write(*, '(a)') trim(plain_echo_line(line))
     end do
     close(unit)
     write(*, '(a)') '# end of effective deck'
