@@ -126,19 +126,20 @@ def main():
         ap.error('--start must be below -2 (the spheres would overlap)')
     dirs = {c: os.path.join(os.path.abspath(args.work), c) for c in args.cases}
     if not args.plot_only:
-        def prepare_case(c, d, steps=None):
-            return prepare(c, d, args.box, args.cells, args.dt, args.start, args.eps_bar, args.reynolds,
-                           args.theta, args.hours, steps=steps)
-
-        commands = {c: prepare_case(c, dirs[c]) for c in args.cases}
         if args.branch is None:
             args.branch = len(args.cases) > 1
+
+        def prepare_case(c, d, steps=None, branched=args.branch):
+            return prepare(c, d, args.box, args.cells, args.dt, args.start, args.eps_bar, args.reynolds,
+                           args.theta, args.hours, steps=steps, branched=branched)
+
+        commands = {c: prepare_case(c, dirs[c]) for c in args.cases}
         if args.branch:
             trunk = os.path.join(os.path.abspath(args.work), 'trunk')
             last = trunk_steps([read_pairtraj(dirs[c]) for c in args.cases], args.dt)
             done = series_steps(trunk)
             if len(done) == 0 or done[-1] < last:
-                command = prepare_case(TRUNK_CASE, trunk, steps=last)
+                command = prepare_case(TRUNK_CASE, trunk, steps=last, branched=False)
                 # the trunk runs alone: it gets every core the study was given
                 status, cpu = run_all(['trunk'], lambda _: start_dns(trunk, command, args.ranks * args.jobs), 1)['trunk']
                 print('trunk (to step %d): exit %d, %.0f CPU s' % (last, status, cpu))
@@ -149,7 +150,7 @@ def main():
             for c in args.cases:
                 if not os.path.exists(os.path.join(dirs[c], 'out', 'checkpoint.h5')):
                     branch(trunk, dirs[c], c)
-                    commands[c] = prepare_case(c, dirs[c])          # now a restart from the trunk's checkpoint
+                    commands[c] = prepare_case(c, dirs[c])          # now a branch from the trunk's checkpoint
         pending = list(args.cases)
         while pending:
             results = run_all(pending, lambda c: start_dns(dirs[c], commands[c], args.ranks), args.jobs)

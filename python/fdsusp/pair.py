@@ -83,10 +83,13 @@ def record_every(dt):
 
 
 def prepare(case, d, box, cells, dt, start, eps_bar=0.05, reynolds=0.01, theta=0.5, hours=0.0, steps_factor=1.05,
-            steps=None):
+            steps=None, branched=False):
     """Write the case's decks, run pairtraj; return the DNS command (continuing from a checkpoint
     when there is one). The DNS runs for steps_factor times pairtraj's transit time, or to step
-    `steps` when given."""
+    `steps` when given. branched: the case was branched from the trunk (branch()), so its
+    checkpoint may be the trunk's, of other contact physics: fdsusp continues it with -branch,
+    which takes this deck's contact model (doc/INPUT.md "Restart"); with the case's own
+    checkpoint -branch checks what -restart does."""
     os.makedirs(d, exist_ok=True)
     ref = pairtraj(case, d, start, eps_bar)
     _, eps_r, mu_d = CASES[case]
@@ -105,7 +108,7 @@ def prepare(case, d, box, cells, dt, start, eps_bar=0.05, reynolds=0.01, theta=0
         copy_program(binary)
     command = [binary, 'deck.nml']
     if os.path.exists(os.path.join(d, 'out', 'checkpoint.h5')):
-        command += ['-restart', 'out/checkpoint.h5']
+        command += ['-branch' if branched else '-restart', 'out/checkpoint.h5']
     return command
 
 

@@ -217,10 +217,11 @@ contains
   ! and a bad file stops the run with a message naming the file and the item at fault, or the
   ! group and the variable of the deck that differs from the checkpoint's. rh: the run's
   ! statistics (&rheology), whose window must fit the checkpoint's accumulators.
-  subroutine checkpoint_check(path, cfg, particles, step, time, rh)
+  subroutine checkpoint_check(path, cfg, particles, branch, step, time, rh)
     character(len=*), intent(in) :: path
     type(config_t), intent(in) :: cfg
     integer, intent(in) :: particles        ! the run's particle count (0: none)
+    logical, intent(in) :: branch           ! -branch: this deck's contact and lubrication physics
     integer, intent(out) :: step
     real(dp), intent(out) :: time
     type(rheology_t), intent(in), optional :: rh
@@ -236,7 +237,7 @@ contains
     group = ''
     variable = ''
     values = 0.0_dp
-    if (is_root()) call inspect(path, cfg, particles, item, message, values, group, variable, rh)
+    if (is_root()) call inspect(path, cfg, particles, branch, item, message, values, group, variable, rh)
     call MPI_Bcast(item, len(item), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
     call MPI_Bcast(group, len(group), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
     call MPI_Bcast(variable, len(variable), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
@@ -250,10 +251,11 @@ contains
     time = values(2)
   end subroutine checkpoint_check
 
-  subroutine inspect(path, cfg, particles, item, message, values, group, variable, rh)
+  subroutine inspect(path, cfg, particles, branch, item, message, values, group, variable, rh)
     character(len=*), intent(in) :: path
     type(config_t), intent(in) :: cfg
     integer, intent(in) :: particles
+    logical, intent(in) :: branch
     character(len=*), intent(out) :: item, message
     real(dp), intent(out) :: values(2)
     character(len=*), intent(out) :: group, variable
@@ -366,10 +368,15 @@ contains
              ': restart with the deck that wrote it'
       end if
     end if
-    ! contacts: the springs are there exactly when the checkpoint's run had contacts
+    ! contacts: the springs are there exactly when the checkpoint's run had contacts; a branch may
+    ! add or drop them (its contacts start without springs, or the springs are not read)
     if (len_trim(message) == 0 .and. particles > 0) then
       springs = has_object(file, 'contacts')
-      if (springs .neqv. cfg%contact_group) then
+      if (branch .and. (springs .neqv. cfg%contact_group)) then
+        if (springs) call log_line('branch: the checkpoint''s run had contacts, this one has none (&contact absent)')
+        if (.not. springs) call log_line('branch: the checkpoint''s run had no contacts; this one''s start '// &
+                                         'without tangential springs')
+      else if (springs .neqv. cfg%contact_group) then
         group = 'contact'
         if (springs) then
           message = 'the checkpoint''s run had contacts (its springs are in /contacts), the deck "'// &
@@ -381,7 +388,7 @@ contains
       end if
     end if
     ! every other input that sets the physics (mod_restart_deck)
-    if (len_trim(message) == 0) call deck_compare(file, cfg, particles, group, variable, message)
+    if (len_trim(message) == 0) call deck_compare(file, cfg, particles, branch, group, variable, message)
     ! the data: every dataset read once, against its checksum
     if (len_trim(message) == 0) then
       unverified = 0

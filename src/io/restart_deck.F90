@@ -6,7 +6,10 @@
 !   deck_compare  compares them with this run's deck: a variable that must match and differs stops
 !                 the restart (its group, its name, both values); one that may change and differs is
 !                 named in the run log; one the checkpoint does not record (written before
-!                 2026-11-27) cannot be checked, and the log says so
+!                 2026-11-27) cannot be checked, and the log says so. A branch (-branch: the
+!                 checkpoint's state, this deck's physics) may also change the contact and
+!                 lubrication models and the particles' loads (BRANCH_MAY_CHANGE), each change
+!                 named in the run log
 ! Only the variables the run uses are recorded and compared (the fluid's only with a resolved
 ! fluid, the particles' only with particles, the contacts' only with contacts). Values are compared
 ! exactly: the attribute holds the double the deck was read into, and the same text reads into the
@@ -23,7 +26,10 @@ module mod_restart_deck
   private
   public :: deck_record, deck_compare
 
-  integer, parameter :: MUST_MATCH = 1, MAY_CHANGE = 2
+  ! MUST_MATCH: on a restart; BRANCH_MAY_CHANGE: must match on a restart, may change on a branch
+  ! (-branch: the contact and lubrication models and the particles' loads, what a study varies
+  ! from a shared state); MAY_CHANGE: on either
+  integer, parameter :: MUST_MATCH = 1, MAY_CHANGE = 2, BRANCH_MAY_CHANGE = 3
   integer, parameter :: max_items = 64
   character(len=*), parameter :: deck_group = 'deck'
 
@@ -90,25 +96,25 @@ contains
                        per=3)
         call real_item('particles', 'omega', MUST_MATCH, reshape(cfg%particles%omega, [size(cfg%particles%omega)]), per=3)
       else if (cfg%particles%motion == 'free') then
-        call real_item('particles', 'external_force', MUST_MATCH, reshape(cfg%particles%external_force, &
+        call real_item('particles', 'external_force', BRANCH_MAY_CHANGE, reshape(cfg%particles%external_force, &
                        [size(cfg%particles%external_force)]), per=3)
-        call real_item('particles', 'external_torque', MUST_MATCH, reshape(cfg%particles%external_torque, &
+        call real_item('particles', 'external_torque', BRANCH_MAY_CHANGE, reshape(cfg%particles%external_torque, &
                        [size(cfg%particles%external_torque)]), per=3)
       end if
-      call text_item('lubrication', 'model', MUST_MATCH, cfg%lubrication%model)
-      call real_item('lubrication', 'outer_cutoff', MUST_MATCH, [cfg%lubrication%outer_cutoff])
-      call real_item('lubrication', 'inner_cutoff', MUST_MATCH, [cfg%lubrication%inner_cutoff])
+      call text_item('lubrication', 'model', BRANCH_MAY_CHANGE, cfg%lubrication%model)
+      call real_item('lubrication', 'outer_cutoff', BRANCH_MAY_CHANGE, [cfg%lubrication%outer_cutoff])
+      call real_item('lubrication', 'inner_cutoff', BRANCH_MAY_CHANGE, [cfg%lubrication%inner_cutoff])
       call real_item('lubrication', 'skin', MAY_CHANGE, [cfg%lubrication%skin])
       ! the table's path (its content is checked against the deck by mod_lubrication_io)
       if (cfg%resolved) call text_item('lubrication', 'table', MAY_CHANGE, cfg%lubrication%table)
     end if
     if (contacts) then
-      call real_item('contact', 'roughness', MUST_MATCH, [cfg%contact%roughness])
-      call real_item('contact', 'normal_stiffness', MUST_MATCH, [cfg%contact%normal_stiffness])
+      call real_item('contact', 'roughness', BRANCH_MAY_CHANGE, [cfg%contact%roughness])
+      call real_item('contact', 'normal_stiffness', BRANCH_MAY_CHANGE, [cfg%contact%normal_stiffness])
       ! eps_bar sets k_n only when normal_stiffness is 0 (doc/CONTACT.md)
-      if (cfg%contact%normal_stiffness <= 0.0_dp) call real_item('contact', 'eps_bar', MUST_MATCH, [cfg%contact%eps_bar])
-      call real_item('contact', 'friction', MUST_MATCH, [cfg%contact%friction])
-      call real_item('contact', 'implicit', MUST_MATCH, [merge(1.0_dp, 0.0_dp, cfg%contact%implicit)])
+      if (cfg%contact%normal_stiffness <= 0.0_dp) call real_item('contact', 'eps_bar', BRANCH_MAY_CHANGE, [cfg%contact%eps_bar])
+      call real_item('contact', 'friction', BRANCH_MAY_CHANGE, [cfg%contact%friction])
+      call real_item('contact', 'implicit', BRANCH_MAY_CHANGE, [merge(1.0_dp, 0.0_dp, cfg%contact%implicit)])
       call real_item('contact', 'neighbour_skin', MAY_CHANGE, [cfg%contact%neighbour_skin])
     end if
     allocate(list(n))
@@ -169,10 +175,11 @@ contains
   ! Compare the deck recorded in FILE with CFG (rank 0). A variable that must match and differs:
   ! group, variable and message are set (the first such variable), else they stay ''. Changes that
   ! are allowed, and variables the checkpoint does not record, go to the run log.
-  subroutine deck_compare(file, cfg, particles, group, variable, message)
+  subroutine deck_compare(file, cfg, particles, branch, group, variable, message)
     integer(HID_T), intent(in) :: file
     type(config_t), intent(in) :: cfg
     integer, intent(in) :: particles
+    logical, intent(in) :: branch
     character(len=*), intent(out) :: group, variable, message
     type(item_t), allocatable :: list(:)
     integer(HID_T) :: deck, loc
@@ -182,11 +189,14 @@ contains
     character(len=400) :: stored
     real(dp), allocatable :: old(:)
     character(len=600) :: line
+    character(len=:), allocatable :: kind, allowed
 
     group = ''
     variable = ''
     message = ''
     missing = ''
+    kind = trim(merge('branch ', 'restart', branch))
+    allowed = trim(merge(' (may change on a branch) ', ' (may change on a restart)', branch))
     call deck_items(cfg, particles, list)
     deck = -1
     has_deck = has_object(file, deck_group)
@@ -201,7 +211,9 @@ contains
         if (has_attribute(file, trim(list(k)%legacy))) loc = file
       end if
       if (loc == -1) then
-        missing = missing//' &'//trim(list(k)%group)//' '//trim(list(k)%name)//','
+        ! (a branch may bring in what the checkpoint's run did not have: contacts)
+        if (.not. (branch .and. (list(k)%rule == BRANCH_MAY_CHANGE .or. list(k)%group == 'contact'))) &
+          missing = missing//' &'//trim(list(k)%group)//' '//trim(list(k)%name)//','
         cycle
       end if
       if (allocated(list(k)%text)) then
@@ -212,13 +224,13 @@ contains
           exit
         end if
         if (old_text == list(k)%text) cycle
-        if (list(k)%rule == MUST_MATCH) then
+        if (must_be_kept(list(k))) then
           call refuse(k, 'the checkpoint''s run had '//trim(list(k)%name)//' = '''//old_text//''', the deck "'// &
                trim(cfg%deck_file)//'" has '''//list(k)%text//'''')
           exit
         end if
-        call log_line('restart: &'//trim(list(k)%group)//' '//trim(list(k)%name)//' changed from '''//old_text// &
-             ''' to '''//list(k)%text//''' (may change on a restart)')
+        call log_line(kind//': &'//trim(list(k)%group)//' '//trim(list(k)%name)//' changed from '''//old_text// &
+             ''' to '''//list(k)%text//''''//allowed)
       else
         if (allocated(old)) deallocate(old)
         allocate(old(size(list(k)%values)))
@@ -229,24 +241,29 @@ contains
         end if
         if (all(old == list(k)%values)) cycle
         first = findloc(old == list(k)%values, .false., 1)
-        if (list(k)%rule == MUST_MATCH) then
+        if (must_be_kept(list(k))) then
           call refuse(k, 'the checkpoint''s run had '//shown(list(k), old, first)//', the deck "'// &
                trim(cfg%deck_file)//'" has '//shown(list(k), list(k)%values, first))
           exit
         end if
-        line = 'restart: &'//trim(list(k)%group)//' changed from '//shown(list(k), old, first)//' to '// &
-               shown(list(k), list(k)%values, first)//' (may change on a restart)'
+        line = kind//': &'//trim(list(k)%group)//' changed from '//shown(list(k), old, first)//' to '// &
+               shown(list(k), list(k)%values, first)//allowed
         call log_line(line)
       end if
     end do
     if (has_deck) call h5gclose_f(deck, err)
     if (len_trim(message) > 0) return
-    if (len(missing) > 0) call log_line('restart: the checkpoint does not record'//missing(1:len(missing) - 1)// &
+    if (len(missing) > 0) call log_line(kind//': the checkpoint does not record'//missing(1:len(missing) - 1)// &
          ' (written before 2026-11-27): these cannot be checked, the deck''s values are used')
-    call log_line('restart: the state is the checkpoint''s; the deck''s initial conditions (&fluid initial_flow, '// &
+    call log_line(kind//': the state is the checkpoint''s; the deck''s initial conditions (&fluid initial_flow, '// &
          '&particles position, position_file, solid_fraction, seed, packing_sweeps, packing_min_gap) are not used')
 
   contains
+
+    logical function must_be_kept(item)
+      type(item_t), intent(in) :: item
+      must_be_kept = item%rule == MUST_MATCH .or. (item%rule == BRANCH_MAY_CHANGE .and. .not. branch)
+    end function must_be_kept
 
     subroutine refuse(k, text)
       integer, intent(in) :: k
@@ -254,8 +271,14 @@ contains
       group = list(k)%group
       variable = list(k)%name
       if (list(k)%per > 0) write(variable, '(a,i0,a)') trim(list(k)%name)//'(:,', (first - 1) / list(k)%per + 1, ')'
-      message = text//': a restart continues the checkpoint''s physics (doc/INPUT.md "Restart"): restore '// &
-                'the value, or start a new run (its spheres may start from the checkpoint: &particles position_file)'
+      if (list(k)%rule == BRANCH_MAY_CHANGE) then
+        message = text//': a restart continues the checkpoint''s physics (doc/INPUT.md "Restart"): restore '// &
+                  'the value, or branch from the checkpoint (-branch CHECKPOINT: its state, this deck''s '// &
+                  'contact and lubrication models and loads)'
+      else
+        message = text//': a restart continues the checkpoint''s physics (doc/INPUT.md "Restart"): restore '// &
+                  'the value, or start a new run (its spheres may start from the checkpoint: &particles position_file)'
+      end if
     end subroutine refuse
   end subroutine deck_compare
 

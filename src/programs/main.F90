@@ -1,7 +1,7 @@
 ! fdsusp: fictitious-domain simulation of sheared suspensions (doc/METHOD.md), or with &fluid model =
 ! 'none' their lubrication dynamics: the spheres alone, one-body Stokes drag plus exact pair and wall
 ! resistance and contacts, between walls or across Lees-Edwards boundaries (doc/METHOD.md §6).
-!   bin/fdsusp DECK [-restart CHECKPOINT | -continue] [PETSc options]
+!   bin/fdsusp DECK [-restart CHECKPOINT | -branch CHECKPOINT | -continue] [PETSc options]
 ! Reads and checks everything before any work, then steps the flow in time, writing the series,
 ! field snapshots and checkpoints the deck asks for. SIGTERM or SIGUSR1 (what batch schedulers
 ! send before the kill) ends the run at the end of the current step with a checkpoint, status 0.
@@ -70,7 +70,7 @@ program fdsusp
   character(len=400) :: text
   integer :: step, first_step, stop_reason
   real(dp) :: time, wall_start, wall_loop, err_vel, err_p_max, err_p_rms
-  logical :: restarting, continuing, has_particles, statistics_afresh
+  logical :: restarting, continuing, branching, has_particles, statistics_afresh
 
   PetscCallA(PetscInitialize(ierr))
   ! SIGTERM/SIGUSR1 from now on only ask the run to stop after its next step (they replace
@@ -80,7 +80,7 @@ program fdsusp
   call h5util_init()
 
   ! ---- everything is checked before any work ----
-  call command_line(deck, restart, restarting, continuing)
+  call command_line(deck, restart, restarting, continuing, branching)
   call fluid_options_check()
   call read_deck(deck, cfg)
   call log_line('fdsusp: '//trim(cfg%run%title))
@@ -98,8 +98,9 @@ program fdsusp
   step = 0
   time = 0.0_dp
   if (restarting) then
-    call checkpoint_check(restart, cfg, parts%n, step, time, rh)   ! rh: absent unless allocated
-    write(text, '(a,i0,a,es12.5)') 'restart from '//trim(restart)//' at step ', step, ', time ', time
+    call checkpoint_check(restart, cfg, parts%n, branching, step, time, rh)   ! rh: absent unless allocated
+    write(text, '(a,i0,a,es12.5)') trim(merge('branch from ', 'restart from', branching))//' '//trim(restart)// &
+         ' at step ', step, ', time ', time
     call log_line(text)
   end if
 
@@ -110,7 +111,8 @@ program fdsusp
     PetscCallA(grid_create(cfg, grid, ierr))
     PetscCallA(fluid_create(cfg, grid, fl, ierr))
     if (has_particles) then
-      PetscCallA(fictitious_domain_create(grid, cfg%fluid%reynolds, cfg%time%dt, cfg%particles%slip_kappa, cfg%particles%radius_offset, fd, ierr))
+      call fictitious_domain_create(grid, cfg%fluid%reynolds, cfg%time%dt, cfg%particles%slip_kappa, &
+                                    cfg%particles%radius_offset, fd, ierr); CHKERRA(ierr)
     end if
   else
     ! lubrication dynamics: no grid, no fluid; the imposed shear comes from the walls or the
@@ -126,7 +128,9 @@ program fdsusp
     if (statistics_afresh) call log_line('statistics: the &rheology window begins after the checkpoint''s step; '// &
          'they start from zero there (nothing the checkpoint accumulated is carried over)')
   end if
-  PetscCallA(make_output(ierr))
+  ! what the run writes, and when, over the pieces it has (disassociated pointers are absent)
+  call run_output_open(out, cfg, state, step, restarting, wall_start, grid_p, fluid_p, le_p, parts_p, contacts_p, &
+                       lubrication_p, rheology_p)
   PetscCallA(stage_pop(ierr))
   ! free lubricated pairs must not separate faster than their Lambda relaxes (mod_fictitious_domain)
   if (cfg%resolved .and. has_particles .and. allocated(pl) .and. parts%motion == MOTION_FREE) &
@@ -262,14 +266,6 @@ contains
       call warn_line(text)
     end if
   end subroutine make_statistics
-
-  ! The output of this run over the pieces it has (disassociated pointers are absent arguments).
-  subroutine make_output(ierr)
-    PetscErrorCode, intent(out) :: ierr
-    ierr = 0
-    call run_output_open(out, cfg, state, step, restarting, wall_start, grid_p, fluid_p, le_p, parts_p, contacts_p, &
-                         lubrication_p, rheology_p)
-  end subroutine make_output
 
   ! The step of this run (mod_time_step) over the pieces it has: its variant follows from them.
   subroutine make_time_step(ierr)

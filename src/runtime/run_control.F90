@@ -17,27 +17,39 @@ module mod_run_control
 
 contains
 
-  ! DECK is the first argument; -restart FILE and -continue are read from PETSc's options database.
-  ! -continue: restart from the deck's output directory's checkpoint.h5 when there is one, else
-  ! start (what each job of a batch chain runs, scripts/slurm/).
-  subroutine command_line(deck, restart, restarting, continuing)
+  ! DECK is the first argument; -restart FILE, -branch FILE and -continue are read from PETSc's
+  ! options database. -continue: restart from the deck's output directory's checkpoint.h5 when
+  ! there is one, else start (what each job of a batch chain runs, scripts/slurm/). -branch: start
+  ! from the checkpoint's state with this deck's contact and lubrication models and loads, which a
+  ! restart must keep (doc/INPUT.md "Restart"): the cases of a study that share their past.
+  subroutine command_line(deck, restart, restarting, continuing, branching)
     character(len=*), intent(out) :: deck, restart
-    logical, intent(out) :: restarting, continuing
+    logical, intent(out) :: restarting, continuing, branching
+    character(len=len(restart)) :: branch_from
     PetscBool :: set
     PetscErrorCode :: ierr
     call get_command_argument(1, deck)
     if (len_trim(deck) == 0 .or. deck(1:1) == '-') &
-      call fatal_error('usage: fdsusp DECK [-restart CHECKPOINT | -continue] [PETSc options]', 2)
+      call fatal_error('usage: fdsusp DECK [-restart CHECKPOINT | -branch CHECKPOINT | -continue] [PETSc options]', 2)
     restart = ''
     PetscCallA(PetscOptionsGetString(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-restart', restart, set, ierr))
     restarting = logical(set)
     if (restarting .and. len_trim(restart) == 0) &
       call fatal_error('fdsusp: -restart needs the path of a checkpoint', 2)
+    branch_from = ''
+    PetscCallA(PetscOptionsGetString(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-branch', branch_from, set, ierr))
+    branching = logical(set)
+    if (branching .and. len_trim(branch_from) == 0) &
+      call fatal_error('fdsusp: -branch needs the path of a checkpoint', 2)
     PetscCallA(PetscOptionsHasName(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-continue', set, ierr))
     continuing = logical(set)
-    if (restarting .and. continuing) &
-      call fatal_error('fdsusp: -restart and -continue exclude each other (-continue restarts from the '// &
+    if (count([restarting, continuing, branching]) > 1) &
+      call fatal_error('fdsusp: -restart, -branch and -continue exclude each other (-continue restarts from the '// &
                        'output directory''s checkpoint.h5)', 2)
+    if (branching) then
+      restart = branch_from
+      restarting = .true.
+    end if
   end subroutine command_line
 
   ! -continue: the output directory's checkpoint.h5 if it exists (looked for under the directory's

@@ -8,7 +8,10 @@ body_force, viscous_theta, manufactured_solution (refused) and steps, pressure_t
 in lubrication dynamics with contacts and &rheology the sphere radius, motion, an external force,
 friction, roughness, the lubrication model and cut-off, the &contact group itself (refused),
 neighbour_skin and steps (logged), and dt, which with &rheology is refused naming dt (before, the
-refusal named the statistics' window). A checkpoint written before /deck existed (the group
+refusal named the statistics' window). A branch (-branch) from the same checkpoint takes other
+friction, roughness, lubrication cut-off and an external force, drops or adds the &contact group,
+each change named in the log ('branch: ...'), and still refuses dt and radius; a restart refused
+for friction names -branch. A checkpoint written before /deck existed (the group
 deleted) still restarts, the log saying which variables cannot be checked, and its root attributes
 dt, reynolds and shear_rate are still checked. Exact checks (message text, bytes, exit status):
 the values compared are the doubles the decks were read into, so no tolerance applies."""
@@ -39,11 +42,11 @@ def base(d, text):
     return path, open(path, 'rb').read()
 
 
-def refused(d, ckpt, before, name, text, words):
-    """A restart from ckpt with this deck is refused before any work, naming words."""
+def refused(d, ckpt, before, name, text, words, how='-restart'):
+    """A restart (how: or a branch) from ckpt with this deck is refused before any work, naming words."""
     shutil.rmtree(os.path.join(d, 'again'), ignore_errors=True)
     T.write_deck(d, 'r.nml', text.format(out='again'))
-    status, out, err = T.run('r.nml', d, args=['-restart', ckpt], expect_ok=False)
+    status, out, err = T.run('r.nml', d, args=[how, ckpt], expect_ok=False)
     messages = [line for line in err.splitlines() if line.startswith('fdsusp:') and 'warning' not in line]
     T.check(status == 2, '%s: refused with status %d == 2' % (name, status))
     T.check(len(messages) == 1 and all(w in messages[0] for w in words),
@@ -53,13 +56,15 @@ def refused(d, ckpt, before, name, text, words):
     T.check(open(os.path.join(d, ckpt), 'rb').read() == before, '%s: the checkpoint is bitwise as it was' % name)
 
 
-def accepted(d, ckpt, name, text, notes):
-    """A restart from ckpt with this deck runs to its end and the log holds each of notes."""
+def accepted(d, ckpt, name, text, notes, how='-restart'):
+    """A restart (how: or a branch) from ckpt with this deck runs to its end and the log's lines
+    of the restart ('restart:', 'branch:') hold each of notes."""
+    shutil.rmtree(os.path.join(d, 'again'), ignore_errors=True)
     T.write_deck(d, 'r.nml', text.format(out='again'))
-    status, out, err = T.run('r.nml', d, args=['-restart', ckpt], expect_ok=False)
+    status, out, err = T.run('r.nml', d, args=[how, ckpt], expect_ok=False)
     T.check(status == 0 and 'finished at step' in out, '%s: accepted, runs to its end (status %d)' % (name, status))
     for note in notes:
-        T.check(any(note in line for line in out.splitlines() if line.startswith('restart:')),
+        T.check(any(note in line for line in out.splitlines() if line.startswith(how[1:] + ':')),
                 '%s: the log says "%s"' % (name, note))
     return out
 
@@ -125,4 +130,40 @@ for name, text, words in [
 accepted(d, ckpt, 'lubrication dynamics steps and neighbour_skin',
          LD.replace('steps = 4', 'steps = 6').replace('friction = 0.3', 'friction = 0.3, neighbour_skin = 0.3'),
          ['steps = 4 to steps = 6', 'neighbour_skin = 2.0E-01 to neighbour_skin = 3.0E-01'])
+
+# ---- -branch: the checkpoint's state, this deck's contact and lubrication physics ----
+# statistics begun at the checkpoint's step are still protected: their contact shell follows the
+# roughness
+refused(d, ckpt, before, 'branch of other roughness into begun statistics', LD.replace('roughness = 0.01', 'roughness = 0.02'),
+        ['group &rheology', 'variable contact_shell', 'start afresh'], how='-branch')
+# the branches' statistics begin after the branch point (step 4): they start afresh. TRUNK runs
+# to step 4, each branch on to step 12
+TRUNK = LD.replace('discard_strain = 0.004', 'discard_strain = 0.02')
+BRANCH = TRUNK.replace('steps = 4', 'steps = 12')
+NO_CONTACTS = '&contact roughness = 0.01, friction = 0.3 /\n'
+ckpt, before = base(d, TRUNK)
+accepted(d, ckpt, 'branch: friction, roughness, cut-off, an external force',
+         BRANCH.replace('friction = 0.3', 'friction = 0.5').replace('roughness = 0.01', 'roughness = 0.02')
+               .replace('outer_cutoff = 1', 'outer_cutoff = 0.8')
+               .replace('number = 2,', 'number = 2, external_force(:,2) = 0.1, 0, 0,'),
+         ['friction = 3.0E-01 to friction = 5.0E-01', 'roughness = 1.0E-02 to roughness = 2.0E-02',
+          'outer_cutoff = 1 to outer_cutoff = 8.0E-01', 'external_force(:,2) = 0, 0, 0 to external_force(:,2) = '
+          '1.0E-01, 0, 0', 'may change on a branch'], how='-branch')
+accepted(d, ckpt, 'branch: contacts dropped', BRANCH.replace(NO_CONTACTS, ''),
+         ["the checkpoint's run had contacts, this one has none"], how='-branch')
+with T.h5py.File(os.path.join(d, 'again', 'checkpoint.h5'), 'r') as f:
+    T.check(int(f.attrs['step'][0]) == 12 and 'contacts' not in f,
+            'branch: contacts dropped: its checkpoint at step 12 holds no springs')
+for name, text, words in [
+    ('dt', BRANCH.replace('dt = 0.002', 'dt = 0.001'), ['&time', 'variable dt']),
+    ('radius', BRANCH.replace('number = 2,', 'number = 2, radius = 0.9,'), ['&particles', 'variable radius']),
+]:
+    refused(d, ckpt, before, 'branch ' + name, text, [ckpt, 'group ' + words[0]] + words[1:], how='-branch')
+# a restart refused for what a branch may change says so
+refused(d, ckpt, before, 'restart of other friction points to -branch', BRANCH.replace('friction = 0.3', 'friction = 0.5'),
+        ['variable friction', 'or branch from the checkpoint (-branch CHECKPOINT'])
+ckpt, before = base(d, TRUNK.replace(NO_CONTACTS, ''))
+out = accepted(d, ckpt, 'branch: contacts added', BRANCH, ["the checkpoint's run had no contacts"], how='-branch')
+T.check(not any('does not record' in line for line in out.splitlines()),
+        'branch: contacts added: the contact variables the checkpoint lacks are not called unchecked')
 T.finish()

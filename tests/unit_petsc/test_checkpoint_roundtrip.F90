@@ -144,7 +144,7 @@ program test_checkpoint_roundtrip
                    cfg%block_steps, info)
   step = -1
   time = -1.0_dp
-  call checkpoint_check(path, cfg, n_particles, step, time, rh2)
+  call checkpoint_check(path, cfg, n_particles, .false., step, time, rh2)
   call check(step == saved_step, trim(scene)//': checkpoint_check accepts the file and finds step 50')
   call check(time == saved_time, trim(scene)//': checkpoint_check finds the time 0.1234567890123 bitwise')
 
