@@ -73,8 +73,10 @@ def test_consolidate_without_series_h5(tmp_path):
 def test_fdsusp_continues_a_branch_with_parts(tmp_path, fdsusp_binary):
     """The trunk run by fdsusp (its series split into series.h5 and parts as a kill leaves it),
     branched and continued by fdsusp from the checkpoint: the continuation keeps every record,
-    warns of nothing and sets nothing aside. The branch is the trunk's own case: the program
-    refuses a restart whose &contact differs from the checkpoint's (src/io/restart_deck.F90)."""
+    warns of nothing and sets nothing aside. The trunk's own case continues with -restart; cases
+    of other contact physics (friction, smooth spheres without &contact) with -branch, which takes
+    their deck's contact model (a -restart refuses it: src/io/restart_deck.F90), as
+    pair.prepare(branched=True) runs them."""
     binary = fdsusp_binary
     dt, steps = 2.5e-3, 24         # a record every 4 steps (pair.record_every), a checkpoint every 2
 
@@ -117,3 +119,21 @@ def test_fdsusp_continues_a_branch_with_parts(tmp_path, fdsusp_binary):
     # the branch's records are the trunk's up to its checkpoint, bit for bit
     k = len(whole['step'])
     assert np.array_equal(cols['particles/position'][:k], whole['particles/position'])
+
+    # cases of other contact physics branch from the same trunk
+    for case, other in (('eps1e-2_mu03', dict(contact, friction=0.3)), ('eps0', None)):
+        d = str(tmp_path / case)
+        pair.branch(trunk, d, case)
+        write(d, case, 2 * steps, other)
+        p = run.run('deck.nml', cwd=d, binary=binary, args=['-restart', 'out/checkpoint.h5'], timeout=300)
+        assert p.returncode == 2 and 'or branch from the checkpoint' in p.stderr
+        p = run.run('deck.nml', cwd=d, binary=binary, args=['-branch', 'out/checkpoint.h5'], timeout=300)
+        assert p.returncode == 0, p.stderr[-2000:]
+        log = p.stdout.splitlines()
+        if other:
+            assert any(l.startswith('branch: &contact changed from friction = 0 to friction = 3.0E-01') for l in log)
+        else:
+            assert any(l.startswith("branch: the checkpoint's run had contacts, this one has none") for l in log)
+        cols = series.read(os.path.join(d, 'out'))[0]
+        assert list(cols['step']) == list(range(4, 2 * steps + 1, 4))
+        assert np.array_equal(cols['particles/position'][:k], whole['particles/position'])

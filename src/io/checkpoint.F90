@@ -380,10 +380,12 @@ contains
         group = 'contact'
         if (springs) then
           message = 'the checkpoint''s run had contacts (its springs are in /contacts), the deck "'// &
-                    trim(cfg%deck_file)//'" has no &contact group: a restart continues the checkpoint''s physics'
+                    trim(cfg%deck_file)//'" has no &contact group: a restart continues the checkpoint''s physics '// &
+                    '(or branch from the checkpoint: -branch CHECKPOINT)'
         else
           message = 'the checkpoint''s run had no contacts (no /contacts), the deck "'//trim(cfg%deck_file)// &
-                    '" has a &contact group: a restart continues the checkpoint''s physics'
+                    '" has a &contact group: a restart continues the checkpoint''s physics (or branch from the '// &
+                    'checkpoint: -branch CHECKPOINT)'
         end if
       end if
     end if
