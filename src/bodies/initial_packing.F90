@@ -27,8 +27,8 @@ contains
     integer :: n, info
     type(packing_report_t) :: report
 
-    n = packing_count(cfg%particles%solid_fraction, cfg%domain%box, cfg%particles%radius)
-    call random_packing(n, cfg%domain%box, [.true., .not. cfg%walls, .true.], cfg%particles%radius, cfg%particles%packing_min_gap, &
+    n = packing_count(cfg%particles%solid_fraction, cfg%domain%box, cfg%radius)
+    call random_packing(n, cfg%domain%box, [.true., .not. cfg%walls, .true.], cfg%radius, cfg%particles%packing_min_gap, &
                         cfg%particles%seed, cfg%particles%packing_sweeps, position, info, message, report)
     select case (info)
     case (0)
@@ -42,7 +42,7 @@ contains
     write(message, '(a,i0,a,f8.5,a,i0,a,es10.3,a)') 'packing: ', n, ' spheres, phi = ', report%phi, &
          ' (seed ', cfg%particles%seed, '), smallest gap ', min(report%min_pair_gap, report%min_wall_gap), ' a'
     call log_line(message)
-    call particles_init(parts, n, cfg%particles%radius, motion_code(cfg%particles%motion))
+    call particles_init(parts, n, cfg%radius, motion_code(cfg%particles%motion))
     parts%position = position
   end subroutine initial_packing_make
 

@@ -9,7 +9,7 @@ module mod_h5util
   implicit none
   private
   public :: h5util_init, write_attribute, read_attribute, has_attribute, has_object
-  public :: write_string_attribute, read_string_attribute, write_dataset, read_dataset, dataset_dims
+  public :: write_string_attribute, read_string_attribute, write_dataset, read_dataset, dataset_dims, read_values
   public :: HID_T, HSIZE_T
 
   interface write_attribute
@@ -271,6 +271,26 @@ contains
     integer, intent(out) :: err
     call read_dataset_2d(loc, name, H5T_NATIVE_INTEGER, shape(values, kind=HSIZE_T), err, int_values=values)
   end subroutine read_dataset_int
+
+  ! The values of a dataset of rank 1 or 2 holding size(values) numbers, whatever its shape (a
+  ! list written by h5py as (N), by Fortran as 1 x N): err /= 0 when it holds another count.
+  subroutine read_values(loc, name, values, err)
+    integer(HID_T), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    real(dp), intent(out) :: values(:)
+    integer, intent(out) :: err
+    integer(HID_T) :: dset
+    integer(HSIZE_T) :: found(2)
+    integer :: rank, e
+    err = 1
+    call dataset_dims(loc, name, rank, found)
+    if (rank == 1) found(2) = 1
+    if (rank < 1 .or. found(1) * found(2) /= size(values, kind=HSIZE_T)) return
+    call h5dopen_f(loc, name, dset, err)
+    if (err /= 0) return
+    call h5dread_f(dset, H5T_NATIVE_DOUBLE, values, [size(values, kind=HSIZE_T)], err)
+    call h5dclose_f(dset, e)
+  end subroutine read_values
 
   subroutine read_dataset_2d(loc, name, dtype, dims, err, real_values, int_values)
     integer(HID_T), intent(in) :: loc, dtype

@@ -109,8 +109,8 @@ contains
       lub%wall_gap = wall(1, :)
       lub%wall_resolved = transpose(wall(2:, :))
     end if
-    call lub_setup(lub, model, cfg%particles%radius, 1.0_dp, cfg%domain%cells_per_radius, cfg%lubrication%outer_cutoff, cfg%lubrication%inner_cutoff)
-    lub%wall_floor = lub_wall_floor(cfg%fluid%reynolds, cfg%time%dt, cfg%particles%radius)
+    call lub_setup(lub, model, cfg%radius, 1.0_dp, cfg%domain%cells_per_radius, cfg%lubrication%outer_cutoff, cfg%lubrication%inner_cutoff)
+    lub%wall_floor = lub_wall_floor(cfg%fluid%reynolds, cfg%time%dt, cfg%radius)
   end subroutine lubrication_load
 
   subroutine read_table(path, cfg, pair, wall, message)

@@ -10,7 +10,7 @@ module mod_particles_io
   use mod_kinds, only: dp
   use mod_params, only: config_t
   use mod_particles, only: particles_t, particles_init, motion_code, configuration_fault
-  use mod_h5util, only: write_attribute, read_attribute, has_object, write_dataset, read_dataset, dataset_dims
+  use mod_h5util, only: read_values, write_attribute, read_attribute, has_object, write_dataset, read_dataset, dataset_dims
   use mod_errors, only: is_root, input_error, file_error, file_error_from_root, abort_run
   use mod_os_services, only: publish_file
   use mod_file_services, only: errno_text, write_failure_cause, directory_of
@@ -26,20 +26,20 @@ contains
   subroutine particles_load(cfg, parts)
     type(config_t), intent(in) :: cfg
     type(particles_t), intent(out) :: parts
-    real(dp), allocatable :: position(:, :)
+    real(dp), allocatable :: position(:, :), radii(:)
     character(len=400) :: message
     integer :: n, culprit, ierr
     character(len=32) :: item
 
     if (len_trim(cfg%particles%position_file) == 0) then
       n = cfg%particles%number
-      call particles_init(parts, n, cfg%particles%radius, motion_code(cfg%particles%motion))
+      call particles_init(parts, n, cfg%radius, motion_code(cfg%particles%motion))
       parts%position = cfg%particles%position(:, 1:n)
       parts%prescribed_velocity = cfg%particles%velocity(:, 1:n)
       parts%prescribed_omega = cfg%particles%omega(:, 1:n)
       parts%external_force = cfg%particles%external_force(:, 1:n)
       parts%external_torque = cfg%particles%external_torque(:, 1:n)
-      message = configuration_fault(parts%position, parts%radius, cfg%domain%box, cfg%walls, culprit, start_gap_roughness(cfg))
+      message = configuration_fault(parts%position, parts%radii, cfg%domain%box, cfg%walls, culprit, start_gap_roughness(cfg))
       if (len_trim(message) > 0) then
         write(item, '(a,i0,a)') 'position(:,', culprit, ')'
         call input_error(cfg%deck_file, 'particles', trim(item), trim(message))
@@ -49,28 +49,90 @@ contains
 
     message = ''
     n = 0
-    if (is_root()) call read_positions(trim(cfg%particles%position_file), position, message)
+    if (is_root()) call read_positions(trim(cfg%particles%position_file), position, radii, message)
     call file_error_from_root(trim(cfg%particles%position_file), 'particles/position', message)
     if (is_root()) n = size(position, 2)
     call MPI_Bcast(n, 1, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
     if (.not. is_root()) allocate(position(3, n))
     call MPI_Bcast(position, 3 * n, MPI_DOUBLE_PRECISION, 0, PETSC_COMM_WORLD, ierr)
-    call particles_init(parts, n, cfg%particles%radius, motion_code(cfg%particles%motion))
+    call particles_init(parts, n, cfg%radius, motion_code(cfg%particles%motion))
     parts%position = position
-    message = configuration_fault(parts%position, parts%radius, cfg%domain%box, cfg%walls, culprit, start_gap_roughness(cfg))
+    ! each sphere's radius: the file's (particles/radius), one of the deck's species
+    if (is_root()) message = radii_fault(cfg, radii)
+    call file_error_from_root(trim(cfg%particles%position_file), 'particles/radius', message)
+    if (is_root() .and. allocated(radii)) parts%radii = radii
+    call MPI_Bcast(parts%radii, n, MPI_DOUBLE_PRECISION, 0, PETSC_COMM_WORLD, ierr)
+    message = configuration_fault(parts%position, parts%radii, cfg%domain%box, cfg%walls, culprit, start_gap_roughness(cfg))
     if (len_trim(message) > 0) call file_error(trim(cfg%particles%position_file), 'particles/position', trim(message))
   end subroutine particles_load
+
+  ! '' when the radii of a position file (absent: not given) are the deck's (doc/INPUT.md
+  ! "Mixtures"): each one of &particles radius, and every species there; without radii in the file
+  ! the deck must list one radius, which every sphere takes.
+  function radii_fault(cfg, radii) result(message)
+    type(config_t), intent(in) :: cfg
+    real(dp), allocatable, intent(in) :: radii(:)
+    character(len=400) :: message
+    ! the file's radii are the deck's to round-off (a radius written and read as a double)
+    real(dp), parameter :: tolerance = 1.0e-12_dp
+    integer :: q, k
+    message = ''
+    associate(species => cfg%particles%radius(1:cfg%species))
+      if (.not. allocated(radii)) then
+        if (cfg%species > 1) message = 'missing: the deck lists a mixture (&particles radius), the file must give '// &
+                                       'each sphere''s radius'
+        return
+      end if
+      do q = 1, size(radii)
+        if (all(abs(radii(q) - species) > tolerance * species)) then
+          write(message, '(a,i0,a,es13.6,a)') 'sphere ', q, ' has radius ', radii(q), &
+               ', not one of the deck''s &particles radius'
+          return
+        end if
+      end do
+      do k = 1, size(species)
+        if (all(abs(radii - species(k)) > tolerance * species(k))) then
+          write(message, '(a,es13.6,a)') 'holds no sphere of the deck''s radius ', species(k), &
+               ' (&particles radius lists a species the file lacks)'
+          return
+        end if
+      end do
+    end associate
+  end function radii_fault
+
+  ! '' when the checkpoint's spheres (its /particles group) have the radii of parts, the run's:
+  ! a mixture's checkpoint holds them (/particles/radius), equal spheres' the attribute radius.
+  function radii_change(group, parts) result(message)
+    integer(HID_T), intent(in) :: group
+    type(particles_t), intent(in) :: parts
+    character(len=200) :: message
+    real(dp) :: stored(parts%n)
+    integer :: err
+    message = ''
+    if (has_object(group, 'radius')) then
+      call read_values(group, 'radius', stored, err)
+      if (err /= 0) then
+        message = 'dataset /particles/radius unreadable or of another size'
+      else if (any(stored /= parts%radii)) then
+        message = 'its spheres have other radii than the run''s (&particles radius, position_file): a restart '// &
+                  'continues the checkpoint''s spheres'
+      end if
+    else if (any(parts%radii /= parts%radius)) then
+      message = 'its spheres are of one size, the run''s a mixture (&particles radius)'
+    end if
+  end function radii_change
 
   ! h_r when the run has rough contacts (their start-gap rule), else 0.
   pure real(dp) function start_gap_roughness(cfg) result(h_r)
     type(config_t), intent(in) :: cfg
     h_r = 0.0_dp
-    if (cfg%contact_group) h_r = cfg%contact%roughness * cfg%particles%radius
+    if (cfg%contact_group) h_r = cfg%contact%roughness * cfg%radius
   end function start_gap_roughness
 
-  subroutine read_positions(path, position, message)
+  ! particles/position (N x 3) of an HDF5 file and, when the file has it, particles/radius (N).
+  subroutine read_positions(path, position, radii, message)
     character(len=*), intent(in) :: path
-    real(dp), allocatable, intent(out) :: position(:, :)
+    real(dp), allocatable, intent(out) :: position(:, :), radii(:)
     character(len=*), intent(out) :: message
     integer(HID_T) :: file
     integer(HSIZE_T) :: dims(2)
@@ -96,6 +158,13 @@ contains
       allocate(position(3, dims(2)))
       call read_dataset(file, 'particles/position', position, err)
       if (err /= 0) message = 'cannot be read'
+    end if
+    if (len_trim(message) == 0) then
+      if (has_object(file, 'particles/radius')) then
+        allocate(radii(size(position, 2)))
+        call read_values(file, 'particles/radius', radii, err)
+        if (err /= 0) message = 'particles/radius must hold one radius per sphere of particles/position'
+      end if
     end if
     call h5fclose_f(file, err)
   end subroutine read_positions
@@ -123,6 +192,8 @@ contains
       call write_matrix(group, 'velocity_prev', parts%velocity_prev)
       call write_attribute(group, 'have_prev', [merge(1, 0, parts%have_prev)], e)
       call write_attribute(group, 'motion', [parts%motion], e)
+      ! a mixture's radii, which a restart checks against its deck's (equal spheres: the attribute)
+      if (any(parts%radii /= parts%radius)) call write_dataset(group, 'radius', reshape(parts%radii, [1, parts%n]), e)
     end if
     call h5gclose_f(group, err)
   end subroutine particles_write
@@ -162,7 +233,7 @@ contains
     call h5gopen_f(file, 'particles', group, err)
     call write_matrix(group, 'velocity', parts%velocity)
     call write_matrix(group, 'omega', parts%omega)
-    call write_dataset(group, 'radius', spread(spread(parts%radius, 1, 1), 2, parts%n), err)
+    call write_dataset(group, 'radius', reshape(parts%radii, [1, parts%n]), err)
     if (err /= 0) call write_failed(path, 'cannot take /particles/radius')
     call h5gclose_f(group, err)
     call h5fclose_f(file, err)
@@ -269,6 +340,7 @@ contains
           if (err /= 0) message = 'cannot read /particles/'//trim(names(e))
         end do
         call read_attribute(group, 'have_prev', flag, err)
+        if (len_trim(message) == 0) message = radii_change(group, parts)
         call h5gclose_f(group, err)
       end if
       call h5fclose_f(file, err)

@@ -83,7 +83,12 @@ contains
     call text_item('run', 'title', MAY_CHANGE, cfg%run%title)
     call real_item('run', 'max_wall_hours', MAY_CHANGE, [cfg%run%max_wall_hours])
     if (particles > 0) then
-      call real_item('particles', 'radius', MUST_MATCH, [cfg%particles%radius])
+      ! (equal spheres: one radius, as checkpoints before mixtures recorded it)
+      call real_item('particles', 'radius', MUST_MATCH, cfg%particles%radius(1:cfg%species))
+      if (cfg%species > 1) then
+        call real_item('particles', 'volume_share', MUST_MATCH, cfg%particles%volume_share(1:cfg%species))
+        call real_item('particles', 'number_share', MUST_MATCH, cfg%particles%number_share(1:cfg%species))
+      end if
       call text_item('particles', 'motion', MUST_MATCH, cfg%particles%motion)
       if (cfg%resolved) then
         call real_item('particles', 'radius_offset', MUST_MATCH, [cfg%particles%radius_offset])

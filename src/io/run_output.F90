@@ -94,7 +94,7 @@ contains
       end if
       call series_attributes(out%series, [character(len=32) :: 'box_x', 'box_y', 'box_z', 'radius', 'shear_rate', &
            'dt', 'core_lo', 'core_hi', 'pair_radius', 'contact_radius', 'blocks', 'discard_step', 'block_steps', &
-           'series_every', 'friction', 'roughness'], [cfg%domain%box, cfg%particles%radius, cfg%domain%shear_rate, &
+           'series_every', 'friction', 'roughness'], [cfg%domain%box, cfg%radius, cfg%domain%shear_rate, &
            cfg%time%dt, out%rheology%core, out%rheology%r_outer, out%rheology%r_contact, &
            real([cfg%rheology%blocks, cfg%discard_step, cfg%block_steps, cfg%output%series_every], dp), &
            friction, roughness])

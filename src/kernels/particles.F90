@@ -22,7 +22,8 @@ module mod_particles
   type :: particles_t
     integer :: n = 0
     integer :: motion = MOTION_FREE
-    real(dp) :: radius = 1.0_dp
+    real(dp) :: radius = 1.0_dp                    ! of equal spheres; of a mixture the smallest (the unit)
+    real(dp), allocatable :: radii(:)              ! (n) each sphere's radius [a]
     real(dp), allocatable :: position(:, :)        ! (3, n) centres [a], wrapped into the box
     real(dp), allocatable :: velocity(:, :)        ! (3, n) U^n [a gamma_dot]
     real(dp), allocatable :: omega(:, :)           ! (3, n) Omega^n [gamma_dot]
@@ -56,6 +57,8 @@ contains
     p%n = n
     p%radius = radius
     p%motion = motion
+    allocate(p%radii(n))
+    p%radii = radius
     allocate(p%position(3, n), p%velocity(3, n), p%omega(3, n), p%velocity_prev(3, n), &
              p%prescribed_velocity(3, n), p%prescribed_omega(3, n), p%external_force(3, n), &
              p%external_torque(3, n), p%force_hydro(3, n), p%torque_hydro(3, n), &
@@ -121,13 +124,13 @@ contains
 
   ! '' if the configuration is acceptable, else what is wrong (and the particle at fault):
   ! a centre outside the box, a sphere crossing a wall, or two spheres overlapping by more than
-  ! 5 % of the radius (an O(N^2) check, done once at start-up). With rough contacts, roughness
-  ! = h_r > 0: every surface gap, pair or wall, must be at least h_r/2, since an overlap
+  ! 5 % of the smallest radius (an O(N^2) check, done once at start-up); radii: each sphere's.
+  ! With rough contacts, roughness = h_r > 0: every surface gap, pair or wall, must be at least h_r/2, since an overlap
   ! |delta'| = h_r - gap beyond h_r/2 is outside what the contact model is stable for (the
   ! extreme scenes of doc/VALIDATION.md §6) and would start the run with a force of
   ! k_n (h_r/2)^(3/2), some 30 times the force scale.
-  function configuration_fault(position, radius, box, walls, culprit, roughness) result(message)
-    real(dp), intent(in) :: position(:, :), radius, box(3)
+  function configuration_fault(position, radii, box, walls, culprit, roughness) result(message)
+    real(dp), intent(in) :: position(:, :), radii(:), box(3)
     logical, intent(in) :: walls
     integer, intent(out) :: culprit
     real(dp), intent(in), optional :: roughness
@@ -138,7 +141,7 @@ contains
     message = ''
     culprit = 0
     periodic = [.true., .not. walls, .true.]
-    min_gap = -0.05_dp * radius
+    min_gap = -0.05_dp * minval(radii)
     if (present(roughness)) then
       if (roughness > 0.0_dp) min_gap = 0.5_dp * roughness
     end if
@@ -150,14 +153,14 @@ contains
           return
         end if
       end do
-      if (walls .and. (position(2, i) < radius .or. position(2, i) > box(2) - radius)) then
+      if (walls .and. (position(2, i) < radii(i) .or. position(2, i) > box(2) - radii(i))) then
         write(message, '(a,i0,a,f12.5,a)') 'particle ', i, ' at y = ', position(2, i), ' crosses a wall'
         culprit = i
         return
       end if
-      if (walls .and. min_gap > 0.0_dp .and. min(position(2, i), box(2) - position(2, i)) - radius < min_gap) then
+      if (walls .and. min_gap > 0.0_dp .and. min(position(2, i), box(2) - position(2, i)) - radii(i) < min_gap) then
         write(message, '(a,i0,a,es10.3,a,es10.3,a)') 'particle ', i, ' starts at a wall gap of ', &
-             min(position(2, i), box(2) - position(2, i)) - radius, ' a: rough contacts need >= h_r/2 = ', &
+             min(position(2, i), box(2) - position(2, i)) - radii(i), ' a: rough contacts need >= h_r/2 = ', &
              min_gap, ' a at the start'
         culprit = i
         return
@@ -166,13 +169,13 @@ contains
     do i = 1, size(position, 2)
       do j = i + 1, size(position, 2)
         dist = norm2(min_image(position(:, j) - position(:, i), box, periodic))
-        if (dist - 2 * radius < min_gap) then
+        if (dist - (radii(i) + radii(j)) < min_gap) then
           if (min_gap > 0.0_dp) then
             write(message, '(a,i0,a,i0,a,es10.3,a,es10.3,a)') 'particles ', i, ' and ', j, ' start at a gap of ', &
-                 dist - 2 * radius, ' a: rough contacts need >= h_r/2 = ', min_gap, ' a at the start'
+                 dist - (radii(i) + radii(j)), ' a: rough contacts need >= h_r/2 = ', min_gap, ' a at the start'
           else
             write(message, '(a,i0,a,i0,a,f10.5,a)') 'particles ', i, ' and ', j, ' overlap (centre distance ', &
-                 dist / radius, ' radii)'
+                 2 * dist / (radii(i) + radii(j)), ' radii)'
           end if
           culprit = i
           return

@@ -25,12 +25,13 @@ module mod_params
   use mod_rheology, only: rheology_settings_t
   implicit none
   private
-  public :: config_t, read_deck, echo_deck, max_line, max_inline_particles
+  public :: config_t, read_deck, echo_deck, max_line, max_inline_particles, max_species
   public :: domain_settings_t, fluid_settings_t, time_settings_t, output_settings_t, run_settings_t, &
             verification_settings_t, particles_settings_t, lubrication_settings_t
 
   integer, parameter :: max_line = deck_line_length
   integer, parameter :: max_inline_particles = 64
+  integer, parameter :: max_species = 8           ! sphere sizes of a mixture (&particles radius)
   integer, parameter :: ngroups = 10
   character(len=16), parameter :: known_groups(ngroups) = [character(len=16) :: &
        'domain', 'fluid', 'time', 'output', 'run', 'verification', 'particles', 'contact', 'lubrication', &
@@ -89,7 +90,11 @@ module mod_params
     integer :: number = 0                               ! particles given inline
     real(dp) :: position(3, max_inline_particles) = 0.0_dp          ! centres [a]
     character(len=max_line) :: position_file = ''       ! HDF5 file with particles/position
-    real(dp) :: radius = 1.0_dp                         ! sphere radius [a]
+    ! the radius of each species [a], smallest first (one entry: equal spheres); the smallest is
+    ! the unit of length, so it is 1 for a mixture (doc/INPUT.md "Mixtures")
+    real(dp) :: radius(max_species) = [1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp]
+    real(dp) :: volume_share(max_species) = 0.0_dp      ! a mixture's share of the solid volume per species [-]
+    real(dp) :: number_share(max_species) = 0.0_dp      ! or of the spheres per species [-]
     character(len=16) :: motion = 'free'                ! 'free', 'prescribed', 'resistance' or 'frozen'
     real(dp) :: velocity(3, max_inline_particles) = 0.0_dp          ! prescribed U [a*gamma_dot]
     real(dp) :: omega(3, max_inline_particles) = 0.0_dp             ! prescribed Omega [gamma_dot]
@@ -126,6 +131,9 @@ module mod_params
     type(lubrication_settings_t) :: lubrication
     type(rheology_settings_t) :: rheology               ! statistics on when the group is present
     ! derived, not read
+    integer :: species = 1                              ! sphere sizes: the positive entries of radius
+    real(dp) :: radius = 1.0_dp                         ! the smallest sphere's radius [a] (of equal spheres: theirs)
+    real(dp) :: radius_max = 1.0_dp                     ! the largest sphere's radius [a]
     logical :: contact_group = .false.                  ! the deck has a &contact group
     logical :: rheology_group = .false.                 ! the deck has a &rheology group
     integer :: discard_step = 0, block_steps = 1        ! the &rheology window in steps
@@ -503,9 +511,9 @@ contains
     ! configurations (the start-gap rule of mod_particles::configuration_fault asks for h_r/2)
     if (cfg%particles%packing_min_gap == -1.0_dp) then
       cfg%particles%packing_min_gap = 0.0_dp
-      if (cfg%contact_group) cfg%particles%packing_min_gap = cfg%contact%roughness * cfg%particles%radius
+      if (cfg%contact_group) cfg%particles%packing_min_gap = cfg%contact%roughness * cfg%radius
     else if (cfg%contact_group .and. cfg%particles%solid_fraction > 0.0_dp &
-             .and. cfg%particles%packing_min_gap < 0.5_dp * cfg%contact%roughness * cfg%particles%radius) then
+             .and. cfg%particles%packing_min_gap < 0.5_dp * cfg%contact%roughness * cfg%radius) then
       call input_error(cfg%deck_file, 'particles', 'packing_min_gap', &
            'rough contacts need gaps >= h_r/2 at the start (&contact roughness x radius / 2)')
     end if
@@ -521,7 +529,7 @@ contains
     type(config_t), intent(inout) :: cfg
     logical :: exists
     call check_int(cfg, 'particles', 'number', cfg%particles%number, 0, max_inline_particles)
-    call check_real(cfg, 'particles', 'radius', cfg%particles%radius, 0.0_dp, 100.0_dp, .true.)
+    call validate_species(cfg)
     if (all(cfg%particles%motion /= [character(len=16) :: 'free', 'prescribed', 'resistance', 'frozen', 'fixed'])) &
       call input_error(cfg%deck_file, 'particles', 'motion', &
            'must be ''free'', ''prescribed'', ''resistance'', ''frozen'' or ''fixed'', not '''// &
@@ -539,6 +547,9 @@ contains
         call input_error(cfg%deck_file, 'particles', 'motion', &
            'prescribed velocities are given inline: use number and position, not position_file')
     end if
+    if (cfg%species > 1 .and. cfg%particles%number > 0) call input_error(cfg%deck_file, 'particles', 'number', &
+         'inline particles are of one size: a mixture''s spheres come from position_file (with particles/radius) '// &
+         'or from solid_fraction')
     call check_real(cfg, 'particles', 'solid_fraction', cfg%particles%solid_fraction, 0.0_dp, phi_max)
     call check_int(cfg, 'particles', 'seed', cfg%particles%seed, 0, huge(1))
     call check_int(cfg, 'particles', 'packing_sweeps', cfg%particles%packing_sweeps, 0, 1000000)
@@ -556,10 +567,70 @@ contains
         cfg%particles%solid_fraction == 0.0_dp) &
       call input_error(cfg%deck_file, 'fluid', 'model', '''none'' (lubrication dynamics) moves spheres and nothing '// &
            'else: give &particles (number/position, position_file or solid_fraction)')
-    if (cfg%resolved .and. cfg%particles%radius + cfg%particles%radius_offset * cfg%h < 1.5_dp * cfg%h) &
+    if (cfg%resolved .and. cfg%radius + cfg%particles%radius_offset * cfg%h < 1.5_dp * cfg%h) &
       call input_error(cfg%deck_file, 'particles', 'radius', &
-           'the sphere must span at least 1.5 grid cells in radius (raise &domain cells_per_radius)')
+           'the (smallest) sphere must span at least 1.5 grid cells in radius (raise &domain cells_per_radius)')
   end subroutine validate_particles
+
+  ! The sizes of the spheres (doc/INPUT.md "Mixtures"): &particles radius lists one radius per
+  ! species, smallest first; a mixture (two or more) is 1 for the smallest, the unit of length,
+  ! and gives the share of each species by volume or by number (volume_share or number_share,
+  ! positive, summing to 1). Sets the derived species, radius (smallest) and radius_max.
+  subroutine validate_species(cfg)
+    type(config_t), intent(inout) :: cfg
+    character(len=200) :: text
+    real(dp), parameter :: share_tolerance = 1.0e-9_dp   ! decimal shares sum to 1 within round-off
+    integer :: k, given
+    associate(particles => cfg%particles)
+      cfg%species = count(particles%radius > 0.0_dp)
+      if (cfg%species == 0) call input_error(cfg%deck_file, 'particles', 'radius', 'needs one positive radius per species')
+      if (any(particles%radius(cfg%species + 1:) /= 0.0_dp)) call input_error(cfg%deck_file, 'particles', 'radius', &
+           'lists its radii one after the other, without zeros or negative values between them')
+      do k = 1, cfg%species
+        write(text, '(a,i0,a)') 'radius(', k, ')'
+        call check_real(cfg, 'particles', trim(text), particles%radius(k), 0.0_dp, 100.0_dp, .true.)
+      end do
+      do k = 2, cfg%species
+        write(text, '(a,i0,a)') 'radius(', k, ')'
+        if (particles%radius(k) <= particles%radius(k - 1)) call input_error(cfg%deck_file, 'particles', &
+             trim(text), 'the radii of a mixture are listed smallest first, each larger than the one before')
+      end do
+      cfg%radius = particles%radius(1)
+      cfg%radius_max = particles%radius(cfg%species)
+      given = count([any(particles%volume_share /= 0.0_dp), any(particles%number_share /= 0.0_dp)])
+      if (cfg%species == 1) then
+        if (given > 0 .and. .not. (all(particles%volume_share(2:) == 0.0_dp) .and. &
+                                   all(particles%number_share(2:) == 0.0_dp))) &
+          call input_error(cfg%deck_file, 'particles', trim(merge('volume_share', 'number_share', &
+               any(particles%volume_share /= 0.0_dp))), 'gives shares of several species, radius lists one')
+        return
+      end if
+      if (particles%radius(1) /= 1.0_dp) call input_error(cfg%deck_file, 'particles', 'radius(1)', &
+           'the smallest sphere of a mixture is the unit of length: radius(1) = 1, the others in its units')
+      if (given /= 1) call input_error(cfg%deck_file, 'particles', 'volume_share', &
+           'a mixture gives the share of each species by volume (volume_share) or by number (number_share), one of them')
+      if (any(particles%volume_share /= 0.0_dp)) then
+        call check_shares('volume_share', particles%volume_share)
+      else
+        call check_shares('number_share', particles%number_share)
+      end if
+    end associate
+
+  contains
+
+    subroutine check_shares(name, share)
+      character(len=*), intent(in) :: name
+      real(dp), intent(in) :: share(:)
+      if (count(share /= 0.0_dp) /= cfg%species .or. any(share(1:cfg%species) <= 0.0_dp)) then
+        write(text, '(a,i0,a)') 'gives one positive share per species (', cfg%species, ' radii)'
+        call input_error(cfg%deck_file, 'particles', name, trim(text))
+      end if
+      if (abs(sum(share(1:cfg%species)) - 1.0_dp) > share_tolerance) then
+        write(text, '(a,es12.5,a)') 'sums to ', sum(share(1:cfg%species)), ', not 1'
+        call input_error(cfg%deck_file, 'particles', name, trim(text))
+      end if
+    end subroutine check_shares
+  end subroutine validate_species
 
   ! Ranges of &rheology, and the step counts of the averaging window (doc/RHEOLOGY.md).
   subroutine validate_rheology(cfg)
@@ -581,7 +652,7 @@ contains
     call check_real(cfg, 'rheology', 'core(2)', cfg%rheology%core(2), 0.0_dp, 1.0_dp)
     if (cfg%rheology%core(2) <= cfg%rheology%core(1)) call input_error(cfg%deck_file, 'rheology', 'core', 'must be y_lo/Ly < y_hi/Ly')
     call check_int(cfg, 'rheology', 'profile_bins', cfg%rheology%profile_bins, 0, 100000)
-    if (cfg%rheology%profile_bins == 0) cfg%rheology%profile_bins = max(1, nint(4 * cfg%domain%box(2) / cfg%particles%radius))
+    if (cfg%rheology%profile_bins == 0) cfg%rheology%profile_bins = max(1, nint(4 * cfg%domain%box(2) / cfg%radius))
     call check_int(cfg, 'rheology', 'angle_bins', cfg%rheology%angle_bins, 4, 3600)
     call check_real(cfg, 'rheology', 'pair_shell', cfg%rheology%pair_shell, 2.0_dp, 3.0_dp, .true.)
     call check_real(cfg, 'rheology', 'contact_shell', cfg%rheology%contact_shell, 0.0_dp, 0.5_dp)
@@ -647,7 +718,7 @@ contains
              'k_n from eps_bar needs a non-zero &domain shear_rate: prescribe normal_stiffness > 0')
     end if
     ! the neighbour search needs every periodic length >= 2 x cutoff (one image in range)
-    cutoff = cfg%particles%radius * (2.0_dp + cfg%contact%roughness) + cfg%contact%neighbour_skin
+    cutoff = 2.0_dp * cfg%radius_max + cfg%contact%roughness * cfg%radius + cfg%contact%neighbour_skin
     do d = 1, 3
       if (d == 2 .and. cfg%walls) cycle
       if (cfg%domain%box(d) < 2.0_dp * cutoff) then

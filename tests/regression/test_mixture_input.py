@@ -1,0 +1,94 @@
+"""Invariant: spheres of several sizes are read as the deck and the position file state them, and
+what does not add up is refused before any work with one message naming the file, the group and
+the variable (or the file's dataset) (doc/INPUT.md "Mixtures"). &particles radius lists the
+species, smallest first, the smallest 1 (the unit of length) for a mixture; volume_share or
+number_share (one of them, one positive share per species, summing to 1 within 1e-9) gives the
+composition of a packing; a position file's particles/radius (N, any shape holding N numbers)
+must hold only the deck's radii and each of them. Equal spheres are unchanged: a deck of one
+radius with a position file whose particles/radius is that radius runs, and its particle
+snapshot holds each sphere's radius. The models do not move a mixture yet: a mixture that
+passes every check is refused naming &particles radius and the model. Exact checks (messages,
+status, absence of any step)."""
+import os
+import fdsusp_testlib as T
+
+LD = """&domain box = 8.0, 8.0, 8.0, y_boundary = 'lees-edwards', shear_rate = 1 /
+&fluid model = 'none' /
+&time dt = 0.002, steps = 2 /
+&output directory = 'out', progress_every = 1, particles_every = 2 /
+&particles {particles} /
+"""
+# three spheres well apart: two of radius 1, one of 1.4
+POSITIONS = [[2.0, 4.0, 4.0], [5.0, 4.0, 4.0], [2.0, 4.0, 1.5]]
+
+
+def position_file(d, name, radii=None, shape=None):
+    with T.h5py.File(os.path.join(d, name), 'w') as f:
+        f.create_dataset('particles/position', data=T.np.array(POSITIONS))
+        if radii is not None:
+            r = T.np.array(radii, dtype=float)
+            f.create_dataset('particles/radius', data=r.reshape(shape) if shape else r)
+
+
+def refused(d, name, particles, words):
+    out_dir = os.path.join(d, 'out')
+    if os.path.isdir(out_dir):
+        T.shutil.rmtree(out_dir)
+    T.write_deck(d, 'mix.nml', LD.format(particles=particles))
+    status, out, err = T.run('mix.nml', d, expect_ok=False)
+    messages = [line for line in err.splitlines() if line.startswith('fdsusp:') and 'warning' not in line]
+    T.check(status == 2 and len(messages) == 1 and all(w in messages[0] for w in words),
+            '%s: refused (status %d) with one message naming %s: %s' % (name, status, ', '.join(words), messages[:1]))
+    T.check(not any(line.startswith('step ') for line in out.splitlines()), '%s: no step taken' % name)
+
+
+d = T.scratch('mixture_input')
+position_file(d, 'mixture.h5', [1.0, 1.0, 1.4])
+position_file(d, 'mixture_2d.h5', [1.0, 1.0, 1.4], shape=(1, 3))     # as Fortran writes a list
+position_file(d, 'foreign.h5', [1.0, 1.0, 1.3])
+position_file(d, 'one_species.h5', [1.0, 1.0, 1.0])
+position_file(d, 'no_radius.h5')
+position_file(d, 'short_radius.h5', [1.0, 1.4])
+
+MIX = "radius = 1.0, 1.4, volume_share = 0.5, 0.5, position_file = '{f}'"
+for name, particles, words in [
+    ('shares that do not sum to 1', "radius = 1.0, 1.4, volume_share = 0.5, 0.4, solid_fraction = 0.1",
+     ['mix.nml', '&particles', 'variable volume_share', 'sums to']),
+    ('both shares', "radius = 1.0, 1.4, volume_share = 0.5, 0.5, number_share = 0.5, 0.5, solid_fraction = 0.1",
+     ['&particles', 'variable volume_share', 'one of them']),
+    ('no shares', "radius = 1.0, 1.4, solid_fraction = 0.1", ['&particles', 'variable volume_share']),
+    ('a share per species', "radius = 1.0, 1.4, number_share = 1.0, solid_fraction = 0.1",
+     ['&particles', 'variable number_share', 'one positive share per species']),
+    ('smallest radius not 1', "radius = 1.2, 1.4, volume_share = 0.5, 0.5, solid_fraction = 0.1",
+     ['&particles', 'variable radius(1)', 'unit of length']),
+    ('radii not increasing', "radius = 1.0, 0.8, volume_share = 0.5, 0.5, solid_fraction = 0.1",
+     ['&particles', 'variable radius(2)', 'smallest first']),
+    ('a gap in the list', "radius(1) = 1.0, radius(3) = 1.4, volume_share = 0.5, 0.5, solid_fraction = 0.1",
+     ['&particles', 'variable radius', 'one after the other']),
+    ('shares for one species', "radius = 1.0, volume_share = 0.5, 0.5, solid_fraction = 0.1",
+     ['&particles', 'variable volume_share', 'radius lists one']),
+    ('inline particles of a mixture', "radius = 1.0, 1.4, number_share = 0.5, 0.5, number = 1, position(:,1) = 4, 4, 4",
+     ['&particles', 'variable number', 'one size']),
+    ('file radius not the deck\'s', MIX.format(f='foreign.h5'), ['foreign.h5', 'particles/radius', 'sphere 3']),
+    ('file lacks a species', MIX.format(f='one_species.h5'), ['one_species.h5', 'particles/radius', 'holds no sphere']),
+    ('file without radii for a mixture', MIX.format(f='no_radius.h5'), ['no_radius.h5', 'particles/radius', 'missing']),
+    ('file radii of another count', MIX.format(f='short_radius.h5'), ['short_radius.h5', 'particles/radius',
+                                                                      'one radius per sphere']),
+    ('file radii of one size, deck another', "radius = 1.4, position_file = 'one_species.h5'",
+     ['one_species.h5', 'particles/radius', 'not one of the deck']),
+    ('a mixture that adds up: not moved yet', MIX.format(f='mixture.h5'),
+     ['mix.nml', '&particles', 'variable radius', 'lubrication dynamics does not move them yet']),
+    ('the same, its radii written 1 x N', MIX.format(f='mixture_2d.h5'),
+     ['mix.nml', '&particles', 'variable radius', 'does not move them yet']),
+]:
+    refused(d, name, particles, words)
+
+# equal spheres: a position file with particles/radius of the deck's radius runs
+T.write_deck(d, 'equal.nml', LD.format(particles="position_file = 'one_species.h5'"))
+status, out, err = T.run('equal.nml', d, expect_ok=False)
+T.check(status == 0 and 'finished at step 2' in out, 'equal spheres with particles/radius in their file run (status %d)'
+        % status)
+with T.h5py.File(os.path.join(d, 'out', 'particles_00000002.h5'), 'r') as f:
+    T.check(T.np.array_equal(T.np.ravel(f['particles/radius'][()]), [1.0, 1.0, 1.0]),
+            'the particle snapshot holds each sphere\'s radius')
+T.finish()
