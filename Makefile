@@ -83,7 +83,7 @@ PURE_F90 := $(wildcard src/kernels/*.F90)
 PURE_OBJ := $(call obj,$(PURE_F90))
 # pairtraj shares only kinds, vector algebra and the resistance modules with the solver (doc/DESIGN.md "Modules").
 RESISTANCE_F90 := $(addprefix src/kernels/,kinds.F90 vector.F90 resistance_table.F90 pair_resistance.F90 \
-                  wall_resistance.F90 resistance_blocks.F90 pair_mobility.F90)
+                  pair_resistance_unequal.F90 wall_resistance.F90 resistance_blocks.F90 pair_mobility.F90)
 PAIRTRAJ_OBJ := $(call obj,$(REF_F90) $(RESISTANCE_F90))
 UNIT_BIN := $(patsubst tests/unit/%.F90,$(BUILD)/tests/%,$(UNIT_F90))
 UNIT_PETSC_BIN := $(patsubst tests/unit_petsc/%.F90,$(BUILD)/tests/%,$(UNIT_PETSC_F90))
