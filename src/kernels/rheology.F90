@@ -31,6 +31,7 @@ module mod_rheology
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates, min_image
   use mod_lees_edwards, only: lees_edwards_t, le_separation
   use mod_columns, only: column_t, column
+  use mod_bond_order, only: bond_order_q6
   implicit none
   private
   public :: rheology_settings_t, rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, rheo_quantities, rheo_block_of, &
@@ -89,6 +90,15 @@ module mod_rheology
     real(dp), allocatable :: block_angles(:, :, :)   ! (nangles, 2, blocks)
     real(dp), allocatable :: block_references(:)     ! (blocks)
     real(dp), allocatable :: block_records(:)        ! (blocks)
+    ! crystalline order of each sample (doc/RHEOLOGY.md "Order"): Steinhardt's Q6 of the bonds
+    ! shorter than bond_range, globally and the mean of the spheres' own; when every periodic
+    ! length holds twice the bonds' search range (order), else not measured
+    logical :: order = .false.
+    real(dp) :: bond_range = 0
+    type(nlist_t) :: bond_list
+    integer :: nbond_pairs = 0, nbond_walls = 0
+    integer, allocatable :: bond_pairs(:, :), bond_walls(:, :)
+    real(dp) :: q6 = 0, q6_local = 0
   end type rheology_t
 
 contains
@@ -106,6 +116,8 @@ contains
     integer, intent(out) :: info
     type(lees_edwards_t), intent(in), optional :: le
     real(dp), parameter :: skin = 0.3_dp
+    real(dp), parameter :: bond_factor = 1.4_dp
+    integer :: bond_info
     if (present(le)) r%le = le
     r%box = box
     r%radius = radius
@@ -126,6 +138,13 @@ contains
     r%block_sums = 0; r%block_profile = 0; r%block_angles = 0; r%block_references = 0; r%block_records = 0
     call nlist_init(r%nl, n, box, [.true., r%le%active, .true.], max(r%r_outer, r%r_contact) + skin, &
                     radius + skin, skin, info, r%le)
+    ! bonds of Q6 up to 1.4 contact distances, near the first minimum of g(r) of a dense
+    ! suspension, so that a crystal's nearest shell is whole and its second shell (sqrt(2) x the
+    ! first for fcc) is not
+    r%bond_range = bond_factor * 2 * radius
+    call nlist_init(r%bond_list, n, box, [.true., r%le%active, .true.], r%bond_range + skin, radius + skin, skin, &
+                    bond_info, r%le)
+    r%order = bond_info == 0
   end subroutine rheo_create
 
   !> The block of a record at step (0-based), or -1 outside the averaging window.
@@ -220,6 +239,7 @@ contains
       if (ref_i) call count_pair(theta)
       if (ref_j) call count_pair(modulo(theta + pi, 2 * pi))
     end do
+    if (r%order) call sample_order(r, position)
   contains
     subroutine count_pair(angle)
       real(dp), intent(in) :: angle
@@ -412,7 +432,7 @@ contains
     type(rheology_t), intent(in) :: r
     type(column_t), allocatable :: c(:)
     ! element by element: an array constructor of column_t leaks their values (gfortran 12)
-    allocate(c(12))
+    allocate(c(merge(14, 12, r%order)))
     c(1) = column('core/stress_hydro', r%values(1:5))
     c(2) = column('core/stress_contact', r%values(6:10))
     c(3) = column('core/solid_fraction', r%values(11))
@@ -425,6 +445,39 @@ contains
     c(10) = column('pairs/contact', r%angles(:, 2))
     c(11) = column('profiles/solid_fraction', r%profile(:, 1))
     c(12) = column('profiles/momentum', r%profile(:, 2))
+    if (r%order) then
+      c(13) = column('structure/q6', r%q6)
+      c(14) = column('structure/q6_local', r%q6_local)
+    end if
   end function rheo_columns
+
+  ! Q6 of this configuration's bonds (mod_bond_order), the whole box's, and the mean local q6 of
+  ! the spheres that have bonds.
+  subroutine sample_order(r, position)
+    type(rheology_t), intent(inout) :: r
+    real(dp), intent(in) :: position(:, :)
+    integer, allocatable :: ends(:, :)
+    real(dp), allocatable :: separation(:, :), local(:)
+    real(dp) :: d(3), vshift(3)
+    integer :: p, nb, n
+    n = size(position, 2)
+    call nlist_candidates(r%bond_list, position, r%bond_pairs, r%nbond_pairs, r%bond_walls, r%nbond_walls, &
+                          r%le%offset)
+    allocate(ends(2, r%nbond_pairs), separation(3, r%nbond_pairs), local(n))
+    nb = 0
+    do p = 1, r%nbond_pairs
+      if (r%le%active) then
+        call le_separation(r%le, position(:, r%bond_pairs(2, p)) - position(:, r%bond_pairs(1, p)), d, vshift)
+      else
+        d = min_image(position(:, r%bond_pairs(2, p)) - position(:, r%bond_pairs(1, p)), r%box, [.true., .false., .true.])
+      end if
+      if (norm2(d) >= r%bond_range) cycle
+      nb = nb + 1
+      ends(:, nb) = r%bond_pairs(:, p)
+      separation(:, nb) = d
+    end do
+    call bond_order_q6(n, nb, ends, separation, r%q6, local)
+    r%q6_local = sum(local) / max(1, count(local > 0))
+  end subroutine sample_order
 
 end module mod_rheology
