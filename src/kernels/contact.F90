@@ -14,6 +14,13 @@
 !   Coulomb   |F_t| <= mu_d |F_n|; when capped, Upsilon = -F_t/k_t (spring consistent)     (2.22)
 !   torque    T_i = T_j = a n x F                                                           (2.23)
 !   stresslet S_i = S_j = 1/2 (F (x) r/2 + r/2 (x) F); wall: r/2 -> (a + gap/2) n           (2.24)
+! Spheres of several sizes (contact_forces' radii; doc/CONTACT.md "Spheres of several sizes"): radii
+! a_i in units of the unit radius a (p%a, to which k_n, eps_bar and h_r refer); for spheres i, j
+!   delta' = |r| - a_i - a_j - h_r (h_r a property of the surface, not scaled with the sphere),
+!   k_ij = k_n sqrt(R*_ij / (a/2)), R*_ij = a_i a_j/(a_i + a_j) (walls: k_n sqrt(a_i/a)),
+!   U^s = (U_i - U_j)_perp + (a_i Omega_i + a_j Omega_j) x n, T_i = a_i n x F, T_j = a_j n x F,
+!   levers (a_i + g/2) n and -(a_j + g/2) n to the middle of the gap g = |r| - a_i - a_j.
+! A pair of unit spheres keeps the arithmetic above (contact_pair) bitwise.
 ! Contact history: Upsilon per open contact, keyed by pair identity (i, partner) with i < partner
 ! for a particle pair and partner = -1 (wall y = 0) or -2 (wall y = Ly) for a wall. Entries are
 ! rebuilt every step from the contacts found, so a contact that opens is forgotten (Upsilon
@@ -36,6 +43,7 @@ module mod_contact
   public :: wall_lower, wall_upper, chatter_number, stick_number, flattening_estimate
   public :: contact_limits, overlap_limit
   public :: contact_links_t, contact_stiffness
+  public :: contact_pair_sized, hertz_stiffness
 
   integer, parameter :: wall_lower = -1, wall_upper = -2   ! history partner ids of the walls
 
@@ -75,12 +83,17 @@ module mod_contact
   !> contact found by contact_forces, in the order it met them. partner: the other particle (> i)
   !> or wall_lower/wall_upper; normal: unit normal from i towards the partner; overlap: delta'
   !> (<= 0); lever: centre of i to the middle of the gap (the stresslet's lever, r/2 for a pair);
-  !> spring: the spring after the step (0 without friction); sliding: at the Coulomb limit.
+  !> lever_partner: the partner's centre to the middle of the gap (-r/2 for equal spheres; a
+  !> wall: 0, it has no stresslet); arm: the torque lever arms (a_i, a_partner) (a wall: (a_i, a_i),
+  !> the second unused, a wall does not rotate); stiffness: the Hertz k of the contact (k_n for unit
+  !> spheres, hertz_stiffness); spring: the spring after the step (0 without friction); sliding: at
+  !> the Coulomb limit.
   type :: contact_links_t
     integer :: n = 0
     integer, allocatable :: i(:), partner(:)
-    real(dp), allocatable :: normal(:,:), lever(:,:), spring(:,:)   ! (3, n)
-    real(dp), allocatable :: overlap(:)
+    real(dp), allocatable :: normal(:,:), lever(:,:), lever_partner(:,:), spring(:,:)   ! (3, n)
+    real(dp), allocatable :: arm(:,:)                                                  ! (2, n)
+    real(dp), allocatable :: overlap(:), stiffness(:)
     logical, allocatable :: sliding(:)
     ! what the partner's velocity gains as seen from i: its Lees-Edwards image's s gamma_dot Ly e_x
     ! (0 without sliding boundaries, and for walls)
@@ -293,25 +306,80 @@ contains
 
   ! ---- one contact -----------------------------------------------------------------------
 
-  !> One contact. n: unit normal from i towards the partner; dlt = delta' (contact iff <= 0);
-  !> du = U_i - U_partner; om_sum = Omega_i + Omega_partner (wall: Omega_i); dt: time step.
-  !> ups: the spring, in: the previous step's (0 for a new contact), out: updated (0 if open or
-  !> mu_d = 0). f: force on i; tq: torque on i (the partner sphere gets -f and the same tq);
-  !> fn: |F_n|; sliding: the Coulomb cap was applied.
+  !> One contact of two unit spheres (or a unit sphere and a wall). n: unit normal from i towards
+  !> the partner; dlt = delta' (contact iff <= 0); du = U_i - U_partner; om_sum = Omega_i +
+  !> Omega_partner (wall: Omega_i); dt: time step. ups: the spring, in: the previous step's (0 for
+  !> a new contact), out: updated (0 if open or mu_d = 0). f: force on i; tq: torque on i (the
+  !> partner sphere gets -f and the same tq); fn: |F_n|; sliding: the Coulomb cap was applied.
   pure subroutine contact_pair(p, n, dlt, du, om_sum, dt, ups, f, tq, fn, sliding)
     type(contact_params_t), intent(in) :: p
     real(dp), intent(in) :: n(3), dlt, du(3), om_sum(3), dt
     real(dp), intent(inout) :: ups(3)
     real(dp), intent(out) :: f(3), tq(3), fn
     logical, intent(out) :: sliding
+    call contact_law(p, p%k_n, n, dlt, du, p%a * cross(om_sum, n), dt, ups, f, fn, sliding)   ! (2.21)
+    tq = 0
+    if (p%mu_d > 0 .and. dlt <= 0) tq = p%a * cross(n, f)              ! (2.23); frictionless: none
+  end subroutine contact_pair
+
+  !> One contact of spheres of any sizes (doc/CONTACT.md "Spheres of several sizes"), or of a sphere
+  !> and a wall. k: the contact's Hertz stiffness (hertz_stiffness); arm_i: the radius a_i of
+  !> sphere i; om_i: Omega_i; om_j, arm_j, tq_j, optional: the partner sphere's Omega_j, radius
+  !> a_j and the torque on it, a_j n x F (absent for a wall, which does not rotate); tq_i: the torque
+  !> a_i n x F on i. Otherwise as contact_pair: the slip is (2.21) with a Omega_i + a Omega_j ->
+  !> a_i Omega_i + a_j Omega_j.
+  pure subroutine contact_pair_sized(p, k, n, dlt, du, om_i, arm_i, dt, ups, f, tq_i, fn, sliding, om_j, arm_j, tq_j)
+    type(contact_params_t), intent(in) :: p
+    real(dp), intent(in) :: k, n(3), dlt, du(3), om_i(3), arm_i, dt
+    real(dp), intent(inout) :: ups(3)
+    real(dp), intent(out) :: f(3), tq_i(3), fn
+    logical, intent(out) :: sliding
+    real(dp), intent(in), optional :: om_j(3), arm_j
+    real(dp), intent(out), optional :: tq_j(3)
+    real(dp) :: roll(3), c(3)
+    if (present(om_j)) then
+      roll = cross(arm_i * om_i + arm_j * om_j, n)
+    else
+      roll = arm_i * cross(om_i, n)      ! a wall: as contact_pair's a (Omega_i x n) for a unit sphere
+    end if
+    call contact_law(p, k, n, dlt, du, roll, dt, ups, f, fn, sliding)
+    c = 0
+    if (p%mu_d > 0 .and. dlt <= 0) c = cross(n, f)
+    tq_i = arm_i * c
+    if (present(tq_j)) tq_j = arm_j * c
+  end subroutine contact_pair_sized
+
+  !> The Hertz stiffness of a contact of spheres of radii ai, aj (absent: a wall), in the unit of
+  !> p%a: k_n sqrt(R*/R*_1) with R* = ai aj/(ai + aj) the reduced radius and R*_1 = a/2 that of two
+  !> unit spheres (for a wall R* = ai and R*_1 = a: the wall keeps the pair's k_n for a unit sphere,
+  !> doc/CONTACT.md "Walls"). Exactly k_n for unit spheres.
+  pure real(dp) function hertz_stiffness(p, ai, aj) result(k)
+    type(contact_params_t), intent(in) :: p
+    real(dp), intent(in) :: ai
+    real(dp), intent(in), optional :: aj
+    if (present(aj)) then
+      k = p%k_n * sqrt(2 * ai * aj / ((ai + aj) * p%a))
+    else
+      k = p%k_n * sqrt(ai / p%a)
+    end if
+  end function hertz_stiffness
+
+  !> The law of one contact (doc/CONTACT.md "One step of a contact"), shared by contact_pair and
+  !> contact_pair_sized: Hertz stiffness k; roll = the rotational part of the slip (2.21),
+  !> (a_i Omega_i + a_j Omega_j) x n; f: the force on i; no torque.
+  pure subroutine contact_law(p, k, n, dlt, du, roll, dt, ups, f, fn, sliding)
+    type(contact_params_t), intent(in) :: p
+    real(dp), intent(in) :: k, n(3), dlt, du(3), roll(3), dt
+    real(dp), intent(inout) :: ups(3)
+    real(dp), intent(out) :: f(3), fn
+    logical, intent(out) :: sliding
     real(dp) :: us(3), len0, len1, k_t, ft(3), ftm
     f = 0
-    tq = 0
     fn = 0
     sliding = .false.
     if (dlt > 0 .or. p%mu_d <= 0) ups = 0
     if (dlt > 0) return
-    fn = p%k_n * abs(dlt)**1.5_dp                                  ! (2.17)
+    fn = k * abs(dlt)**1.5_dp                                      ! (2.17)
     f = -fn * n
     if (p%mu_d > 0) then
       ! rotate the old spring into the current tangent plane, keeping its length
@@ -323,9 +391,9 @@ contains
       else
         ups = 0
       end if
-      us = du - dot_product(du, n) * n + p%a * cross(om_sum, n)     ! (2.21)
+      us = du - dot_product(du, n) * n + roll                       ! (2.21)
       ups = ups + us * dt                                           ! (2.20)
-      k_t = p%kt_coeff * p%k_n * sqrt(abs(dlt))
+      k_t = p%kt_coeff * k * sqrt(abs(dlt))
       ft = -k_t * ups                                               ! (2.19)
       ftm = norm2(ft)
       if (fn <= 0) then
@@ -337,9 +405,8 @@ contains
         sliding = .true.
       end if
       f = f + ft
-      tq = p%a * cross(n, f)                                        ! (2.23)
-    end if                                     ! frictionless: F parallel to n, no torque
-  end subroutine contact_pair
+    end if                                     ! frictionless: F parallel to n
+  end subroutine contact_law
 
   !> Symmetric contact stresslet (2.24) of a force f applied with lever l (centre to contact).
   pure function contact_stresslet(f, l) result(s)
@@ -371,30 +438,39 @@ contains
   !>            contacts, and those at delta' = 0, have none.
   !> Both symmetric positive semi-definite by construction (sums of outer products). Open
   !> contacts (dlt > 0) give zero blocks.
-  pure subroutine contact_stiffness(p, n, dlt, ups, sliding, k_norm, k_tan)
+  !> Spheres of several sizes (doc/CONTACT.md "Spheres of several sizes"), optional: arms = (a_i,
+  !> a_partner), the lever arms in B (-a_i [n]x, -a_partner [n]x; default (a, a); a wall's is
+  !> unused), and k_hertz, the contact's Hertz stiffness (hertz_stiffness; default k_n), which
+  !> replaces k_n in k and k_t. Rows 10-12 of both blocks are then a_partner/a_i times rows 4-6.
+  pure subroutine contact_stiffness(p, n, dlt, ups, sliding, k_norm, k_tan, arms, k_hertz)
     type(contact_params_t), intent(in) :: p
     real(dp), intent(in) :: n(3), dlt, ups(3)
     logical, intent(in) :: sliding
     real(dp), intent(out) :: k_norm(12, 12), k_tan(12, 12)
-    real(dp) :: b(12), bt(3, 12), k, k_t, s(3)
+    real(dp), intent(in), optional :: arms(2), k_hertz
+    real(dp) :: b(12), bt(3, 12), k, k_t, s(3), kh, arm(2)
     integer :: c
     k_norm = 0
     k_tan = 0
     if (dlt > 0) return
-    k = 1.5_dp * p%k_n * sqrt(abs(dlt))
+    kh = p%k_n
+    if (present(k_hertz)) kh = k_hertz
+    arm = p%a
+    if (present(arms)) arm = arms
+    k = 1.5_dp * kh * sqrt(abs(dlt))
     b = 0
     b(1:3) = n
     b(7:9) = -n
     k_norm = k * spread(b, 2, 12) * spread(b, 1, 12)
     if (p%mu_d <= 0 .or. dlt == 0) return
-    k_t = p%kt_coeff * p%k_n * sqrt(abs(dlt))
+    k_t = p%kt_coeff * kh * sqrt(abs(dlt))
     bt = 0
     do c = 1, 3
       bt(c, c) = 1
       bt(:, c) = bt(:, c) - n(c) * n                       ! P
       bt(:, 6 + c) = -bt(:, c)                             ! -P
-      bt(:, 3 + c) = -p%a * cross(n, unit(c))              ! -a n x e_c
-      bt(:, 9 + c) = bt(:, 3 + c)
+      bt(:, 3 + c) = -arm(1) * cross(n, unit(c))           ! -a_i n x e_c
+      bt(:, 9 + c) = -arm(2) * cross(n, unit(c))           ! -a_partner n x e_c
     end do
     k_tan = k_t * matmul(transpose(bt), bt)
     if (sliding) then
@@ -422,9 +498,12 @@ contains
   !> stresslet (3, 3, np); stats. The history h advances by one step (not touched if mu_d = 0).
   !> info: 0 ok; 1 the history was built for another particle count. links, optional: the open
   !> contacts of this step (for their implicit stiffness, contact_stiffness). le, optional:
-  !> Lees-Edwards boundaries in y (mod_lees_edwards), when active.
+  !> Lees-Edwards boundaries in y (mod_lees_edwards), when active. radii, optional: (np) the
+  !> spheres' radii in units of p%a (doc/CONTACT.md "Spheres of several sizes"); absent, all are
+  !> p%a. A pair of unit spheres (radius exactly 1) takes the arithmetic of the equal-sphere law
+  !> (contact_pair) whether radii is given or not, so that results are bitwise those without it.
   subroutine contact_forces(p, h, x, u, om, box, periodic, vw, pairs, npairs, walls, nwalls, dt, &
-                            force, torque, stresslet, stats, info, links, le)
+                            force, torque, stresslet, stats, info, links, le, radii)
     type(contact_params_t), intent(in) :: p
     type(contact_history_t), intent(inout) :: h
     real(dp), intent(in) :: x(:,:), u(:,:), om(:,:), box(3), vw(3, 2), dt
@@ -435,11 +514,13 @@ contains
     integer, intent(out) :: info
     type(contact_links_t), intent(inout), optional :: links
     type(lees_edwards_t), intent(in), optional :: le
+    real(dp), intent(in), optional :: radii(:)
     integer :: m, i, j, k, w, np, nnew
     integer, allocatable :: new_owner(:), new_partner(:)
     real(dp), allocatable :: new_ups(:,:)
-    real(dp) :: r(3), d, n(3), dlt, ups(3), f(3), tq(3), fn, scale, s(3, 3), vshift(3)
-    logical :: tangential, sliding, sliding_boundaries
+    real(dp) :: r(3), d, n(3), dlt, ups(3), f(3), tq(3), tqj(3), fn, scale, s(3, 3), sj(3, 3), vshift(3)
+    real(dp) :: ai, aj, kh, li(3), lj(3)
+    logical :: tangential, sliding, sliding_boundaries, sized
 
     info = 0
     np = size(x, 2)
@@ -473,22 +554,46 @@ contains
         end do
       end if
       d = norm2(r)
-      dlt = d - 2 * p%a - p%h_r
+      ai = p%a
+      aj = p%a
+      sized = .false.
+      if (present(radii)) then
+        sized = radii(i) /= 1 .or. radii(j) /= 1
+        ai = radii(i) * p%a
+        aj = radii(j) * p%a
+      end if
+      dlt = d - (ai + aj) - p%h_r               ! unit spheres: ai + aj = 2a exactly
       if (dlt > 0) cycle
       n = r / d
       ups = 0
       if (tangential) ups = history_lookup(h, i, j)
-      call contact_pair(p, n, dlt, u(:, i) - (u(:, j) + vshift), om(:, i) + om(:, j), dt, ups, f, tq, fn, &
-                        sliding)
+      if (sized) then
+        ! levers to the middle of the gap d - ai - aj (doc/CONTACT.md "Spheres of several sizes")
+        kh = hertz_stiffness(p, ai, aj)
+        call contact_pair_sized(p, kh, n, dlt, u(:, i) - (u(:, j) + vshift), om(:, i), ai, dt, ups, f, tq, fn, &
+                                sliding, om(:, j), aj, tqj)
+        li = (ai + 0.5_dp * (d - ai - aj)) * n
+        lj = -(aj + 0.5_dp * (d - ai - aj)) * n
+        s = contact_stresslet(f, li)
+        sj = contact_stresslet(-f, lj)
+      else
+        kh = p%k_n
+        call contact_pair(p, n, dlt, u(:, i) - (u(:, j) + vshift), om(:, i) + om(:, j), dt, ups, f, tq, fn, &
+                          sliding)
+        tqj = tq
+        li = 0.5_dp * r
+        lj = -li
+        s = contact_stresslet(f, li)
+        sj = s
+      end if
       if (tangential) call append(i, j)
       force(:, i) = force(:, i) + f
       force(:, j) = force(:, j) - f
       torque(:, i) = torque(:, i) + tq
-      torque(:, j) = torque(:, j) + tq
-      s = contact_stresslet(f, 0.5_dp * r)
+      torque(:, j) = torque(:, j) + tqj
       stresslet(:, :, i) = stresslet(:, :, i) + s
-      stresslet(:, :, j) = stresslet(:, :, j) + s
-      if (present(links)) call add_link(j, 0.5_dp * r, vshift)
+      stresslet(:, :, j) = stresslet(:, :, j) + sj
+      if (present(links)) call add_link(j, li, lj, [ai, aj], vshift)
       call tally(.false., j)
     end do
 
@@ -502,16 +607,21 @@ contains
         d = box(2) - x(2, i)
         n = [0.0_dp, 1.0_dp, 0.0_dp]
       end if
-      dlt = d - p%a - p%h_r
+      ai = p%a
+      if (present(radii)) ai = radii(i) * p%a
+      dlt = d - ai - p%h_r
       if (dlt > 0) cycle
       ups = 0
       if (tangential) ups = history_lookup(h, i, -w)
-      call contact_pair(p, n, dlt, u(:, i) - vw(:, w), om(:, i), dt, ups, f, tq, fn, sliding)
+      ! a unit sphere: k_n and contact_pair's arithmetic exactly (ai = a)
+      kh = hertz_stiffness(p, ai)
+      call contact_pair_sized(p, kh, n, dlt, u(:, i) - vw(:, w), om(:, i), ai, dt, ups, f, tq, fn, sliding)
       if (tangential) call append(i, -w)
       force(:, i) = force(:, i) + f
       torque(:, i) = torque(:, i) + tq
-      stresslet(:, :, i) = stresslet(:, :, i) + contact_stresslet(f, 0.5_dp * (p%a + d) * n)
-      if (present(links)) call add_link(-w, 0.5_dp * (p%a + d) * n, [0.0_dp, 0.0_dp, 0.0_dp])
+      li = 0.5_dp * (ai + d) * n               ! (a_i + gap/2) n, gap = d - a_i
+      stresslet(:, :, i) = stresslet(:, :, i) + contact_stresslet(f, li)
+      if (present(links)) call add_link(-w, li, [0.0_dp, 0.0_dp, 0.0_dp], [ai, ai], [0.0_dp, 0.0_dp, 0.0_dp])
       call tally(.true., -w)
     end do
 
@@ -527,14 +637,17 @@ contains
       new_ups(:, nnew) = ups
     end subroutine append
 
-    subroutine add_link(other, lever, image_velocity)
+    subroutine add_link(other, lever, lever_partner, arm, image_velocity)
       integer, intent(in) :: other
-      real(dp), intent(in) :: lever(3), image_velocity(3)
+      real(dp), intent(in) :: lever(3), lever_partner(3), arm(2), image_velocity(3)
       links%n = links%n + 1
       links%i(links%n) = i
       links%partner(links%n) = other
       links%normal(:, links%n) = n
       links%lever(:, links%n) = lever
+      links%lever_partner(:, links%n) = lever_partner
+      links%arm(:, links%n) = arm
+      links%stiffness(links%n) = kh
       links%overlap(links%n) = dlt
       links%spring(:, links%n) = ups
       links%sliding(links%n) = sliding
@@ -566,11 +679,12 @@ contains
     links%n = 0
     if (allocated(links%i)) then
       if (size(links%i) >= m) return
-      deallocate(links%i, links%partner, links%normal, links%lever, links%spring, links%overlap, links%sliding, &
-                 links%image_velocity)
+      deallocate(links%i, links%partner, links%normal, links%lever, links%lever_partner, links%arm, links%spring, &
+                 links%overlap, links%stiffness, links%sliding, links%image_velocity)
     end if
     allocate(links%i(max(m, 16)), links%partner(max(m, 16)), links%normal(3, max(m, 16)), &
-             links%lever(3, max(m, 16)), links%spring(3, max(m, 16)), links%overlap(max(m, 16)), &
+             links%lever(3, max(m, 16)), links%lever_partner(3, max(m, 16)), links%arm(2, max(m, 16)), &
+             links%spring(3, max(m, 16)), links%overlap(max(m, 16)), links%stiffness(max(m, 16)), &
              links%sliding(max(m, 16)), links%image_velocity(3, max(m, 16)))
   end subroutine links_reserve
 

@@ -4,8 +4,8 @@
 ! and computes the same forces.
 !
 ! One step (doc/METHOD.md §7.1 item 2), at the positions X^n, before the particle sub-problem:
-!   1. the neighbour list (cutoff 2a + h_r + skin, walls a + h_r + skin) is rebuilt when some
-!      sphere has moved more than skin/2 since the last build;
+!   1. the neighbour list (cutoff 2a + h_r + skin, walls a + h_r + skin, a the largest radius) is
+!      rebuilt when some sphere has moved more than skin/2 since the last build;
 !   2. its candidates are put in canonical order (pairs by i then j, walls by particle then wall),
 !      so that the forces are summed in the same order whatever list is in use: a run restarted
 !      from a checkpoint (fresh list) repeats the arithmetic of an uninterrupted one bitwise;
@@ -17,6 +17,8 @@
 ! (particle_contacts_add_stiffness) and, once U^n is known, the force it implied to the step's contact
 ! force, torque and stresslet (particle_contacts_implicit_update): the force the balance used is the
 ! contact force at the end of the step, X^{n+1}, linearised about X^n.
+! Spheres of several sizes (doc/CONTACT.md "Spheres of several sizes"): particle_contacts_create's
+! radii; each contact then has its own Hertz stiffness, lever arms and stresslet levers (the links).
 module mod_particle_contacts
   use mod_kinds, only: dp
   use mod_contact, only: contact_params_t, contact_setup, contact_stats_t, contact_history_t, &
@@ -63,6 +65,7 @@ module mod_particle_contacts
     real(dp) :: c_now = 0, c_before = 0      ! X^{n+1} - X^n = c_now U^n + c_before U^{n-1}
     real(dp), allocatable :: u_before(:,:), om_before(:,:)   ! U^{n-1}, Omega^{n-1}
     type(lees_edwards_t) :: le               ! sliding boundaries in y (le%active), delta of the step
+    real(dp), allocatable :: radii(:)        ! (np) in units of a; not allocated: all a
   end type particle_contacts_t
 
 contains
@@ -84,7 +87,9 @@ contains
   !> shear rate (walls at -+ shear_rate Ly/2 when walls); box, walls: the domain; dt: time step.
   !> info: 0 ok, else msg says what is wrong (contact_setup or nlist_init refused).
   !> le, optional: Lees-Edwards boundaries in y (walls must then be .false.).
-  subroutine particle_contacts_create(pc, np, a, settings, shear_rate, box, walls, dt, info, msg, le)
+  !> radii, optional: (np) the spheres' radii in units of a (doc/CONTACT.md "Spheres of several
+  !> sizes"); a is then the unit radius to which k_n, eps_bar and h_r refer (the smallest species').
+  subroutine particle_contacts_create(pc, np, a, settings, shear_rate, box, walls, dt, info, msg, le, radii)
     type(particle_contacts_t), intent(out) :: pc
     integer, intent(in) :: np
     real(dp), intent(in) :: a, shear_rate, box(3), dt
@@ -93,8 +98,10 @@ contains
     integer, intent(out) :: info
     character(len=*), intent(out) :: msg
     type(lees_edwards_t), intent(in), optional :: le
+    real(dp), intent(in), optional :: radii(:)
     ! the viscosity is the unit of stress (doc/METHOD.md §0.2)
     real(dp), parameter :: eta = 1.0_dp
+    real(dp) :: a_max
     call contact_setup(pc%params, a, settings%roughness, settings%friction, settings%eps_bar, &
                        settings%normal_stiffness, eta, shear_rate, info, msg)
     if (info /= 0) return
@@ -112,8 +119,19 @@ contains
     pc%overlap_limit = pc%params%h_r
     if (pc%overlap_limit <= 0) pc%overlap_limit = 0.05_dp * a
     if (present(le)) pc%le = le
-    call nlist_init(pc%nlist, np, box, pc%periodic, 2 * a + pc%params%h_r + settings%neighbour_skin, &
-                    a + pc%params%h_r + settings%neighbour_skin, settings%neighbour_skin, info, pc%le)
+    ! the largest sphere's contacts (conservative for the smaller ones; unit spheres: a exactly)
+    a_max = a
+    if (present(radii)) then
+      if (size(radii) /= np .or. .not. all(radii > 0)) then
+        info = 1
+        msg = 'contacts: the radii must be one per sphere and > 0'
+        return
+      end if
+      pc%radii = radii
+      a_max = maxval(radii) * a
+    end if
+    call nlist_init(pc%nlist, np, box, pc%periodic, 2 * a_max + pc%params%h_r + settings%neighbour_skin, &
+                    a_max + pc%params%h_r + settings%neighbour_skin, settings%neighbour_skin, info, pc%le)
     if (info /= 0) then
       msg = 'contacts: the neighbour search refuses this box (a periodic length below 2 x cutoff)'
       return
@@ -140,11 +158,12 @@ contains
     if (pc%implicit) then
       call contact_forces(pc%params, pc%history, x, u, om, pc%box, pc%periodic, pc%wall_velocity, &
                           pc%pairs, pc%npairs, pc%walls, pc%nwalls, pc%dt, pc%force, pc%torque, &
-                          pc%stresslet, pc%stats, info, pc%links, pc%le)
+                          pc%stresslet, pc%stats, info, pc%links, pc%le, pc%radii)
     else
+      ! pc%radii unallocated: not present (all spheres of radius a)
       call contact_forces(pc%params, pc%history, x, u, om, pc%box, pc%periodic, pc%wall_velocity, &
                           pc%pairs, pc%npairs, pc%walls, pc%nwalls, pc%dt, pc%force, pc%torque, &
-                          pc%stresslet, pc%stats, info, le=pc%le)
+                          pc%stresslet, pc%stats, info, le=pc%le, radii=pc%radii)
     end if
     if (info /= 0) return
     pc%max_overlap = pc%stats%max_overlap * pc%params%h_r
@@ -184,7 +203,8 @@ contains
     pc%om_before = om
     do m = 1, pc%links%n
       call contact_stiffness(pc%params, pc%links%normal(:, m), pc%links%overlap(m), &
-                             pc%links%spring(:, m), pc%links%sliding(m), kn, kt)
+                             pc%links%spring(:, m), pc%links%sliding(m), kn, kt, pc%links%arm(:, m), &
+                             pc%links%stiffness(m))
       a = pc%c_now * kn + pc%dt * kt
       i = pc%links%i(m)
       j = pc%links%partner(m)
@@ -213,7 +233,7 @@ contains
   end subroutine particle_contacts_add_stiffness
 
   !> After the solve: u, om (3, np) = U^n, Omega^n. Adds dF of particle_contacts_add_stiffness to the
-  !> step's contact force, torque and stresslet (lever as in contact_forces), which then hold the
+  !> step's contact force, torque and stresslet (levers as in contact_forces), which then hold the
   !> contact force the particle balance used. Nothing unless particle_contacts_add_stiffness ran this step.
   subroutine particle_contacts_implicit_update(pc, u, om)
     type(particle_contacts_t), intent(inout) :: pc
@@ -223,7 +243,8 @@ contains
     if (.not. pc%stiffness_added) return
     do m = 1, pc%links%n
       call contact_stiffness(pc%params, pc%links%normal(:, m), pc%links%overlap(m), &
-                             pc%links%spring(:, m), pc%links%sliding(m), kn, kt)
+                             pc%links%spring(:, m), pc%links%sliding(m), kn, kt, pc%links%arm(:, m), &
+                             pc%links%stiffness(m))
       i = pc%links%i(m)
       j = pc%links%partner(m)
       if (j > 0) then
@@ -234,9 +255,10 @@ contains
         q = [u(:, i), om(:, i), pc%wall_velocity(:, -j), 0.0_dp, 0.0_dp, 0.0_dp]
         q0 = [pc%u_before(:, i), pc%om_before(:, i), pc%wall_velocity(:, -j), 0.0_dp, 0.0_dp, 0.0_dp]
       end if
-      ! the generalised force on i; the partner takes -dF and the same torque (rows 7-12 of K
-      ! are those of -F and of the same torque), set from rows 1-6 so that action = reaction
-      ! exactly
+      ! the generalised force on i; the partner takes -dF and a_j/a_i times the torque (rows 7-12
+      ! of K are those of -F and of a_j n x F), set from rows 1-6 so that action = reaction
+      ! exactly (equal spheres: the ratio is 1 exactly, the same torque); its stresslet with its own
+      ! lever
       g(1:6) = -matmul(pc%c_now * kn(1:6, :) + pc%dt * kt(1:6, :), q) - pc%c_before * matmul(kn(1:6, :), q0)
       pc%force(:, i) = pc%force(:, i) + g(1:3)
       pc%torque(:, i) = pc%torque(:, i) + g(4:6)
@@ -244,8 +266,8 @@ contains
       pc%stresslet(:, :, i) = pc%stresslet(:, :, i) + s
       if (j > 0) then
         pc%force(:, j) = pc%force(:, j) - g(1:3)
-        pc%torque(:, j) = pc%torque(:, j) + g(4:6)
-        pc%stresslet(:, :, j) = pc%stresslet(:, :, j) + s
+        pc%torque(:, j) = pc%torque(:, j) + (pc%links%arm(2, m) / pc%links%arm(1, m)) * g(4:6)
+        pc%stresslet(:, :, j) = pc%stresslet(:, :, j) + contact_stresslet(-g(1:3), pc%links%lever_partner(:, m))
       end if
     end do
     pc%stiffness_added = .false.
