@@ -229,8 +229,15 @@ contains
     integer :: info
     if (.not. (has_particles .and. cfg%contact_group)) return
     allocate(pc)
-    call particle_contacts_create(pc, parts%n, parts%radius, cfg%contact, cfg%domain%shear_rate, cfg%domain%box, &
-                                  cfg%walls, cfg%time%dt, info, text, le)
+    if (cfg%species > 1) then
+      ! each pair with its reduced radius, each sphere with its own lever (doc/CONTACT.md "Spheres
+      ! of several sizes"); the radii in units of the smallest, the unit
+      call particle_contacts_create(pc, parts%n, parts%radius, cfg%contact, cfg%domain%shear_rate, cfg%domain%box, &
+                                    cfg%walls, cfg%time%dt, info, text, le, radii=parts%radii / parts%radius)
+    else
+      call particle_contacts_create(pc, parts%n, parts%radius, cfg%contact, cfg%domain%shear_rate, cfg%domain%box, &
+                                    cfg%walls, cfg%time%dt, info, text, le)
+    end if
     if (info /= 0) call input_error(cfg%deck_file, 'contact', '', trim(text))
   end subroutine make_contacts
 
