@@ -17,6 +17,7 @@ module mod_pair_deck
     real(dp) :: kn_smooth = 1.0e6_dp    ! Hertz stiffness used when eps_r = 0
     real(dp) :: start(3) = [-6.0_dp, 0.5_dp, 0.0_dp]   ! r = x_2 - x_1 at t = 0, units of a
     real(dp) :: x_end = 6.0_dp          ! stop when r_x reaches x_end
+    real(dp) :: size_ratio = 1.0_dp     ! radius of sphere 2 over that of sphere 1 (the unit a)
     ! &integration
     real(dp) :: rtol = 1.0e-9_dp
     real(dp) :: atol = 1.0e-12_dp
@@ -28,8 +29,8 @@ module mod_pair_deck
     real(dp) :: dt_out = 0.02_dp
   end type pair_deck
 
-  character(len=*), parameter :: known_pair(6) = [character(len=12) :: 'eps_r', 'eps_bar', &
-    'mu_d', 'kn_smooth', 'start', 'x_end']
+  character(len=*), parameter :: known_pair(7) = [character(len=12) :: 'eps_r', 'eps_bar', &
+    'mu_d', 'kn_smooth', 'start', 'x_end', 'size_ratio']
   character(len=*), parameter :: known_integration(5) = [character(len=12) :: 'rtol', 'atol', &
     'h_init', 'max_steps', 't_max']
   character(len=*), parameter :: known_output(2) = [character(len=12) :: 'csv_file', 'dt_out']
@@ -41,16 +42,17 @@ contains
     character(len=*), intent(in) :: path
     type(pair_deck), intent(out) :: deck
     real(dp) :: eps_r, eps_bar, mu_d, kn_smooth, start(3), x_end, rtol, atol, h_init, t_max, dt_out
+    real(dp) :: size_ratio
     integer :: max_steps, unit, ios
     character(len=512) :: csv_file
     character(len=256) :: msg
     logical :: exists
-    namelist /pair/ eps_r, eps_bar, mu_d, kn_smooth, start, x_end
+    namelist /pair/ eps_r, eps_bar, mu_d, kn_smooth, start, x_end, size_ratio
     namelist /integration/ rtol, atol, h_init, max_steps, t_max
     namelist /output/ csv_file, dt_out
 
     eps_r = deck%eps_r; eps_bar = deck%eps_bar; mu_d = deck%mu_d; kn_smooth = deck%kn_smooth
-    start = deck%start; x_end = deck%x_end
+    start = deck%start; x_end = deck%x_end; size_ratio = deck%size_ratio
     rtol = deck%rtol; atol = deck%atol; h_init = deck%h_init; max_steps = deck%max_steps
     t_max = deck%t_max
     csv_file = deck%csv_file; dt_out = deck%dt_out
@@ -85,7 +87,7 @@ contains
     close (unit)
 
     deck%eps_r = eps_r; deck%eps_bar = eps_bar; deck%mu_d = mu_d; deck%kn_smooth = kn_smooth
-    deck%start = start; deck%x_end = x_end
+    deck%start = start; deck%x_end = x_end; deck%size_ratio = size_ratio
     deck%rtol = rtol; deck%atol = atol; deck%h_init = h_init; deck%max_steps = max_steps
     deck%t_max = t_max
     deck%csv_file = csv_file; deck%dt_out = dt_out
@@ -96,8 +98,12 @@ contains
     call require(mu_d >= 0.0_dp .and. mu_d <= 10.0_dp, 'pair', 'mu_d', 'must be in [0, 10]')
     call require(kn_smooth > 0.0_dp .and. kn_smooth <= 1.0e15_dp, 'pair', 'kn_smooth', &
                  'must be in (0, 1e15]')
-    call require(norm2(start) > 2.0_dp + eps_r, 'pair', 'start', &
-                 'spheres must start apart: |start| > 2 + eps_r')
+    ! The unequal-sphere scalars are accurate to 1.4e-3 at contact for 0.1 <= lambda <= 10
+    ! (doc/RESISTANCE.md "Unequal spheres").
+    call require(size_ratio >= 0.1_dp .and. size_ratio <= 10.0_dp, 'pair', 'size_ratio', &
+                 'must be in [0.1, 10] (radius of sphere 2 over that of sphere 1)')
+    call require(norm2(start) > 1.0_dp + size_ratio + eps_r, 'pair', 'start', &
+                 'spheres must start apart: |start| > 1 + size_ratio + eps_r')
     call require(norm2(start) < 1.0e3_dp, 'pair', 'start', '|start| must be < 1000')
     call require(x_end > start(1) .and. x_end < 1.0e3_dp, 'pair', 'x_end', &
                  'must exceed start(1) and be < 1000')

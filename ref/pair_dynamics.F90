@@ -1,7 +1,8 @@
-! Relative motion of two equal, inertialess, force- and torque-free spheres in unbounded simple
-! shear u = (gamma_dot y, 0, 0), with the exact two-sphere hydrodynamics (mod_pair_resistance,
+! Relative motion of two inertialess, force- and torque-free spheres in unbounded simple shear
+! u = (gamma_dot y, 0, 0), with the exact two-sphere hydrodynamics (mod_pair_resistance,
 ! mod_resistance_blocks) and the contact law of the reference paper (Gallier et al. 2014 JFM
-! section 2.4, eqs 2.16-2.24; doc/METHOD.md §4 and §9). Units: a = eta = gamma_dot = 1.
+! section 2.4, eqs 2.16-2.24; doc/METHOD.md §4 and §9). Units: a = eta = gamma_dot = 1, a the
+! radius of sphere 1; sphere 2 has radius lambda a (the deck's size_ratio, default 1).
 !
 ! State y = (r, Upsilon): r = x_2 - x_1 (units of a) and the tangential spring elongation
 ! Upsilon (JFM 2.20), integrated only while the rough surfaces touch. The spheres sit at
@@ -29,11 +30,25 @@
 ! S^c = (1/2)(F^c r/2 + r/2 F^c) per sphere (JFM 2.24, sphere 1: F^c_1 and r = x_2 - x_1; sphere 2
 ! gives the same). N1* = 2 (S_xx - S_yy) / S_inf, N2* = 2 (S_yy - S_zz) / S_inf with S = S^h + S^c
 ! of one sphere and S_inf = (20/3) pi eta a^3 gamma_dot (JFM 3.1, 3.2).
+!
+! Unequal spheres (lambda /= 1; lambda == 1 takes the equal-sphere arithmetic above, bitwise):
+!   hydrodynamics from the unequal scalars (mod_pair_resistance_unequal, gap xi = 2|r|/(1 + lambda)
+!   - 2) and the sized blocks (Jeffrey & Onishi 1984 scaling, doc/RESISTANCE.md "Unequal spheres");
+!   contact as doc/CONTACT.md "Spheres of several sizes" with a = sphere 1's radius: delta' =
+!   |r| - 1 - lambda - h_r, k = k_n sqrt(R*/(1/2)) with R* = lambda/(1 + lambda), slip
+!   (U_1 - U_2)_t + (Om_1 + lambda Om_2) x n, torques n x F^c on 1 and lambda n x F^c on 2, contact
+!   stresslets with the levers l_1 = (1 + g/2) n, l_2 = -(lambda + g/2) n (g = |r| - 1 - lambda);
+!   N1*, N2* of the pair = 2 (S_1 + S_2)_(xx - yy, yy - zz) / (S_inf (1 + lambda^3)), the pair's
+!   stresslet over that of the two spheres alone (at lambda = 1 the equal-sphere definition), and
+!   per sphere 2 S_alpha / (S_inf a_alpha^3) (doc/PAIRTRAJ_INPUT.md "Output").
 module mod_pair_dynamics
   use mod_kinds, only: dp, pi
   use mod_vector, only: cross, outer
   use mod_pair_resistance, only: n_pair_scalars, resistance_scalars
-  use mod_resistance_blocks, only: pair_resistance_fu, pair_resistance_fe, pair_stresslets
+  use mod_pair_resistance_unequal, only: sized_pair_scalars, sized_pair_scalars_22
+  use mod_resistance_blocks, only: pair_resistance_fu, pair_resistance_fe, pair_stresslets, &
+                                   pair_resistance_fu_sized, pair_resistance_fe_sized, &
+                                   pair_stresslets_sized
   implicit none
   private
   public :: pair_model, pair_diagnostics, pair_state_size, make_pair_model, pair_rates, &
@@ -46,6 +61,8 @@ module mod_pair_dynamics
     real(dp) :: h_r = 0.0_dp        ! roughness height (units of a)
     real(dp) :: k_n = 0.0_dp        ! Hertz stiffness
     real(dp) :: mu_d = 0.0_dp       ! Coulomb friction coefficient
+    real(dp) :: lambda = 1.0_dp     ! radius of sphere 2 (sphere 1: 1)
+    real(dp) :: k_pair = 0.0_dp     ! Hertz stiffness of this pair, k_n sqrt(R*/(1/2))
   end type pair_model
 
   !> Everything written per output record.
@@ -56,6 +73,8 @@ module mod_pair_dynamics
     real(dp) :: n1star = 0.0_dp, n2star = 0.0_dp                 ! total (JFM 3.1, 3.2)
     real(dp) :: n1star_contact = 0.0_dp, n2star_contact = 0.0_dp ! contact stresslet part
     real(dp) :: omega1(3) = 0.0_dp        ! angular velocity of sphere 1
+    real(dp) :: omega2(3) = 0.0_dp        ! angular velocity of sphere 2
+    real(dp) :: n1star_sphere(2) = 0.0_dp, n2star_sphere(2) = 0.0_dp ! per sphere, 2 S_a/(S_inf a_a^3)
     logical :: in_contact = .false.
     logical :: sliding = .false.
   end type pair_diagnostics
@@ -68,18 +87,23 @@ module mod_pair_dynamics
 
 contains
 
-  !> Contact constants from the deck values (JFM section 2.4).
-  pure function make_pair_model(eps_r, eps_bar, mu_d, kn_smooth) result(model)
-    real(dp), intent(in) :: eps_r, eps_bar, mu_d, kn_smooth
+  !> Contact constants from the deck values (JFM section 2.4); size_ratio = lambda, the radius of
+  !> sphere 2 in units of sphere 1's.
+  pure function make_pair_model(eps_r, eps_bar, mu_d, kn_smooth, size_ratio) result(model)
+    real(dp), intent(in) :: eps_r, eps_bar, mu_d, kn_smooth, size_ratio
     type(pair_model) :: model
     model%h_r = eps_r
     model%mu_d = mu_d
+    model%lambda = size_ratio
     if (eps_r > 0.0_dp) then
       ! Balance 6 pi eta gamma_dot a^2 = k_n (eps_bar h_r)^{3/2}.
       model%k_n = 6.0_dp * pi / (eps_bar * eps_r)**1.5_dp
     else
       model%k_n = kn_smooth
     end if
+    model%k_pair = model%k_n
+    ! Hertz: stiffness as sqrt(R*), normalised by R* = 1/2 of two unit spheres (doc/CONTACT.md).
+    if (size_ratio /= 1.0_dp) model%k_pair = model%k_n * sqrt(2.0_dp * size_ratio / (1.0_dp + size_ratio))
   end function make_pair_model
 
   !> Time derivative of the state, and (optionally) the diagnostics at that state.
@@ -90,15 +114,22 @@ contains
     type(pair_diagnostics), intent(out), optional :: diag
     real(dp) :: r(3), rho, d(3), gap, overlap, f(n_pair_scalars), rfu(12, 12), rfe(12, 3, 3)
     real(dp) :: fc(3), fn_mag, ft(3), kt, rhs(12), w(12), u1(3), u2(3), om1(3), om2(3), us(3)
-    real(dp) :: s(3, 3, 2), sc(3, 3), stot(3, 3), ups(3), ft_mag, x1(3), x2(3)
-    logical :: contact, sliding
+    real(dp) :: s(3, 3, 2), sc(3, 3), stot(3, 3), ups(3), ft_mag, x1(3), x2(3), f2(n_pair_scalars)
+    real(dp) :: sc2(3, 3), lam
+    logical :: contact, sliding, sized
     integer :: m
 
+    lam = model%lambda
+    sized = lam /= 1.0_dp
     r = y(1:3)
     ups = y(4:6)
     rho = norm2(r)
     d = r / rho
-    gap = rho - 2.0_dp
+    if (sized) then
+      gap = rho - 1.0_dp - lam         ! true surface gap g
+    else
+      gap = rho - 2.0_dp
+    end if
     overlap = gap - model%h_r          ! delta' (negative in contact)
     contact = overlap < 0.0_dp
     sliding = .false.
@@ -109,10 +140,10 @@ contains
     ft = 0.0_dp
     ft_mag = 0.0_dp
     if (contact) then
-      fn_mag = model%k_n * abs(overlap)**1.5_dp
+      fn_mag = model%k_pair * abs(overlap)**1.5_dp
       fc = -fn_mag * d
       if (model%mu_d > 0.0_dp) then
-        kt = 2.0_dp / 7.0_dp * model%k_n * sqrt(abs(overlap))
+        kt = 2.0_dp / 7.0_dp * model%k_pair * sqrt(abs(overlap))
         ups = ups - dot_product(ups, d) * d
         ft = -kt * ups
         ft_mag = norm2(ft)
@@ -126,16 +157,28 @@ contains
     end if
 
     ! Hydrodynamics: R_FU . w = -(R_FE : E + F^c).
-    f = resistance_scalars(max(gap, 1.0e-12_dp))
-    rfu = pair_resistance_fu(f, d, 1.0_dp, 1.0_dp)
-    rfe = pair_resistance_fe(f, d, 1.0_dp, 1.0_dp)
+    if (sized) then
+      ! Jeffrey & Onishi's gap 2|r|/(a_1 + a_2) - 2.
+      f = sized_pair_scalars(max(2.0_dp * gap / (1.0_dp + lam), 1.0e-12_dp), lam)
+      f2 = sized_pair_scalars_22(max(2.0_dp * gap / (1.0_dp + lam), 1.0e-12_dp), lam)
+      rfu = pair_resistance_fu_sized(f, f2, d, 1.0_dp, lam, 1.0_dp)
+      rfe = pair_resistance_fe_sized(f, f2, d, 1.0_dp, lam, 1.0_dp)
+    else
+      f = resistance_scalars(max(gap, 1.0e-12_dp))
+      rfu = pair_resistance_fu(f, d, 1.0_dp, 1.0_dp)
+      rfe = pair_resistance_fe(f, d, 1.0_dp, 1.0_dp)
+    end if
     do m = 1, 12
       rhs(m) = -sum(rfe(m, :, :) * shear_strain)
     end do
     rhs(1:3) = rhs(1:3) - fc
     rhs(4:6) = rhs(4:6) - cross(d, fc)     ! T^c_1 = a n x F^c_1
     rhs(7:9) = rhs(7:9) + fc
-    rhs(10:12) = rhs(10:12) - cross(d, fc) ! T^c_2 = a n x F^c_1 as well
+    if (sized) then
+      rhs(10:12) = rhs(10:12) - lam * cross(d, fc)   ! T^c_2 = a_2 n x F^c_1
+    else
+      rhs(10:12) = rhs(10:12) - cross(d, fc) ! T^c_2 = a n x F^c_1 as well
+    end if
     w = solve_spd(rfu, rhs)
 
     x1 = -0.5_dp * r
@@ -148,23 +191,51 @@ contains
     dydt(1:3) = u2 - u1
     dydt(4:6) = 0.0_dp
     if (contact .and. model%mu_d > 0.0_dp) then
-      us = (u1 - u2) - dot_product(u1 - u2, d) * d + cross(om1 + om2, d)
+      if (sized) then
+        ! Relative velocity of the surface points x_1 + a_1 n and x_2 - a_2 n.
+        us = (u1 - u2) - dot_product(u1 - u2, d) * d + cross(om1 + lam * om2, d)
+      else
+        us = (u1 - u2) - dot_product(u1 - u2, d) * d + cross(om1 + om2, d)
+      end if
       dydt(4:6) = us - dot_product(us, d) * d
     end if
 
     if (present(diag)) then
-      s = pair_stresslets(f, d, w, shear_strain, 1.0_dp, 1.0_dp)
-      ! Contact stresslet of sphere 1: (1/2)(F^c r/2 + r/2 F^c), r = x_2 - x_1.
-      sc = 0.25_dp * (outer(fc, r) + outer(r, fc))
-      stot = s(:, :, 1) + sc
+      if (sized) then
+        s = pair_stresslets_sized(f, f2, d, w, shear_strain, 1.0_dp, lam, 1.0_dp)
+        ! Contact stresslets with the levers to the middle of the gap (doc/CONTACT.md).
+        sc = 0.5_dp * (outer(fc, (1.0_dp + 0.5_dp * gap) * d) + outer((1.0_dp + 0.5_dp * gap) * d, fc))
+        sc2 = 0.5_dp * (outer(fc, (lam + 0.5_dp * gap) * d) + outer((lam + 0.5_dp * gap) * d, fc))
+        stot = s(:, :, 1) + s(:, :, 2) + sc + sc2
+        diag%n1star = 2.0_dp * (stot(1, 1) - stot(2, 2)) / (stresslet_unit * (1.0_dp + lam**3))
+        diag%n2star = 2.0_dp * (stot(2, 2) - stot(3, 3)) / (stresslet_unit * (1.0_dp + lam**3))
+        diag%n1star_contact = 2.0_dp * (sc(1, 1) + sc2(1, 1) - sc(2, 2) - sc2(2, 2)) &
+                              / (stresslet_unit * (1.0_dp + lam**3))
+        diag%n2star_contact = 2.0_dp * (sc(2, 2) + sc2(2, 2) - sc(3, 3) - sc2(3, 3)) &
+                              / (stresslet_unit * (1.0_dp + lam**3))
+        stot = s(:, :, 1) + sc
+      else
+        s = pair_stresslets(f, d, w, shear_strain, 1.0_dp, 1.0_dp)
+        ! Contact stresslet of sphere 1: (1/2)(F^c r/2 + r/2 F^c), r = x_2 - x_1.
+        sc = 0.25_dp * (outer(fc, r) + outer(r, fc))
+        sc2 = sc
+        stot = s(:, :, 1) + sc
+        diag%n1star = 2.0_dp * (stot(1, 1) - stot(2, 2)) / stresslet_unit
+        diag%n2star = 2.0_dp * (stot(2, 2) - stot(3, 3)) / stresslet_unit
+        diag%n1star_contact = 2.0_dp * (sc(1, 1) - sc(2, 2)) / stresslet_unit
+        diag%n2star_contact = 2.0_dp * (sc(2, 2) - sc(3, 3)) / stresslet_unit
+      end if
+      diag%n1star_sphere(1) = 2.0_dp * (stot(1, 1) - stot(2, 2)) / stresslet_unit
+      diag%n2star_sphere(1) = 2.0_dp * (stot(2, 2) - stot(3, 3)) / stresslet_unit
+      ! Sphere 2: -F^c with the lever l_2 = -(a_2 + g/2) n gives the same sign as sphere 1's.
+      stot = s(:, :, 2) + sc2
+      diag%n1star_sphere(2) = 2.0_dp * (stot(1, 1) - stot(2, 2)) / (stresslet_unit * lam**3)
+      diag%n2star_sphere(2) = 2.0_dp * (stot(2, 2) - stot(3, 3)) / (stresslet_unit * lam**3)
       diag%gap = gap
       diag%fc_normal = fn_mag
       diag%fc_tangential = ft_mag
-      diag%n1star = 2.0_dp * (stot(1, 1) - stot(2, 2)) / stresslet_unit
-      diag%n2star = 2.0_dp * (stot(2, 2) - stot(3, 3)) / stresslet_unit
-      diag%n1star_contact = 2.0_dp * (sc(1, 1) - sc(2, 2)) / stresslet_unit
-      diag%n2star_contact = 2.0_dp * (sc(2, 2) - sc(3, 3)) / stresslet_unit
       diag%omega1 = om1
+      diag%omega2 = om2
       diag%in_contact = contact
       diag%sliding = sliding
     end if
@@ -182,7 +253,11 @@ contains
     ups = y(4:6)
     if (all(ups == 0.0_dp)) return
     d = y(1:3) / norm2(y(1:3))
-    overlap = norm2(y(1:3)) - 2.0_dp - model%h_r
+    if (model%lambda /= 1.0_dp) then
+      overlap = norm2(y(1:3)) - 1.0_dp - model%lambda - model%h_r
+    else
+      overlap = norm2(y(1:3)) - 2.0_dp - model%h_r
+    end if
     if (overlap >= 0.0_dp .or. model%mu_d <= 0.0_dp) then
       y(4:6) = 0.0_dp
       changed = .true.

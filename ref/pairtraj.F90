@@ -1,14 +1,16 @@
-! pairtraj: reference trajectory of two rough, frictional, force- and torque-free equal spheres in
+! pairtraj: reference trajectory of two rough, frictional, force- and torque-free spheres in
 ! unbounded simple shear (the "theory" curves of Gallier et al. 2014 JFM section 3, figures 3-5;
-! DaCunha & Hinch 1996). Independent of the DNS solver: it shares only mod_kinds, mod_vector and
-! the resistance kernels (mod_pair_resistance + its table, mod_resistance_blocks) with src/.
+! DaCunha & Hinch 1996), equal or of radii a and size_ratio * a. Independent of the DNS solver: it
+! shares only mod_kinds, mod_vector and the resistance kernels (mod_pair_resistance + its table,
+! mod_pair_resistance_unequal, mod_resistance_blocks) with src/.
 !
 !   usage: pairtraj DECK.nml
 !
 ! Reads the namelist deck (doc/PAIRTRAJ_INPUT.md), integrates r = x_2 - x_1 from start until
 ! r_x = x_end with the adaptive Dormand-Prince 5(4) integrator (mod_pair_integrator), and writes a
 ! CSV (header: t,x,y,z,theta,gap,fc_normal,fc_tangential,N1star,N2star,...; positions in units
-! of a, time in strain units, forces in units of eta gamma_dot a^2; theta = atan2(y, x) from +x,
+! of a, time in strain units, forces in units of eta gamma_dot a^2, then per-sphere columns
+! omega2_z, N1star_1, N2star_1, N1star_2, N2star_2; theta = atan2(y, x) from +x,
 ! so the pair arrives at theta ~ pi and leaves at theta ~ 0). A summary goes to stdout.
 program pairtraj
   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
@@ -39,16 +41,20 @@ program pairtraj
   end if
   call get_command_argument(1, deck_path)
   call read_pair_deck(trim(deck_path), deck)
-  model = make_pair_model(deck%eps_r, deck%eps_bar, deck%mu_d, deck%kn_smooth)
+  model = make_pair_model(deck%eps_r, deck%eps_bar, deck%mu_d, deck%kn_smooth, deck%size_ratio)
   call system_clock(clock0, clock_rate)
 
   call open_csv(trim(deck%csv_file), csv)
   write (csv, '(a)') 't,x,y,z,theta,gap,fc_normal,fc_tangential,N1star,N2star,' // &
-    'N1star_contact,N2star_contact,omega1_z,contact,sliding'
+    'N1star_contact,N2star_contact,omega1_z,contact,sliding,omega2_z,N1star_1,N2star_1,' // &
+    'N1star_2,N2star_2'
 
   write (output_unit, '(a,a)') 'pairtraj: deck ', trim(deck_path)
   write (output_unit, '(a,es10.3,a,es10.3,a,es10.3,a,es10.3)') 'pairtraj: eps_r = ', deck%eps_r, &
     ', eps_bar = ', deck%eps_bar, ', mu_d = ', deck%mu_d, ', k_n = ', model%k_n
+  if (deck%size_ratio /= 1.0_dp) write (output_unit, '(a,es10.3,a,es10.3)') &
+    'pairtraj: unequal spheres: radii 1 and size_ratio = ', deck%size_ratio, &
+    ', pair stiffness k = ', model%k_pair
   if (deck%mu_d > 0.0_dp) then
     write (output_unit, '(a)') 'pairtraj: models: lubrication (exact two-sphere), Hertz contact, ' // &
       'tangential spring with Coulomb cap'
@@ -196,9 +202,11 @@ contains
     real(dp), intent(in) :: tt, yy(:)
     type(pair_diagnostics) :: dg
     call rhs_diag(yy, dg)
-    write (csv, '(13(es23.15e3,","),i1,",",i1)') tt, yy(1), yy(2), yy(3), atan2(yy(2), yy(1)), &
-      dg%gap, dg%fc_normal, dg%fc_tangential, dg%n1star, dg%n2star, dg%n1star_contact, &
-      dg%n2star_contact, dg%omega1(3), merge(1, 0, dg%in_contact), merge(1, 0, dg%sliding)
+    write (csv, '(13(es23.15e3,","),i1,",",i1,5(",",es23.15e3))') tt, yy(1), yy(2), yy(3), &
+      atan2(yy(2), yy(1)), dg%gap, dg%fc_normal, dg%fc_tangential, dg%n1star, dg%n2star, &
+      dg%n1star_contact, dg%n2star_contact, dg%omega1(3), merge(1, 0, dg%in_contact), &
+      merge(1, 0, dg%sliding), dg%omega2(3), dg%n1star_sphere(1), dg%n2star_sphere(1), &
+      dg%n1star_sphere(2), dg%n2star_sphere(2)
   end subroutine write_record
 
   subroutine open_csv(path, unit)

@@ -19,6 +19,8 @@ module mod_resistance_blocks
   private
 
   public :: pair_resistance_fu, pair_resistance_fe, pair_resistance_su, pair_resistance_se
+  public :: pair_resistance_fu_sized, pair_resistance_fe_sized, pair_resistance_su_sized, &
+            pair_resistance_se_sized, pair_stresslets_sized
   public :: pair_force_torque_from_strain, pair_stresslets
   public :: strain_d0, strain_d1, strain_d2
   public :: wall_resistance_fu, wall_resistance_block
@@ -124,84 +126,214 @@ contains
   pure function pair_resistance_fu(f, d, radius, viscosity) result(r)
     real(dp), intent(in) :: f(n_pair_scalars), d(3), radius, viscosity
     real(dp) :: r(12, 12)
+    r = fu_blocks(equal_block_scalars(f), spread_scale(6.0_dp * pi * viscosity * radius), &
+                  spread_scale(4.0_dp * pi * viscosity * radius**2), &
+                  spread_scale(8.0_dp * pi * viscosity * radius**3), d)
+  end function pair_resistance_fu
+
+  !> R_FU of two UNEQUAL spheres, radii a1 and a2: f are the 11 and 12 scalars and f2 the 22 and
+  !> 21 scalars (sized_pair_scalars, sized_pair_scalars_22 of mod_pair_resistance_unequal), scaled
+  !> as Jeffrey & Onishi (1984) scale them: block (alpha, beta) by 3 pi eta (a_alpha + a_beta) for
+  !> A, pi eta (a_alpha + a_beta)^2 for B, pi eta (a_alpha + a_beta)^3 for C (doc/RESISTANCE.md
+  !> "Unequal spheres"). Same layout and d as pair_resistance_fu.
+  pure function pair_resistance_fu_sized(f, f2, d, a1, a2, viscosity) result(r)
+    real(dp), intent(in) :: f(n_pair_scalars), f2(n_pair_scalars), d(3), a1, a2, viscosity
+    real(dp) :: r(12, 12)
+    real(dp) :: sum_a(2, 2)
+    sum_a = radius_sums(a1, a2)
+    r = fu_blocks(sized_block_scalars(f, f2), 3.0_dp * pi * viscosity * sum_a, &
+                  pi * viscosity * sum_a**2, pi * viscosity * sum_a**3, d)
+  end function pair_resistance_fu_sized
+
+  !> R_FU from the scalars s(k, alpha, beta) of each block and each block's dimensional factors
+  !> of A, B and C.
+  pure function fu_blocks(s, ca, cb, cc, d) result(r)
+    real(dp), intent(in) :: s(11, 2, 2), ca(2, 2), cb(2, 2), cc(2, 2), d(3)
+    real(dp) :: r(12, 12)
     integer :: alpha, beta, i, j, k, ro, co
-    real(dp) :: xa, ya, yb, xc, yc, ca, cb, cc, bij
-    ca = 6.0_dp * pi * viscosity * radius
-    cb = 4.0_dp * pi * viscosity * radius**2
-    cc = 8.0_dp * pi * viscosity * radius**3
+    real(dp) :: xa, ya, yb, xc, yc, bij
     r = 0.0_dp
     do alpha = 1, 2
       do beta = 1, 2
         ro = 6 * (alpha - 1)
         co = 6 * (beta - 1)
-        xa = block_scalar(f, i_xa11, alpha, beta)
-        ya = block_scalar(f, i_ya11, alpha, beta)
-        yb = block_scalar(f, i_yb11, alpha, beta)
-        xc = block_scalar(f, i_xc11, alpha, beta)
-        yc = block_scalar(f, i_yc11, alpha, beta)
+        xa = s(i_xa11, alpha, beta)
+        ya = s(i_ya11, alpha, beta)
+        yb = s(i_yb11, alpha, beta)
+        xc = s(i_xc11, alpha, beta)
+        yc = s(i_yc11, alpha, beta)
         do j = 1, 3
           do i = 1, 3
-            r(ro + i, co + j) = ca * (xa * d(i) * d(j) + ya * (kron(i, j) - d(i) * d(j)))
-            r(ro + 3 + i, co + 3 + j) = cc * (xc * d(i) * d(j) + yc * (kron(i, j) - d(i) * d(j)))
+            r(ro + i, co + j) = ca(alpha, beta) * (xa * d(i) * d(j) + ya * (kron(i, j) - d(i) * d(j)))
+            r(ro + 3 + i, co + 3 + j) = cc(alpha, beta) * (xc * d(i) * d(j) + yc * (kron(i, j) - d(i) * d(j)))
             bij = 0.0_dp
             do k = 1, 3
               bij = bij + levi_civita(i, j, k) * d(k)
             end do
             ! T_alpha <- U_beta: B^ab ; F_beta <- Om_alpha: Bt^ba_ji = B^ab_ij (transpose).
-            r(ro + 3 + i, co + j) = cb * yb * bij
-            r(co + j, ro + 3 + i) = cb * yb * bij
+            r(ro + 3 + i, co + j) = cb(alpha, beta) * yb * bij
+            r(co + j, ro + 3 + i) = cb(alpha, beta) * yb * bij
           end do
         end do
       end do
     end do
-  end function pair_resistance_fu
+  end function fu_blocks
 
   !> R_FE as a 12x3x3 array: (F_1, T_1, F_2, T_2)_m = sum_jk r(m, j, k) E_jk.
   pure function pair_resistance_fe(f, d, radius, viscosity) result(r)
     real(dp), intent(in) :: f(n_pair_scalars), d(3), radius, viscosity
     real(dp) :: r(12, 3, 3)
-    real(dp) :: g(3, 3, 3), h(3, 3, 3), cg, ch
+    r = fe_blocks(equal_block_scalars(f), spread_scale(4.0_dp * pi * viscosity * radius**2), &
+                  spread_scale(8.0_dp * pi * viscosity * radius**3), d)
+  end function pair_resistance_fe
+
+  !> R_FE of two unequal spheres (scalars and scaling as pair_resistance_fu_sized: G by
+  !> pi eta (a_alpha + a_beta)^2, H by pi eta (a_alpha + a_beta)^3).
+  pure function pair_resistance_fe_sized(f, f2, d, a1, a2, viscosity) result(r)
+    real(dp), intent(in) :: f(n_pair_scalars), f2(n_pair_scalars), d(3), a1, a2, viscosity
+    real(dp) :: r(12, 3, 3)
+    real(dp) :: sum_a(2, 2)
+    sum_a = radius_sums(a1, a2)
+    r = fe_blocks(sized_block_scalars(f, f2), pi * viscosity * sum_a**2, pi * viscosity * sum_a**3, d)
+  end function pair_resistance_fe_sized
+
+  pure function fe_blocks(s, cg, ch, d) result(r)
+    real(dp), intent(in) :: s(11, 2, 2), cg(2, 2), ch(2, 2), d(3)
+    real(dp) :: r(12, 3, 3)
+    real(dp) :: g(3, 3, 3), h(3, 3, 3)
     integer :: alpha, beta, i, j, k
-    cg = 4.0_dp * pi * viscosity * radius**2
-    ch = 8.0_dp * pi * viscosity * radius**3
     r = 0.0_dp
     do alpha = 1, 2
       do beta = 1, 2
         ! Gt^ab_ijk = G^ba_jki: force on alpha from the stresslet response of beta.
-        g = g_tensor(block_scalar(f, i_xg11, beta, alpha), block_scalar(f, i_yg11, beta, alpha), d)
-        h = h_tensor(block_scalar(f, i_yh11, beta, alpha), d)
+        g = g_tensor(s(i_xg11, beta, alpha), s(i_yg11, beta, alpha), d)
+        h = h_tensor(s(i_yh11, beta, alpha), d)
         do k = 1, 3
           do j = 1, 3
             do i = 1, 3
-              r(6 * (alpha - 1) + i, j, k) = r(6 * (alpha - 1) + i, j, k) + cg * g(j, k, i)
-              r(6 * (alpha - 1) + 3 + i, j, k) = r(6 * (alpha - 1) + 3 + i, j, k) + ch * h(j, k, i)
+              r(6 * (alpha - 1) + i, j, k) = r(6 * (alpha - 1) + i, j, k) + cg(alpha, beta) * g(j, k, i)
+              r(6 * (alpha - 1) + 3 + i, j, k) = r(6 * (alpha - 1) + 3 + i, j, k) &
+                                                 + ch(alpha, beta) * h(j, k, i)
             end do
           end do
         end do
       end do
     end do
-  end function pair_resistance_fe
+  end function fe_blocks
 
   !> R_SU as a 3x3x2x12 array: S_alpha,ij = sum_m r(i, j, alpha, m) w_m, with
   !> w = (U^inf_1 - U_1, Om^inf - Om_1, U^inf_2 - U_2, Om^inf - Om_2).
   pure function pair_resistance_su(f, d, radius, viscosity) result(r)
     real(dp), intent(in) :: f(n_pair_scalars), d(3), radius, viscosity
     real(dp) :: r(3, 3, 2, 12)
-    real(dp) :: g(3, 3, 3), h(3, 3, 3), cg, ch
+    r = su_blocks(equal_block_scalars(f), spread_scale(4.0_dp * pi * viscosity * radius**2), &
+                  spread_scale(8.0_dp * pi * viscosity * radius**3), d)
+  end function pair_resistance_su
+
+  !> R_SU of two unequal spheres (as pair_resistance_fe_sized).
+  pure function pair_resistance_su_sized(f, f2, d, a1, a2, viscosity) result(r)
+    real(dp), intent(in) :: f(n_pair_scalars), f2(n_pair_scalars), d(3), a1, a2, viscosity
+    real(dp) :: r(3, 3, 2, 12)
+    real(dp) :: sum_a(2, 2)
+    sum_a = radius_sums(a1, a2)
+    r = su_blocks(sized_block_scalars(f, f2), pi * viscosity * sum_a**2, pi * viscosity * sum_a**3, d)
+  end function pair_resistance_su_sized
+
+  pure function su_blocks(s, cg, ch, d) result(r)
+    real(dp), intent(in) :: s(11, 2, 2), cg(2, 2), ch(2, 2), d(3)
+    real(dp) :: r(3, 3, 2, 12)
+    real(dp) :: g(3, 3, 3), h(3, 3, 3)
     integer :: alpha, beta, k
-    cg = 4.0_dp * pi * viscosity * radius**2
-    ch = 8.0_dp * pi * viscosity * radius**3
     do alpha = 1, 2
       do beta = 1, 2
-        g = g_tensor(block_scalar(f, i_xg11, alpha, beta), block_scalar(f, i_yg11, alpha, beta), d)
-        h = h_tensor(block_scalar(f, i_yh11, alpha, beta), d)
+        g = g_tensor(s(i_xg11, alpha, beta), s(i_yg11, alpha, beta), d)
+        h = h_tensor(s(i_yh11, alpha, beta), d)
         do k = 1, 3
-          r(:, :, alpha, 6 * (beta - 1) + k) = cg * g(:, :, k)
-          r(:, :, alpha, 6 * (beta - 1) + 3 + k) = ch * h(:, :, k)
+          r(:, :, alpha, 6 * (beta - 1) + k) = cg(alpha, beta) * g(:, :, k)
+          r(:, :, alpha, 6 * (beta - 1) + 3 + k) = ch(alpha, beta) * h(:, :, k)
         end do
       end do
     end do
-  end function pair_resistance_su
+  end function su_blocks
+
+  !> R_SE of two unequal spheres as a 3x3x2x3x3 array: S_alpha = sum_beta M^ab : E, M^ab scaled by
+  !> (5/6) pi eta (a_alpha + a_beta)^3 (Jeffrey 1992; the M scalars are even under exchange, so the
+  !> 21 ones are the 12 ones at 1/lambda).
+  pure function pair_resistance_se_sized(f, f2, d, a1, a2, viscosity) result(r)
+    real(dp), intent(in) :: f(n_pair_scalars), f2(n_pair_scalars), d(3), a1, a2, viscosity
+    real(dp) :: r(3, 3, 2, 3, 3)
+    real(dp) :: s(11, 2, 2), cm(2, 2), x(2), y(2), z(2)
+    integer :: alpha
+    s = sized_block_scalars(f, f2)
+    cm = 5.0_dp / 6.0_dp * pi * viscosity * radius_sums(a1, a2)**3
+    do alpha = 1, 2
+      x = s(i_xm11, alpha, :) * cm(alpha, :)
+      y = s(i_ym11, alpha, :) * cm(alpha, :)
+      z = s(i_zm11, alpha, :) * cm(alpha, :)
+      r(:, :, alpha, :, :) = m_tensor(sum(x), sum(y), sum(z), d)
+    end do
+  end function pair_resistance_se_sized
+
+  !> Stresslets S_1, S_2 (3x3x2) of two unequal spheres from w (as pair_stresslets) and E: the
+  !> contractions of pair_resistance_su_sized and pair_resistance_se_sized.
+  pure function pair_stresslets_sized(f, f2, d, w, e, a1, a2, viscosity) result(s)
+    real(dp), intent(in) :: f(n_pair_scalars), f2(n_pair_scalars), d(3), w(12), e(3, 3), a1, a2, &
+                            viscosity
+    real(dp) :: s(3, 3, 2)
+    real(dp) :: rsu(3, 3, 2, 12), rse(3, 3, 2, 3, 3)
+    integer :: alpha, i, j
+    rsu = pair_resistance_su_sized(f, f2, d, a1, a2, viscosity)
+    rse = pair_resistance_se_sized(f, f2, d, a1, a2, viscosity)
+    do alpha = 1, 2
+      do j = 1, 3
+        do i = 1, 3
+          s(i, j, alpha) = sum(rsu(i, j, alpha, :) * w) + sum(rse(i, j, alpha, :, :) * e)
+        end do
+      end do
+    end do
+  end function pair_stresslets_sized
+
+  !> The scalars of each block, s(k, alpha, beta), of two equal spheres from the 11 and 12 ones.
+  pure function equal_block_scalars(f) result(s)
+    real(dp), intent(in) :: f(n_pair_scalars)
+    real(dp) :: s(11, 2, 2)
+    integer :: k, alpha, beta
+    do beta = 1, 2
+      do alpha = 1, 2
+        do k = 1, 11
+          s(k, alpha, beta) = block_scalar(f, k, alpha, beta)
+        end do
+      end do
+    end do
+  end function equal_block_scalars
+
+  !> The same for unequal spheres: f = (11, 12) scalars, f2 = (22, 21) scalars, exchange signs
+  !> already applied (sized_pair_scalars_22).
+  pure function sized_block_scalars(f, f2) result(s)
+    real(dp), intent(in) :: f(n_pair_scalars), f2(n_pair_scalars)
+    real(dp) :: s(11, 2, 2)
+    s(:, 1, 1) = f(1:11)
+    s(:, 1, 2) = f(12:22)
+    s(:, 2, 2) = f2(1:11)
+    s(:, 2, 1) = f2(12:22)
+  end function sized_block_scalars
+
+  !> a_alpha + a_beta of each block.
+  pure function radius_sums(a1, a2) result(sum_a)
+    real(dp), intent(in) :: a1, a2
+    real(dp) :: sum_a(2, 2)
+    sum_a(1, 1) = 2.0_dp * a1
+    sum_a(1, 2) = a1 + a2
+    sum_a(2, 1) = a1 + a2
+    sum_a(2, 2) = 2.0_dp * a2
+  end function radius_sums
+
+  !> One dimensional factor for all four blocks (equal spheres).
+  pure function spread_scale(c) result(cs)
+    real(dp), intent(in) :: c
+    real(dp) :: cs(2, 2)
+    cs = c
+  end function spread_scale
 
   !> R_SE as a 3x3x2x3x3 array: S_alpha,ij = sum_kl r(i, j, alpha, k, l) E_kl.
   pure function pair_resistance_se(f, d, radius, viscosity) result(r)

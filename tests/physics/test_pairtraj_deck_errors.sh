@@ -4,7 +4,7 @@
 # ONE message line on stderr that names the deck file, the namelist group and the variable, and
 # no CSV is written. Cases: unknown variable, value out of range, unreadable value, integer
 # variable given a real, overlapping start, too many values, unclosed group, unknown group,
-# missing file. Exact text matching
+# missing file, size ratio out of range or unreadable, a start that overlaps only the larger sphere. Exact text matching
 # (no tolerance involved).
 set -u
 . "$(dirname "$0")/../checks.sh"     # check_result, checks_finish: the verdict shared by shell tests
@@ -103,6 +103,38 @@ cat > "$tmp/toomany.nml" <<EOF
 /
 EOF
 check "too many values" "$tmp/toomany.nml" pair start
+
+cat > "$tmp/ratio.nml" <<EOF
+&pair
+  size_ratio = 0.0
+/
+&output
+  csv_file = '$tmp/out.csv'
+/
+EOF
+check "size ratio out of range" "$tmp/ratio.nml" pair size_ratio
+
+cat > "$tmp/ratiotext.nml" <<EOF
+&pair
+  size_ratio = big
+/
+&output
+  csv_file = '$tmp/out.csv'
+/
+EOF
+check "size ratio unreadable" "$tmp/ratiotext.nml" pair size_ratio
+
+# |start| = 3.2 > 2 + eps_r would do for equal spheres, not for radii 1 and 3
+cat > "$tmp/ratiostart.nml" <<EOF
+&pair
+  size_ratio = 3.0
+  start = -3.2, 0.1, 0.0
+/
+&output
+  csv_file = '$tmp/out.csv'
+/
+EOF
+check "start inside the larger sphere" "$tmp/ratiostart.nml" pair start
 
 check "missing file" "$tmp/does_not_exist.nml" "" ""
 
