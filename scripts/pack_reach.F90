@@ -4,13 +4,14 @@
 ! target, seeds that reached it, the phi reached (the last overlap-free stage when jammed), the
 ! compression stages, relaxation sweeps and seconds (mean over the seeds). Above phi_max the packer
 ! refuses; scripts/pack_reach.sh builds this against a copy of the kernels with the limit lifted.
+!   pack_reach [N [SEEDS [PHI ...]]]     defaults 1000, 3, and 0.55 0.58 0.60 0.61 0.62 0.63
 program pack_reach
   use mod_kinds, only: dp, i8
   use mod_packing, only: random_packing_mixture, packing_report_t
   use mod_packing_geometry, only: species_counts_total, species_box_for
   implicit none
-  integer, parameter :: nseed = 3
-  real(dp), parameter :: targets(6) = [0.55_dp, 0.58_dp, 0.60_dp, 0.61_dp, 0.62_dp, 0.63_dp]
+  integer :: nseed = 3
+  real(dp), allocatable :: targets(:)
   real(dp) :: radius(2), share(2), box(3), phimin, t, stages, sweeps
   real(dp), allocatable :: r(:), x(:,:)
   integer :: mix, geo, k, s, info, counts(2), nok, n, nsp
@@ -21,9 +22,22 @@ program pack_reach
   logical :: per(3)
 
   n = 1000
+  targets = [0.55_dp, 0.58_dp, 0.60_dp, 0.61_dp, 0.62_dp, 0.63_dp]
   if (command_argument_count() > 0) then
     call get_command_argument(1, arg)
     read(arg, *) n
+  end if
+  if (command_argument_count() > 1) then
+    call get_command_argument(2, arg)
+    read(arg, *) nseed
+  end if
+  if (command_argument_count() > 2) then
+    deallocate(targets)
+    allocate(targets(command_argument_count() - 2))
+    do k = 1, size(targets)
+      call get_command_argument(k + 2, arg)
+      read(arg, *) targets(k)
+    end do
   end if
   print '(a,i0,a)', '| spheres | box | N | target | reached (seeds) | phi reached min | stages | relax sweeps | s |'
   print '(a)', '|---|---|---|---|---|---|---|---|---|'

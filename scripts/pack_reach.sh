@@ -2,7 +2,8 @@
 # How dense the packer gets, for doc/VALIDATION.md "Packings": builds scripts/pack_reach.F90
 # against a copy of the packing kernels whose phi_max is lifted to 0.64 (so that targets past the
 # shipped limit run and show where the compression jams), and prints a Markdown table.
-#   bash scripts/pack_reach.sh [N]        (N spheres per case, default 1000; ~10 min at N = 1000)
+#   bash scripts/pack_reach.sh [N [SEEDS [PHI ...]]]   (defaults 1000, 3, 0.55 ... 0.63; the jams
+#   above 0.61 take minutes each)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"

@@ -18,9 +18,10 @@
 !      radius rad (1 + 0.03), until no overlap exceeds 0.015 rad: every gap ends >= 0.045 rad.
 !      Relaxing with that margin, rather than to bare contact, leaves no contact network (which
 !      would freeze the Monte Carlo below); 5 Monte Carlo sweeps at radius rad then mix the
-!      structure before the next growth. Above phi_s ~ 0.55 the margin shrinks with the room
-!      left, to 0.6 x the mean-gap estimate (a relaxation at phi_s (1 + 0.03)^3 would pass random
-!      close packing); no stage at or below 0.55 sees that (doc/PACKING_INPUT.md "Dense").
+!      structure before the next growth. Above phi_s = 0.64/1.05^3 = 0.553 (mean-gap estimate
+!      g = (0.64/phi_s)^(1/3) - 1 below 0.05) the margin shrinks as 0.03 (g/0.05)^2 (a relaxation
+!      at phi_s (1 + 0.03)^3 would pass random close packing; quadratic rather than linear in g
+!      lets walls reach 0.60); no stage at or below 0.55 sees that (doc/PACKING_INPUT.md "Dense").
 !   3. Equilibration: hard-sphere Metropolis Monte Carlo at the final radius, n_sweeps sweeps of
 !      n trial displacements of a sphere chosen at random, uniform in a cube of side 2 step; a
 !      move is rejected when it overlaps another sphere or a wall. The step is tuned towards
@@ -47,7 +48,7 @@ module mod_packing
   real(dp), parameter :: phi_start = 0.1_dp    ! volume fraction of the first stage
   real(dp), parameter :: phi_rcp = 0.64_dp     ! random close packing, for the growth schedule
   real(dp), parameter :: growth = 0.1_dp       ! diameter growth per stage / mean gap estimate
-  real(dp), parameter :: margin_room = 0.6_dp  ! largest margin / mean gap estimate (dense stages)
+  real(dp), parameter :: gap_dense = 0.05_dp   ! mean gap estimate below which the margin shrinks
   integer, parameter :: max_stages = 1000
   integer, parameter :: stage_sweeps = 5       ! Monte Carlo sweeps after each stage
   integer, parameter :: max_relax = 20000      ! relaxation sweeps per stage
@@ -281,7 +282,7 @@ contains
     ok = .false.
     do stage = 1, max_stages
       phis = phie * (rad / ae)**3
-      mrg = min(margin, max(1.0e-3_dp, margin_room * ((phi_rcp / phis)**(1.0_dp / 3) - 1)))
+      mrg = min(margin, max(1.0e-3_dp, margin * (((phi_rcp / phis)**(1.0_dp / 3) - 1) / gap_dense)**2))
       call relax_overlaps(x, box, periodic, rad, mrg, f, ylo, yhi, its, ok)
       rep%relax_sweeps = rep%relax_sweeps + its
       rep%stages = stage

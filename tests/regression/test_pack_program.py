@@ -125,7 +125,7 @@ with open(os.path.join(d, 'a_file'), 'w') as f:
     f.write('not a directory')
 cases = [
     ('unknown variable', GOOD.replace('phi = 0.3', 'phii = 0.3'), ['bad.nml', '&packing', 'phii', 'unknown variable']),
-    ('phi out of range', GOOD.replace('phi = 0.3', 'phi = 0.6'), ['bad.nml', '&packing', 'phi', 'out of range']),
+    ('phi out of range', GOOD.replace('phi = 0.3', 'phi = 0.65'), ['bad.nml', '&packing', 'phi', 'out of range']),
     ('wrong type', GOOD.replace('seed = 3', "seed = 'x'"), ['bad.nml', '&packing', 'seed', 'cannot read']),
     ('bad y_boundary', GOOD.replace("'walls'", "'wall'"), ['bad.nml', '&packing', 'y_boundary']),
     ('box too small', GOOD.replace('box = 12, 12, 12', 'box = 12, 3, 12'), ['bad.nml', '&packing', 'box(y)', 'at least 4']),
