@@ -1,8 +1,11 @@
-! Random hard-sphere configurations (doc/PACKING_INPUT.md): equal spheres of radius a at a
-! target volume fraction in a triply periodic box or in the Couette cell (x, z periodic; walls at
-! y = 0 and y = Ly, which no sphere overlaps: a <= y <= Ly - a). Pure: no PETSc, MPI or HDF5.
-! An optional minimum gap g_min keeps every surface-to-surface gap >= g_min (spheres of radius
-! a + g_min/2 for the pairs, centres in [a + g_min, Ly - a - g_min] for the walls).
+! Random hard-sphere configurations (doc/PACKING_INPUT.md): spheres of radius a_i (equal, or a
+! mixture) at a target volume fraction in a triply periodic box or in the Couette cell (x, z
+! periodic; walls at y = 0 and y = Ly, which no sphere overlaps: a_i <= y <= Ly - a_i). Pure: no
+! PETSc, MPI or HDF5. An optional minimum gap g_min keeps every surface-to-surface gap >= g_min
+! (spheres of radius a_i + g_min/2 for the pairs, centres in [a_i + g_min, Ly - a_i - g_min]).
+! Radii are held as one reference radius (the largest) times a factor f_i <= 1 per sphere; equal
+! spheres have f_i = 1 exactly, so their arithmetic and random numbers are those of the
+! equal-sphere packer, bit for bit (tests/unit/test_packing_mixture.F90).
 !
 ! Algorithm
 !   1. n centres uniformly at random in the accessible region.
@@ -15,7 +18,10 @@
 !      radius rad (1 + 0.03), until no overlap exceeds 0.015 rad: every gap ends >= 0.045 rad.
 !      Relaxing with that margin, rather than to bare contact, leaves no contact network (which
 !      would freeze the Monte Carlo below); 5 Monte Carlo sweeps at radius rad then mix the
-!      structure before the next growth.
+!      structure before the next growth. Above phi_s = 0.64/1.05^3 = 0.553 (mean-gap estimate
+!      g = (0.64/phi_s)^(1/3) - 1 below 0.05) the margin shrinks as 0.03 (g/0.05)^2 (a relaxation
+!      at phi_s (1 + 0.03)^3 would pass random close packing; quadratic rather than linear in g
+!      lets walls reach 0.60); no stage at or below 0.55 sees that (doc/PACKING_INPUT.md "Dense").
 !   3. Equilibration: hard-sphere Metropolis Monte Carlo at the final radius, n_sweeps sweeps of
 !      n trial displacements of a sphere chosen at random, uniform in a cube of side 2 step; a
 !      move is rejected when it overlaps another sphere or a wall. The step is tuned towards
@@ -27,11 +33,11 @@
 module mod_packing
   use mod_kinds, only: dp, i8, pi
   use mod_neighbours, only: cell_coord, cell_index, cells_around, min_image
-  use mod_packing_geometry, only: phi_max
+  use mod_packing_geometry, only: phi_max, volume_fraction
   implicit none
   private
   public :: rng_t, rng_seed, rng_uniform
-  public :: packing_report_t, random_packing, hs_monte_carlo, min_separation
+  public :: packing_report_t, random_packing, random_packing_mixture, hs_monte_carlo, min_separation
 
   type :: rng_t
     integer(i8) :: s(6) = 12345_i8             ! MRG32k3a state: s(1:3) component 1, s(4:6) 2
@@ -42,19 +48,21 @@ module mod_packing
   real(dp), parameter :: phi_start = 0.1_dp    ! volume fraction of the first stage
   real(dp), parameter :: phi_rcp = 0.64_dp     ! random close packing, for the growth schedule
   real(dp), parameter :: growth = 0.1_dp       ! diameter growth per stage / mean gap estimate
+  real(dp), parameter :: gap_dense = 0.05_dp   ! mean gap estimate below which the margin shrinks
   integer, parameter :: max_stages = 1000
   integer, parameter :: stage_sweeps = 5       ! Monte Carlo sweeps after each stage
   integer, parameter :: max_relax = 20000      ! relaxation sweeps per stage
 
   type :: packing_report_t
     integer :: n = 0
-    real(dp) :: phi = 0                        ! n (4/3) pi a^3 / (Lx Ly Lz)
+    real(dp) :: phi = 0                        ! sum_i (4/3) pi a_i^3 / (Lx Ly Lz)
+    real(dp) :: phi_reached = 0                ! phi of the last overlap-free compression stage
     integer :: stages = 0                      ! compression stages
     integer :: relax_sweeps = 0                ! total overlap-relaxation sweeps
     real(dp) :: acceptance = 0                 ! Monte Carlo acceptance over the frozen-step half
     real(dp) :: step = 0                       ! final Monte Carlo step [a]
-    real(dp) :: min_pair_gap = 0               ! min |r| - 2a [a]
-    real(dp) :: min_wall_gap = 0               ! min distance to a wall - a [a] (huge if periodic)
+    real(dp) :: min_pair_gap = 0               ! min |r| - a_i - a_j [a]
+    real(dp) :: min_wall_gap = 0               ! min distance to a wall - a_i [a] (huge if periodic)
   end type packing_report_t
 
   !> Cell lists for spheres of diameter <= cell side, kept up to date under single moves.
@@ -167,13 +175,8 @@ contains
 
   ! ---- the packing --------------------------------------------------------------------------
 
-  !> n spheres of radius a at random in box (periodic(2) = .false.: walls at y = 0, Ly), every
-  !> gap >= min_gap, then n_sweeps Monte Carlo sweeps. x(3, n) is allocated here, positions in
-  !> [0, L) per periodic direction.
-  !> info: 0 ok; 1 n < 1, min_gap < 0, or phi (1 + min_gap/2a)^3 above phi_max by more than one
-  !> sphere; 2 a box length
-  !> below 4 (a + min_gap); 3 the compression did not remove every overlap (target not
-  !> reached). msg says which.
+  !> n equal spheres of radius a: random_packing_mixture with a_i = a (bit for bit the
+  !> equal-sphere packer of before the mixtures; fdsusp's in-run packing calls it).
   subroutine random_packing(n, box, periodic, a, min_gap, seed, n_sweeps, x, info, msg, rep)
     integer, intent(in) :: n, seed, n_sweeps
     real(dp), intent(in) :: box(3), a, min_gap
@@ -182,22 +185,56 @@ contains
     integer, intent(out) :: info
     character(len=*), intent(out) :: msg
     type(packing_report_t), intent(out) :: rep
+    real(dp), allocatable :: radius(:)
+    allocate(radius(max(n, 0)))
+    radius = a
+    call random_packing_mixture(radius, box, periodic, min_gap, seed, n_sweeps, x, info, msg, rep)
+  end subroutine random_packing
+
+  !> size(radius) spheres of radii radius(:) at random in box (periodic(2) = .false.: walls at
+  !> y = 0, Ly), every gap >= min_gap, then n_sweeps Monte Carlo sweeps. x(3, n) is allocated
+  !> here, positions in [0, L) per periodic direction; sphere i has radius radius(i).
+  !> info: 0 ok; 1 no sphere, a radius <= 0, min_gap < 0, or the volume fraction with the
+  !> minimum gap above phi_max by more than one (largest) sphere; 2 a box length below
+  !> 4 (a_max + min_gap); 3 the compression jammed (target not reached). msg says which.
+  subroutine random_packing_mixture(radius, box, periodic, min_gap, seed, n_sweeps, x, info, msg, rep)
+    real(dp), intent(in) :: radius(:), box(3), min_gap
+    integer, intent(in) :: seed, n_sweeps
+    logical, intent(in) :: periodic(3)
+    real(dp), allocatable, intent(out) :: x(:,:)
+    integer, intent(out) :: info
+    character(len=*), intent(out) :: msg
+    type(packing_report_t), intent(out) :: rep
     type(rng_t) :: g
-    integer :: i, k, stage, its
-    real(dp) :: ae, rad, lo(3), hi(3), step, acc, phi, phie, phis
+    integer :: n, i, k, stage, its
+    real(dp) :: a, ae, rad, lo(3), hi(3), step, acc, phi, phie, phis, mrg
+    real(dp), allocatable :: f(:), ylo(:), yhi(:)
     logical :: ok
 
     info = 0
     msg = ''
     allocate(x(3, 0))
+    n = size(radius)
     if (n < 1 .or. .not. (min_gap >= 0)) then
       info = 1
       msg = 'packing: no sphere to place, or a negative minimum gap'
       return
     end if
-    ae = a + 0.5_dp * min_gap                  ! hard-sphere radius of the pairs
-    phi = n * (4.0_dp / 3 * pi * a**3) / product(box)
-    phie = phi * (ae / a)**3
+    if (.not. all(radius > 0)) then
+      info = 1
+      msg = 'packing: a radius is not positive'
+      return
+    end if
+    a = maxval(radius)
+    ae = a + 0.5_dp * min_gap                  ! hard-sphere radius of the largest pairs
+    ! radius of sphere i at any stage: rad f(i), rad growing to ae; f = 1 for equal spheres
+    f = (radius + 0.5_dp * min_gap) / ae
+    phi = volume_fraction(radius, box)
+    if (all(radius == a)) then
+      phie = phi * (ae / a)**3
+    else
+      phie = volume_fraction(radius + 0.5_dp * min_gap, box)
+    end if
     rep%n = n
     rep%phi = phi
     ! (one sphere of slack: the count closest to phi_max V / v may round up)
@@ -213,21 +250,27 @@ contains
     end if
     if (any(box < 4 * (a + min_gap))) then
       info = 2
-      msg = 'packing: every box length must be at least 4 (a + min_gap)'
+      msg = 'packing: every box length must be at least 4 (a + min_gap), a the largest radius'
       return
     end if
     deallocate(x)
     allocate(x(3, n))
 
-    ! centres are confined to [lo, hi]: the walls exclude a layer a + min_gap thick
+    ! centres are confined to [lo, hi], in y to [ylo(i), yhi(i)]: the walls exclude a layer
+    ! a_i + min_gap thick
     call rng_seed(g, seed)
     lo = 0
     hi = box
+    allocate(ylo(n), yhi(n))
+    ylo = lo(2)
+    yhi = hi(2)
     if (.not. periodic(2)) then
-      lo(2) = a + min_gap
-      hi(2) = box(2) - a - min_gap
+      ylo = radius + min_gap
+      yhi = box(2) - radius - min_gap
     end if
     do i = 1, n
+      lo(2) = ylo(i)
+      hi(2) = yhi(i)
       do k = 1, 3
         x(k, i) = lo(k) + (hi(k) - lo(k)) * rng_uniform(g)
       end do
@@ -238,19 +281,29 @@ contains
     rad = ae * (min(phie, phi_start) / phie)**(1.0_dp / 3)
     ok = .false.
     do stage = 1, max_stages
-      call relax_overlaps(x, box, periodic, rad, lo, hi, its, ok)
+      phis = phie * (rad / ae)**3
+      mrg = min(margin, max(1.0e-3_dp, margin * (((phi_rcp / phis)**(1.0_dp / 3) - 1) / gap_dense)**2))
+      call relax_overlaps(x, box, periodic, rad, mrg, f, ylo, yhi, its, ok)
       rep%relax_sweeps = rep%relax_sweeps + its
       rep%stages = stage
       if (.not. ok) exit
-      call mc_core(x, box, periodic, rad, lo(2), hi(2), g, step, stage_sweeps, .true., acc)
+      rep%phi_reached = phi * (rad / ae)**3
+      call mc_core(x, box, periodic, rad, f, ylo, yhi, g, step, stage_sweeps, .true., acc)
       if (rad >= ae) exit
       phis = phie * (rad / ae)**3
       rad = min(ae, rad * (1 + growth * ((phi_rcp / phis)**(1.0_dp / 3) - 1)))
     end do
 
     ! --- exact check: every gap >= min_gap (up to rounding of a + min_gap - a at a clamped wall)
-    call min_separation(x, box, periodic, a, rep%min_pair_gap, rep%min_wall_gap)
-    if (.not. ok .or. rad < ae .or. rep%min_pair_gap < min_gap - 1.0e-12_dp * a .or. &
+    call min_separation(x, box, periodic, a, rep%min_pair_gap, rep%min_wall_gap, radius)
+    if (.not. ok) then
+      info = 3
+      write(msg, '(a,f6.4,a,i0,a,f6.4,a)') 'packing: jammed at phi = ', rep%phi_reached, &
+        ' (overlaps not removed in ', max_relax, ' relaxation sweeps) below the target ', phi, &
+        ' (target not reached)'
+      return
+    end if
+    if (rad < ae .or. rep%min_pair_gap < min_gap - 1.0e-12_dp * a .or. &
         rep%min_wall_gap < min_gap - 1.0e-12_dp * a) then
       info = 3
       write(msg, '(a,f6.4,a)') 'packing: compression could not remove every overlap at phi = ', &
@@ -259,36 +312,38 @@ contains
     end if
 
     ! --- equilibration
-    call mc_core(x, box, periodic, ae, lo(2), hi(2), g, step, n_sweeps, .true., acc)
+    call mc_core(x, box, periodic, ae, f, ylo, yhi, g, step, n_sweeps, .true., acc)
     rep%acceptance = acc
     rep%step = step
-    call min_separation(x, box, periodic, a, rep%min_pair_gap, rep%min_wall_gap)
-  end subroutine random_packing
+    call min_separation(x, box, periodic, a, rep%min_pair_gap, rep%min_wall_gap, radius)
+  end subroutine random_packing_mixture
 
-  !> Push overlapping spheres of radius rad apart until every gap is positive: Gauss-Seidel
+  !> Push overlapping spheres of radii rad f(i) apart until every gap is positive: Gauss-Seidel
   !> sweeps in which each overlapping pair in turn is separated along its line of centres by
   !> 1.05 x its overlap (the small excess ends pairs with a gap rather than at contact), the
-  !> centres clamped to [lo, hi] in bounded directions, with radius rad (1 + margin) and
-  !> tolerance margin rad / 2, so that every gap at radius rad ends >= 1.5 margin rad.
+  !> centres clamped to [ylo(i), yhi(i)] in a bounded y, with radii rad f(i) (1 + mrg) and
+  !> tolerance mrg rad min(f) / 2, so that every gap at radii rad f(i) ends >= 1.5 mrg rad min(f).
   !> its: sweeps done; ok: converged.
-  subroutine relax_overlaps(x, box, periodic, rad, lo, hi, its, ok)
+  subroutine relax_overlaps(x, box, periodic, rad, mrg, f, ylo, yhi, its, ok)
     real(dp), intent(inout) :: x(:,:)
-    real(dp), intent(in) :: box(3), rad, lo(3), hi(3)
+    real(dp), intent(in) :: box(3), rad, mrg, f(:), ylo(:), yhi(:)
     logical, intent(in) :: periodic(3)
     integer, intent(out) :: its
     logical, intent(out) :: ok
     type(cells_t) :: cl
     integer :: n, i, j, k, m, cells(27), nu
-    real(dp) :: rr, tol, r(3), d, ov, maxov, push(3)
+    real(dp) :: rr, rri, tol, r(3), d, ov, maxov, push(3)
     n = size(x, 2)
-    rr = rad * (1 + margin)
-    tol = 0.5_dp * margin * rad
+    rr = rad * (1 + mrg)
+    tol = 0.5_dp * mrg * rad * minval(f)
+    ! f <= 1: cells of side 2 rr hold every overlapping pair in neighbouring cells
     call cells_init(cl, box, periodic, 2 * rr, n)
     ok = .false.
     do its = 1, max_relax
       call cells_fill(cl, x, n)
       maxov = 0
       do i = 1, n
+        rri = rr * f(i)
         call cells_near(cl, x(:, i), cells, nu)
         do m = 1, nu
           j = cl%head(cells(m))
@@ -296,7 +351,7 @@ contains
             if (j > i) then
               r = min_image(x(:, j) - x(:, i), box, periodic)
               d = norm2(r)
-              ov = 2 * rr - d
+              ov = (rri + rr * f(j)) - d
               if (ov > 0) then
                 maxov = max(maxov, ov)
                 if (d > 1.0e-12_dp * rad) then
@@ -307,8 +362,8 @@ contains
                 x(:, i) = x(:, i) - push
                 x(:, j) = x(:, j) + push
                 if (.not. periodic(2)) then
-                  x(2, i) = min(max(x(2, i), lo(2)), hi(2))
-                  x(2, j) = min(max(x(2, j), lo(2)), hi(2))
+                  x(2, i) = min(max(x(2, i), ylo(i)), yhi(i))
+                  x(2, j) = min(max(x(2, j), ylo(j)), yhi(j))
                 end if
               end if
             end if
@@ -334,12 +389,12 @@ contains
     its = min(its, max_relax)
   end subroutine relax_overlaps
 
-  !> Hard-sphere Metropolis Monte Carlo on spheres of radius a, centres confined to
-  !> a <= y <= Ly - a when y is bounded: n_sweeps sweeps of size(x, 2) trial moves of a sphere
-  !> chosen at random, displaced uniformly in a cube of side 2 step. x must be overlap-free.
-  !> adapt: tune step towards 40 % acceptance during the first half, then keep it; acc is the
-  !> acceptance ratio over the sweeps with a fixed step.
-  subroutine hs_monte_carlo(x, box, periodic, a, g, step, n_sweeps, adapt, acc)
+  !> Hard-sphere Metropolis Monte Carlo on spheres of radius a (or radius(i) when given),
+  !> centres confined to a_i <= y <= Ly - a_i when y is bounded: n_sweeps sweeps of size(x, 2)
+  !> trial moves of a sphere chosen at random, displaced uniformly in a cube of side 2 step.
+  !> x must be overlap-free. adapt: tune step towards 40 % acceptance during the first half, then
+  !> keep it; acc is the acceptance ratio over the sweeps with a fixed step.
+  subroutine hs_monte_carlo(x, box, periodic, a, g, step, n_sweeps, adapt, acc, radius)
     real(dp), intent(inout) :: x(:,:)
     real(dp), intent(in) :: box(3), a
     logical, intent(in) :: periodic(3), adapt
@@ -347,13 +402,25 @@ contains
     real(dp), intent(inout) :: step
     integer, intent(in) :: n_sweeps
     real(dp), intent(out) :: acc
-    call mc_core(x, box, periodic, a, a, box(2) - a, g, step, n_sweeps, adapt, acc)
+    real(dp), intent(in), optional :: radius(:)
+    real(dp), allocatable :: ai(:)
+    real(dp) :: amax
+    if (present(radius)) then
+      ai = radius
+    else
+      allocate(ai(size(x, 2)))
+      ai = a
+    end if
+    amax = a
+    if (size(ai) > 0) amax = maxval(ai)
+    call mc_core(x, box, periodic, amax, ai / amax, ai, box(2) - ai, g, step, n_sweeps, adapt, acc)
   end subroutine hs_monte_carlo
 
-  !> hs_monte_carlo for spheres of radius rad with the centres confined to ylo <= y <= yhi.
-  subroutine mc_core(x, box, periodic, rad, ylo, yhi, g, step, n_sweeps, adapt, acc)
+  !> hs_monte_carlo for spheres of radii rad f(i) (f <= 1) with the centres confined to
+  !> ylo(i) <= y <= yhi(i).
+  subroutine mc_core(x, box, periodic, rad, f, ylo, yhi, g, step, n_sweeps, adapt, acc)
     real(dp), intent(inout) :: x(:,:)
-    real(dp), intent(in) :: box(3), rad, ylo, yhi
+    real(dp), intent(in) :: box(3), rad, f(:), ylo(:), yhi(:)
     logical, intent(in) :: periodic(3), adapt
     type(rng_t), intent(inout) :: g
     real(dp), intent(inout) :: step
@@ -362,7 +429,7 @@ contains
     type(cells_t) :: cl
     integer :: n, sweep, m, i, k, c, nacc
     integer(i8) :: nacc_fixed, ntry_fixed
-    real(dp) :: xn(3), d2
+    real(dp) :: xn(3)
     logical :: tuning
     n = size(x, 2)
     acc = 0
@@ -370,7 +437,6 @@ contains
     ! cells of side >= 2 rad: a sphere can only overlap spheres in the 27 cells around it
     call cells_init(cl, box, periodic, 2 * rad, n)
     call cells_fill(cl, x, n)
-    d2 = 4 * rad * rad
     nacc_fixed = 0
     ntry_fixed = 0
     do sweep = 1, n_sweeps
@@ -386,7 +452,7 @@ contains
           end if
         end do
         if (.not. periodic(2)) then
-          if (xn(2) < ylo .or. xn(2) > yhi) cycle
+          if (xn(2) < ylo(i) .or. xn(2) > yhi(i)) cycle
         end if
         if (.not. fits(i, xn)) cycle
         nacc = nacc + 1
@@ -409,17 +475,22 @@ contains
     end do
     if (ntry_fixed > 0) acc = real(nacc_fixed, dp) / real(ntry_fixed, dp)
   contains
+    !> Sphere ip at y overlaps no other: |r| >= rad (f(ip) + f(jj)) for every neighbour jj (for
+    !> equal spheres (2 rad)^2 = 4 rad^2 exactly, the test of the equal-sphere packer).
     logical function fits(ip, y) result(yes)
       integer, intent(in) :: ip
       real(dp), intent(in) :: y(3)
       integer :: cells(27), nu, mm, jj
+      real(dp) :: ri, sigma
       yes = .true.
+      ri = rad * f(ip)
       call cells_near(cl, y, cells, nu)
       do mm = 1, nu
         jj = cl%head(cells(mm))
         do while (jj > 0)
           if (jj /= ip) then
-            if (sum(min_image(x(:, jj) - y, box, periodic)**2) < d2) then
+            sigma = ri + rad * f(jj)
+            if (sum(min_image(x(:, jj) - y, box, periodic)**2) < sigma * sigma) then
               yes = .false.
               return
             end if
@@ -430,20 +501,30 @@ contains
     end function fits
   end subroutine mc_core
 
-  !> Smallest gap between spheres of radius a (min |r| - 2a over pairs, minimum image) and to the
-  !> walls (min over spheres of min(y, Ly - y) - a; huge(1.0) if y is periodic). O(n) with cells.
-  subroutine min_separation(x, box, periodic, a, pair_gap, wall_gap)
+  !> Smallest gap between spheres of radius a, or radius(i) when given (min |r| - a_i - a_j over
+  !> pairs, minimum image) and to the walls (min over spheres of min(y, Ly - y) - a_i; huge(1.0)
+  !> if y is periodic). O(n) with cells.
+  subroutine min_separation(x, box, periodic, a, pair_gap, wall_gap, radius)
     real(dp), intent(in) :: x(:,:), box(3), a
     logical, intent(in) :: periodic(3)
     real(dp), intent(out) :: pair_gap, wall_gap
+    real(dp), intent(in), optional :: radius(:)
     type(cells_t) :: cl
     integer :: n, i, j, m, cells(27), nu
-    real(dp) :: d2min, side
+    real(dp) :: side, amax
+    real(dp), allocatable :: ai(:)
     n = size(x, 2)
-    d2min = huge(1.0_dp)
-    ! cells of side >= 2.5a: any pair closer than 2.5a is seen; a farther closest pair means
-    ! no sphere has a neighbour within 0.5a, reported as a gap of >= 0.5a
-    side = 2.5_dp * a
+    if (present(radius)) then
+      ai = radius
+    else
+      allocate(ai(n))
+      ai = a
+    end if
+    amax = maxval([ai, 0.0_dp])
+    pair_gap = huge(1.0_dp)
+    ! cells of side >= 2.5 a_max: any pair closer than 2.5 a_max is seen; a farther closest
+    ! pair means a gap of >= 0.5 a_max, reported as such
+    side = 2.5_dp * amax
     call cells_init(cl, box, periodic, min(side, minval(box) / 2), n)
     call cells_fill(cl, x, n)
     do i = 1, n
@@ -451,16 +532,17 @@ contains
       do m = 1, nu
         j = cl%head(cells(m))
         do while (j > 0)
-          if (j > i) d2min = min(d2min, sum(min_image(x(:, j) - x(:, i), box, periodic)**2))
+          if (j > i) pair_gap = min(pair_gap, &
+                                    sqrt(sum(min_image(x(:, j) - x(:, i), box, periodic)**2)) - (ai(i) + ai(j)))
           j = cl%next(j)
         end do
       end do
     end do
-    pair_gap = min(sqrt(d2min), side) - 2 * a
+    pair_gap = min(pair_gap, side - 2 * amax)
     wall_gap = huge(1.0_dp)
     if (.not. periodic(2)) then
       do i = 1, n
-        wall_gap = min(wall_gap, x(2, i) - a, box(2) - x(2, i) - a)
+        wall_gap = min(wall_gap, x(2, i) - ai(i), box(2) - x(2, i) - ai(i))
       end do
     end if
   end subroutine min_separation

@@ -2,7 +2,8 @@
 !   bin/fdsusp-pack DECK
 ! Reads the &packing group of DECK, builds the packing (mod_packing: compression, then hard-sphere
 ! Monte Carlo) and writes DIRECTORY/FILE (HDF5): dataset particles/position (N x 3, units of a)
-! with attribute box (Lx, Ly, Lz), the layout fdsusp's &particles position_file reads. Serial: on
+! with attribute box (Lx, Ly, Lz), the layout fdsusp's &particles position_file reads, and
+! particles/radius (N; equal spheres too), with the species as attributes. Serial: on
 ! several ranks every rank builds the same packing and rank 0 writes it. The file is written
 ! under a temporary name and renamed, so an interrupted run never leaves a half-written packing.
 program fdsusp_pack
@@ -13,19 +14,19 @@ program fdsusp_pack
   use mod_errors, only: input_error, fatal_error, log_line, is_root, abort_run
   use mod_h5util, only: h5util_init, write_attribute, write_string_attribute
   use mod_os_services, only: make_directory, probe_directory, publish_file
-  use mod_packing, only: random_packing, packing_report_t
+  use mod_packing, only: random_packing_mixture, packing_report_t
   use mod_packing_deck, only: pack_config_t, read_pack_deck, pack_deck_lines, max_line
   implicit none
 
   PetscErrorCode :: ierr
   type(pack_config_t) :: cfg
   type(packing_report_t) :: rep
-  real(dp), allocatable :: x(:,:)
+  real(dp), allocatable :: x(:,:), radius(:)
   character(len=max_line) :: deck, path
   character(len=max_line), allocatable :: echo(:)
   character(len=300) :: msg, text
   character(len=16) :: seconds
-  integer :: info, err, nargs, l
+  integer :: info, err, nargs, l, k
   real(dp) :: t0
 
   PetscCallA(PetscInitialize(ierr))
@@ -51,11 +52,26 @@ program fdsusp_pack
   end if
   path = trim(cfg%packing%directory)//'/'//trim(cfg%packing%file)
 
-  write(text, '(a,i0,a,3(f0.4,1x),a,a)') 'packing ', cfg%n, ' spheres of radius 1 in a box ', &
-    cfg%packing%box, 'a, y: ', trim(cfg%packing%y_boundary)
+  ! the spheres species by species (their order is immaterial: the positions are random)
+  allocate(radius(0))
+  do k = 1, cfg%n_species
+    radius = [radius, spread(cfg%packing%radius(k), 1, cfg%counts(k))]
+  end do
+  if (cfg%n_species == 1) then
+    write(text, '(a,i0,a,3(f0.4,1x),a,a)') 'packing ', cfg%n, ' spheres of radius 1 in a box ', &
+      cfg%packing%box, 'a, y: ', trim(cfg%packing%y_boundary)
+  else
+    write(text, '(a,i0,a,i0,a,3(f0.4,1x),a,a)') 'packing ', cfg%n, ' spheres of ', cfg%n_species, &
+      ' species in a box ', cfg%packing%box, 'a, y: ', trim(cfg%packing%y_boundary)
+  end if
   call log_line(text)
-  call random_packing(cfg%n, cfg%packing%box, cfg%periodic, 1.0_dp, cfg%packing%min_gap, cfg%packing%seed, cfg%packing%mc_sweeps, &
-                      x, info, msg, rep)
+  do k = 1, merge(cfg%n_species, 0, cfg%n_species > 1)
+    write(text, '(a,i0,a,f0.4,a,i0,a)') '  species ', k, ': radius ', cfg%packing%radius(k), ' a, ', &
+      cfg%counts(k), ' spheres'
+    call log_line(text)
+  end do
+  call random_packing_mixture(radius, cfg%packing%box, cfg%periodic, cfg%packing%min_gap, cfg%packing%seed, &
+                              cfg%packing%mc_sweeps, x, info, msg, rep)
   select case (info)
   case (0)
   case (1)
@@ -92,7 +108,7 @@ contains
     character(len=max_line) :: tmp
     integer(HID_T) :: file, group, space, dset
     integer(HSIZE_T) :: dims(2)
-    integer :: e(10), st
+    integer :: e(15), st
     tmp = trim(final)//'.tmp'
     e = 0
     call h5fcreate_f(trim(tmp), H5F_ACC_TRUNC_F, file, st)
@@ -106,7 +122,16 @@ contains
     call h5dclose_f(dset, st)
     call h5sclose_f(space, st)
     call write_attribute(group, 'box', cfg%packing%box, e(6))
+    ! the unit of length (the smallest radius), as before the mixtures; the radii follow
     call write_attribute(group, 'radius', [1.0_dp], e(7))
+    call write_attribute(group, 'species_radius', cfg%packing%radius(1:cfg%n_species), e(11))
+    call write_attribute(group, 'species_count', cfg%counts(1:cfg%n_species), e(12))
+    dims(1) = size(radius, kind=HSIZE_T)
+    call h5screate_simple_f(1, dims(1:1), space, e(13))
+    call h5dcreate_f(group, 'radius', H5T_NATIVE_DOUBLE, space, dset, e(14))
+    call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, radius, dims(1:1), e(15))
+    call h5dclose_f(dset, st)
+    call h5sclose_f(space, st)
     call h5gclose_f(group, st)
     call write_attribute(file, 'phi', [rep%phi], e(8))
     call write_attribute(file, 'seed', [cfg%packing%seed], e(9))

@@ -113,7 +113,7 @@ cases = [
     ('statistics without particles', GOOD + '&rheology /\n', [], ['bad.nml', '&rheology', 'needs particles']),
     ('packing and inline particles', GOOD + '&particles solid_fraction = 0.1, number = 1, position(:,1) = 1.6, 1.6, 1.6 /\n',
      [], ['bad.nml', '&particles', 'solid_fraction', 'one way']),
-    ('packing beyond the supported fraction', GOOD + '&particles solid_fraction = 0.6 /\n', [],
+    ('packing beyond the supported fraction', GOOD + '&particles solid_fraction = 0.65 /\n', [],
      ['bad.nml', '&particles', 'solid_fraction', 'out of range']),
     # lubrication dynamics (issue 30)
     ('unknown fluid model', GOOD.replace('reynolds = 0.01', "reynolds = 0.01, model = 'stokes'"), [],

@@ -10,7 +10,15 @@
 2. Reproducible from the seed: the same deck gives bit-identical positions; another seed does not.
 3. fdsusp loads the file (&particles position_file) and takes a step.
 4. Bad decks stop before any work, non-zero status, one message naming the file, the group and
-   the variable (as for fdsusp's deck); no packing file is written."""
+   the variable (as for fdsusp's deck); no packing file is written. Among them the mixtures'
+   (doc/PACKING_INPUT.md): shares not adding up to 1, a negative radius, lists of different
+   lengths, both shares given, a mixture without shares, a smallest radius other than 1.
+5. A mixture (radius = 1, 1.4, volume_share = 0.5, 0.5) in the Couette cell at phi = 0.55:
+   particles/radius holds N radii, species 1 and 1.4 in the counts of the attributes
+   species_count (nearest to the volume shares: each species within half a sphere of its share
+   of the solid volume), no pair closer than a_i + a_j, no sphere closer to a wall than a_i;
+   equal spheres write particles/radius too (all 1).
+6. A mixture by number_share with n_particles: the counts are the shares of N exactly."""
 import os
 import shutil
 import subprocess
@@ -39,14 +47,18 @@ def load(path):
     return x, box
 
 
-def min_pair_distance(x, box, periodic):
+def min_pair_distance(x, box, periodic, radius=None):
+    """min |r| (minimum image), or min |r| - a_i - a_j when radius is given."""
     best = np.inf
     for i in range(len(x) - 1):
         r = x[i + 1:] - x[i]
         for k in range(3):
             if periodic[k]:
                 r[:, k] -= box[k] * np.round(r[:, k] / box[k])
-        best = min(best, np.sqrt((r * r).sum(axis=1)).min())
+        d = np.sqrt((r * r).sum(axis=1))
+        if radius is not None:
+            d -= radius[i + 1:] + radius[i]
+        best = min(best, d.min())
     return best
 
 
@@ -58,6 +70,8 @@ for name, n_expected, phi, periodic in [('pack_periodic', 2000, 0.3, (True, True
     path = os.path.join(d, 'out', name, 'packing.h5')
     T.check(os.path.exists(path), '%s: wrote out/%s/packing.h5 (%.1f s)' % (name, name, seconds))
     x, box = load(path)
+    with h5py.File(path, 'r') as f:
+        T.check(np.array_equal(f['particles/radius'][()], np.ones(len(x))), '%s: particles/radius, all 1' % name)
     n = len(x)
     phin = n * 4 * np.pi / 3 / box.prod()
     dmin = min_pair_distance(x, box, periodic)
@@ -111,7 +125,7 @@ with open(os.path.join(d, 'a_file'), 'w') as f:
     f.write('not a directory')
 cases = [
     ('unknown variable', GOOD.replace('phi = 0.3', 'phii = 0.3'), ['bad.nml', '&packing', 'phii', 'unknown variable']),
-    ('phi out of range', GOOD.replace('phi = 0.3', 'phi = 0.6'), ['bad.nml', '&packing', 'phi', 'out of range']),
+    ('phi out of range', GOOD.replace('phi = 0.3', 'phi = 0.65'), ['bad.nml', '&packing', 'phi', 'out of range']),
     ('wrong type', GOOD.replace('seed = 3', "seed = 'x'"), ['bad.nml', '&packing', 'seed', 'cannot read']),
     ('bad y_boundary', GOOD.replace("'walls'", "'wall'"), ['bad.nml', '&packing', 'y_boundary']),
     ('box too small', GOOD.replace('box = 12, 12, 12', 'box = 12, 3, 12'), ['bad.nml', '&packing', 'box(y)', 'at least 4']),
@@ -123,6 +137,22 @@ cases = [
     ('unknown group', GOOD + '&domain box = 1, 1, 1 /\n', ['bad.nml', '&domain', 'unknown group']),
     ('missing group', '! nothing here\n', ['bad.nml', '&packing', 'missing']),
     ('missing deck', None, ['bad.nml', 'does not exist']),
+    ('shares not adding up to 1', GOOD.replace('phi = 0.3', 'phi = 0.3, radius = 1, 1.4, volume_share = 0.5, 0.4'),
+     ['bad.nml', '&packing', 'volume_share', 'add up to']),
+    ('negative radius', GOOD.replace('phi = 0.3', 'phi = 0.3, radius = 1, -1.4, volume_share = 0.5, 0.5'),
+     ['bad.nml', '&packing', 'radius', 'must be positive']),
+    ('lists of different lengths', GOOD.replace('phi = 0.3', 'phi = 0.3, radius = 1, 1.4, number_share = 0.2, 0.3, 0.5'),
+     ['bad.nml', '&packing', 'number_share', '3 entries, radius 2']),
+    ('both shares', GOOD.replace('phi = 0.3', 'phi = 0.3, radius = 1, 1.4, volume_share = 0.5, 0.5, number_share = 0.5, 0.5'),
+     ['bad.nml', '&packing', 'number_share', 'together with volume_share']),
+    ('negative share', GOOD.replace('phi = 0.3', 'phi = 0.3, radius = 1, 1.4, volume_share = 1.2, -0.2'),
+     ['bad.nml', '&packing', 'volume_share', 'must be in (0, 1]']),
+    ('mixture without shares', GOOD.replace('phi = 0.3', 'phi = 0.3, radius = 1, 1.4'),
+     ['bad.nml', '&packing', 'volume_share', 'needs volume_share or number_share']),
+    ('smallest radius not 1', GOOD.replace('phi = 0.3', 'phi = 0.3, radius = 2, 1.4, volume_share = 0.5, 0.5'),
+     ['bad.nml', '&packing', 'radius', 'must be 1']),
+    ('mixture above phi_max', GOOD.replace('phi = 0.3', 'phi = 0.7, radius = 1, 1.4, volume_share = 0.5, 0.5'),
+     ['bad.nml', '&packing', 'phi', 'out of range']),
 ]
 for name, text, words in cases:
     deck = os.path.join(d, 'bad.nml')
@@ -136,4 +166,54 @@ for name, text, words in cases:
     T.check(len(messages) == 1, '%s: one message: %s' % (name, messages[:1]))
     T.check(all(w in p.stderr for w in words), '%s: the message names %s' % (name, ', '.join(words)))
     T.check(not os.path.exists(os.path.join(d, 'bad_out', 'packing.h5')), '%s: no packing written' % name)
+
+# ---- 5. a mixture in the Couette cell
+T.write_deck(d, 'mix.nml', """&packing
+  box = 16, 16, 16
+  y_boundary = 'walls'
+  phi = 0.55
+  radius = 1.0, 1.4
+  volume_share = 0.5, 0.5
+  seed = 4
+  mc_sweeps = 100
+  directory = 'out/mix'
+/
+""")
+p, seconds = pack('mix.nml')
+with h5py.File(os.path.join(d, 'out', 'mix', 'packing.h5'), 'r') as f:
+    x = np.array(f['particles/position'])
+    box = np.array(f['particles/position'].attrs['box'])
+    radius = np.array(f['particles/radius'])
+    species_radius = np.array(f['particles'].attrs['species_radius'])
+    species_count = np.array(f['particles'].attrs['species_count'])
+    phi_file = float(f.attrs['phi'])
+v = 4 * np.pi / 3 * species_radius ** 3
+counts = [int((radius == a).sum()) for a in species_radius]
+print('mixture: N = %d, counts %s, phi = %.5f, %.1f s' % (len(x), species_count, phi_file, seconds))
+T.check(radius.shape == (len(x),), 'mixture: particles/radius holds N radii')
+T.check(list(species_radius) == [1.0, 1.4] and counts == list(species_count), 'mixture: radii 1 and 1.4 in the counts of species_count')
+T.check(all(abs(species_count * v - 0.5 * 0.55 * box.prod()) <= v / 2), 'mixture: each species within half a sphere of its volume share')
+T.check(abs(phi_file - (radius ** 3).sum() * 4 * np.pi / 3 / box.prod()) < 1e-12, 'mixture: phi attribute is the packing\'s')
+T.check(min_pair_distance(x, box, (True, False, True), radius) >= 0, 'mixture: no pair closer than a_i + a_j')
+T.check((x[:, 1] - radius).min() >= -1e-12 and (box[1] - x[:, 1] - radius).min() >= -1e-12, 'mixture: no sphere closer to a wall than a_i')
+T.check('species 2: radius 1.4000 a' in p.stdout, 'mixture: the log lists the species')
+
+# ---- 6. number shares with n_particles
+T.write_deck(d, 'mixn.nml', """&packing
+  box = 1, 1, 1
+  y_boundary = 'periodic'
+  phi = 0.3
+  n_particles = 301
+  radius = 1.4, 1.0
+  number_share = 0.3, 0.7
+  mc_sweeps = 10
+  directory = 'out/mixn'
+/
+""")
+pack('mixn.nml')
+with h5py.File(os.path.join(d, 'out', 'mixn', 'packing.h5'), 'r') as f:
+    radius = np.array(f['particles/radius'])
+    box = np.array(f['particles/position'].attrs['box'])
+T.check([int((radius == 1.4).sum()), int((radius == 1.0).sum())] == [90, 211], 'number shares: 90 + 211 of 301 (largest remainder)')
+T.check(abs((radius ** 3).sum() * 4 * np.pi / 3 / box.prod() - 0.3) < 1e-12, 'number shares: phi exact with n_particles')
 T.finish()
