@@ -7,8 +7,8 @@ module mod_initial_packing
   use mod_kinds, only: dp
   use mod_params, only: config_t
   use mod_particles, only: particles_t, particles_init, motion_code
-  use mod_packing, only: random_packing, packing_report_t
-  use mod_packing_geometry, only: packing_count
+  use mod_packing, only: random_packing, random_packing_mixture, packing_report_t
+  use mod_packing_geometry, only: packing_count, species_counts
   use mod_errors, only: input_error, fatal_error, log_line
   implicit none
   private
@@ -16,20 +16,40 @@ module mod_initial_packing
 
 contains
 
-  !> parts: packing_count(solid_fraction) spheres at random, non-overlapping positions (off the
-  !> walls when there are walls). A target the packer refuses stops the run with one message
-  !> naming the deck variable; a compression that fails, with status 3.
+  !> parts: the spheres of &particles solid_fraction at random, non-overlapping positions (off the
+  !> walls when there are walls): packing_count of them, or of a mixture (several &particles
+  !> radius) the counts per species of its volume_share or number_share (mod_packing_geometry's
+  !> rounding, doc/PACKING_INPUT.md), each sphere with its radius. A target the packer refuses
+  !> stops the run with one message naming the deck variable; a compression that fails, with
+  !> status 3.
   subroutine initial_packing_make(cfg, parts)
     type(config_t), intent(in) :: cfg
     type(particles_t), intent(out) :: parts
-    real(dp), allocatable :: position(:, :)
+    real(dp), allocatable :: position(:, :), radius(:)
     character(len=400) :: message
-    integer :: n, info
+    integer :: n, info, k, counts(cfg%species)
     type(packing_report_t) :: report
 
-    n = packing_count(cfg%particles%solid_fraction, cfg%domain%box, cfg%radius)
-    call random_packing(n, cfg%domain%box, [.true., .not. cfg%walls, .true.], cfg%radius, cfg%particles%packing_min_gap, &
-                        cfg%particles%seed, cfg%particles%packing_sweeps, position, info, message, report)
+    if (cfg%species == 1) then
+      n = packing_count(cfg%particles%solid_fraction, cfg%domain%box, cfg%radius)
+      call random_packing(n, cfg%domain%box, [.true., .not. cfg%walls, .true.], cfg%radius, &
+                          cfg%particles%packing_min_gap, cfg%particles%seed, cfg%particles%packing_sweeps, position, &
+                          info, message, report)
+    else
+      associate(share_by_volume => any(cfg%particles%volume_share /= 0.0_dp))
+        counts = species_counts(cfg%particles%solid_fraction, cfg%domain%box, cfg%particles%radius(1:cfg%species), &
+                                merge(cfg%particles%volume_share(1:cfg%species), &
+                                      cfg%particles%number_share(1:cfg%species), share_by_volume), share_by_volume)
+      end associate
+      allocate(radius(0))
+      do k = 1, cfg%species
+        radius = [radius, spread(cfg%particles%radius(k), 1, counts(k))]
+      end do
+      n = size(radius)
+      call random_packing_mixture(radius, cfg%domain%box, [.true., .not. cfg%walls, .true.], &
+                                  cfg%particles%packing_min_gap, cfg%particles%seed, cfg%particles%packing_sweeps, &
+                                  position, info, message, report)
+    end if
     select case (info)
     case (0)
     case (1)
@@ -42,8 +62,13 @@ contains
     write(message, '(a,i0,a,f8.5,a,i0,a,es10.3,a)') 'packing: ', n, ' spheres, phi = ', report%phi, &
          ' (seed ', cfg%particles%seed, '), smallest gap ', min(report%min_pair_gap, report%min_wall_gap), ' a'
     call log_line(message)
+    if (cfg%species > 1) then
+      write(message, '(a,8(i0,:,", "))') 'packing: spheres per species (&particles radius): ', counts
+      call log_line(message)
+    end if
     call particles_init(parts, n, cfg%radius, motion_code(cfg%particles%motion))
     parts%position = position
+    if (allocated(radius)) parts%radii = radius
   end subroutine initial_packing_make
 
 end module mod_initial_packing
