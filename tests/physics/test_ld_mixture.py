@@ -14,8 +14,10 @@ random with numpy (gaps >= 0.05 a) in a 10a Lees-Edwards cube, exact pair hydrod
    column core/solid_fraction equals sum (4/3) pi a_i^3 / V at every record, and between walls a
    static configuration (motion 'fixed', 19 spheres cut by the core's edges, 19 wall links) has
    phi_core = sum_i V_i(core) / V_core with each sphere's slab volume of its own radius, computed
-   here independently; 1e-12 relative (round-off of ~50 terms; measured 7e-16).
-About 4 s on one core."""
+   here independently; 1e-12 relative (round-off of ~50 terms; measured 7e-16);
+4. the run on 2 ranks (each evaluates a share of the pair links, gathered in order,
+   mod_lubrication_links) writes the same series.h5, bitwise (wall_time excepted).
+About 8 s."""
 import json
 import os
 import numpy as np
@@ -111,6 +113,11 @@ late = mean[-100:].mean(axis=0)
 T.check(np.abs(whole).max() <= bound and np.abs(late).max() <= bound,
         'affine mean velocity: <U - U_inf> over the run %s and over the last 100 steps %s within 3 sigma/sqrt(N) = %.3f '
         'gamma_dot a' % (np.array2string(whole, precision=4), np.array2string(late, precision=4), bound))
+
+# 4: two ranks share out the pair links (the unequal pairs' 22/21 scalars gathered with them)
+T.run(T.write_deck(d, 'le2.nml', LE.replace("directory = 'out'", "directory = 'out2'")), d, np_ranks=2)
+T.compare_h5(os.path.join(d, 'out', 'series.h5'), os.path.join(d, 'out2', 'series.h5'), '2 ranks against 1',
+             skip=('wall_time', 'deck@output.directory'), rtol=0)
 
 # 3: a static configuration between walls, phi_core from each sphere's own slab volume
 d = T.scratch('ld_mixture_walls')
