@@ -339,7 +339,8 @@ contains
   !> gap xi = 2r/(a_1 + a_2) - 2 (mod_pair_resistance_unequal, Jeffrey & Onishi's scaling, in which
   !> each sphere's self scalars X^A, Y^A, X^C, Y^C, X^M, Y^M, Z^M of one isolated sphere are 1):
   !> made R_2B - R_1B of both spheres and tapered to zero at the outer cut-off (over the same
-  !> xi), in place. Zero beyond the cut-off and for the other models.
+  !> xi), in place. The caller evaluates them at max(gap, inner_cutoff). Zero beyond the cut-off
+  !> and for the other models.
   pure subroutine lub_sized_scalars(lub, gap, f, f2)
     type(lubrication_t), intent(in) :: lub
     real(dp), intent(in) :: gap
