@@ -49,6 +49,7 @@ contains
       pl%pair(:, displs(rank) + 1:displs(rank) + mine) = pl%pair(:, 1:mine)
       pl%pair_d(:, displs(rank) + 1:displs(rank) + mine) = pl%pair_d(:, 1:mine)
       pl%pair_f(:, displs(rank) + 1:displs(rank) + mine) = pl%pair_f(:, 1:mine)
+      if (pl%sized) pl%pair_f2(:, displs(rank) + 1:displs(rank) + mine) = pl%pair_f2(:, 1:mine)
       pl%pair_uinf(:, displs(rank) + 1:displs(rank) + mine) = pl%pair_uinf(:, 1:mine)
       pl%pair_r(:, :, displs(rank) + 1:displs(rank) + mine) = pl%pair_r(:, :, 1:mine)
       pl%pair_drive(:, displs(rank) + 1:displs(rank) + mine) = pl%pair_drive(:, 1:mine)
@@ -56,6 +57,7 @@ contains
     PetscCallMPI(MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, pl%pair, 2 * counts, 2 * displs, MPI_INTEGER, PETSC_COMM_WORLD, ierr))
     call gather(pl%pair_d, 3)
     call gather(pl%pair_f, n_pair_scalars)
+    if (pl%sized) call gather(pl%pair_f2, n_pair_scalars)     ! spheres of several sizes
     call gather(pl%pair_uinf, 6)
     call gather(pl%pair_r, 144)
     call gather(pl%pair_drive, 12)

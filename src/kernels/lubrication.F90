@@ -39,11 +39,13 @@ module mod_lubrication
   use mod_wall_resistance, only: wall_normal_resistance, wall_tangential_resistance, &
        wall_twist_resistance
   use mod_resistance_blocks, only: pair_resistance_fu, pair_force_torque_from_strain, &
-       pair_stresslets, wall_resistance_block
+       pair_stresslets, wall_resistance_block, pair_resistance_fu_sized, pair_resistance_fe_sized, &
+       pair_stresslets_sized
   implicit none
   private
   public :: lubrication_t, lub_description, lub_setup, lub_wall_floor, lub_pair_scalars, lub_wall_scalars, lub_pair_link, lub_wall_link, &
-            lub_pair_stresslets, lub_wall_stresslet, clip_to_psd, lub_taper, model_code, grains3d_cutoff
+            lub_pair_stresslets, lub_wall_stresslet, clip_to_psd, lub_taper, model_code, grains3d_cutoff, &
+            lub_sized_scalars, lub_pair_link_sized, lub_pair_stresslets_sized, clip_scaled
   integer, parameter, public :: LUB_NONE = 0, LUB_SIMPLE = 1, LUB_FULL = 2, LUB_EXACT = 3
   ! outer cut-off of the exact model when the deck gives none [a]
   real(dp), parameter, public :: exact_default_cutoff = 1.0_dp
@@ -270,16 +272,19 @@ contains
   !> One sphere-wall link: normal n from the wall into the fluid, w the subgrid wall scalars,
   !> u_wall the wall velocity. (F, T)_lub = drive - r . (U, Om), drive = r . (u_wall, 0).
   !> info (optional): as for lub_pair_link. floor (optional): replaces lub%wall_floor.
-  subroutine lub_wall_link(lub, w, normal, u_wall, r, drive, info, floor)
+  !> radius (optional): the sphere's own radius (a mixture; w at its own gap over radius), else lub%radius.
+  subroutine lub_wall_link(lub, w, normal, u_wall, r, drive, info, floor, radius)
     type(lubrication_t), intent(in) :: lub
     real(dp), intent(in) :: w(n_wall_scalars), normal(3), u_wall(3)
     real(dp), intent(out) :: r(6, 6), drive(6)
     integer, intent(out), optional :: info
-    real(dp), intent(in), optional :: floor
-    real(dp) :: lowest
+    real(dp), intent(in), optional :: floor, radius
+    real(dp) :: lowest, a
     lowest = lub%wall_floor
     if (present(floor)) lowest = floor
-    r = clip_to_psd(wall_resistance_block(w(1), w(2), w(3), w(4), w(5), normal, lub%radius, lub%viscosity), &
+    a = lub%radius
+    if (present(radius)) a = radius
+    r = clip_to_psd(wall_resistance_block(w(1), w(2), w(3), w(4), w(5), normal, a, lub%viscosity), &
                     lowest, info)
     drive = matmul(r(:, 1:3), u_wall)
   end subroutine lub_wall_link
@@ -313,13 +318,110 @@ contains
 
   !> Stresslet of a sphere-wall correction force f_lub acting at the gap point -a n:
   !> S = -a sym(n f_n) with f_n the normal (squeeze) part, so tr S = -a n . f_lub.
-  pure function lub_wall_stresslet(lub, normal, f_lub) result(s)
+  !> radius (optional): the sphere's own radius (a mixture), else lub%radius.
+  pure function lub_wall_stresslet(lub, normal, f_lub, radius) result(s)
     type(lubrication_t), intent(in) :: lub
     real(dp), intent(in) :: normal(3), f_lub(3)
-    real(dp) :: s(3, 3), fn(3)
+    real(dp), intent(in), optional :: radius
+    real(dp) :: s(3, 3), fn(3), a
+    a = lub%radius
+    if (present(radius)) a = radius
     fn = dot_product(normal, f_lub) * normal
-    s = -0.5_dp * lub%radius * (spread(normal, 2, 3) * spread(fn, 1, 3) + spread(fn, 2, 3) * spread(normal, 1, 3))
+    s = -0.5_dp * a * (spread(normal, 2, 3) * spread(fn, 1, 3) + spread(fn, 2, 3) * spread(normal, 1, 3))
   end function lub_wall_stresslet
+
+  ! ---------------------------------------------------------------------------------------------
+  ! Two spheres of different sizes, model 'exact' only (lubrication dynamics of a mixture;
+  ! doc/LUBRICATION.md "Spheres of several sizes")
+  ! ---------------------------------------------------------------------------------------------
+
+  !> f (11, 12 scalars) and f2 (22, 21 scalars, exchange signs applied) of two unequal spheres at
+  !> gap xi = 2r/(a_1 + a_2) - 2 (mod_pair_resistance_unequal, Jeffrey & Onishi's scaling, in which
+  !> each sphere's self scalars X^A, Y^A, X^C, Y^C, X^M, Y^M, Z^M of one isolated sphere are 1):
+  !> made R_2B - R_1B of both spheres and tapered to zero at the outer cut-off (over the same
+  !> xi), in place. The caller evaluates them at max(gap, inner_cutoff). Zero beyond the cut-off
+  !> and for the other models.
+  pure subroutine lub_sized_scalars(lub, gap, f, f2)
+    type(lubrication_t), intent(in) :: lub
+    real(dp), intent(in) :: gap
+    real(dp), intent(inout) :: f(n_pair_scalars), f2(n_pair_scalars)
+    real(dp) :: taper
+    if (lub%model /= LUB_EXACT .or. gap >= lub%outer_cutoff) then
+      f = 0.0_dp
+      f2 = 0.0_dp
+      return
+    end if
+    taper = lub_taper(gap, lub%outer_cutoff)
+    f(one_body_scalars) = f(one_body_scalars) - 1.0_dp
+    f2(one_body_scalars) = f2(one_body_scalars) - 1.0_dp
+    f = taper * f
+    f2 = taper * f2
+  end subroutine lub_sized_scalars
+
+  !> One lubricating pair of unequal spheres, radii a1, a2 (as lub_pair_link): r = R_FU of the
+  !> sized blocks, its eigenvalues clipped in the metric of scale (clip_scaled: r >= -diag(scale^2),
+  !> scale (12) set by the caller from each sphere's one-body block), drive = r . (U_inf, Om_inf)
+  !> + R_FE : E_inf.
+  subroutine lub_pair_link_sized(lub, f, f2, d, a1, a2, u_inf, om_inf, e_inf, scale, r, drive, info)
+    type(lubrication_t), intent(in) :: lub
+    real(dp), intent(in) :: f(n_pair_scalars), f2(n_pair_scalars), d(3), a1, a2, u_inf(3, 2), om_inf(3), &
+                            e_inf(3, 3), scale(12)
+    real(dp), intent(out) :: r(12, 12), drive(12)
+    integer, intent(out), optional :: info
+    r = clip_scaled(pair_resistance_fu_sized(f, f2, d, a1, a2, lub%viscosity), scale, info)
+    drive = matmul(r, [u_inf(:, 1), om_inf, u_inf(:, 2), om_inf]) + strain_part(f, f2, d, a1, a2, lub%viscosity, e_inf)
+  end subroutine lub_pair_link_sized
+
+  ! R_FE : E of two unequal spheres
+  pure function strain_part(f, f2, d, a1, a2, viscosity, e) result(ft)
+    real(dp), intent(in) :: f(n_pair_scalars), f2(n_pair_scalars), d(3), a1, a2, viscosity, e(3, 3)
+    real(dp) :: ft(12), rfe(12, 3, 3)
+    integer :: m
+    rfe = pair_resistance_fe_sized(f, f2, d, a1, a2, viscosity)
+    do m = 1, 12
+      ft(m) = sum(rfe(m, :, :) * e)
+    end do
+  end function strain_part
+
+  !> Stresslet corrections of a pair of unequal spheres (3, 3, 2), as lub_pair_stresslets: the
+  !> deviatoric R_SU . w + R_SE : E of the sized blocks, and the particle-pressure trace with each
+  !> sphere's own lever, tr S_alpha = a_alpha n_alpha . F_alpha (n_1 = d, n_2 = -d; d . F_alpha is
+  !> the squeeze part, from the unclipped blocks as for equal spheres).
+  function lub_pair_stresslets_sized(lub, f, f2, d, a1, a2, w, e_inf) result(s)
+    type(lubrication_t), intent(in) :: lub
+    real(dp), intent(in) :: f(n_pair_scalars), f2(n_pair_scalars), d(3), a1, a2, w(12), e_inf(3, 3)
+    real(dp) :: s(3, 3, 2), ft(12)
+    integer :: k
+    s = pair_stresslets_sized(f, f2, d, w, e_inf, a1, a2, lub%viscosity)
+    ft = matmul(pair_resistance_fu_sized(f, f2, d, a1, a2, lub%viscosity), w) &
+         + strain_part(f, f2, d, a1, a2, lub%viscosity, e_inf)
+    do k = 1, 3
+      s(k, k, 1) = s(k, k, 1) + a1 * dot_product(d, ft(1:3)) / 3.0_dp
+      s(k, k, 2) = s(k, k, 2) - a2 * dot_product(d, ft(7:9)) / 3.0_dp
+    end do
+  end function lub_pair_stresslets_sized
+
+  !> The symmetric a with its eigenvalues in the metric S = diag(scale) clipped at -1:
+  !> b = S clip_to_psd(S^-1 a S^-1, -1) S, so that b + S^2 is positive semi-definite. With S^2 a
+  !> share of the two spheres' one-body blocks, each sphere's links cannot lower its one-body
+  !> resistance by more than that share, whatever its size (doc/LUBRICATION.md).
+  function clip_scaled(a, scale, info) result(b)
+    real(dp), intent(in) :: a(:, :), scale(:)
+    integer, intent(out), optional :: info
+    real(dp) :: b(size(a, 1), size(a, 2)), c(size(a, 1), size(a, 2))
+    integer :: i, j
+    do j = 1, size(a, 2)
+      do i = 1, size(a, 1)
+        c(i, j) = a(i, j) / (scale(i) * scale(j))
+      end do
+    end do
+    c = clip_to_psd(c, -1.0_dp, info)
+    do j = 1, size(a, 2)
+      do i = 1, size(a, 1)
+        b(i, j) = c(i, j) * scale(i) * scale(j)
+      end do
+    end do
+  end function clip_scaled
 
   !> The nearest positive semi-definite matrix (Frobenius norm) of a symmetric matrix: negative
   !> eigenvalues set to zero; with floor (<= 0), eigenvalues below floor set to floor instead.

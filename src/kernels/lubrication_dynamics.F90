@@ -16,6 +16,9 @@
 ! system stays positive definite); their stresslets are lub_pair_stresslets' (the deviatoric
 ! R_SU, R_SE part and the trace of doc/METHOD.md §5.9, as for the DNS correction), so the rheology
 ! compares with the DNS quantity by quantity.
+! Spheres of several sizes (lubrication_dynamics_create's radii): each sphere's one-body
+! resistance, force, torque and stresslet with its own radius a_i (doc/LUBRICATION.md "Spheres of
+! several sizes"); equal spheres keep the one block of ld%radius.
 ! Pure: no PETSc, MPI or files (the system is solved by its owner, mod_particle_solver, in
 ! mod_ld_motion).
 module mod_lubrication_dynamics
@@ -36,15 +39,23 @@ module mod_lubrication_dynamics
     real(dp) :: shear_rate = 0.0_dp
     real(dp) :: box(3) = 0.0_dp
     logical :: sheared = .false.            ! walls or Lees-Edwards boundaries carry the shear
+    logical :: sized = .false.              ! spheres of several sizes: radii (n) [a], each its own
+    real(dp), allocatable :: radii(:)
   end type lubrication_dynamics_t
 
 contains
 
   !> sheared: the imposed flow is the shear (walls or Lees-Edwards), else the fluid is at rest.
-  subroutine lubrication_dynamics_create(ld, radius, viscosity, shear_rate, box, sheared)
+  !> radii, optional: (n) each sphere's radius in units of radius (absent or all equal: equal spheres).
+  subroutine lubrication_dynamics_create(ld, radius, viscosity, shear_rate, box, sheared, radii)
     type(lubrication_dynamics_t), intent(out) :: ld
     real(dp), intent(in) :: radius, viscosity, shear_rate, box(3)
     logical, intent(in) :: sheared
+    real(dp), intent(in), optional :: radii(:)
+    if (present(radii)) then
+      ld%sized = any(radii /= radii(1))
+      if (ld%sized) ld%radii = radius * radii
+    end if
     ld%radius = radius
     ld%viscosity = viscosity
     ld%shear_rate = shear_rate
@@ -75,16 +86,28 @@ contains
   end subroutine lubrication_dynamics_ambient_gradients
 
   !> The one-body resistance R_1B = diag(6 pi eta a I, 8 pi eta a^3 I) (Stokes; Kim & Karrila §2.2).
-  pure function lubrication_dynamics_one_body_block(ld) result(r)
+  !> q (optional): of sphere q, with its own radius (spheres of several sizes).
+  pure function lubrication_dynamics_one_body_block(ld, q) result(r)
     type(lubrication_dynamics_t), intent(in) :: ld
-    real(dp) :: r(6, 6)
+    integer, intent(in), optional :: q
+    real(dp) :: r(6, 6), a
     integer :: k
+    a = sphere_radius(ld, q)
     r = 0.0_dp
     do k = 1, 3
-      r(k, k) = 6.0_dp * pi * ld%viscosity * ld%radius
-      r(3 + k, 3 + k) = 8.0_dp * pi * ld%viscosity * ld%radius**3
+      r(k, k) = 6.0_dp * pi * ld%viscosity * a
+      r(3 + k, 3 + k) = 8.0_dp * pi * ld%viscosity * a**3
     end do
   end function lubrication_dynamics_one_body_block
+
+  ! the radius of sphere q (ld%radius for equal spheres or without q)
+  pure real(dp) function sphere_radius(ld, q) result(a)
+    type(lubrication_dynamics_t), intent(in) :: ld
+    integer, intent(in), optional :: q
+    a = ld%radius
+    if (.not. present(q)) return
+    if (ld%sized) a = ld%radii(q)
+  end function sphere_radius
 
   !> The 6N system sys of free (or frozen) spheres at their positions (reset here; its owner,
   !> mod_particle_solver, solves it): R_1B on every diagonal block and R_1B (U_inf, Omega_inf) +
@@ -103,6 +126,7 @@ contains
     call lubrication_dynamics_ambient_gradients(ld, om, e)
     call particle_system_reset(sys, parts%n)
     do q = 1, parts%n
+      if (ld%sized) r1 = lubrication_dynamics_one_body_block(ld, q)
       call particle_system_add_diagonal(sys, q, r1)
       rhs(:, q) = matmul(r1, [lubrication_dynamics_ambient_velocity(ld, parts%position(:, q)), om]) &
                   + [parts%external_force(:, q), parts%external_torque(:, q)]
@@ -120,14 +144,15 @@ contains
     type(lubrication_dynamics_t), intent(in) :: ld
     type(particles_t), intent(inout) :: parts
     type(particle_lubrication_t), intent(in), optional :: lubrication
-    real(dp) :: om(3), e(3, 3)
+    real(dp) :: om(3), e(3, 3), a
     integer :: q
     call lubrication_dynamics_ambient_gradients(ld, om, e)
     do q = 1, parts%n
-      parts%force_hydro(:, q) = 6.0_dp * pi * ld%viscosity * ld%radius &
+      a = sphere_radius(ld, q)
+      parts%force_hydro(:, q) = 6.0_dp * pi * ld%viscosity * a &
                                 * (lubrication_dynamics_ambient_velocity(ld, parts%position(:, q)) - parts%velocity(:, q))
-      parts%torque_hydro(:, q) = 8.0_dp * pi * ld%viscosity * ld%radius**3 * (om - parts%omega(:, q))
-      parts%stresslet_hydro(:, :, q) = 20.0_dp / 3.0_dp * pi * ld%viscosity * ld%radius**3 * e
+      parts%torque_hydro(:, q) = 8.0_dp * pi * ld%viscosity * a**3 * (om - parts%omega(:, q))
+      parts%stresslet_hydro(:, :, q) = 20.0_dp / 3.0_dp * pi * ld%viscosity * a**3 * e
     end do
     if (present(lubrication)) &
       call particle_lubrication_add_corrections(lubrication, parts%force_hydro, parts%torque_hydro, parts%stresslet_hydro)

@@ -16,11 +16,22 @@
 ! so the 6N system of mod_lubrication_dynamics stays positive definite, and an isolated pair,
 ! whose R_2B is positive definite, keeps its exact block (its lowest eigenvalue, ~-0.36 x 6 pi
 ! eta a at contact, is above the floor -3 pi eta a).
+! Spheres of several sizes (particle_lubrication_create's radii; model 'exact' only,
+! doc/LUBRICATION.md "Spheres of several sizes"): a pair's gap is xi = 2r/(a_i + a_j) - 2 (over the
+! mean radius, as Jeffrey & Onishi's), its blocks the sized ones of mod_resistance_blocks at
+! lambda = a_j/a_i minus each sphere's one-body part, the outer cut-off applies to xi; a wall
+! link takes the wall functions at the sphere's own gap over its own radius, scaled by its radius.
+! The floor of a pair block is in the metric of the one-body blocks (clip_scaled): the links of
+! sphere i lower its one-body block R_1B,i by at most R_1B,i / 2; a wall block's floor is
+! -(1/2) min(6 pi eta a_i, 8 pi eta a_i^3) / z_i.
 module mod_particle_lubrication
   use mod_kinds, only: dp, i8, pi
-  use mod_pair_resistance, only: n_pair_scalars
+  use mod_pair_resistance, only: n_pair_scalars, resistance_scalars
+  use mod_pair_resistance_unequal, only: unequal_pair_t, unequal_pair_setup, unequal_pair_scalars, &
+       exchange_sign, twin_multipole_order, sphere_wall_gap
   use mod_lubrication, only: lubrication_t, lub_pair_scalars, lub_wall_scalars, lub_pair_link, &
-       lub_wall_link, lub_pair_stresslets, lub_wall_stresslet, n_wall_scalars, LUB_NONE, LUB_EXACT
+       lub_wall_link, lub_pair_stresslets, lub_wall_stresslet, n_wall_scalars, LUB_NONE, LUB_EXACT, &
+       lub_sized_scalars, lub_pair_link_sized, lub_pair_stresslets_sized
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates
   use mod_lees_edwards, only: lees_edwards_t, le_separation
   use mod_particle_system, only: particle_system_t, particle_system_add_diagonal, particle_system_add_pair
@@ -45,6 +56,7 @@ module mod_particle_lubrication
     integer :: npairs = 0, nwalls = 0
     integer, allocatable :: pair(:, :)                         ! (2, npairs)
     real(dp), allocatable :: pair_d(:, :), pair_f(:, :)        ! (3, :), (22, :)
+    real(dp), allocatable :: pair_f2(:, :)                     ! (22, :) 22 and 21 scalars (sized)
     real(dp), allocatable :: pair_uinf(:, :)                   ! (6, :) U_inf at both centres
     real(dp), allocatable :: pair_r(:, :, :), pair_drive(:, :) ! (12, 12, :), (12, :)
     integer, allocatable :: wall_part(:)
@@ -53,6 +65,13 @@ module mod_particle_lubrication
     ! the first link whose block could not be decomposed (non-finite input): particle, partner
     ! (0 for a wall); 0, 0 when all were
     integer :: failed_link(2) = 0
+    ! spheres of several sizes (sized): each sphere's radius, its species (index into
+    ! species_radius) and the unequal-pair set-up of each ordered pair of species (lambda =
+    ! species_radius(t) / species_radius(s); s = t unused: equal radii take mod_pair_resistance)
+    logical :: sized = .false.
+    real(dp), allocatable :: radii(:), species_radius(:)
+    integer, allocatable :: species(:)
+    type(unequal_pair_t), allocatable :: setup(:, :)
     ! corrections of the last step, on each particle
     real(dp), allocatable :: force(:, :), torque(:, :), stresslet(:, :, :)
   end type particle_lubrication_t
@@ -61,7 +80,9 @@ contains
 
   !> lub: the configured model (mod_lubrication lub_setup); skin: neighbour-list skin [a].
   !> le, optional: Lees-Edwards boundaries in y (walls .false.).
-  subroutine particle_lubrication_create(pl, lub, np, box, walls, shear_rate, skin, info, msg, le)
+  !> radii, optional: (np) the spheres' radii in units of lub%radius (a mixture: model 'exact'
+  !> only); absent or all equal: equal spheres.
+  subroutine particle_lubrication_create(pl, lub, np, box, walls, shear_rate, skin, info, msg, le, radii)
     type(particle_lubrication_t), intent(out) :: pl
     type(lubrication_t), intent(in) :: lub
     integer, intent(in) :: np
@@ -70,7 +91,8 @@ contains
     integer, intent(out) :: info
     character(len=*), intent(out) :: msg
     type(lees_edwards_t), intent(in), optional :: le
-    real(dp) :: reach
+    real(dp), intent(in), optional :: radii(:)
+    real(dp) :: reach, a_max
     pl%lub = lub
     if (present(le)) pl%le = le
     allocate(pl%links_of(np))
@@ -83,11 +105,17 @@ contains
     pl%force = 0
     pl%torque = 0
     pl%stresslet = 0
-    allocate(pl%pair(2, 16), pl%pair_d(3, 16), pl%pair_f(n_pair_scalars, 16), pl%pair_uinf(6, 16), pl%pair_r(12, 12, 16), &
+    allocate(pl%pair(2, 16), pl%pair_d(3, 16), pl%pair_f(n_pair_scalars, 16), pl%pair_f2(n_pair_scalars, 16), &
+             pl%pair_uinf(6, 16), pl%pair_r(12, 12, 16), &
              pl%pair_drive(12, 16), pl%wall_part(16), pl%wall_n(3, 16), pl%wall_r(6, 6, 16), pl%wall_drive(6, 16))
     info = 0
     msg = ''
     if (lub%model == LUB_NONE) return
+    a_max = lub%radius
+    if (present(radii)) then
+      if (any(radii /= radii(1))) call set_sizes()
+      if (info /= 0) return
+    end if
     if (np == 1) then
       ! one sphere: no pairs, and its two wall candidates need no search (nor a box large
       ! enough for one)
@@ -100,11 +128,47 @@ contains
       end if
       return
     end if
-    reach = lub%outer_cutoff * lub%radius
-    call nlist_init(pl%nlist, np, box, pl%periodic, 2 * lub%radius + reach + skin, lub%radius + reach + skin, &
+    ! a pair is in range while r < (a_i + a_j)(1 + outer_cutoff/2) <= 2 a_max + outer_cutoff a_max,
+    ! a wall link while its height < a_i (1 + outer_cutoff) (a_max = a for equal spheres)
+    reach = lub%outer_cutoff * a_max
+    call nlist_init(pl%nlist, np, box, pl%periodic, 2 * a_max + reach + skin, a_max + reach + skin, &
                     skin, info, pl%le)
     if (info /= 0) msg = 'lubrication: the neighbour search refuses this box (a periodic length below '// &
-                         '2 x (2a + outer_cutoff + skin))'
+                         '2 x (2a + outer_cutoff + skin), a the largest radius)'
+
+  contains
+
+    ! the radii, their species and the set-up of each unequal pair of species
+    subroutine set_sizes()
+      integer :: i, s, t, ns
+      real(dp) :: found(np)
+      if (lub%model /= LUB_EXACT) then
+        info = 1
+        msg = 'lubrication: spheres of several sizes take the exact functions only (lubrication dynamics)'
+        return
+      end if
+      pl%sized = .true.
+      pl%radii = lub%radius * radii
+      a_max = maxval(pl%radii)
+      ns = 0
+      allocate(pl%species(np))
+      do i = 1, np
+        s = findloc(found(1:ns), pl%radii(i), 1)
+        if (s == 0) then
+          ns = ns + 1
+          found(ns) = pl%radii(i)
+          s = ns
+        end if
+        pl%species(i) = s
+      end do
+      pl%species_radius = found(1:ns)
+      allocate(pl%setup(ns, ns))
+      do t = 1, ns
+        do s = 1, ns
+          if (s /= t) pl%setup(s, t) = unequal_pair_setup(found(t) / found(s), twin_multipole_order)
+        end do
+      end do
+    end subroutine set_sizes
   end subroutine particle_lubrication_create
 
   pure function ambient_velocity(pl, x) result(u)
@@ -140,7 +204,7 @@ contains
     real(dp), intent(in), optional :: offset
     integer :: c, i, j, side, first, last, status
     real(dp) :: r(3), dist, gap, d(3), om_inf(3), e_inf(3, 3), u_inf(3, 2), normal(3), u_wall(3), w(n_wall_scalars)
-    real(dp) :: vshift(3), floor_scale
+    real(dp) :: vshift(3), floor_scale, scale(12)
     pl%npairs = 0
     pl%nwalls = 0
     pl%min_gap = huge(1.0_dp)
@@ -166,7 +230,7 @@ contains
       j = pl%cand(2, c)
       r = separation(i, j)
       dist = norm2(r)
-      gap = dist / pl%lub%radius - 2.0_dp
+      gap = pair_gap(i, j, dist)
       pl%min_gap = min(pl%min_gap, gap)
       if (gap >= pl%lub%outer_cutoff) cycle
       call grow_pairs()
@@ -183,6 +247,16 @@ contains
       pl%pair(:, pl%npairs) = [i, j]
       pl%pair_d(:, pl%npairs) = d
       pl%pair_uinf(:, pl%npairs) = [u_inf(:, 1), u_inf(:, 2)]
+      if (pl%sized) then
+        call sized_scalars(i, j, gap, pl%pair_f(:, pl%npairs), pl%pair_f2(:, pl%npairs))
+        scale(1:6) = floor_metric(i)
+        scale(7:12) = floor_metric(j)
+        call lub_pair_link_sized(pl%lub, pl%pair_f(:, pl%npairs), pl%pair_f2(:, pl%npairs), d, pl%radii(i), pl%radii(j), &
+                                 u_inf, om_inf, e_inf, scale, pl%pair_r(:, :, pl%npairs), pl%pair_drive(:, pl%npairs), &
+                                 status)
+        if (status /= 0 .and. pl%failed_link(1) == 0) pl%failed_link = [i, j]
+        cycle
+      end if
       pl%pair_f(:, pl%npairs) = lub_pair_scalars(pl%lub, gap)
       if (pl%lub%model == LUB_EXACT) then
         call lub_pair_link(pl%lub, pl%pair_f(:, pl%npairs), d, u_inf, om_inf, e_inf, &
@@ -197,12 +271,11 @@ contains
     do c = 1, pl%ncand_walls
       i = pl%cand_walls(1, c)
       side = pl%cand_walls(2, c)
+      gap = wall_gap(i, side)
       if (side == 1) then
-        gap = x(2, i) / pl%lub%radius - 1.0_dp
         normal = [0.0_dp, 1.0_dp, 0.0_dp]
         u_wall = [-0.5_dp * pl%shear_rate * pl%box(2), 0.0_dp, 0.0_dp]
       else
-        gap = (pl%box(2) - x(2, i)) / pl%lub%radius - 1.0_dp
         normal = [0.0_dp, -1.0_dp, 0.0_dp]
         u_wall = [0.5_dp * pl%shear_rate * pl%box(2), 0.0_dp, 0.0_dp]
       end if
@@ -213,7 +286,11 @@ contains
       w = lub_wall_scalars(pl%lub, gap)
       pl%wall_part(pl%nwalls) = i
       pl%wall_n(:, pl%nwalls) = normal
-      if (pl%lub%model == LUB_EXACT) then
+      if (pl%sized) then
+        ! the floor of equal spheres with this sphere's own one-body block
+        call lub_wall_link(pl%lub, w, normal, u_wall, pl%wall_r(:, :, pl%nwalls), pl%wall_drive(:, pl%nwalls), status, &
+                           -minval(floor_metric(i)**2), pl%radii(i))
+      else if (pl%lub%model == LUB_EXACT) then
         call lub_wall_link(pl%lub, w, normal, u_wall, pl%wall_r(:, :, pl%nwalls), pl%wall_drive(:, pl%nwalls), status, &
                            floor_scale / pl%links_of(i))
       else
@@ -223,6 +300,59 @@ contains
     end do
 
   contains
+
+    ! the gap of a pair [a]; of unequal spheres over their mean radius, xi = 2r/(a_i + a_j) - 2
+    real(dp) function pair_gap(i, j, dist) result(g)
+      integer, intent(in) :: i, j
+      real(dp), intent(in) :: dist
+      if (pl%sized) then
+        g = 2.0_dp * dist / (pl%radii(i) + pl%radii(j)) - 2.0_dp
+      else
+        g = dist / pl%lub%radius - 2.0_dp
+      end if
+    end function pair_gap
+
+    ! the gap of sphere i to the wall side (1: y = 0, 2: y = Ly) over its radius
+    real(dp) function wall_gap(i, side) result(g)
+      integer, intent(in) :: i, side
+      real(dp) :: height
+      height = x(2, i)
+      if (side /= 1) height = pl%box(2) - x(2, i)
+      if (pl%sized) then
+        g = sphere_wall_gap(height, pl%radii(i))
+      else
+        g = height / pl%lub%radius - 1.0_dp
+      end if
+    end function wall_gap
+
+    ! R_2B - R_1B scalars of an unequal pair at gap (evaluated at the inner cut-off below it)
+    subroutine sized_scalars(i, j, gap, f, f2)
+      integer, intent(in) :: i, j
+      real(dp), intent(in) :: gap
+      real(dp), intent(out) :: f(n_pair_scalars), f2(n_pair_scalars)
+      real(dp) :: xi
+      integer :: s, t
+      xi = max(gap, pl%lub%inner_cutoff)
+      s = pl%species(i)
+      t = pl%species(j)
+      if (s == t) then
+        f = resistance_scalars(xi)
+        f2 = exchange_sign * f
+      else
+        f = unequal_pair_scalars(pl%setup(s, t), xi)
+        f2 = exchange_sign * unequal_pair_scalars(pl%setup(t, s), xi)
+      end if
+      call lub_sized_scalars(pl%lub, gap, f, f2)
+    end subroutine sized_scalars
+
+    ! sqrt of the share of sphere i's one-body block (6 pi eta a_i, 8 pi eta a_i^3) its links may
+    ! take each: half of it over its links
+    function floor_metric(i) result(m)
+      integer, intent(in) :: i
+      real(dp) :: m(6)
+      m(1:3) = sqrt(0.5_dp * 6.0_dp * pi * pl%lub%viscosity * pl%radii(i) / pl%links_of(i))
+      m(4:6) = sqrt(0.5_dp * 8.0_dp * pi * pl%lub%viscosity * pl%radii(i)**3 / pl%links_of(i))
+    end function floor_metric
 
     ! r = x_j - x_i, minimum image (across sliding boundaries: le_separation's)
     function separation(i, j) result(r)
@@ -245,18 +375,14 @@ contains
       do k = 1, pl%ncand
         a = pl%cand(1, k)
         b = pl%cand(2, k)
-        g = norm2(separation(a, b)) / pl%lub%radius - 2.0_dp
+        g = pair_gap(a, b, norm2(separation(a, b)))
         if (g >= pl%lub%outer_cutoff) cycle
         pl%links_of(a) = pl%links_of(a) + 1
         pl%links_of(b) = pl%links_of(b) + 1
       end do
       do k = 1, pl%ncand_walls
         a = pl%cand_walls(1, k)
-        if (pl%cand_walls(2, k) == 1) then
-          g = x(2, a) / pl%lub%radius - 1.0_dp
-        else
-          g = (pl%box(2) - x(2, a)) / pl%lub%radius - 1.0_dp
-        end if
+        g = wall_gap(a, pl%cand_walls(2, k))
         if (g < pl%lub%outer_cutoff) pl%links_of(a) = pl%links_of(a) + 1
       end do
     end subroutine count_links
@@ -292,6 +418,7 @@ contains
     allocate(ip(2, m)); ip(:, 1:pl%npairs) = pl%pair(:, 1:pl%npairs); call move_alloc(ip, pl%pair)
     allocate(t2(3, m)); t2(:, 1:pl%npairs) = pl%pair_d(:, 1:pl%npairs); call move_alloc(t2, pl%pair_d)
     allocate(t2(n_pair_scalars, m)); t2(:, 1:pl%npairs) = pl%pair_f(:, 1:pl%npairs); call move_alloc(t2, pl%pair_f)
+    allocate(t2(n_pair_scalars, m)); t2(:, 1:pl%npairs) = pl%pair_f2(:, 1:pl%npairs); call move_alloc(t2, pl%pair_f2)
     allocate(t2(6, m)); t2(:, 1:pl%npairs) = pl%pair_uinf(:, 1:pl%npairs); call move_alloc(t2, pl%pair_uinf)
     allocate(t3(12, 12, m)); t3(:, :, 1:pl%npairs) = pl%pair_r(:, :, 1:pl%npairs); call move_alloc(t3, pl%pair_r)
     allocate(t2(12, m)); t2(:, 1:pl%npairs) = pl%pair_drive(:, 1:pl%npairs); call move_alloc(t2, pl%pair_drive)
@@ -343,7 +470,12 @@ contains
       pl%force(:, j) = pl%force(:, j) + ft(7:9)
       pl%torque(:, j) = pl%torque(:, j) + ft(10:12)
       w = [pl%pair_uinf(1:3, l) - u(:, i), om_inf - om(:, i), pl%pair_uinf(4:6, l) - u(:, j), om_inf - om(:, j)]
-      s = lub_pair_stresslets(pl%lub, pl%pair_f(:, l), pl%pair_d(:, l), w, e_inf)
+      if (pl%sized) then
+        s = lub_pair_stresslets_sized(pl%lub, pl%pair_f(:, l), pl%pair_f2(:, l), pl%pair_d(:, l), pl%radii(i), &
+                                      pl%radii(j), w, e_inf)
+      else
+        s = lub_pair_stresslets(pl%lub, pl%pair_f(:, l), pl%pair_d(:, l), w, e_inf)
+      end if
       pl%stresslet(:, :, i) = pl%stresslet(:, :, i) + s(:, :, 1)
       pl%stresslet(:, :, j) = pl%stresslet(:, :, j) + s(:, :, 2)
     end do
@@ -352,7 +484,11 @@ contains
       ft6 = pl%wall_drive(:, l) - matmul(pl%wall_r(:, :, l), [u(:, i), om(:, i)])
       pl%force(:, i) = pl%force(:, i) + ft6(1:3)
       pl%torque(:, i) = pl%torque(:, i) + ft6(4:6)
-      pl%stresslet(:, :, i) = pl%stresslet(:, :, i) + lub_wall_stresslet(pl%lub, pl%wall_n(:, l), ft6(1:3))
+      if (pl%sized) then
+        pl%stresslet(:, :, i) = pl%stresslet(:, :, i) + lub_wall_stresslet(pl%lub, pl%wall_n(:, l), ft6(1:3), pl%radii(i))
+      else
+        pl%stresslet(:, :, i) = pl%stresslet(:, :, i) + lub_wall_stresslet(pl%lub, pl%wall_n(:, l), ft6(1:3))
+      end if
     end do
   end subroutine particle_lubrication_corrections
 

@@ -20,6 +20,13 @@
 ! phi_core = N (4/3) pi a^3 / V), its centre is a reference of g(theta), and pairs are taken across
 ! the sliding boundary (le_separation).
 !
+! Spheres of several sizes (rheo_create's radii; doc/RHEOLOGY.md "Spheres of several sizes"): each
+! sphere's weight w_i is the fraction of its own volume (4/3) pi a_i^3 in the core, phi_core and
+! the profiles sum each sphere's slab volumes with its own radius, the velocity fit weights each
+! sphere by its volume in the core (w_i a_i^3 / a^3: the particle phase), pairs are in the shells
+! r < pair_shell (a_i + a_j)/2 and r < a_i + a_j + contact_shell a, and Q6 bonds are shorter than
+! 1.4 (a_i + a_j). Equal spheres keep the arithmetic of one radius.
+!
 ! Statistics (paper §4, "five statistically independent time-segments"): the records after
 ! discard_step are split into `blocks` blocks of block_steps steps; a block's mean is taken over
 ! its records, every summary quantity is evaluated on each complete block's means (the error: the
@@ -34,6 +41,9 @@ module mod_rheology
   use mod_bond_order, only: bond_order_q6
   implicit none
   private
+  ! bonds of Q6: shorter than bond_factor (a_i + a_j)
+  real(dp), parameter :: bond_factor = 1.4_dp
+
   public :: rheology_settings_t, rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, rheo_quantities, rheo_block_of, &
             rheo_state, rheo_restore, rheo_summarise, rheo_columns, NQ, NSUMMARY, summary_names, slab_volume
 
@@ -66,6 +76,11 @@ module mod_rheology
 
   type :: rheology_t
     real(dp) :: box(3) = 0, radius = 1, shear_rate = 1
+    ! spheres of several sizes: each sphere's radius [a] (allocated only then), and the mean
+    ! sphere volume (the core's number density from phi_core)
+    logical :: sized = .false.
+    real(dp), allocatable :: radii(:)
+    real(dp) :: mean_volume = 0
     real(dp) :: core(2) = 0                 ! y_lo, y_hi of the core region [a]
     real(dp) :: r_outer = 2.1_dp            ! pair shell of g(theta): r < r_outer [a]
     real(dp) :: r_contact = 2.005_dp        ! contact shell: r < 2a + h_c [a]
@@ -107,7 +122,8 @@ contains
   !> resolved by the deck reader: non-zero); steps are counted from the start of the simulation.
   !> info: 0 ok; 1 a periodic length below twice the pair search range.
   !> le, optional: Lees-Edwards boundaries in y (the core is then the whole box).
-  subroutine rheo_create(r, n, box, radius, shear_rate, settings, discard_step, block_steps, info, le)
+  !> radii, optional: (n) each sphere's radius in units of radius (absent or all equal: equal spheres).
+  subroutine rheo_create(r, n, box, radius, shear_rate, settings, discard_step, block_steps, info, le, radii)
     type(rheology_t), intent(out) :: r
     integer, intent(in) :: n                ! number of spheres
     real(dp), intent(in) :: box(3), radius, shear_rate
@@ -115,10 +131,20 @@ contains
     integer, intent(in) :: discard_step, block_steps
     integer, intent(out) :: info
     type(lees_edwards_t), intent(in), optional :: le
+    real(dp), intent(in), optional :: radii(:)
     real(dp), parameter :: skin = 0.3_dp
-    real(dp), parameter :: bond_factor = 1.4_dp
     integer :: bond_info
+    real(dp) :: a_max
     if (present(le)) r%le = le
+    a_max = radius
+    if (present(radii)) then
+      r%sized = any(radii /= radii(1))
+      if (r%sized) then
+        r%radii = radius * radii
+        a_max = maxval(r%radii)
+        r%mean_volume = 4.0_dp / 3.0_dp * pi * sum(r%radii**3) / n
+      end if
+    end if
     r%box = box
     r%radius = radius
     r%shear_rate = shear_rate
@@ -136,14 +162,15 @@ contains
              r%block_references(r%blocks), r%block_records(r%blocks))
     r%profile = 0; r%angles = 0
     r%block_sums = 0; r%block_profile = 0; r%block_angles = 0; r%block_references = 0; r%block_records = 0
-    call nlist_init(r%nl, n, box, [.true., r%le%active, .true.], max(r%r_outer, r%r_contact) + skin, &
-                    radius + skin, skin, info, r%le)
+    ! the pair search reaches the largest pair's shells (a_max = a for equal spheres)
+    call nlist_init(r%nl, n, box, [.true., r%le%active, .true.], max(r%r_outer, r%r_contact) * a_max / radius + skin, &
+                    a_max + skin, skin, info, r%le)
     ! bonds of Q6 up to 1.4 contact distances, near the first minimum of g(r) of a dense
     ! suspension, so that a crystal's nearest shell is whole and its second shell (sqrt(2) x the
     ! first for fcc) is not
     r%bond_range = bond_factor * 2 * radius
-    call nlist_init(r%bond_list, n, box, [.true., r%le%active, .true.], r%bond_range + skin, radius + skin, skin, &
-                    bond_info, r%le)
+    call nlist_init(r%bond_list, n, box, [.true., r%le%active, .true.], r%bond_range * a_max / radius + skin, &
+                    a_max + skin, skin, bond_info, r%le)
     r%order = bond_info == 0
   end subroutine rheo_create
 
@@ -176,7 +203,8 @@ contains
     real(dp), intent(in) :: position(:, :), velocity(:, :), stresslet_hydro(:, :, :)
     real(dp), intent(in), optional :: stresslet_contact(:, :, :)
     real(dp), intent(in), optional :: offset
-    real(dp) :: a, vp, v_core, w, y, u, dbin, d(3), dist, theta, sin_half, gap, vshift(3)
+    real(dp) :: a, vp, v_core, w, y, u, dbin, d(3), dist, theta, sin_half, gap, vshift(3), ai, vi, phi, fit
+    real(dp) :: r_outer, r_contact
     integer :: n, i, b, b1, b2, k, p, i1, i2
     logical :: ref_i, ref_j
 
@@ -189,28 +217,43 @@ contains
     r%angles = 0
     r%references = 0
     dbin = r%box(2) / r%nbins
+    ai = a
+    vi = vp
+    phi = 0
     do i = 1, n
       y = position(2, i)
       u = velocity(1, i)
-      w = slab_volume(y, a, r%core(1), r%core(2)) / vp
+      if (r%sized) then
+        ai = r%radii(i)
+        vi = 4.0_dp / 3.0_dp * pi * ai**3
+      end if
+      w = slab_volume(y, ai, r%core(1), r%core(2)) / vi
       if (r%le%active) w = 1.0_dp
       if (w > 0) then
         r%values(1:5) = r%values(1:5) + w * components(stresslet_hydro(:, :, i))
         if (present(stresslet_contact)) r%values(6:10) = r%values(6:10) + w * components(stresslet_contact(:, :, i))
-        r%values(11) = r%values(11) + w
-        r%values(12:16) = r%values(12:16) + w * [1.0_dp, y, u, y * y, y * u]
+        if (r%sized) then
+          ! each sphere's volume in the core: phi_core, and the particle phase's velocity fit
+          phi = phi + w * vi
+          fit = w * vi / vp
+          r%values(12:16) = r%values(12:16) + fit * [1.0_dp, y, u, y * y, y * u]
+        else
+          r%values(11) = r%values(11) + w
+          r%values(12:16) = r%values(12:16) + w * [1.0_dp, y, u, y * y, y * u]
+        end if
       end if
       if (y >= r%core(1) .and. y < r%core(2)) r%references = r%references + 1
-      b1 = max(1, int((y - a) / dbin) + 1)
-      b2 = min(r%nbins, int((y + a) / dbin) + 1)
+      b1 = max(1, int((y - ai) / dbin) + 1)
+      b2 = min(r%nbins, int((y + ai) / dbin) + 1)
       do b = b1, b2
-        w = slab_volume(y, a, (b - 1) * dbin, b * dbin)
+        w = slab_volume(y, ai, (b - 1) * dbin, b * dbin)
         r%profile(b, 1) = r%profile(b, 1) + w
         r%profile(b, 2) = r%profile(b, 2) + w * u
       end do
     end do
     r%values(1:11) = r%values(1:11) / v_core
     r%values(11) = r%values(11) * vp
+    if (r%sized) r%values(11) = phi / v_core
     r%profile = r%profile / (r%box(1) * r%box(3) * dbin)
     r%shear_rate_core = line_slope(r%values(12:16))
 
@@ -228,9 +271,18 @@ contains
         d = min_image(position(:, i2) - position(:, i1), r%box, [.true., .false., .true.])
       end if
       dist = norm2(d)
-      gap = dist - 2 * a
+      r_outer = r%r_outer
+      r_contact = r%r_contact
+      if (r%sized) then
+        ! the pair's own shells and surface gap
+        r_outer = r%r_outer * 0.5_dp * (r%radii(i1) + r%radii(i2)) / a
+        r_contact = r%r_contact - 2 * a + r%radii(i1) + r%radii(i2)
+        gap = dist - r%radii(i1) - r%radii(i2)
+      else
+        gap = dist - 2 * a
+      end if
       r%min_pair_gap = min(r%min_pair_gap, gap)
-      if (dist >= r%r_outer .and. dist >= r%r_contact) cycle
+      if (dist >= r_outer .and. dist >= r_contact) cycle
       if (abs(d(3)) >= dist * sin_half) cycle
       ref_i = position(2, i1) >= r%core(1) .and. position(2, i1) < r%core(2)
       ref_j = position(2, i2) >= r%core(1) .and. position(2, i2) < r%core(2)
@@ -244,8 +296,8 @@ contains
     subroutine count_pair(angle)
       real(dp), intent(in) :: angle
       k = min(r%nangles, int(angle / (2 * pi) * r%nangles) + 1)
-      if (dist < r%r_outer) r%angles(k, 1) = r%angles(k, 1) + 1
-      if (dist < r%r_contact) r%angles(k, 2) = r%angles(k, 2) + 1
+      if (dist < r_outer) r%angles(k, 1) = r%angles(k, 1) + 1
+      if (dist < r_contact) r%angles(k, 2) = r%angles(k, 2) + 1
     end subroutine count_pair
   end subroutine rheo_sample
 
@@ -414,6 +466,7 @@ contains
       profile(:, 1) = profile(:, 1) / records
       dtheta = 2 * pi / r%nangles
       n_core = value(26) / (4.0_dp / 3.0_dp * pi * r%radius**3)
+      if (r%sized) n_core = value(26) / r%mean_volume
       shell = [(r%r_outer**3 - (2 * r%radius)**3), (r%r_contact**3 - (2 * r%radius)**3)] / 3.0_dp &
               * dtheta * 2 * sin(0.5_dp * dtheta)
       do k = 1, 2
@@ -471,7 +524,11 @@ contains
       else
         d = min_image(position(:, r%bond_pairs(2, p)) - position(:, r%bond_pairs(1, p)), r%box, [.true., .false., .true.])
       end if
-      if (norm2(d) >= r%bond_range) cycle
+      if (r%sized) then
+        if (norm2(d) >= bond_factor * (r%radii(r%bond_pairs(1, p)) + r%radii(r%bond_pairs(2, p)))) cycle
+      else
+        if (norm2(d) >= r%bond_range) cycle
+      end if
       nb = nb + 1
       ends(:, nb) = r%bond_pairs(:, p)
       separation(:, nb) = d

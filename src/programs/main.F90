@@ -117,8 +117,14 @@ program fdsusp
   else
     ! lubrication dynamics: no grid, no fluid; the imposed shear comes from the walls or the
     ! sliding boundaries (mod_lubrication_dynamics)
-    call lubrication_dynamics_create(ld, parts%radius, 1.0_dp, cfg%domain%shear_rate, cfg%domain%box, &
-                                     cfg%walls .or. cfg%lees_edwards)
+    if (cfg%species > 1) then
+      ! each sphere's one-body drag with its own radius, in units of the smallest
+      call lubrication_dynamics_create(ld, parts%radius, 1.0_dp, cfg%domain%shear_rate, cfg%domain%box, &
+                                       cfg%walls .or. cfg%lees_edwards, parts%radii / parts%radius)
+    else
+      call lubrication_dynamics_create(ld, parts%radius, 1.0_dp, cfg%domain%shear_rate, cfg%domain%box, &
+                                       cfg%walls .or. cfg%lees_edwards)
+    end if
     PetscCallA(particle_solver_create(ld_solver, ierr))
   end if
   ! the pieces this run has, and the state the checkpoints hold and a restart restores
@@ -213,14 +219,12 @@ contains
   end subroutine make_particles
 
   ! Spheres of several sizes (&particles radius) are read and checked, in the deck and in position
-  ! files (doc/INPUT.md "Mixtures"), but the models do not take them yet: refused before any work.
+  ! files, and packed at start-up (doc/INPUT.md "Mixtures"); lubrication dynamics moves them, the
+  ! resolved fluid does not yet: refused before any work.
   subroutine refuse_mixture()
-    character(len=40) :: model
     if (cfg%species == 1) return
-    model = 'lubrication dynamics'
-    if (cfg%resolved) model = 'the resolved fluid (fictitious domain)'
-    call input_error(cfg%deck_file, 'particles', 'radius', 'spheres of several sizes are read and checked, '// &
-         'but '//trim(model)//' does not move them yet (doc/INPUT.md "Mixtures")')
+    if (cfg%resolved) call input_error(cfg%deck_file, 'particles', 'radius', 'spheres of several sizes are read '// &
+         'and checked, but the resolved fluid (fictitious domain) does not move them yet (doc/INPUT.md "Mixtures")')
   end subroutine refuse_mixture
 
   ! Contacts when the deck has &contact and the run has particles (doc/CONTACT.md); their limits
@@ -249,12 +253,19 @@ contains
     call lubrication_load(cfg, has_particles .and. (parts%n >= 2 .or. cfg%walls), lub)
     if (lub%model /= LUB_NONE) then
       allocate(pl)
-      call particle_lubrication_create(pl, lub, parts%n, cfg%domain%box, cfg%walls, cfg%domain%shear_rate, &
-                                       cfg%lubrication%skin, info, text, le)
+      if (cfg%species > 1) then
+        ! each pair and wall link with its spheres' radii (doc/LUBRICATION.md "Spheres of several sizes")
+        call particle_lubrication_create(pl, lub, parts%n, cfg%domain%box, cfg%walls, cfg%domain%shear_rate, &
+                                         cfg%lubrication%skin, info, text, le, parts%radii / parts%radius)
+      else
+        call particle_lubrication_create(pl, lub, parts%n, cfg%domain%box, cfg%walls, cfg%domain%shear_rate, &
+                                         cfg%lubrication%skin, info, text, le)
+      end if
       if (info /= 0) call input_error(cfg%deck_file, 'lubrication', 'skin', trim(text))
     end if
     if (allocated(pc) .and. (allocated(pl) .or. .not. cfg%resolved)) then
       solid_fraction = parts%n * (4.0_dp / 3.0_dp) * pi * parts%radius**3 / product(cfg%domain%box)
+      if (cfg%species > 1) solid_fraction = sum((4.0_dp / 3.0_dp) * pi * parts%radii**3) / product(cfg%domain%box)
       call report_limits(cfg%deck_file, contact_limits(pc%params, cfg%time%dt, pc%implicit, &
                          cfg%walls .or. cfg%lees_edwards, solid_fraction, cfg%contact%eps_bar, &
                          cfg%contact%normal_stiffness > 0.0_dp))
@@ -267,8 +278,14 @@ contains
     real(dp) :: core_edge_speed
     if (.not. cfg%rheology_group) return
     allocate(rh)
-    call rheo_create(rh, parts%n, cfg%domain%box, parts%radius, cfg%domain%shear_rate, cfg%rheology, &
-                     cfg%discard_step, cfg%block_steps, info, le)
+    if (cfg%species > 1) then
+      ! each sphere's volume and shells with its own radius (doc/RHEOLOGY.md "Spheres of several sizes")
+      call rheo_create(rh, parts%n, cfg%domain%box, parts%radius, cfg%domain%shear_rate, cfg%rheology, &
+                       cfg%discard_step, cfg%block_steps, info, le, parts%radii / parts%radius)
+    else
+      call rheo_create(rh, parts%n, cfg%domain%box, parts%radius, cfg%domain%shear_rate, cfg%rheology, &
+                       cfg%discard_step, cfg%block_steps, info, le)
+    end if
     if (info /= 0) call input_error(cfg%deck_file, 'domain', 'box', &
          'with &rheology every periodic length must be >= 2 (pair_shell + 0.3) a')
     write(text, '(a,i0,a,i0,a,i0,a,i0)') 'statistics: discard ', cfg%discard_step, ' steps, then ', &

@@ -6,9 +6,12 @@ number_share (one of them, one positive share per species, summing to 1 within 1
 composition of a packing; a position file's particles/radius (N, any shape holding N numbers)
 must hold only the deck's radii and each of them. Equal spheres are unchanged: a deck of one
 radius with a position file whose particles/radius is that radius runs, and its particle
-snapshot holds each sphere's radius. The models do not move a mixture yet: a mixture that
-passes every check is refused naming &particles radius and the model. Exact checks (messages,
-status, absence of any step)."""
+snapshot holds each sphere's radius. Lubrication dynamics moves a mixture (it runs, and its
+snapshot holds each sphere's radius as the file gave it), also a mixture packed at start-up
+(solid_fraction: its snapshot holds the species' radii in the counts the log gives, their volume
+within half a large sphere of the asked fraction); the resolved fluid does not move a mixture
+yet: it is refused naming &particles radius and the resolved fluid. Exact checks (messages,
+status, absence of any step) except the packed volume fraction (counts rounded per species)."""
 import os
 import fdsusp_testlib as T
 
@@ -76,12 +79,52 @@ for name, particles, words in [
                                                                       'one radius per sphere']),
     ('file radii of one size, deck another', "radius = 1.4, position_file = 'one_species.h5'",
      ['one_species.h5', 'particles/radius', 'not one of the deck']),
-    ('a mixture that adds up: not moved yet', MIX.format(f='mixture.h5'),
-     ['mix.nml', '&particles', 'variable radius', 'lubrication dynamics does not move them yet']),
-    ('the same, its radii written 1 x N', MIX.format(f='mixture_2d.h5'),
-     ['mix.nml', '&particles', 'variable radius', 'does not move them yet']),
 ]:
     refused(d, name, particles, words)
+
+# the resolved fluid does not move a mixture yet
+RESOLVED = LD.replace("&fluid model = 'none' /", "&fluid reynolds = 0.1 /").replace(
+    "y_boundary = 'lees-edwards', shear_rate = 1", "cells_per_radius = 2")
+out_dir = os.path.join(d, 'out')
+T.write_deck(d, 'resolved.nml', RESOLVED.format(particles=MIX.format(f='mixture.h5')))
+status, out, err = T.run('resolved.nml', d, expect_ok=False)
+messages = [line for line in err.splitlines() if line.startswith('fdsusp:') and 'warning' not in line]
+T.check(status == 2 and len(messages) == 1 and all(w in messages[0] for w in
+        ['resolved.nml', '&particles', 'variable radius', 'resolved fluid', 'does not move them yet']),
+        'a mixture with the resolved fluid: refused (status %d) naming &particles radius: %s' % (status, messages[:1]))
+T.check(not any(line.startswith('step ') for line in out.splitlines()), 'resolved fluid: no step taken')
+
+# lubrication dynamics moves a mixture, its radii as the file gives them (N or 1 x N)
+for name in ('mixture.h5', 'mixture_2d.h5'):
+    if os.path.isdir(out_dir):
+        T.shutil.rmtree(out_dir)
+    # a box of 10: the lubrication search reaches (a_i + a_j)(1 + outer_cutoff/2) + skin = 4.2a + skin
+    T.write_deck(d, 'ld_mix.nml', LD.replace('box = 8.0, 8.0, 8.0', 'box = 10.0, 10.0, 10.0')
+                 .format(particles=MIX.format(f=name)))
+    status, out, err = T.run('ld_mix.nml', d, expect_ok=False)
+    T.check(status == 0 and 'finished at step 2' in out, 'lubrication dynamics runs the mixture of %s (status %d)'
+            % (name, status))
+    with T.h5py.File(os.path.join(out_dir, 'particles_00000002.h5'), 'r') as f:
+        T.check(T.np.array_equal(T.np.ravel(f['particles/radius'][()]), [1.0, 1.0, 1.4]),
+                '%s: the particle snapshot holds each sphere\'s radius' % name)
+
+# lubrication dynamics packs a mixture at start-up (50/50 by volume, phi 0.2) and moves it
+if os.path.isdir(out_dir):
+    T.shutil.rmtree(out_dir)
+T.write_deck(d, 'ld_packed.nml', LD.replace('box = 8.0, 8.0, 8.0', 'box = 10.0, 10.0, 10.0').format(
+    particles='radius = 1.0, 1.4, volume_share = 0.5, 0.5, solid_fraction = 0.2'))
+status, out, err = T.run('ld_packed.nml', d, expect_ok=False)
+counts = [line for line in out.splitlines() if line.startswith('packing: spheres per species')]
+T.check(status == 0 and 'finished at step 2' in out and len(counts) == 1,
+        'lubrication dynamics packs a 1:1.4 mixture at start-up and moves it (status %d; %s)' % (status, counts))
+with T.h5py.File(os.path.join(out_dir, 'particles_00000002.h5'), 'r') as f:
+    radii = T.np.ravel(f['particles/radius'][()])
+n_small, n_large = [int(v) for v in counts[0].split(':')[-1].split(',')] if counts else (-1, -1)
+T.check(sorted(set(radii)) == [1.0, 1.4] and (radii == 1.0).sum() == n_small and (radii == 1.4).sum() == n_large,
+        'packed mixture: the snapshot holds %d spheres of radius 1 and %d of 1.4, as the log says' % (n_small, n_large))
+phi = (4 / 3 * T.np.pi * radii**3).sum() / 1000.0
+T.check(abs(phi - 0.2) <= 0.5 * 4 / 3 * T.np.pi * 1.4**3 / 1000.0 * 2,
+        'packed mixture: volume fraction %.4f within one sphere of each species of 0.2 (rounding per species)' % phi)
 
 # equal spheres: a position file with particles/radius of the deck's radius runs
 T.write_deck(d, 'equal.nml', LD.format(particles="position_file = 'one_species.h5'"))
