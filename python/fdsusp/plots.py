@@ -32,7 +32,9 @@ def run_figures(runs, directory):
         parts = os.path.normpath(os.path.abspath(outdir)).split(os.sep)
         name = parts[-2] if parts[-1] == 'out' and len(parts) > 1 else parts[-1]
         strain = s['time'] * abs(a['shear_rate'])
-        fig, ax = plt.subplots(1, 3, figsize=(15, 4))
+        # a fourth panel for the crystalline order when the run measured it (doc/RHEOLOGY.md "Order")
+        order = 'structure/q6' in s
+        fig, ax = plt.subplots(1, 4 if order else 3, figsize=(20 if order else 15, 4))
         gd = a['shear_rate']
         ax[0].plot(strain, s['core/stress_hydro'][:, 3] / gd, label=r'$\Sigma^h_{xy}$')
         ax[0].plot(strain, s['core/stress_contact'][:, 3] / gd, label=r'$\Sigma^c_{xy}$')
@@ -64,6 +66,14 @@ def run_figures(runs, directory):
                        label=lab + (' (scaled to max 1)' if scale != 1.0 else ''))
         ax[2].set_xlabel(r'$\pi - \theta$')
         ax[2].legend(fontsize=7)
+        if order:
+            ax[3].plot(strain, s['structure/q6'], label=r'$Q_6$ (all bonds)')
+            ax[3].plot(strain, s['structure/q6_local'], lw=0.8, label=r'mean local $q_6$')
+            ax[3].axhline(0.5745, color='k', ls=':', lw=0.8, label='fcc crystal')
+            ax[3].set_xlabel(r'strain $\dot\gamma t$')
+            ax[3].set_ylabel('bond-orientational order')
+            ax[3].set_ylim(0.0, 0.65)
+            ax[3].legend(fontsize=7)
         fig.suptitle(f"{name}: phi_core = {summ['quantities']['phi_core']['value']:.3f}, "
                      f"eta_r = {summ['quantities']['eta_r']['value']:.3f}")
         fig.tight_layout()

@@ -91,7 +91,11 @@ def load(outdir):
     names = ['step', 'time', 'core/stress_hydro', 'core/stress_contact', 'core/solid_fraction', 'core/velocity_fit',
              'core/flow_fit', 'core/shear_rate', 'pairs/references', 'pairs/shell', 'pairs/contact',
              'profiles/solid_fraction', 'profiles/momentum']
+    # the crystalline order, when the run measured it (doc/RHEOLOGY.md "Order")
+    order = ['structure/q6', 'structure/q6_local']
     try:
+        if all(n in series.names(outdir) for n in order):
+            names += order
         s, attrs = series.read(outdir, names)
     except KeyError:
         raise NoRheology(f'{outdir}/series.h5 holds no core statistics: the run had no &rheology')

@@ -17,10 +17,13 @@ from fdsusp import plots  # noqa: E402
 
 
 def test_run_figures(tmp_path):
+    """Run b measured the order (structure/q6): rheology.load returns its columns and its figure
+    draws them; run a did not, and loads and draws without them."""
     runs = []
-    for name in ('a', 'b'):
-        d = synthetic(str(tmp_path / name / 'out'))
+    for name, order in (('a', False), ('b', True)):
+        d = synthetic(str(tmp_path / name / 'out'), order=order)
         a, s = rheology.load(d)
+        assert ('structure/q6' in s) == order
         runs.append((d, a, s, rheology.summarise(a, s)))
     plots.run_figures(runs, str(tmp_path / 'plots'))
     assert sorted(os.listdir(tmp_path / 'plots')) == ['a_run.png', 'b_run.png', 'rheology_vs_phi.png']

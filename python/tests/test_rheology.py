@@ -14,10 +14,11 @@ ATTRS = dict(shear_rate=1.0, dt=0.01, series_every=2, blocks=5, discard_step=10,
              box_y=10.0, radius=1.0, pair_radius=2.5, contact_radius=2.05, core_lo=2.0, core_hi=8.0)
 
 
-def synthetic(outdir, last_step=60, attrs=ATTRS):
+def synthetic(outdir, last_step=60, attrs=ATTRS, order=False):
     """Records at every step 1..last_step: on the grid (even steps) after discard_step, the shear
     stress of block b is 1 + b (hydrodynamic) and 0.5 (contact), the shear rate 1; records before
-    the discard and off the grid carry values that must not count."""
+    the discard and off the grid carry values that must not count. order: with the order columns
+    (structure/q6, structure/q6_local) of a run that measured them."""
     step = np.arange(1, last_step + 1)
     n = len(step)
     block = (step - 10 - 1) // 10
@@ -33,6 +34,9 @@ def synthetic(outdir, last_step=60, attrs=ATTRS):
             'core/shear_rate': np.ones(n), 'pairs/references': np.full(n, 10.0),
             'pairs/shell': np.ones((n, NANG)), 'pairs/contact': np.ones((n, NANG)),
             'profiles/solid_fraction': np.full((n, NB), 0.4), 'profiles/momentum': np.full((n, NB), 0.2)}
+    if order:
+        cols['structure/q6'] = np.linspace(0.05, 0.5, n)
+        cols['structure/q6_local'] = np.linspace(0.4, 0.55, n)
     write_series(os.path.join(outdir, 'series.h5'), cols, attrs)
     return outdir
 
