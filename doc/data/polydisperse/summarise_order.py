@@ -19,7 +19,7 @@ for k, name in enumerate(('equal', 'mixture')):
     strain = s['time']
     q6, ql = s['structure/q6'], s['structure/q6_local']
     rows = {}
-    for lo, hi in ((0, 1), (4, 6), (9, 11), (14, 16), (18, 20)):
+    for lo, hi in ((0, 1), (4, 6), (9, 11), (14, 16), (18, 20), (28, 30), (38, 40)):
         m = (strain >= lo) & (strain < hi)
         if m.any():
             rows[f'{lo}-{hi}'] = {'q6': float(q6[m].mean()), 'q6_local': float(ql[m].mean())}
