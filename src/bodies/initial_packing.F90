@@ -7,8 +7,8 @@ module mod_initial_packing
   use mod_kinds, only: dp
   use mod_params, only: config_t
   use mod_particles, only: particles_t, particles_init, motion_code
-  use mod_packing, only: random_packing, random_packing_mixture, packing_report_t
-  use mod_packing_geometry, only: packing_count, species_counts
+  use mod_packing, only: random_packing_mixture, packing_report_t
+  use mod_packing_geometry, only: species_counts
   use mod_errors, only: input_error, fatal_error, log_line
   implicit none
   private
@@ -30,26 +30,20 @@ contains
     integer :: n, info, k, counts(cfg%species)
     type(packing_report_t) :: report
 
-    if (cfg%species == 1) then
-      n = packing_count(cfg%particles%solid_fraction, cfg%domain%box, cfg%radius)
-      call random_packing(n, cfg%domain%box, [.true., .not. cfg%walls, .true.], cfg%radius, &
-                          cfg%particles%packing_min_gap, cfg%particles%seed, cfg%particles%packing_sweeps, position, &
-                          info, message, report)
-    else
-      associate(share_by_volume => any(cfg%particles%volume_share /= 0.0_dp))
-        counts = species_counts(cfg%particles%solid_fraction, cfg%domain%box, cfg%particles%radius(1:cfg%species), &
-                                merge(cfg%particles%volume_share(1:cfg%species), &
-                                      cfg%particles%number_share(1:cfg%species), share_by_volume), share_by_volume)
-      end associate
-      allocate(radius(0))
-      do k = 1, cfg%species
-        radius = [radius, spread(cfg%particles%radius(k), 1, counts(k))]
-      end do
-      n = size(radius)
-      call random_packing_mixture(radius, cfg%domain%box, [.true., .not. cfg%walls, .true.], &
-                                  cfg%particles%packing_min_gap, cfg%particles%seed, cfg%particles%packing_sweeps, &
-                                  position, info, message, report)
-    end if
+    ! the counts per species (of equal spheres: packing_count), then the spheres species by species
+    associate(share_by_volume => any(cfg%particles%volume_share /= 0.0_dp))
+      counts = species_counts(cfg%particles%solid_fraction, cfg%domain%box, cfg%particles%radius(1:cfg%species), &
+                              merge(cfg%particles%volume_share(1:cfg%species), &
+                                    cfg%particles%number_share(1:cfg%species), share_by_volume), share_by_volume)
+    end associate
+    allocate(radius(0))
+    do k = 1, cfg%species
+      radius = [radius, spread(cfg%particles%radius(k), 1, counts(k))]
+    end do
+    n = size(radius)
+    call random_packing_mixture(radius, cfg%domain%box, [.true., .not. cfg%walls, .true.], &
+                                cfg%particles%packing_min_gap, cfg%particles%seed, cfg%particles%packing_sweeps, &
+                                position, info, message, report)
     select case (info)
     case (0)
     case (1)
@@ -68,7 +62,7 @@ contains
     end if
     call particles_init(parts, n, cfg%radius, motion_code(cfg%particles%motion))
     parts%position = position
-    if (allocated(radius)) parts%radii = radius
+    parts%radii = radius
   end subroutine initial_packing_make
 
 end module mod_initial_packing

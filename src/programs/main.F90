@@ -71,6 +71,7 @@ program fdsusp
   integer :: step, first_step, stop_reason
   real(dp) :: time, wall_start, wall_loop, err_vel, err_p_max, err_p_rms
   logical :: restarting, continuing, branching, has_particles, statistics_afresh
+  real(dp), allocatable :: mixture_radii(:)         ! a mixture's radii; unallocated (absent) for equal spheres
 
   PetscCallA(PetscInitialize(ierr))
   ! SIGTERM/SIGUSR1 from now on only ask the run to stop after its next step (they replace
@@ -89,6 +90,10 @@ program fdsusp
   if (continuing) call continue_from_directory(cfg, restart, restarting)
   call make_particles()
   has_particles = parts%n > 0
+  ! a mixture's radii, in units of the smallest (the unit), for the models that take each sphere's
+  ! radius: contacts, lubrication, lubrication dynamics, statistics (doc/INPUT.md "Mixtures");
+  ! unallocated for equal spheres, which passes them as absent
+  if (cfg%species > 1) mixture_radii = parts%radii / parts%radius
   ! sliding periodic boundaries in y (lubrication dynamics): the offset starts at 0, a restart
   ! reads it from the checkpoint
   if (cfg%lees_edwards) le = le_create(cfg%domain%box, cfg%domain%shear_rate, 0.0_dp)
@@ -117,14 +122,8 @@ program fdsusp
   else
     ! lubrication dynamics: no grid, no fluid; the imposed shear comes from the walls or the
     ! sliding boundaries (mod_lubrication_dynamics)
-    if (cfg%species > 1) then
-      ! each sphere's one-body drag with its own radius, in units of the smallest
-      call lubrication_dynamics_create(ld, parts%radius, 1.0_dp, cfg%domain%shear_rate, cfg%domain%box, &
-                                       cfg%walls .or. cfg%lees_edwards, parts%radii / parts%radius)
-    else
-      call lubrication_dynamics_create(ld, parts%radius, 1.0_dp, cfg%domain%shear_rate, cfg%domain%box, &
-                                       cfg%walls .or. cfg%lees_edwards)
-    end if
+    call lubrication_dynamics_create(ld, parts%radius, 1.0_dp, cfg%domain%shear_rate, cfg%domain%box, &
+                                     cfg%walls .or. cfg%lees_edwards, mixture_radii)
     PetscCallA(particle_solver_create(ld_solver, ierr))
   end if
   ! the pieces this run has, and the state the checkpoints hold and a restart restores
@@ -233,15 +232,8 @@ contains
     integer :: info
     if (.not. (has_particles .and. cfg%contact_group)) return
     allocate(pc)
-    if (cfg%species > 1) then
-      ! each pair with its reduced radius, each sphere with its own lever (doc/CONTACT.md "Spheres
-      ! of several sizes"); the radii in units of the smallest, the unit
-      call particle_contacts_create(pc, parts%n, parts%radius, cfg%contact, cfg%domain%shear_rate, cfg%domain%box, &
-                                    cfg%walls, cfg%time%dt, info, text, le, radii=parts%radii / parts%radius)
-    else
-      call particle_contacts_create(pc, parts%n, parts%radius, cfg%contact, cfg%domain%shear_rate, cfg%domain%box, &
-                                    cfg%walls, cfg%time%dt, info, text, le)
-    end if
+    call particle_contacts_create(pc, parts%n, parts%radius, cfg%contact, cfg%domain%shear_rate, cfg%domain%box, &
+                                  cfg%walls, cfg%time%dt, info, text, le, mixture_radii)
     if (info /= 0) call input_error(cfg%deck_file, 'contact', '', trim(text))
   end subroutine make_contacts
 
@@ -253,14 +245,8 @@ contains
     call lubrication_load(cfg, has_particles .and. (parts%n >= 2 .or. cfg%walls), lub)
     if (lub%model /= LUB_NONE) then
       allocate(pl)
-      if (cfg%species > 1) then
-        ! each pair and wall link with its spheres' radii (doc/LUBRICATION.md "Spheres of several sizes")
-        call particle_lubrication_create(pl, lub, parts%n, cfg%domain%box, cfg%walls, cfg%domain%shear_rate, &
-                                         cfg%lubrication%skin, info, text, le, parts%radii / parts%radius)
-      else
-        call particle_lubrication_create(pl, lub, parts%n, cfg%domain%box, cfg%walls, cfg%domain%shear_rate, &
-                                         cfg%lubrication%skin, info, text, le)
-      end if
+      call particle_lubrication_create(pl, lub, parts%n, cfg%domain%box, cfg%walls, cfg%domain%shear_rate, &
+                                       cfg%lubrication%skin, info, text, le, mixture_radii)
       if (info /= 0) call input_error(cfg%deck_file, 'lubrication', 'skin', trim(text))
     end if
     if (allocated(pc) .and. (allocated(pl) .or. .not. cfg%resolved)) then
@@ -278,14 +264,8 @@ contains
     real(dp) :: core_edge_speed
     if (.not. cfg%rheology_group) return
     allocate(rh)
-    if (cfg%species > 1) then
-      ! each sphere's volume and shells with its own radius (doc/RHEOLOGY.md "Spheres of several sizes")
-      call rheo_create(rh, parts%n, cfg%domain%box, parts%radius, cfg%domain%shear_rate, cfg%rheology, &
-                       cfg%discard_step, cfg%block_steps, info, le, parts%radii / parts%radius)
-    else
-      call rheo_create(rh, parts%n, cfg%domain%box, parts%radius, cfg%domain%shear_rate, cfg%rheology, &
-                       cfg%discard_step, cfg%block_steps, info, le)
-    end if
+    call rheo_create(rh, parts%n, cfg%domain%box, parts%radius, cfg%domain%shear_rate, cfg%rheology, &
+                     cfg%discard_step, cfg%block_steps, info, le, mixture_radii)
     if (info /= 0) call input_error(cfg%deck_file, 'domain', 'box', &
          'with &rheology every periodic length must be >= 2 (pair_shell + 0.3) a')
     write(text, '(a,i0,a,i0,a,i0,a,i0)') 'statistics: discard ', cfg%discard_step, ' steps, then ', &
