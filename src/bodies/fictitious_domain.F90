@@ -68,6 +68,7 @@ module mod_fictitious_domain
     ! the covered faces and cells of this rank, in runs of one sphere and one component (mod_sphere_faces)
     type(face_list_t) :: faces
     real(dp), allocatable :: rigid_matrix(:, :, :)               ! M_p (6, 6, n), summed over ranks
+    real(dp), allocatable :: inflated_radius(:)                  ! (n) a_q + radius_offset h (§3.3)
     ! The rivals of each sphere: the spheres whose control-volume reach meets its own (centres
     ! closer than twice the reach). Only they can contest a face; elsewhere a sphere owns what it
     ! covers outright. Found by mod_neighbours' cell lists, or among all spheres in a box too
@@ -154,13 +155,18 @@ contains
     type(fictitious_domain_t), intent(inout) :: fd
     type(particles_t), intent(in) :: parts
     integer :: ierr
-    real(dp) :: radius, h
+    real(dp) :: h
     type(mac_block_t) :: block
 
     PetscCallA(event_begin(EVENT_GEOMETRY, ierr))
-    radius = parts%radius + fd%radius_offset * grid%h
+    ! each sphere inflated by the same offset in cells (§3.3): the offset is the grid's, not the sphere's
+    if (allocated(fd%inflated_radius)) then
+      if (size(fd%inflated_radius) /= parts%n) deallocate(fd%inflated_radius)
+    end if
+    if (.not. allocated(fd%inflated_radius)) allocate(fd%inflated_radius(parts%n))
+    fd%inflated_radius = parts%radii + fd%radius_offset * grid%h
     fd%lambda_listed = .false.      ! Lambda^n may sit on faces of another geometry (fictitious_domain_follow carries it)
-    call find_rivals(grid, fd, parts, radius)
+    call find_rivals(grid, fd, parts, fd%inflated_radius)
     if (allocated(fd%rigid_matrix)) then
       if (size(fd%rigid_matrix, 3) /= parts%n) deallocate(fd%rigid_matrix)
     end if
@@ -169,22 +175,23 @@ contains
     h = grid%h
     block = mac_block_t(h=h, box=grid%box, n=grid%n, walls=grid%walls, lo=grid%lo, hi=grid%hi)
     ! the unit of gamma = kappa (1 - alpha) beta h^2 / eta (doc/METHOD.md §3.3)
-    call faces_build(block, parts%position, radius, fd%kappa * fd%beta * h**2 / fd%eta, fd%rival_start, &
+    call faces_build(block, parts%position, fd%inflated_radius, fd%kappa * fd%beta * h**2 / fd%eta, fd%rival_start, &
                      fd%rival_part, fd%rival_offset, fd%faces, fd%rigid_matrix)
     call MPI_Allreduce(MPI_IN_PLACE, fd%rigid_matrix, 36 * parts%n, MPI_DOUBLE_PRECISION, MPI_SUM, &
                        PETSC_COMM_WORLD, ierr)
     PetscCallA(event_end(EVENT_GEOMETRY, ierr))
   end subroutine fictitious_domain_geometry
 
-  ! The rivals of each sphere: the spheres whose centres are closer than twice the reach
-  ! R + sqrt(3) h/2, so that some control volume may meet both (mod_neighbours' cell lists, with a
-  ! skin of one cell; every pair when a periodic length is below twice the list's cut-off).
-  ! A periodic length below twice the reach would let a sphere reach its own image: refused.
-  subroutine find_rivals(grid, fd, parts, radius)
+  ! The rivals of each sphere: the spheres whose centres are closer than the sum of the two
+  ! reaches R_i + sqrt(3) h/2 (R the inflated radius), so that some control volume may meet both
+  ! (mod_neighbours' cell lists over the largest reach, with a skin of one cell; every pair when a
+  ! periodic length is below twice the list's cut-off). A periodic length below twice the largest
+  ! reach would let a sphere reach its own image: refused.
+  subroutine find_rivals(grid, fd, parts, radii)
     type(grid_t), intent(in) :: grid
     type(fictitious_domain_t), intent(inout) :: fd
     type(particles_t), intent(in) :: parts
-    real(dp), intent(in) :: radius
+    real(dp), intent(in) :: radii(:)
     real(dp) :: reach
     integer :: info, l, i, j, n, pass
     logical :: periodic(3)
@@ -192,7 +199,7 @@ contains
     character(len=200) :: text
 
     n = parts%n
-    reach = radius + 0.5_dp * sqrt(3.0_dp) * grid%h
+    reach = maxval(radii) + 0.5_dp * sqrt(3.0_dp) * grid%h
     periodic = [.true., .not. grid%walls, .true.]
     if (.not. allocated(fd%rival_start)) then
       if (any(periodic .and. grid%box < 2.0_dp * reach)) then
@@ -244,7 +251,7 @@ contains
       integer, intent(in) :: i, j, pass
       real(dp) :: d(3)
       d = min_image(parts%position(:, j) - parts%position(:, i), grid%box, periodic)
-      if (sum(d**2) >= (2.0_dp * reach)**2) return
+      if (sum(d**2) >= (radii(i) + radii(j) + sqrt(3.0_dp) * grid%h)**2) return
       if (pass == 2) then
         fd%rival_part(fd%rival_start(i) + count(i)) = j
         fd%rival_offset(:, fd%rival_start(i) + count(i)) = d

@@ -39,6 +39,7 @@ contains
       parts%prescribed_omega = cfg%particles%omega(:, 1:n)
       parts%external_force = cfg%particles%external_force(:, 1:n)
       parts%external_torque = cfg%particles%external_torque(:, 1:n)
+      parts%radii = cfg%particles%radius(cfg%particles%species(1:n))
       message = configuration_fault(parts%position, parts%radii, cfg%domain%box, cfg%walls, culprit, start_gap_roughness(cfg))
       if (len_trim(message) > 0) then
         write(item, '(a,i0,a)') 'position(:,', culprit, ')'

@@ -55,13 +55,14 @@ module mod_sphere_faces
 contains
 
   ! Every sphere visited once per component, in order (q, then c = 1..4), into a fresh list;
-  ! rigid (6, 6, n) gains each sphere's M_p from this block. positions (3, n), radius: the
-  ! inflated radius of the visit (a + radius_offset h, §3.3). gamma_unit: kappa beta h^2 / eta.
+  ! rigid (6, 6, n) gains each sphere's M_p from this block. positions (3, n), radii (n): each
+  ! sphere's inflated radius (a_q + radius_offset h, §3.3; a mixture's spheres have their own
+  ! a_q). gamma_unit: kappa beta h^2 / eta.
   ! The rivals of q are rival_part(rival_start(q) : rival_start(q+1)-1), their centres minus
   ! q's (minimum image) in rival_offset.
-  subroutine faces_build(block, positions, radius, gamma_unit, rival_start, rival_part, rival_offset, faces, rigid)
+  subroutine faces_build(block, positions, radii, gamma_unit, rival_start, rival_part, rival_offset, faces, rigid)
     type(mac_block_t), intent(in) :: block
-    real(dp), intent(in) :: positions(:, :), radius, gamma_unit
+    real(dp), intent(in) :: positions(:, :), radii(:), gamma_unit
     integer, intent(in) :: rival_start(:), rival_part(:)
     real(dp), intent(in) :: rival_offset(:, :)
     type(face_list_t), intent(inout) :: faces
@@ -82,7 +83,7 @@ contains
       m1 = rival_start(q + 1) - 1
       do c = 1, 4
         f0 = faces%nf + 1
-        call sphere_visit(block, c, q, positions, radius, gamma_unit, rival_part(m0:m1), rival_offset(:, m0:m1), &
+        call sphere_visit(block, c, q, positions, radii, gamma_unit, rival_part(m0:m1), rival_offset(:, m0:m1), &
                           faces, rigid(:, :, q))
         if (faces%nf >= f0) then
           faces%nruns = faces%nruns + 1
@@ -150,33 +151,36 @@ contains
   ! expressions), so every sphere takes the same decision: the largest alpha owns the unknown
   ! (ties to the lower index) with weight alpha - the runner-up's (doc/METHOD.md §3.4). No
   ! grid-sized ownership arrays, no second pass. rival_part, rival_offset (3, :): q's rivals and
-  ! their centres minus q's (minimum image); positions (3, :): every centre.
-  subroutine sphere_visit(block, c, q, positions, radius, gamma_unit, rival_part, rival_offset, faces, rigid)
+  ! their centres minus q's (minimum image); positions (3, :), radii (:): every centre and every
+  ! inflated radius (a rival of another size reaches as far as its own radius takes it).
+  subroutine sphere_visit(block, c, q, positions, radii, gamma_unit, rival_part, rival_offset, faces, rigid)
     type(mac_block_t), intent(in) :: block
     integer, intent(in) :: c, q
-    real(dp), intent(in) :: positions(:, :), radius, gamma_unit
+    real(dp), intent(in) :: positions(:, :), radii(:), gamma_unit
     integer, intent(in) :: rival_part(:)
     real(dp), intent(in) :: rival_offset(:, :)
     type(face_list_t), intent(inout) :: faces
     real(dp), intent(inout) :: rigid(6, 6)
-    integer :: wrapped(box_width(radius, block%h), 3)
-    logical :: mine(box_width(radius, block%h), 3)
+    integer :: wrapped(box_width(radii(q), block%h), 3)
+    logical :: mine(box_width(radii(q), block%h), 3)
     integer :: lo(3), hi(3), i, j, k, m, ilo, ihi, iw, jw, kw, f, nrow, idx(3), arm(2)
-    real(dp) :: centre(3), r(3), a, h, reach2, inside2, rest2, chord, gamma, rival2, second, rival_alpha
+    real(dp) :: centre(3), r(3), a, h, radius, reach2, inside2, rest2, chord, gamma, rival2, second, rival_alpha
     real(dp) :: w, dv, sgn(2), block3(3, 3), sums6(6), v2, v3
     logical :: owned
     ! the rivals that reach the current row, and what is left of the reach there
     integer :: row_rival(max(1, size(rival_part)))
     real(dp) :: row_rest2(max(1, size(rival_part)))
+    ! each rival's reach and inside (as q's own below, with its radius)
+    real(dp) :: rival_reach2(max(1, size(rival_part))), rival_inside2(max(1, size(rival_part)))
     h = block%h
     dv = h**3
+    radius = radii(q)
     centre = positions(:, q)
     call sphere_box(block, c, centre, radius, lo, hi, wrapped, mine)
-    ! beyond this distance from the centre a control volume lies wholly outside (its half-diagonal)
-    reach2 = (radius + 0.5_dp * sqrt(3.0_dp) * h)**2
-    ! within this distance it lies wholly inside (alpha = 1)
-    inside2 = -1.0_dp
-    if (radius > 0.5_dp * sqrt(3.0_dp) * h) inside2 = (radius - 0.5_dp * sqrt(3.0_dp) * h)**2
+    call reach_of(radius, reach2, inside2)
+    do m = 1, size(rival_part)
+      call reach_of(radii(rival_part(m)), rival_reach2(m), rival_inside2(m))
+    end do
     ! room for every unknown of the box, once, so that the loop below stores without checks
     call faces_reserve(faces, faces%nf + product(hi - lo + 1))
     ! gamma = kappa (1 - alpha) beta h^2 / eta (relaxation_gamma, doc/METHOD.md §3.3), written out;
@@ -206,15 +210,15 @@ contains
         nrow = 0
         do m = 1, size(rival_part)
           rival2 = (r(2) - rival_offset(2, m))**2 + (r(3) - rival_offset(3, m))**2
-          if (rival2 >= reach2 * (1.0_dp + 1.0e-12_dp)) cycle
+          if (rival2 >= rival_reach2(m) * (1.0_dp + 1.0e-12_dp)) cycle
           nrow = nrow + 1
           row_rival(nrow) = m
-          row_rest2(nrow) = reach2 * (1.0_dp + 1.0e-12_dp) - rival2
+          row_rest2(nrow) = rival_reach2(m) * (1.0_dp + 1.0e-12_dp) - rival2
         end do
         do i = ilo, ihi
           if (.not. mine(i - lo(1) + 1, 1)) cycle
           r(1) = (i + STAGGER(1, c)) * h - centre(1)
-          a = alpha_at(r)
+          a = alpha_at(r, radius, reach2, inside2)
           if (a <= 0.0_dp) cycle
           iw = wrapped(i - lo(1) + 1, 1)
           ! the rivals that reach this unknown: the largest alpha owns it, the runner-up's is taken off
@@ -222,7 +226,7 @@ contains
           owned = .true.
           do m = 1, nrow
             if ((r(1) - rival_offset(1, row_rival(m)))**2 >= row_rest2(m)) cycle
-            rival_alpha = alpha_of_rival(rival_part(row_rival(m)), [iw, jw, kw])
+            rival_alpha = alpha_of_rival(row_rival(m), [iw, jw, kw])
             if (rival_alpha > a .or. (rival_alpha == a .and. rival_part(row_rival(m)) < q)) then
               owned = .false.
               exit
@@ -258,33 +262,45 @@ contains
       rigid(idx, idx) = rigid(idx, idx) + block3
     end if
   contains
-    ! The cover of the control volume at offset x from a centre (0 beyond the reach).
-    real(dp) function alpha_at(x)
-      real(dp), intent(in) :: x(3)
+    ! Beyond reach2_of from a centre a control volume lies wholly outside the sphere of radius rad
+    ! (its half-diagonal); within inside2_of wholly inside (alpha = 1; -1 when none is).
+    pure subroutine reach_of(rad, reach2_of, inside2_of)
+      real(dp), intent(in) :: rad
+      real(dp), intent(out) :: reach2_of, inside2_of
+      reach2_of = (rad + 0.5_dp * sqrt(3.0_dp) * h)**2
+      inside2_of = -1.0_dp
+      if (rad > 0.5_dp * sqrt(3.0_dp) * h) inside2_of = (rad - 0.5_dp * sqrt(3.0_dp) * h)**2
+    end subroutine reach_of
+
+    ! The cover of the control volume at offset x from the centre of a sphere of radius rad (0
+    ! beyond its reach).
+    real(dp) function alpha_at(x, rad, reach2_of, inside2_of)
+      real(dp), intent(in) :: x(3), rad, reach2_of, inside2_of
       real(dp) :: d2
       d2 = x(1)**2 + x(2)**2 + x(3)**2
-      if (d2 >= reach2) then
+      if (d2 >= reach2_of) then
         alpha_at = 0.0_dp
-      else if (d2 <= inside2) then
+      else if (d2 <= inside2_of) then
         alpha_at = 1.0_dp      ! the whole control volume is inside (cube_fraction's first test)
       else
-        alpha_at = cube_fraction(x, radius, h)
+        alpha_at = cube_fraction(x, rad, h)
       end if
     end function alpha_at
 
-    ! Rival p's alpha of the unknown with wrapped index ijk, computed as p's own visit does: from
-    ! the image of the unknown nearest to p's centre (the one p's box holds).
-    real(dp) function alpha_of_rival(p, ijk)
-      integer, intent(in) :: p, ijk(3)
-      integer :: d, unwrapped
+    ! Rival m's alpha of the unknown with wrapped index ijk, computed as its own visit does: from
+    ! the image of the unknown nearest to its centre (the one its box holds), with its radius.
+    real(dp) function alpha_of_rival(m, ijk)
+      integer, intent(in) :: m, ijk(3)
+      integer :: d, unwrapped, p
       real(dp) :: x(3)
+      p = rival_part(m)
       do d = 1, 3
         unwrapped = ijk(d)
         if (.not. (d == 2 .and. block%walls)) unwrapped = ijk(d) + block%n(d) * &
              nint((positions(d, p) - (ijk(d) + STAGGER(d, c)) * h) / block%box(d))
         x(d) = (unwrapped + STAGGER(d, c)) * h - positions(d, p)
       end do
-      alpha_of_rival = alpha_at(x)
+      alpha_of_rival = alpha_at(x, radii(p), rival_reach2(m), rival_inside2(m))
     end function alpha_of_rival
   end subroutine sphere_visit
 

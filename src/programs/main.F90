@@ -201,11 +201,9 @@ contains
   ! yields none leaves nothing to compute (the deck itself is checked in mod_params).
   subroutine make_particles()
     if (cfg%particles%solid_fraction > 0.0_dp) then
-      call refuse_mixture()
       call initial_packing_make(cfg, parts)
     else
       call particles_load(cfg, parts)
-      call refuse_mixture()
     end if
     if (cfg%resolved .or. parts%n > 0) return
     if (len_trim(cfg%particles%position_file) > 0) then
@@ -216,15 +214,6 @@ contains
            '&fluid model = ''none'' (lubrication dynamics) has nothing to compute')
     end if
   end subroutine make_particles
-
-  ! Spheres of several sizes (&particles radius) are read and checked, in the deck and in position
-  ! files, and packed at start-up (doc/INPUT.md "Mixtures"); lubrication dynamics moves them, the
-  ! resolved fluid does not yet: refused before any work.
-  subroutine refuse_mixture()
-    if (cfg%species == 1) return
-    if (cfg%resolved) call input_error(cfg%deck_file, 'particles', 'radius', 'spheres of several sizes are read '// &
-         'and checked, but the resolved fluid (fictitious domain) does not move them yet (doc/INPUT.md "Mixtures")')
-  end subroutine refuse_mixture
 
   ! Contacts when the deck has &contact and the run has particles (doc/CONTACT.md); their limits
   ! (doc/CONTACT.md, doc/VALIDATION.md §6) checked before any work.

@@ -95,6 +95,7 @@ module mod_params
     real(dp) :: radius(max_species) = [1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp]
     real(dp) :: volume_share(max_species) = 0.0_dp      ! a mixture's share of the solid volume per species [-]
     real(dp) :: number_share(max_species) = 0.0_dp      ! or of the spheres per species [-]
+    integer :: species(max_inline_particles) = 1        ! a mixture's inline particle i: its radius is radius(species(i))
     character(len=16) :: motion = 'free'                ! 'free', 'prescribed', 'resistance' or 'frozen'
     real(dp) :: velocity(3, max_inline_particles) = 0.0_dp          ! prescribed U [a*gamma_dot]
     real(dp) :: omega(3, max_inline_particles) = 0.0_dp             ! prescribed Omega [gamma_dot]
@@ -341,8 +342,8 @@ contains
     character(len=64) :: group
     integer :: g, unit, ios, e, p
     logical :: inline_array
-    character(len=16), parameter :: inline_arrays(5) = [character(len=16) :: 'position', 'velocity', 'omega', &
-                                                         'external_force', 'external_torque']
+    character(len=16), parameter :: inline_arrays(6) = [character(len=16) :: 'position', 'velocity', 'omega', &
+                                                         'external_force', 'external_torque', 'species']
     if (.not. is_root()) return
     copy = cfg
     open(newunit=unit, status='scratch', action='readwrite', recl=8192)
@@ -389,6 +390,7 @@ contains
         write(*, row) ' external_force(:,', p, ')=', particles%external_force(:, p)
       if (any(particles%external_torque(:, p) /= 0.0_dp)) &
         write(*, row) ' external_torque(:,', p, ')=', particles%external_torque(:, p)
+      if (particles%species(p) /= 1) write(*, '(a,i0,a,i0)') ' species(', p, ')=', particles%species(p)
     end do
   end subroutine echo_inline_particles
 
@@ -547,9 +549,7 @@ contains
         call input_error(cfg%deck_file, 'particles', 'motion', &
            'prescribed velocities are given inline: use number and position, not position_file')
     end if
-    if (cfg%species > 1 .and. cfg%particles%number > 0) call input_error(cfg%deck_file, 'particles', 'number', &
-         'inline particles are of one size: a mixture''s spheres come from position_file (with particles/radius) '// &
-         'or from solid_fraction')
+    call validate_inline_species(cfg)
     call check_real(cfg, 'particles', 'solid_fraction', cfg%particles%solid_fraction, 0.0_dp, phi_max)
     call check_int(cfg, 'particles', 'seed', cfg%particles%seed, 0, huge(1))
     call check_int(cfg, 'particles', 'packing_sweeps', cfg%particles%packing_sweeps, 0, 1000000)
@@ -607,11 +607,13 @@ contains
       end if
       if (particles%radius(1) /= 1.0_dp) call input_error(cfg%deck_file, 'particles', 'radius(1)', &
            'the smallest sphere of a mixture is the unit of length: radius(1) = 1, the others in its units')
-      if (given /= 1) call input_error(cfg%deck_file, 'particles', 'volume_share', &
-           'a mixture gives the share of each species by volume (volume_share) or by number (number_share), one of them')
+      ! the shares make a packing's counts; spheres given inline or in a file have their own
+      if (given > 1 .or. (given == 0 .and. particles%solid_fraction > 0.0_dp)) &
+        call input_error(cfg%deck_file, 'particles', 'volume_share', &
+             'a mixture gives the share of each species by volume (volume_share) or by number (number_share), one of them')
       if (any(particles%volume_share /= 0.0_dp)) then
         call check_shares('volume_share', particles%volume_share)
-      else
+      else if (any(particles%number_share /= 0.0_dp)) then
         call check_shares('number_share', particles%number_share)
       end if
     end associate
@@ -631,6 +633,34 @@ contains
       end if
     end subroutine check_shares
   end subroutine validate_species
+
+  ! The species of inline particles (doc/INPUT.md "Mixtures"): each species(i) names one of the
+  ! deck's radii, and a mixture's inline particles hold every species it lists (as a position
+  ! file must); equal spheres leave species alone.
+  subroutine validate_inline_species(cfg)
+    type(config_t), intent(in) :: cfg
+    character(len=200) :: text
+    integer :: i, k
+    associate(particles => cfg%particles)
+      do i = 1, max_inline_particles
+        write(text, '(a,i0,a)') 'species(', i, ')'
+        if (i > particles%number) then
+          if (particles%species(i) /= 1) call input_error(cfg%deck_file, 'particles', trim(text), &
+               'is given for a particle beyond number')
+        else
+          call check_int(cfg, 'particles', trim(text), particles%species(i), 1, cfg%species)
+        end if
+      end do
+      if (particles%number == 0 .or. cfg%species == 1) return
+      do k = 1, cfg%species
+        if (all(particles%species(1:particles%number) /= k)) then
+          write(text, '(a,i0,a,i0,a)') 'gives no inline particle of species ', k, &
+               ' (radius(', k, ')): a mixture''s inline particles hold every species &particles radius lists'
+          call input_error(cfg%deck_file, 'particles', 'species', trim(text))
+        end if
+      end do
+    end associate
+  end subroutine validate_inline_species
 
   ! Ranges of &rheology, and the step counts of the averaging window (doc/RHEOLOGY.md).
   subroutine validate_rheology(cfg)

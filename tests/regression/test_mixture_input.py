@@ -9,9 +9,10 @@ radius with a position file whose particles/radius is that radius runs, and its 
 snapshot holds each sphere's radius. Lubrication dynamics moves a mixture (it runs, and its
 snapshot holds each sphere's radius as the file gave it), also a mixture packed at start-up
 (solid_fraction: its snapshot holds the species' radii in the counts the log gives, their volume
-within half a large sphere of the asked fraction); the resolved fluid does not move a mixture
-yet: it is refused naming &particles radius and the resolved fluid. Exact checks (messages,
-status, absence of any step) except the packed volume fraction (counts rounded per species)."""
+within half a large sphere of the asked fraction); so does the resolved fluid, from a file and
+from inline particles with &particles species(i) (each one of the radii, every species present,
+none beyond number). Exact checks (messages, status, absence of any step) except the packed
+volume fraction (counts rounded per species)."""
 import os
 import fdsusp_testlib as T
 
@@ -70,8 +71,12 @@ for name, particles, words in [
      ['&particles', 'variable radius', 'one after the other']),
     ('shares for one species', "radius = 1.0, volume_share = 0.5, 0.5, solid_fraction = 0.1",
      ['&particles', 'variable volume_share', 'radius lists one']),
-    ('inline particles of a mixture', "radius = 1.0, 1.4, number_share = 0.5, 0.5, number = 1, position(:,1) = 4, 4, 4",
-     ['&particles', 'variable number', 'one size']),
+    ('inline particles of a mixture without species', "radius = 1.0, 1.4, number = 1, position(:,1) = 4, 4, 4",
+     ['&particles', 'variable species', 'no inline particle of species 2']),
+    ('an inline species beyond the radii', "radius = 1.0, 1.4, number = 2, position(:,1) = 2, 4, 4, "
+     "position(:,2) = 6, 4, 4, species = 1, 3", ['&particles', 'variable species(2)']),
+    ('a species for a particle beyond number', "radius = 1.0, 1.4, number = 1, position(:,1) = 2, 4, 4, "
+     "species = 1, 2", ['&particles', 'variable species(2)', 'beyond number']),
     ('file radius not the deck\'s', MIX.format(f='foreign.h5'), ['foreign.h5', 'particles/radius', 'sphere 3']),
     ('file lacks a species', MIX.format(f='one_species.h5'), ['one_species.h5', 'particles/radius', 'holds no sphere']),
     ('file without radii for a mixture', MIX.format(f='no_radius.h5'), ['no_radius.h5', 'particles/radius', 'missing']),
@@ -82,17 +87,23 @@ for name, particles, words in [
 ]:
     refused(d, name, particles, words)
 
-# the resolved fluid does not move a mixture yet
-RESOLVED = LD.replace("&fluid model = 'none' /", "&fluid reynolds = 0.1 /").replace(
-    "y_boundary = 'lees-edwards', shear_rate = 1", "cells_per_radius = 2")
+# the resolved fluid moves a mixture (the fictitious domain takes each sphere's radius), from a
+# position file and inline (species), here without lubrication correction
+RESOLVED = LD.replace("&fluid model = 'none' /", "&fluid reynolds = 0.1 /\n&lubrication model = 'none' /").replace(
+    "y_boundary = 'lees-edwards', shear_rate = 1", "cells_per_radius = 3")
 out_dir = os.path.join(d, 'out')
-T.write_deck(d, 'resolved.nml', RESOLVED.format(particles=MIX.format(f='mixture.h5')))
-status, out, err = T.run('resolved.nml', d, expect_ok=False)
-messages = [line for line in err.splitlines() if line.startswith('fdsusp:') and 'warning' not in line]
-T.check(status == 2 and len(messages) == 1 and all(w in messages[0] for w in
-        ['resolved.nml', '&particles', 'variable radius', 'resolved fluid', 'does not move them yet']),
-        'a mixture with the resolved fluid: refused (status %d) naming &particles radius: %s' % (status, messages[:1]))
-T.check(not any(line.startswith('step ') for line in out.splitlines()), 'resolved fluid: no step taken')
+INLINE = ("radius = 1.0, 1.4, number = 3, species = 1, 1, 2, " +
+          ", ".join("position(:,%d) = %g, %g, %g" % ((i + 1,) + tuple(x)) for i, x in enumerate(POSITIONS)))
+for name, particles in (('a position file', MIX.format(f='mixture.h5')), ('inline species', INLINE)):
+    if os.path.isdir(out_dir):
+        T.shutil.rmtree(out_dir)
+    T.write_deck(d, 'resolved.nml', RESOLVED.format(particles=particles))
+    status, out, err = T.run('resolved.nml', d, expect_ok=False)
+    T.check(status == 0 and 'finished at step 2' in out, 'the resolved fluid moves a mixture from %s (status %d)'
+            % (name, status))
+    with T.h5py.File(os.path.join(out_dir, 'particles_00000002.h5'), 'r') as f:
+        T.check(T.np.array_equal(T.np.ravel(f['particles/radius'][()]), [1.0, 1.0, 1.4]),
+                'resolved fluid, %s: the particle snapshot holds each sphere\'s radius' % name)
 
 # lubrication dynamics moves a mixture, its radii as the file gives them (N or 1 x N)
 for name in ('mixture.h5', 'mixture_2d.h5'):

@@ -68,6 +68,7 @@ program test_sphere_faces
   call periodic_images()
   call decomposition()
   call close_pair()
+  call unequal_pair()
   call walls()
   call run_kernels()
   call carry()
@@ -88,17 +89,21 @@ contains
 
   ! The faces of spheres at positions (3, :) without rivals (every sphere alone) or, with
   ! rivals, each sphere the rival of every other (the minimum image of a periodic block).
-  subroutine build(block, positions, faces, rigid, gamma_unit, rivals)
+  ! radii (optional): each sphere's radius (a mixture), else radius for all.
+  subroutine build(block, positions, faces, rigid, gamma_unit, rivals, radii)
     type(mac_block_t), intent(in) :: block
     real(dp), intent(in) :: positions(:, :)
     type(face_list_t), intent(inout) :: faces
     real(dp), allocatable, intent(out) :: rigid(:, :, :)
     real(dp), intent(in) :: gamma_unit
     logical, intent(in) :: rivals
+    real(dp), intent(in), optional :: radii(:)
     integer :: n, q, p, m
     integer, allocatable :: start(:), part(:)
-    real(dp), allocatable :: offset(:, :)
+    real(dp), allocatable :: offset(:, :), sphere_radii(:)
     n = size(positions, 2)
+    sphere_radii = spread(radius, 1, n)
+    if (present(radii)) sphere_radii = radii
     allocate(rigid(6, 6, n), start(n + 1), part(max(1, n * n)), offset(3, max(1, n * n)))
     rigid = 0.0_dp
     m = 0
@@ -114,7 +119,7 @@ contains
       end do
     end do
     start(n + 1) = m + 1
-    call faces_build(block, positions, radius, gamma_unit, start, part, offset, faces, rigid)
+    call faces_build(block, positions, sphere_radii, gamma_unit, start, part, offset, faces, rigid)
   end subroutine build
 
   ! Sum of alpha over the runs of component c (and sphere q, when given).
@@ -335,6 +340,65 @@ contains
     end do
     call check_below('close pair mirrored about a grid plane: the same total weight per component', worst_sym, 1.0e-12_dp)
   end subroutine close_pair
+
+  ! 11. spheres of two sizes (radii R and 2R, a mixture): alone, each covers its own volume
+  ! 4/3 pi R_i^3 within 3e-3 (the planar ramp's error, as in 2); 0.1 h apart, they list disjoint
+  ! unknowns, the owner of a contested one is the sphere with the larger cube_fraction of its OWN
+  ! radius and its weight is the excess, to 1e-13 (the large sphere crosses the periodic boundary:
+  ! its wrapped offsets differ from the visit's unwrapped ones by ~1 ulp of the box, 1e-15, and
+  ! alpha moves by at most 4 |dr|/h, 2e-14 at h = 0.2); and the
+  ! small sphere keeps unknowns the large one reaches (the rival test uses each sphere's reach:
+  ! with the small sphere's reach in its place the large sphere would miss unknowns it contests,
+  ! which the disjointness check would catch).
+  subroutine unequal_pair()
+    type(mac_block_t) :: block
+    type(face_list_t) :: faces
+    real(dp), allocatable :: rigid(:, :, :)
+    real(dp) :: positions(3, 2), radii(2), a(2), x(3), worst_rule, worst_vol
+    integer :: f, g, c, q, n_shared
+    integer, allocatable :: seen(:, :, :, :)
+    logical :: disjoint
+    block = periodic_block(5, 40)
+    radii = [radius, 2.0_dp * radius]
+    positions(:, 1) = [4.03_dp, 4.01_dp, 3.97_dp]
+    positions(:, 2) = [4.03_dp + 3.0_dp * radius + 0.1_dp * block%h, 4.01_dp, 3.97_dp]
+    ! alone (no rivals): each sphere's own volume, component by component
+    call build(block, positions, faces, rigid, 3.0_dp, .false., radii)
+    worst_vol = 0.0_dp
+    do c = 1, 4
+      do q = 1, 2
+        worst_vol = max(worst_vol, abs(alpha_sum(faces, c, q) * block%h**3 / (4.0_dp / 3.0_dp * pi * radii(q)**3) - 1))
+      end do
+    end do
+    call check_below('radii R and 2R, alone: sum alpha h^3 / (4/3 pi R_i^3) - 1', worst_vol, 3.0e-3_dp)
+    call build(block, positions, faces, rigid, 3.0_dp, .true., radii)
+    allocate(seen(0:39, 0:39, 0:39, 4))
+    seen = 0
+    disjoint = .true.
+    worst_rule = 0.0_dp
+    n_shared = 0
+    do f = 1, faces%nf
+      c = comp_of(faces, f)
+      q = faces%run_part(run_of(faces, f))
+      if (seen(faces%ijk(1, f), faces%ijk(2, f), faces%ijk(3, f), c) /= 0) disjoint = .false.
+      seen(faces%ijk(1, f), faces%ijk(2, f), faces%ijk(3, f), c) = q
+      do g = 1, 2
+        x = (faces%ijk(:, f) + STAGGER(:, c)) * block%h - positions(:, g)
+        x = x - block%box * nint(x / block%box)
+        a(g) = cube_fraction(x, radii(g), block%h)
+      end do
+      if (a(3 - q) > 0.0_dp) n_shared = n_shared + 1
+      if (a(q) < a(3 - q)) then
+        worst_rule = huge(1.0_dp)
+      else
+        worst_rule = max(worst_rule, abs(faces%alpha(f) - (a(q) - a(3 - q))))
+      end if
+    end do
+    call check(disjoint, 'radii R and 2R 0.1 h apart: the two spheres list disjoint unknowns')
+    call check(n_shared > 0, 'radii R and 2R: both spheres reach some unknowns (the rule is exercised)')
+    call check_below('radii R and 2R: owner = larger cover of its own radius, weight = the excess', worst_rule, &
+                     1.0e-13_dp)
+  end subroutine unequal_pair
 
   ! 7. walls in y
   subroutine walls()
