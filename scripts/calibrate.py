@@ -39,12 +39,13 @@ Modes are separable because the cross terms land on other components (doc/METHOD
 forms): translation along d gives no torque, rotation about d no force; translation along e1
 torques about e2 = d x e1 and rotation about e1 forces along e2.
 """
-import argparse, math, os
+import argparse, math, os, sys
 import numpy as np
 import h5py
 import _fdsusp_path  # noqa: F401,E402  (this checkout's python/ on sys.path)
 from fdsusp.resistance import (NAMES, WALL_NAMES, SHEAR_E, STRAIN_CONDITION, Runner, m_fit,  # noqa: E402
-                               pair_scalars, steady, strain_conditioning, wall_excess, with_flow)
+                               pair_scalars, sized_pair, steady, strain_conditioning, wall_excess, with_flow)
+from fdsusp import pair_blocks as pb  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 GAPS = [0.001, 0.01, 0.05, 0.1, 0.2, 0.35, 0.6, 1.0]
@@ -83,7 +84,12 @@ def main():
     ap.add_argument('--jobs', type=int, default=2)
     ap.add_argument('--work', default=None)
     ap.add_argument('--output', default=None)
+    ap.add_argument('--size-ratio', type=float, default=None,
+                    help='an unequal pair: sphere 2 of radius SIZE_RATIO times sphere 1 (of CELLS_PER_RADIUS)')
     args = ap.parse_args()
+    if args.size_ratio is not None:
+        calibrate_unequal(args)
+        return
     if args.samples is None:
         args.samples = SAMPLES.get(args.cells_per_radius, 2)
     if args.samples < 2:
@@ -223,6 +229,212 @@ def main():
         f['reciprocity_yb'].attrs['columns'] = ('gap,YB11 - YB12 from the torque on sphere 1,'
                                                 'YB11 from the force on sphere 1,YB12 from the force on sphere 2')
     print(f'calibrate: wrote {out}')
+
+
+# ---- unequal pairs (doc/LUBRICATION.md "Tables for mixtures") ----
+
+def ratio_tag(value):
+    """The shortest decimal of a resolution or size ratio, as table names write it (4, 5.6, 1.4)."""
+    return ('%.6f' % value).rstrip('0').rstrip('.')
+
+
+def one_body_scalars(s):
+    """s less the one-body part of each sphere (an isolated sphere's self scalars X^A, Y^A, X^C,
+    Y^C, X^M, Y^M, Z^M are 1 in Jeffrey & Onishi's scaling)."""
+    s = np.array(s)
+    for n in ('XA', 'YA', 'XC', 'YC', 'XM', 'YM', 'ZM'):
+        for al in range(2):
+            s[pb.K[n], al, al] -= 1.0
+    return s
+
+
+def exact_pair_part(gap, lam):
+    """R_2B - R_1B of radii 1 and lam in the block scalars of fdsusp.pair_blocks, M folded."""
+    f = sized_pair(gap, lam)
+    g = sized_pair(gap, 1.0 / lam)
+    return pb.fold_strain(one_body_scalars(pb.from_arrays(f, EXCHANGE * g)), 1.0, lam)
+
+
+EXCHANGE = np.array([1, 1, -1, 1, 1, -1, -1, 1, 1, 1, 1] * 2, dtype=float)
+# the unknowns of the fit: every block scalar but the cross M slots (folded into the self slots)
+FREE = [(k, al, be) for k in range(11) for al in range(2) for be in range(2)
+        if not (pb.NAMES11[k] in ('XM', 'YM', 'ZM') and al != be)]
+# weight of the co-moving rows: they pin the regular combinations to their exact values
+COMOVING_WEIGHT = 100.0
+
+
+def calibrate_unequal(args):
+    """The resolved pair part of spheres of radii 1 (at CELLS_PER_RADIUS) and lam: every mode of
+    the equal calibration, each sphere spun in turn, fitted with fdsusp.pair_blocks (see
+    fit_pair), the regular co-moving translations held at their exact values."""
+    n, lam = args.cells_per_radius, args.size_ratio
+    if lam < 1.0:
+        sys.exit('calibrate: --size-ratio is the larger sphere over the smaller, >= 1 (1: the equal pair '
+                 'by this method, a check of it against the equal table)')
+    samples_n = args.samples or 2
+    h = 1.0 / n
+    a1, a2 = 1.0, lam
+    tag = f'a{n}_ratio{ratio_tag(lam)}'
+    work = args.work or os.path.join(ROOT, 'out', f'calibrate_{tag}')
+    os.makedirs(work, exist_ok=True)
+    rng = np.random.default_rng(20261127 + n + int(round(100 * lam)))
+    # the periodic cube and the Couette cell scaled with the pair (8a and 10a for equal spheres),
+    # whole cells
+    L = round(4.0 * (a1 + a2) * n) / n
+    LW = round(5.0 * (a1 + a2) * n) / n
+    E = SHEAR_E
+    zero = np.zeros(3)
+    radii = [a1, a2]
+    runner = Runner(work, args.jobs)
+    samples = []
+    for s in range(samples_n):
+        off = rng.uniform(0, h, size=3)
+        d, e1, e2 = frame(rng)
+        dc = strain_direction(d, E, seed=20261127 + 100 * n + s)
+        samples.append((off, d, e1, e2, dc))
+        c = np.array([L / 2, L / 2, L / 2]) + off
+        cc = np.array([L / 2, LW / 2, L / 2]) + off
+        # one body: each sphere alone at the pair's centre, spinning as in the pair runs, and
+        # with the flow (its rotation and strain parts are subtracted)
+        for k, a in enumerate(radii, 1):
+            one = dict(h=h, radii=[a])
+            runner.add(f's{s}_one{k}_A', box=(L, L, L), walls=False, shear=0.0, spheres=[(c, zero, d)], **one)
+            runner.add(f's{s}_one{k}_B', box=(L, L, L), walls=False, shear=0.0, spheres=[(c, zero, e1)], **one)
+            runner.add(f's{s}_one{k}_C', box=(L, LW, L), walls=True, shear=1.0, spheres=[with_flow(cc, LW)], **one)
+        for g in GAPS:
+            r = (a1 + a2) * (1 + g / 2)
+            x1, x2 = c - 0.5 * r * d, c + 0.5 * r * d
+            pair = dict(h=h, radii=radii)
+            runner.add(f's{s}_g{g}_A', box=(L, L, L), walls=False, shear=0.0,
+                       spheres=[(x1, d, d), (x2, -d, zero)], **pair)
+            runner.add(f's{s}_g{g}_A2', box=(L, L, L), walls=False, shear=0.0,
+                       spheres=[(x1, zero, zero), (x2, zero, d)], **pair)
+            runner.add(f's{s}_g{g}_B', box=(L, L, L), walls=False, shear=0.0,
+                       spheres=[(x1, e1, e1), (x2, -e1, zero)], **pair)
+            runner.add(f's{s}_g{g}_B2', box=(L, L, L), walls=False, shear=0.0,
+                       spheres=[(x1, zero, zero), (x2, zero, e1)], **pair)
+            y1, y2 = cc - 0.5 * r * dc, cc + 0.5 * r * dc
+            runner.add(f's{s}_g{g}_C', box=(L, LW, L), walls=True, shear=1.0,
+                       spheres=[with_flow(y1, LW), with_flow(y2, LW)], **pair)
+    runner.run()
+
+    # ---- reduce: per sample and gap, the fit of the block scalars ----
+    table = np.zeros((samples_n, len(GAPS), 44))
+    residuals = np.zeros((samples_n, len(GAPS)))
+    quiet = np.zeros((3, 3))
+    for s, (off, d, e1, e2, dc) in enumerate(samples):
+        one = {}
+        for k in (1, 2):
+            for mode in 'ABC':
+                one[k, mode] = steady(os.path.join(work, f's{s}_one{k}_{mode}'))
+        for gi, g in enumerate(GAPS):
+            exact = exact_pair_part(g, lam)
+            measured = []
+
+            def pair_part(mode, velocities, spins, with_flow_=False):
+                """The measured pair responses of a run, one-body parts removed: the exact drag
+                of each translating sphere, the measured one-body torque and stresslet of each
+                spinning sphere (and of each sphere in the flow)."""
+                F, T, S = steady(os.path.join(work, f's{s}_g{g}_{mode}'))
+                F, T, S = F.copy(), T.copy(), S.copy()
+                for al, a in enumerate(radii):
+                    F[al] += 6 * PI * a * velocities[al]
+                    if spins[al] is not None:
+                        F1, T1, S1 = one[al + 1, spins[al]]
+                        T[al] -= T1[0]
+                        S[al] -= S1[0]
+                        if with_flow_:
+                            F[al] -= F1[0]
+                w = np.zeros((2, 6))
+                if not with_flow_:
+                    w[:, :3] = -np.array(velocities)
+                return w, F, T, S
+
+            vel_d = [d, -d]
+            w, F, T, S = pair_part('A', vel_d, ['A', None])
+            w[0, 3:] = -d
+            measured.append((w, quiet, F, T, S))
+            w, F, T, S = pair_part('A2', [zero, zero], [None, 'A'])
+            w[1, 3:] = -d
+            measured.append((w, quiet, F, T, S))
+            w, F, T, S = pair_part('B', [e1, -e1], ['B', None])
+            w[0, 3:] = -e1
+            measured.append((w, quiet, F, T, S))
+            w, F, T, S = pair_part('B2', [zero, zero], [None, 'B'])
+            w[1, 3:] = -e1
+            measured.append((w, quiet, F, T, S))
+            w, F, T, S = pair_part('C', [zero, zero], ['C', 'C'], with_flow_=True)
+            # the strain run's line of centres is dc: refit it in the frame of d below
+            comoving = []
+            for u in (d, e1, e2):
+                wc = np.zeros((2, 6))
+                wc[:, :3] = -u
+                comoving.append((wc, quiet) + pb.responses(exact, a1, a2, d, wc, quiet))
+            # modes A, B and the co-moving rows share d; mode C has its own line of centres dc,
+            # so its rows join the fit through the response model in that frame
+            s_fit, res = fit_pair(measured, comoving, (w, E, F, T, S), a1, a2, d, dc)
+            residuals[s, gi] = res
+            f, f2 = pb.to_arrays(s_fit)
+            table[s, gi] = np.concatenate([f, f2])
+    out = args.output or os.path.join(ROOT, 'input', 'lubrication', f'resolved_{tag}.h5')
+    os.makedirs(os.path.dirname(out), exist_ok=True)
+    names = [n + '11' for n in pb.NAMES11] + [n + '12' for n in pb.NAMES11]
+    names += [n + '22' for n in pb.NAMES11] + [n + '21' for n in pb.NAMES11]
+    with h5py.File(out, 'w') as fh:
+        fh.attrs['cells_per_radius'] = float(n)
+        fh.attrs['size_ratio'] = float(lam)
+        fh.attrs['radius_offset'] = 0.38
+        fh.attrs['slip_kappa'] = 0.5
+        fh.attrs['command'] = f'scripts/calibrate.py {n} --size-ratio {ratio_tag(lam)} --samples {samples_n}'
+        fh.attrs['description'] = ('resolved pair part R~2B - R~1B of two spheres of radii 1 and size_ratio '
+                                   '(Jeffrey & Onishi scaling; sphere 1: 11 and 12 scalars, sphere 2: 22 and 21 '
+                                   'with exchange signs; M folded into the self slots), measured by fdsusp in '
+                                   'resistance mode and fitted with fdsusp.pair_blocks')
+        gcol = np.array(GAPS)[:, None]
+        fh.create_dataset('pair/resolved', data=np.hstack([gcol, table.mean(axis=0)]))
+        fh.create_dataset('pair/scatter', data=np.hstack([gcol, table.std(axis=0, ddof=1)]))
+        fh['pair'].attrs['columns'] = 'gap,' + ','.join(names)
+        fh.create_dataset('fit_residual', data=np.hstack([gcol, residuals.T]))
+        fh['fit_residual'].attrs['columns'] = 'gap, then per sample the relative residual of the fit'
+    print(f'calibrate: wrote {out}; largest relative fit residual {residuals.max():.3g}')
+
+
+def fit_pair(measured, comoving, strain_run, a1, a2, d, dc):
+    """The resolved pair scalars (M folded) that best reproduce the measured pair responses, by
+    linear least squares (the responses are linear in the scalars: each column is the response to
+    one scalar). measured: (w (2, 6), e (3, 3), F (2, 3), T (2, 3), S (2, 3, 3)) of the runs along
+    d, one-body parts removed; strain_run: the same of the run in the flow, whose line of centres is
+    dc (the scalars do not depend on the frame); comoving: (w, e, F, T, S) that the exact pair part
+    gives for co-moving translations, weighted COMOVING_WEIGHT so that the regular combinations keep
+    their exact values. Rows are scaled by each sphere's one-body drag, rotational and strain
+    resistance. Returns the scalars and the relative residual of the measured rows."""
+    scale = [(6 * PI * a, 8 * PI * a ** 3, 20.0 / 3.0 * PI * a ** 3) for a in (a1, a2)]
+
+    def rows(F, T, S):
+        return np.concatenate([np.concatenate([F[al] / scale[al][0], T[al] / scale[al][1],
+                                               S[al].ravel() / scale[al][2]]) for al in range(2)])
+
+    design, target = [], []
+    n_meas = 0
+    groups = [(measured, d, 1.0), ([strain_run], dc, 1.0), (comoving, d, COMOVING_WEIGHT)]
+    for items, frame_d, weight in groups:
+        for w, e, F, T, S in items:
+            cols = []
+            for k, al, be in FREE:
+                unit = np.zeros((11, 2, 2))
+                unit[k, al, be] = 1.0
+                cols.append(rows(*pb.responses(unit, a1, a2, frame_d, w, e)))
+            design.append(weight * np.array(cols).T)
+            target.append(weight * rows(F, T, S))
+            if weight == 1.0:
+                n_meas += len(target[-1])
+    A, b = np.vstack(design), np.concatenate(target)
+    x, *_ = np.linalg.lstsq(A, b, rcond=None)
+    s = np.zeros((11, 2, 2))
+    for v, (k, al, be) in zip(x, FREE):
+        s[k, al, be] = v
+    residual = np.linalg.norm((A @ x - b)[:n_meas]) / max(np.linalg.norm(b[:n_meas]), 1e-300)
+    return s, residual
 
 
 if __name__ == '__main__':

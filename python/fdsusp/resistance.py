@@ -32,8 +32,8 @@ WALL_NAMES = ["lambda_perp", "f_tt", "f_tr", "f_rr", "x_w"]
 FREE_SPHERE_WALL = np.array([1.0, 1.0, 0.0, 1.0, 1.0])
 
 
-def _table(kind, gaps):
-    out = subprocess.run([program('fdsusp-resistance'), kind] + ['%.17g' % g for g in gaps],
+def _table(kind, gaps, options=()):
+    out = subprocess.run([program('fdsusp-resistance'), kind] + ['%.17g' % g for g in gaps] + list(options),
                          check=True, capture_output=True, text=True).stdout
     return np.array([[float(v) for v in line.split()] for line in out.splitlines() if not line.startswith('#')])
 
@@ -41,6 +41,12 @@ def _table(kind, gaps):
 def pair_scalars(gap):
     """The 22 equal-sphere scalars at this gap, in the order of NAMES."""
     return _table('pair', [gap])[0, 1:]
+
+
+def sized_pair(gap, size_ratio):
+    """The 22 scalars of sphere 1 (radius 1) facing sphere 2 (radius size_ratio) at gap
+    xi = 2r/(a1 + a2) - 2, Jeffrey & Onishi's scaling, in the order of NAMES (11 then 12)."""
+    return _table('pair', [gap], ['--size-ratio', '%.17g' % size_ratio])[0, 1:]
 
 
 def shear_functions(gaps):
@@ -85,12 +91,19 @@ def with_flow(x, height):
     return (x, np.array([x[1] - height / 2, 0.0, 0.0]), SHEAR_OMEGA)
 
 
-def deck(path, out, box, walls, shear, spheres, h, model='none', vtol=1e-6, ptol=1e-8, motion='resistance'):
+def deck(path, out, box, walls, shear, spheres, h, model='none', vtol=1e-6, ptol=1e-8, motion='resistance',
+         radii=None):
     """spheres: list of (position, velocity, omega); motion: 'resistance' (the velocities imposed)
     or 'frozen' (the velocities force-free, scripts/frozen_pair.py); model: the lubrication model (calibration
-    measures the resolved part alone, so 'none'); vtol, ptol: the solver tolerances. Written by
-    fdsusp.deck (floats exactly)."""
+    measures the resolved part alone, so 'none'); vtol, ptol: the solver tolerances; radii: each
+    sphere's radius (spheres of several sizes: &particles radius and species(i)), else radius 1.
+    Written by fdsusp.deck (floats exactly)."""
     particles = {'number': len(spheres), 'motion': motion}
+    if radii is not None and len(set(radii)) > 1:
+        species = sorted(set(float(r) for r in radii))
+        particles.update({'radius': species, 'species': [species.index(float(r)) + 1 for r in radii]})
+    elif radii is not None:
+        particles['radius'] = float(radii[0])
     for i, (x, u, w) in enumerate(spheres, 1):
         particles.update({'position(:,%d)' % i: [float(c) for c in x], 'velocity(:,%d)' % i: [float(c) for c in u],
                           'omega(:,%d)' % i: [float(c) for c in w]})
