@@ -323,8 +323,8 @@ contains
         end if
         ! a sphere half way through a wall: nothing physical holds it back any more (no wall
         ! contacts or lubrication, or a step far too large for them)
-        if (ts%walls .and. (parts%position(2, q) < 0.5_dp * parts%radius .or. &
-                            parts%position(2, q) > ts%box(2) - 0.5_dp * parts%radius)) then
+        if (ts%walls .and. (parts%position(2, q) < 0.5_dp * parts%radii(q) .or. &
+                            parts%position(2, q) > ts%box(2) - 0.5_dp * parts%radii(q))) then
           write(ts%failure, '(a,i0,a,f10.5,a,f10.5,a)') 'particle ', q, ' is half way through a wall (centre y = ', &
                parts%position(2, q), ', walls at 0 and ', ts%box(2), &
                '): add &contact, keep &lubrication on, or lower &time dt'
