@@ -16,7 +16,8 @@ none beyond number). The full lubrication model of a mixture in the resolved flu
 one missing, one of another cells_per_radius or size_ratio, an explicit &lubrication table, and
 model 'simple' are each refused before any step with one message naming &lubrication and the
 file (or variable); with its tables (synthetic, in the scratch directory through
-$FDSUSP_TABLE_DIR) it runs and lubricates its unequal pair. Exact checks (messages, status,
+$FDSUSP_TABLE_DIR) it runs and lubricates its unequal pair; a size ratio of 2/1.4 takes the table
+calibrated at 1.428571 (the 6 decimals of the names). Exact checks (messages, status,
 absence of any step) except the packed volume fraction (counts rounded per species)."""
 import os
 import fdsusp_testlib as T
@@ -188,6 +189,22 @@ if status == 0:
     s = T.series(out_dir)
     T.check(int(T.np.max(s['lubrication_pairs'])) == 1, 'full model of a mixture: the unequal pair is lubricated '
             '(%d links)' % int(T.np.max(s['lubrication_pairs'])))
+# three species (radii 1, 1.4, 2 at a/Delta = 4): six tables, the pair (1.4, 2) at a/Delta 5.6 and
+# size ratio 2/1.4, which the names and the table write to 6 decimals (1.428571): that table is
+# accepted, and the last one read (resolved_a8.h5, made wrong here) is the one refused
+with T.h5py.File(os.path.join(d, 'three.h5'), 'w') as f:
+    f.create_dataset('particles/position', data=T.np.array([[2.5, 5.0, 5.0], [6.0, 5.0, 5.0], [4.0, 5.0, 9.5]]))
+    f.create_dataset('particles/radius', data=T.np.array([1.0, 1.4, 2.0]))
+unequal_table('resolved_a4_ratio2.h5', size_ratio=2.0)
+unequal_table('resolved_a5.6_ratio1.428571.h5', size_ratio=1.428571, cells_per_radius=5.6)
+equal_table('resolved_a8.h5', 4)
+T.write_deck(d, 'three.nml', FULL.format(lub="model = 'full'", particles="radius = 1.0, 1.4, 2.0, position_file = 'three.h5'"))
+status, out, err = T.run('three.nml', d, expect_ok=False)
+messages = [line for line in err.splitlines() if line.startswith('fdsusp:') and 'warning' not in line]
+T.check(status == 2 and len(messages) == 1 and 'resolved_a8.h5' in messages[0] and 'needs 8' in messages[0] and
+        'resolved_a5.6_ratio1.428571.h5' in out,
+        'three species: the table of size ratio 1.428571 for 2/1.4 accepted, the wrong resolved_a8.h5 refused: %s'
+        % messages[:1])
 del T.ENV['FDSUSP_TABLE_DIR']
 
 # lubrication dynamics moves a mixture, its radii as the file gives them (N or 1 x N)
