@@ -16,7 +16,9 @@
 !   full    the exact functions (mod_pair_resistance, mod_wall_resistance) minus the resolved part measured by fdsusp
 !           itself at this resolution (scripts/calibrate.py, tables in input/lubrication),
 !           interpolated linearly in ln(gap); below the smallest calibrated gap the resolved part
-!           is held (it saturates once the gap is below the grid spacing).
+!           is held (it saturates once the gap is below the grid spacing). A mixture (spheres of
+!           several sizes) takes one table per pair of species and the wall part of each
+!           species' equal table (lub_sized_scalars, doc/LUBRICATION.md "Tables for mixtures").
 !   exact   the same exact functions minus the one-body part, nothing resolved to
 !           subtract: the pair and wall hydrodynamics of the lubrication dynamics mode (&fluid
 !           model = 'none', mod_lubrication_dynamics), where no grid resolves anything. Its blocks
@@ -38,6 +40,7 @@ module mod_lubrication
        i_xg12, i_yh11, i_yh12, i_xc12, i_yc12
   use mod_wall_resistance, only: wall_normal_resistance, wall_tangential_resistance, &
        wall_twist_resistance
+  use mod_pair_resistance_unequal, only: exchange_sign
   use mod_resistance_blocks, only: pair_resistance_fu, pair_force_torque_from_strain, &
        pair_stresslets, wall_resistance_block, pair_resistance_fu_sized, pair_resistance_fe_sized, &
        pair_stresslets_sized
@@ -45,11 +48,17 @@ module mod_lubrication
   private
   public :: lubrication_t, lub_description, lub_setup, lub_wall_floor, lub_pair_scalars, lub_wall_scalars, lub_pair_link, lub_wall_link, &
             lub_pair_stresslets, lub_wall_stresslet, clip_to_psd, lub_taper, model_code, grains3d_cutoff, &
-            lub_sized_scalars, lub_pair_link_sized, lub_pair_stresslets_sized, clip_scaled
+            lub_sized_scalars, lub_pair_link_sized, lub_pair_stresslets_sized, clip_scaled, &
+            lub_fold_strain, lub_species_wall_floor
   integer, parameter, public :: LUB_NONE = 0, LUB_SIMPLE = 1, LUB_FULL = 2, LUB_EXACT = 3
   ! outer cut-off of the exact model when the deck gives none [a]
   real(dp), parameter, public :: exact_default_cutoff = 1.0_dp
   integer, parameter, public :: n_wall_scalars = 5    ! lambda_perp, f_tt, f_tr, f_rr, x_w
+
+  !> One calibrated table of the full model: its gaps (ascending) and the resolved part on them.
+  type, public :: lub_table_t
+    real(dp), allocatable :: gap(:), resolved(:, :)            ! (ng), (ng, columns)
+  end type lub_table_t
 
   type :: lubrication_t
     integer :: model = LUB_NONE
@@ -66,6 +75,14 @@ module mod_lubrication
     ! full model: resolved pair and wall parts on their gap grids (ascending)
     real(dp), allocatable :: pair_gap(:), pair_resolved(:, :)    ! (ng), (ng, 22)
     real(dp), allocatable :: wall_gap(:), wall_resolved(:, :)    ! (ng), (ng, 5)
+    ! full model of a mixture (doc/LUBRICATION.md "Tables for mixtures"; unallocated for equal
+    ! spheres): the species' radii in the units of radius, ascending; species_pair(s, t), s <= t,
+    ! the resolved pair part of a pair of species s and t: s = t the equal table's 22 columns,
+    ! s < t the unequal table's 44 (22 of sphere s, then 22 of sphere t with the exchange
+    ! signs, the M functions folded, lub_fold_strain); species_wall(s) the wall part (5 columns)
+    ! of species s's equal table
+    real(dp), allocatable :: species_radius(:)
+    type(lub_table_t), allocatable :: species_pair(:, :), species_wall(:)
   end type lubrication_t
 
   real(dp), parameter :: taper_fraction = 0.3_dp
@@ -90,8 +107,13 @@ contains
     case (LUB_SIMPLE)
       write(line, '(a,f6.3,a)') 'lubrication simple (singular terms, outer cut-off ', lub%outer_cutoff, ' a)'
     case default
-      write(line, '(a,f6.3,a,i0,a)') 'lubrication full (calibrated, outer cut-off ', lub%outer_cutoff, &
-           ' a, ', size(lub%pair_gap), ' tabulated gaps)'
+      if (allocated(lub%species_pair)) then
+        write(line, '(a,i0,a,f6.3,a)') 'lubrication full (calibrated, a mixture of ', size(lub%species_radius), &
+             ' species: a table per pair of species, outer cut-off ', lub%outer_cutoff, ' a)'
+      else
+        write(line, '(a,f6.3,a,i0,a)') 'lubrication full (calibrated, outer cut-off ', lub%outer_cutoff, &
+             ' a, ', size(lub%pair_gap), ' tabulated gaps)'
+      end if
     end select
   end function lub_description
 
@@ -112,7 +134,9 @@ contains
   end function grains3d_cutoff
 
   !> model: LUB_*; outer_cutoff 0 = the model's default (simple: xi_c; full: the last calibrated
-  !> gap, where the resolved part has met the theory within its scatter).
+  !> gap, where the resolved part has met the theory within its scatter; a mixture's tables, set
+  !> before (species_pair), the smallest of their last pair gaps, so that no pair is corrected
+  !> beyond its own table).
   subroutine lub_setup(lub, model, radius, viscosity, cells_per_radius, outer_cutoff, inner_cutoff)
     type(lubrication_t), intent(inout) :: lub
     integer, intent(in) :: model
@@ -126,7 +150,11 @@ contains
     case (LUB_SIMPLE)
       lub%outer_cutoff = lub%simple_cutoff
     case (LUB_FULL)
-      lub%outer_cutoff = lub%pair_gap(size(lub%pair_gap))
+      if (allocated(lub%species_pair)) then
+        lub%outer_cutoff = mixture_outer_cutoff(lub)
+      else
+        lub%outer_cutoff = lub%pair_gap(size(lub%pair_gap))
+      end if
     case (LUB_EXACT)
       lub%outer_cutoff = exact_default_cutoff
     case default
@@ -134,6 +162,18 @@ contains
     end select
     if (outer_cutoff > 0.0_dp) lub%outer_cutoff = outer_cutoff
   end subroutine lub_setup
+
+  ! the smallest of the last pair gaps of a mixture's tables
+  pure real(dp) function mixture_outer_cutoff(lub) result(cut)
+    type(lubrication_t), intent(in) :: lub
+    integer :: s, t
+    cut = huge(1.0_dp)
+    do t = 1, size(lub%species_radius)
+      do s = 1, t
+        cut = min(cut, lub%species_pair(s, t)%gap(size(lub%species_pair(s, t)%gap)))
+      end do
+    end do
+  end function mixture_outer_cutoff
 
   !> C1 taper: 1 below (1 - taper_fraction) outer, 0 at and beyond outer (smoothstep between).
   pure real(dp) function lub_taper(gap, outer)
@@ -215,9 +255,12 @@ contains
 
   !> The subgrid sphere-wall scalars (lambda_perp, f_tt, f_tr, f_rr, x_w) at this gap. The twist
   !> x_w is not singular and is left to the grid (doc/METHOD.md §5.8).
-  function lub_wall_scalars(lub, gap) result(w)
+  !> species (optional): a mixture's sphere of that species (lub%species_radius), gap over its own
+  !> radius: model 'full' takes the wall part of that species' table.
+  function lub_wall_scalars(lub, gap, species) result(w)
     type(lubrication_t), intent(in) :: lub
     real(dp), intent(in) :: gap
+    integer, intent(in), optional :: species
     real(dp) :: w(n_wall_scalars), eps, e, ec
     w = 0.0_dp
     if (lub%model == LUB_NONE .or. gap >= lub%outer_cutoff) return
@@ -235,7 +278,11 @@ contains
       call wall_tangential_resistance(eps, w(2), w(3), w(4))
       w(2) = w(2) - 1.0_dp
       w(4) = w(4) - 1.0_dp
-      w(1:4) = w(1:4) - interpolate(lub%wall_gap, lub%wall_resolved(:, 1:4), eps)
+      if (present(species)) then
+        w(1:4) = w(1:4) - interpolate(lub%species_wall(species)%gap, lub%species_wall(species)%resolved(:, 1:4), eps)
+      else
+        w(1:4) = w(1:4) - interpolate(lub%wall_gap, lub%wall_resolved(:, 1:4), eps)
+      end if
     case (LUB_EXACT)
       w(1) = wall_normal_resistance(eps) - 1.0_dp
       call wall_tangential_resistance(eps, w(2), w(3), w(4))
@@ -331,22 +378,36 @@ contains
   end function lub_wall_stresslet
 
   ! ---------------------------------------------------------------------------------------------
-  ! Two spheres of different sizes, model 'exact' only (lubrication dynamics of a mixture;
-  ! doc/LUBRICATION.md "Spheres of several sizes")
+  ! Two spheres of different sizes: model 'exact' (lubrication dynamics of a mixture) and model
+  ! 'full' with a table per pair of species (the DNS of a mixture; doc/LUBRICATION.md "Spheres of
+  ! several sizes" and "Tables for mixtures")
   ! ---------------------------------------------------------------------------------------------
 
   !> f (11, 12 scalars) and f2 (22, 21 scalars, exchange signs applied) of two unequal spheres at
   !> gap xi = 2r/(a_1 + a_2) - 2 (mod_pair_resistance_unequal, Jeffrey & Onishi's scaling, in which
   !> each sphere's self scalars X^A, Y^A, X^C, Y^C, X^M, Y^M, Z^M of one isolated sphere are 1):
-  !> made R_2B - R_1B of both spheres and tapered to zero at the outer cut-off (over the same
-  !> xi), in place. The caller evaluates them at max(gap, inner_cutoff). Zero beyond the cut-off
-  !> and for the other models.
-  pure subroutine lub_sized_scalars(lub, gap, f, f2)
+  !> made the subgrid scalars of both spheres and tapered to zero at the outer cut-off (over the
+  !> same xi), in place. The caller evaluates them at max(gap, inner_cutoff). Zero beyond the
+  !> cut-off and for the models other than 'exact' and 'full'.
+  !>   exact  R_2B - R_1B (nothing resolved).
+  !>   full   [R_2B - R_1B] - [R~_2B - R~_1B] (doc/METHOD.md §5.3): species1, species2 (required)
+  !>          are the spheres' species, indices into lub%species_radius; the M functions are
+  !>          folded first (lub_fold_strain, as the tables hold them) and the resolved part is
+  !>          interpolated in ln(xi) from lub%species_pair of the two species: an equal pair's
+  !>          table (22 columns) gives f2 as exchange_sign times its row, so that a pair of one
+  !>          species equals the equal-sphere 'full' model (to rounding); an unequal pair's table
+  !>          (44 columns) is laid out with the smaller sphere first, so a pair whose sphere 1 is
+  !>          the larger takes the columns swapped (sphere 1's are the table's sphere 2 ones with
+  !>          the exchange signs undone: f = exchange_sign t(23:44), f2 = exchange_sign t(1:22)).
+  pure subroutine lub_sized_scalars(lub, gap, f, f2, species1, species2)
     type(lubrication_t), intent(in) :: lub
     real(dp), intent(in) :: gap
     real(dp), intent(inout) :: f(n_pair_scalars), f2(n_pair_scalars)
-    real(dp) :: taper
-    if (lub%model /= LUB_EXACT .or. gap >= lub%outer_cutoff) then
+    integer, intent(in), optional :: species1, species2
+    real(dp) :: taper, xi
+    real(dp) :: t(2 * n_pair_scalars)
+    integer :: s1, s2
+    if ((lub%model /= LUB_EXACT .and. lub%model /= LUB_FULL) .or. gap >= lub%outer_cutoff) then
       f = 0.0_dp
       f2 = 0.0_dp
       return
@@ -354,21 +415,72 @@ contains
     taper = lub_taper(gap, lub%outer_cutoff)
     f(one_body_scalars) = f(one_body_scalars) - 1.0_dp
     f2(one_body_scalars) = f2(one_body_scalars) - 1.0_dp
+    if (lub%model == LUB_FULL) then
+      s1 = species1
+      s2 = species2
+      xi = max(gap, lub%inner_cutoff)
+      call lub_fold_strain(f, f2, lub%species_radius(s1), lub%species_radius(s2))
+      if (s1 == s2) then
+        t(1:n_pair_scalars) = interpolate(lub%species_pair(s1, s1)%gap, lub%species_pair(s1, s1)%resolved, xi)
+        f = f - t(1:n_pair_scalars)
+        f2 = f2 - exchange_sign * t(1:n_pair_scalars)
+      else if (s1 < s2) then
+        t = interpolate(lub%species_pair(s1, s2)%gap, lub%species_pair(s1, s2)%resolved, xi)
+        f = f - t(1:n_pair_scalars)
+        f2 = f2 - t(n_pair_scalars + 1:)
+      else
+        t = interpolate(lub%species_pair(s2, s1)%gap, lub%species_pair(s2, s1)%resolved, xi)
+        f = f - exchange_sign * t(n_pair_scalars + 1:)
+        f2 = f2 - exchange_sign * t(1:n_pair_scalars)
+      end if
+    end if
     f = taper * f
     f2 = taper * f2
   end subroutine lub_sized_scalars
 
+  !> The strain (M) functions of two spheres of radii a1 and a2 folded into each sphere's own slot,
+  !> in place: R_SE enters the stresslet of sphere 1 only as M11 (5/6) pi eta (2 a1)^3 + M12 (5/6)
+  !> pi eta (a1 + a2)^3 (mod_resistance_blocks pair_resistance_se_sized), so the 11 slots of f
+  !> take M11 + M12 ((a1 + a2)/(2 a1))^3 and the 12 slots 0; likewise the 22 slots of f2 take
+  !> M22 + M21 ((a1 + a2)/(2 a2))^3 and the 21 slots 0. The stresslets are unchanged for every
+  !> strain (test_lubrication_mixture); the calibrated tables of a mixture hold the M functions
+  !> so folded (their measured stresslet separates no further). For a1 = a2 the factor is 1
+  !> exactly: the sums M11 + M12 of the equal-sphere tables.
+  pure subroutine lub_fold_strain(f, f2, a1, a2)
+    real(dp), intent(inout) :: f(n_pair_scalars), f2(n_pair_scalars)
+    real(dp), intent(in) :: a1, a2
+    integer, parameter :: m11(3) = [i_xm11, i_ym11, i_zm11], m12(3) = [i_xm12, i_ym12, i_zm12]
+    f(m11) = f(m11) + f(m12) * ((a1 + a2) / (2.0_dp * a1))**3
+    f(m12) = 0.0_dp
+    f2(m11) = f2(m11) + f2(m12) * ((a1 + a2) / (2.0_dp * a2))**3
+    f2(m12) = 0.0_dp
+  end subroutine lub_fold_strain
+
+  !> The wall floor (lub%wall_floor, that of a sphere of radius lub%radius) of a sphere of radius
+  !> a: lub_wall_floor scales with the fictitious-fluid moment of inertia, a^5 (doc/METHOD.md §5.8).
+  pure real(dp) function lub_species_wall_floor(lub, a) result(floor)
+    type(lubrication_t), intent(in) :: lub
+    real(dp), intent(in) :: a
+    floor = lub%wall_floor * (a / lub%radius)**5
+  end function lub_species_wall_floor
+
   !> One lubricating pair of unequal spheres, radii a1, a2 (as lub_pair_link): r = R_FU of the
-  !> sized blocks, its eigenvalues clipped in the metric of scale (clip_scaled: r >= -diag(scale^2),
-  !> scale (12) set by the caller from each sphere's one-body block), drive = r . (U_inf, Om_inf)
-  !> + R_FE : E_inf.
+  !> sized blocks, drive = r . (U_inf, Om_inf) + R_FE : E_inf. Model 'exact': its eigenvalues
+  !> clipped in the metric of scale (clip_scaled: r >= -diag(scale^2), scale (12) set by the caller
+  !> from each sphere's one-body block). Model 'full' (the DNS): made positive semi-definite
+  !> (clip_to_psd) as the equal-sphere full model's blocks, scale unused: the fictitious-fluid
+  !> mass carries each sphere's one-body resistance, so no link may take any of it.
   subroutine lub_pair_link_sized(lub, f, f2, d, a1, a2, u_inf, om_inf, e_inf, scale, r, drive, info)
     type(lubrication_t), intent(in) :: lub
     real(dp), intent(in) :: f(n_pair_scalars), f2(n_pair_scalars), d(3), a1, a2, u_inf(3, 2), om_inf(3), &
                             e_inf(3, 3), scale(12)
     real(dp), intent(out) :: r(12, 12), drive(12)
     integer, intent(out), optional :: info
-    r = clip_scaled(pair_resistance_fu_sized(f, f2, d, a1, a2, lub%viscosity), scale, info)
+    if (lub%model == LUB_FULL) then
+      r = clip_to_psd(pair_resistance_fu_sized(f, f2, d, a1, a2, lub%viscosity), info=info)
+    else
+      r = clip_scaled(pair_resistance_fu_sized(f, f2, d, a1, a2, lub%viscosity), scale, info)
+    end if
     drive = matmul(r, [u_inf(:, 1), om_inf, u_inf(:, 2), om_inf]) + strain_part(f, f2, d, a1, a2, lub%viscosity, e_inf)
   end subroutine lub_pair_link_sized
 

@@ -16,14 +16,18 @@
 ! so the 6N system of mod_lubrication_dynamics stays positive definite, and an isolated pair,
 ! whose R_2B is positive definite, keeps its exact block (its lowest eigenvalue, ~-0.36 x 6 pi
 ! eta a at contact, is above the floor -3 pi eta a).
-! Spheres of several sizes (particle_lubrication_create's radii; model 'exact' only,
-! doc/LUBRICATION.md "Spheres of several sizes"): a pair's gap is xi = 2r/(a_i + a_j) - 2 (over the
-! mean radius, as Jeffrey & Onishi's), its blocks the sized ones of mod_resistance_blocks at
-! lambda = a_j/a_i minus each sphere's one-body part, the outer cut-off applies to xi; a wall
-! link takes the wall functions at the sphere's own gap over its own radius, scaled by its radius.
-! The floor of a pair block is in the metric of the one-body blocks (clip_scaled): the links of
-! sphere i lower its one-body block R_1B,i by at most R_1B,i / 2; a wall block's floor is
-! -(1/2) min(6 pi eta a_i, 8 pi eta a_i^3) / z_i.
+! Spheres of several sizes (particle_lubrication_create's radii; models 'exact' and 'full',
+! doc/LUBRICATION.md "Spheres of several sizes" and "Tables for mixtures"): a pair's gap is
+! xi = 2r/(a_i + a_j) - 2 (over the mean radius, as Jeffrey & Onishi's), its blocks the sized ones
+! of mod_resistance_blocks at lambda = a_j/a_i minus each sphere's one-body part (and, 'full',
+! minus the resolved part of the table of its two species), the outer cut-off applies to xi; a
+! wall link takes the wall functions at the sphere's own gap over its own radius, scaled by its
+! radius ('full': minus the wall part of its species' table). Model 'exact': the floor of a pair
+! block is in the metric of the one-body blocks (clip_scaled): the links of sphere i lower its
+! one-body block R_1B,i by at most R_1B,i / 2; a wall block's floor is
+! -(1/2) min(6 pi eta a_i, 8 pi eta a_i^3) / z_i. Model 'full' (the DNS): pair blocks made positive
+! semi-definite, wall blocks floored at lub_wall_floor with the sphere's own radius, as for equal
+! spheres.
 module mod_particle_lubrication
   use mod_kinds, only: dp, i8, pi
   use mod_pair_resistance, only: n_pair_scalars, resistance_scalars
@@ -31,7 +35,7 @@ module mod_particle_lubrication
        exchange_sign, twin_multipole_order, sphere_wall_gap
   use mod_lubrication, only: lubrication_t, lub_pair_scalars, lub_wall_scalars, lub_pair_link, &
        lub_wall_link, lub_pair_stresslets, lub_wall_stresslet, n_wall_scalars, LUB_NONE, LUB_EXACT, &
-       lub_sized_scalars, lub_pair_link_sized, lub_pair_stresslets_sized
+       lub_sized_scalars, lub_pair_link_sized, lub_pair_stresslets_sized, LUB_FULL, lub_species_wall_floor
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates
   use mod_lees_edwards, only: lees_edwards_t, le_separation
   use mod_particle_system, only: particle_system_t, particle_system_add_diagonal, particle_system_add_pair
@@ -66,7 +70,8 @@ module mod_particle_lubrication
     ! (0 for a wall); 0, 0 when all were
     integer :: failed_link(2) = 0
     ! spheres of several sizes (sized): each sphere's radius, its species (index into
-    ! species_radius) and the unequal-pair set-up of each ordered pair of species (lambda =
+    ! species_radius: model 'full' lub%species_radius, the tables' species, else the radii in the
+    ! order met) and the unequal-pair set-up of each ordered pair of species (lambda =
     ! species_radius(t) / species_radius(s); s = t unused: equal radii take mod_pair_resistance)
     logical :: sized = .false.
     real(dp), allocatable :: radii(:), species_radius(:)
@@ -80,8 +85,9 @@ contains
 
   !> lub: the configured model (mod_lubrication lub_setup); skin: neighbour-list skin [a].
   !> le, optional: Lees-Edwards boundaries in y (walls .false.).
-  !> radii, optional: (np) the spheres' radii in units of lub%radius (a mixture: model 'exact'
-  !> only); absent or all equal: equal spheres.
+  !> radii, optional: (np) the spheres' radii in units of lub%radius (a mixture: model 'exact', or
+  !> 'full' with a mixture's tables in lub, lub%species_radius holding every radius); absent or all
+  !> equal: equal spheres.
   subroutine particle_lubrication_create(pl, lub, np, box, walls, shear_rate, skin, info, msg, le, radii)
     type(particle_lubrication_t), intent(out) :: pl
     type(lubrication_t), intent(in) :: lub
@@ -116,6 +122,11 @@ contains
       if (any(radii /= radii(1))) call set_sizes()
       if (info /= 0) return
     end if
+    if (lub%model == LUB_FULL .and. .not. pl%sized .and. .not. allocated(lub%pair_gap)) then
+      info = 1
+      msg = 'lubrication: the full model of equal spheres needs their table (a mixture''s tables were given)'
+      return
+    end if
     if (np == 1) then
       ! one sphere: no pairs, and its two wall candidates need no search (nor a box large
       ! enough for one)
@@ -142,9 +153,16 @@ contains
     subroutine set_sizes()
       integer :: i, s, t, ns
       real(dp) :: found(np)
-      if (lub%model /= LUB_EXACT) then
+      if (lub%model /= LUB_EXACT .and. lub%model /= LUB_FULL) then
         info = 1
-        msg = 'lubrication: spheres of several sizes take the exact functions only (lubrication dynamics)'
+        msg = 'lubrication: spheres of several sizes take the exact functions (lubrication dynamics) or '// &
+              'the full model with a table per pair of species (the resolved fluid), not model ''simple'''
+        return
+      end if
+      if (lub%model == LUB_FULL .and. .not. allocated(lub%species_pair)) then
+        info = 1
+        msg = 'lubrication: the full model of spheres of several sizes needs a table per pair of species '// &
+              '(mod_lubrication_io; doc/LUBRICATION.md "Tables for mixtures")'
         return
       end if
       pl%sized = .true.
@@ -152,15 +170,31 @@ contains
       a_max = maxval(pl%radii)
       ns = 0
       allocate(pl%species(np))
-      do i = 1, np
-        s = findloc(found(1:ns), pl%radii(i), 1)
-        if (s == 0) then
-          ns = ns + 1
-          found(ns) = pl%radii(i)
-          s = ns
-        end if
-        pl%species(i) = s
-      end do
+      if (lub%model == LUB_FULL) then
+        ! the tables' species: each radius must be one of them (to rounding of the units)
+        ns = size(lub%species_radius)
+        found(1:ns) = lub%species_radius
+        do i = 1, np
+          s = minloc(abs(found(1:ns) - pl%radii(i)), 1)
+          if (abs(found(s) - pl%radii(i)) > 1.0e-12_dp * found(s)) then
+            info = 1
+            write(msg, '(a,i0,a,es12.5,a)') 'lubrication: sphere ', i, ' has radius ', pl%radii(i), &
+                 ', which no table of the mixture is for'
+            return
+          end if
+          pl%species(i) = s
+        end do
+      else
+        do i = 1, np
+          s = findloc(found(1:ns), pl%radii(i), 1)
+          if (s == 0) then
+            ns = ns + 1
+            found(ns) = pl%radii(i)
+            s = ns
+          end if
+          pl%species(i) = s
+        end do
+      end if
       pl%species_radius = found(1:ns)
       allocate(pl%setup(ns, ns))
       do t = 1, ns
@@ -249,8 +283,12 @@ contains
       pl%pair_uinf(:, pl%npairs) = [u_inf(:, 1), u_inf(:, 2)]
       if (pl%sized) then
         call sized_scalars(i, j, gap, pl%pair_f(:, pl%npairs), pl%pair_f2(:, pl%npairs))
-        scale(1:6) = floor_metric(i)
-        scale(7:12) = floor_metric(j)
+        ! the floor's metric of model 'exact' ('full' makes the block PSD and counts no links)
+        scale = 1.0_dp
+        if (pl%lub%model == LUB_EXACT) then
+          scale(1:6) = floor_metric(i)
+          scale(7:12) = floor_metric(j)
+        end if
         call lub_pair_link_sized(pl%lub, pl%pair_f(:, pl%npairs), pl%pair_f2(:, pl%npairs), d, pl%radii(i), pl%radii(j), &
                                  u_inf, om_inf, e_inf, scale, pl%pair_r(:, :, pl%npairs), pl%pair_drive(:, pl%npairs), &
                                  status)
@@ -283,9 +321,17 @@ contains
       if (gap >= pl%lub%outer_cutoff) cycle
       call grow_walls()
       pl%nwalls = pl%nwalls + 1
-      w = lub_wall_scalars(pl%lub, gap)
       pl%wall_part(pl%nwalls) = i
       pl%wall_n(:, pl%nwalls) = normal
+      if (pl%sized .and. pl%lub%model == LUB_FULL) then
+        ! the wall part of this sphere's species' table, and the wall floor with its own radius
+        w = lub_wall_scalars(pl%lub, gap, pl%species(i))
+        call lub_wall_link(pl%lub, w, normal, u_wall, pl%wall_r(:, :, pl%nwalls), pl%wall_drive(:, pl%nwalls), status, &
+                           lub_species_wall_floor(pl%lub, pl%radii(i)), pl%radii(i))
+        if (status /= 0 .and. pl%failed_link(1) == 0) pl%failed_link = [i, 0]
+        cycle
+      end if
+      w = lub_wall_scalars(pl%lub, gap)
       if (pl%sized) then
         ! the floor of equal spheres with this sphere's own one-body block
         call lub_wall_link(pl%lub, w, normal, u_wall, pl%wall_r(:, :, pl%nwalls), pl%wall_drive(:, pl%nwalls), status, &
@@ -325,7 +371,8 @@ contains
       end if
     end function wall_gap
 
-    ! R_2B - R_1B scalars of an unequal pair at gap (evaluated at the inner cut-off below it)
+    ! the subgrid scalars of an unequal pair at gap (evaluated at the inner cut-off below it):
+    ! R_2B - R_1B, and for model 'full' minus the resolved part of its species' table
     subroutine sized_scalars(i, j, gap, f, f2)
       integer, intent(in) :: i, j
       real(dp), intent(in) :: gap
@@ -342,7 +389,7 @@ contains
         f = unequal_pair_scalars(pl%setup(s, t), xi)
         f2 = exchange_sign * unequal_pair_scalars(pl%setup(t, s), xi)
       end if
-      call lub_sized_scalars(pl%lub, gap, f, f2)
+      call lub_sized_scalars(pl%lub, gap, f, f2, s, t)
     end subroutine sized_scalars
 
     ! sqrt of the share of sphere i's one-body block (6 pi eta a_i, 8 pi eta a_i^3) its links may

@@ -11,8 +11,14 @@ snapshot holds each sphere's radius as the file gave it), also a mixture packed 
 (solid_fraction: its snapshot holds the species' radii in the counts the log gives, their volume
 within half a large sphere of the asked fraction); so does the resolved fluid, from a file and
 from inline particles with &particles species(i) (each one of the radii, every species present,
-none beyond number). Exact checks (messages, status, absence of any step) except the packed
-volume fraction (counts rounded per species)."""
+none beyond number). The full lubrication model of a mixture in the resolved fluid (doc/LUBRICATION.md
+"Tables for mixtures") needs a table per species at its own resolution and one per unequal pair:
+one missing, one of another cells_per_radius or size_ratio, an explicit &lubrication table, and
+model 'simple' are each refused before any step with one message naming &lubrication and the
+file (or variable); with its tables (synthetic, in the scratch directory through
+$FDSUSP_TABLE_DIR) it runs and lubricates its unequal pair; a size ratio of 2/1.4 takes the table
+calibrated at 1.428571 (the 6 decimals of the names). Exact checks (messages, status,
+absence of any step) except the packed volume fraction (counts rounded per species)."""
 import os
 import fdsusp_testlib as T
 
@@ -104,6 +110,102 @@ for name, particles in (('a position file', MIX.format(f='mixture.h5')), ('inlin
     with T.h5py.File(os.path.join(out_dir, 'particles_00000002.h5'), 'r') as f:
         T.check(T.np.array_equal(T.np.ravel(f['particles/radius'][()]), [1.0, 1.0, 1.4]),
                 'resolved fluid, %s: the particle snapshot holds each sphere\'s radius' % name)
+
+# the full lubrication model of a mixture in the resolved fluid (doc/LUBRICATION.md "Tables for
+# mixtures"): one table per species at its own resolution (radii 1, 1.4 at a/Delta = 4:
+# resolved_a4.h5, resolved_a5.6.h5) and one per unequal pair (resolved_a4_ratio1.4.h5), looked for
+# in $FDSUSP_TABLE_DIR here. Synthetic tables in the scratch directory (never in input/): the
+# a/Delta = 4 table, a copy of it labelled 5.6, and the unequal pair's table made from it at
+# lambda = 1 (sphere 2's columns exchange signs times sphere 1's, M already folded).
+tables = os.path.join(d, 'tables')
+os.makedirs(tables)
+EXCHANGE = T.np.array([1, 1, -1, 1, 1, -1, -1, 1, 1, 1, 1] * 2, dtype=float)
+
+
+def equal_table(name, cells_per_radius):
+    T.shutil.copy(os.path.join(T.ROOT, 'input', 'lubrication', 'resolved_a4.h5'), os.path.join(tables, name))
+    with T.h5py.File(os.path.join(tables, name), 'r+') as f:
+        f.attrs['cells_per_radius'] = cells_per_radius
+
+
+def unequal_table(name, size_ratio=1.4, cells_per_radius=4.0):
+    with T.h5py.File(os.path.join(T.ROOT, 'input', 'lubrication', 'resolved_a4.h5'), 'r') as f:
+        pair, scatter = f['pair/resolved'][()], f['pair/scatter'][()]
+    with T.h5py.File(os.path.join(tables, name), 'w') as f:
+        for key, rows in (('resolved', pair), ('scatter', scatter)):
+            f.create_dataset('pair/' + key, data=T.np.hstack([rows, EXCHANGE * rows[:, 1:]]))
+        f.attrs.update(cells_per_radius=cells_per_radius, size_ratio=size_ratio, radius_offset=0.38,
+                       slip_kappa=0.5, command='tests/regression/test_mixture_input.py (synthetic)')
+
+
+FULL = LD.replace("&fluid model = 'none' /", "&fluid reynolds = 0.1 /\n&lubrication {lub} /").replace(
+    "y_boundary = 'lees-edwards', shear_rate = 1", "cells_per_radius = 4").replace(
+    'box = 8.0, 8.0, 8.0', 'box = 10.0, 10.0, 10.0')
+T.ENV['FDSUSP_TABLE_DIR'] = tables
+
+
+def full_run(lub="model = 'full'"):
+    if os.path.isdir(out_dir):
+        T.shutil.rmtree(out_dir)
+    T.write_deck(d, 'full.nml', FULL.format(lub=lub, particles=MIX.format(f='mixture.h5')))
+    return T.run('full.nml', d, expect_ok=False)
+
+
+def full_refused(name, words, lub="model = 'full'"):
+    status, out, err = full_run(lub)
+    messages = [line for line in err.splitlines() if line.startswith('fdsusp:') and 'warning' not in line]
+    T.check(status == 2 and len(messages) == 1 and all(w in messages[0] for w in words),
+            'full model of a mixture, %s: refused (status %d) with one message naming %s: %s'
+            % (name, status, ', '.join(words), messages[:1]))
+    T.check(not any(line.startswith('step ') for line in out.splitlines()), 'full model, %s: no step taken' % name)
+
+
+equal_table('resolved_a4.h5', 4)
+equal_table('resolved_a5.6.h5', 5.6)
+full_refused('the unequal pair\'s table missing', ['full.nml', '&lubrication', 'variable model', '&particles radius',
+             os.path.join(tables, 'resolved_a4_ratio1.4.h5'), 'is missing', 'scripts/calibrate.py 4 --size-ratio 1.4'])
+unequal_table('resolved_a4_ratio1.4.h5')
+os.remove(os.path.join(tables, 'resolved_a5.6.h5'))
+full_refused('the larger species\' table missing', ['&lubrication', 'variable model',
+             os.path.join(tables, 'resolved_a5.6.h5'), 'is missing', 'make calibrate CELLS_PER_RADIUS=5.6'])
+equal_table('resolved_a5.6.h5', 4)
+full_refused('a species\' table of another resolution', ['&lubrication', 'variable model', 'resolved_a5.6.h5',
+             'cells_per_radius = 4', 'needs 5.6'])
+equal_table('resolved_a5.6.h5', 5.6)
+unequal_table('resolved_a4_ratio1.4.h5', size_ratio=2.0)
+full_refused('an unequal table of another size ratio', ['&lubrication', 'variable model', 'resolved_a4_ratio1.4.h5',
+             'size_ratio = 2', 'needs 1.4'])
+unequal_table('resolved_a4_ratio1.4.h5')
+full_refused('an explicit table', ['&lubrication', 'variable table', 'for equal spheres'],
+             lub="model = 'full', table = '%s'" % os.path.join(tables, 'resolved_a4.h5'))
+full_refused('model simple', ['&lubrication', 'variable model', 'simple', 'equal spheres'], lub="model = 'simple'")
+# with its three tables the mixture runs, its unequal pair (spheres 1 and 3, xi = 0.083) lubricated
+status, out, err = full_run()
+logged = [line.split(': ', 1)[-1] for line in out.splitlines() if line.startswith('lubrication table: ')]
+T.check(status == 0 and 'finished at step 2' in out and sorted(os.path.basename(p) for p in logged) ==
+        ['resolved_a4.h5', 'resolved_a4_ratio1.4.h5', 'resolved_a5.6.h5'],
+        'full model of a mixture with its three tables runs (status %d; tables %s)' % (status, logged))
+if status == 0:
+    s = T.series(out_dir)
+    T.check(int(T.np.max(s['lubrication_pairs'])) == 1, 'full model of a mixture: the unequal pair is lubricated '
+            '(%d links)' % int(T.np.max(s['lubrication_pairs'])))
+# three species (radii 1, 1.4, 2 at a/Delta = 4): six tables, the pair (1.4, 2) at a/Delta 5.6 and
+# size ratio 2/1.4, which the names and the table write to 6 decimals (1.428571): that table is
+# accepted, and the last one read (resolved_a8.h5, made wrong here) is the one refused
+with T.h5py.File(os.path.join(d, 'three.h5'), 'w') as f:
+    f.create_dataset('particles/position', data=T.np.array([[2.5, 5.0, 5.0], [6.0, 5.0, 5.0], [4.0, 5.0, 9.5]]))
+    f.create_dataset('particles/radius', data=T.np.array([1.0, 1.4, 2.0]))
+unequal_table('resolved_a4_ratio2.h5', size_ratio=2.0)
+unequal_table('resolved_a5.6_ratio1.428571.h5', size_ratio=1.428571, cells_per_radius=5.6)
+equal_table('resolved_a8.h5', 4)
+T.write_deck(d, 'three.nml', FULL.format(lub="model = 'full'", particles="radius = 1.0, 1.4, 2.0, position_file = 'three.h5'"))
+status, out, err = T.run('three.nml', d, expect_ok=False)
+messages = [line for line in err.splitlines() if line.startswith('fdsusp:') and 'warning' not in line]
+T.check(status == 2 and len(messages) == 1 and 'resolved_a8.h5' in messages[0] and 'needs 8' in messages[0] and
+        'resolved_a5.6_ratio1.428571.h5' in out,
+        'three species: the table of size ratio 1.428571 for 2/1.4 accepted, the wrong resolved_a8.h5 refused: %s'
+        % messages[:1])
+del T.ENV['FDSUSP_TABLE_DIR']
 
 # lubrication dynamics moves a mixture, its radii as the file gives them (N or 1 x N)
 for name in ('mixture.h5', 'mixture_2d.h5'):
