@@ -24,7 +24,7 @@ module mod_lubrication_io
   use mod_os_services, only: executable_dir
   implicit none
   private
-  public :: lubrication_load, default_table_path, table_path, table_tag
+  public :: lubrication_load, table_path, table_tag
 
 #ifndef FDSUSP_TABLE_DIR
 #define FDSUSP_TABLE_DIR "input/lubrication"
@@ -33,19 +33,11 @@ module mod_lubrication_io
 
 contains
 
-  !> The shipped table for a/Delta = n, looked for in $FDSUSP_TABLE_DIR when it is set (then only
-  !> there), else in PREFIX/share/fdsusp/lubrication beside an installed program (its bin/../share),
-  !> in bin/../input/lubrication of a build tree, and last in the build tree compiled in
-  !> (FDSUSP_TABLE_DIR): the first that holds it (the last place when none does: the message names it).
-  function default_table_path(cells_per_radius) result(path)
-    real(dp), intent(in) :: cells_per_radius
-    character(len=:), allocatable :: path
-    character(len=16) :: tag
-    write(tag, '(i0)') nint(cells_per_radius)
-    path = table_path('resolved_a'//trim(tag)//'.h5')
-  end function default_table_path
-
-  !> The table file name, looked for as default_table_path says.
+  !> A table file by name (resolved_a<tag>.h5, table_tag), looked for in $FDSUSP_TABLE_DIR when it
+  !> is set (then only there), else in PREFIX/share/fdsusp/lubrication beside an installed program
+  !> (its bin/../share), in bin/../input/lubrication of a build tree, and last in the build tree
+  !> compiled in (FDSUSP_TABLE_DIR): the first that holds it (the last place when none does: the
+  !> message names it).
   function table_path(name) result(path)
     character(len=*), intent(in) :: name
     character(len=:), allocatable :: path, bin
@@ -101,8 +93,12 @@ contains
     character(len=300) :: message
     integer :: model, dims(2), ierr
     real(dp), allocatable :: pair(:, :), wall(:, :)
+    real(dp) :: resolution
     logical :: exists
 
+    ! equal spheres of radius a sit at a/Delta = cells_per_radius a (a = 1, the unit of length,
+    ! but for studies of the discrete sphere): their table is the one of that resolution
+    resolution = cfg%domain%cells_per_radius * cfg%radius
     model = model_code(trim(cfg%lubrication%model))
     if (.not. needed) model = LUB_NONE
     ! lubrication dynamics (&fluid model = 'none'): nothing is resolved, so 'full' is the exact
@@ -121,13 +117,21 @@ contains
     else if (model == LUB_FULL) then
       path = trim(cfg%lubrication%table)
       if (len(path) == 0) then
-        path = default_table_path(cfg%domain%cells_per_radius)
+        path = table_path('resolved_a'//table_tag(resolution)//'.h5')
         inquire(file=path, exist=exists)
-        if (abs(cfg%domain%cells_per_radius - nint(cfg%domain%cells_per_radius)) > 1.0e-9_dp .or. .not. exists) &
-          call input_error(cfg%deck_file, 'lubrication', 'model', 'the full model has no table for '// &
-               'cells_per_radius = '//trim(number(cfg%domain%cells_per_radius))//' ('//path//' is missing): '// &
-               'calibrate it (make calibrate CELLS_PER_RADIUS=n), use a calibrated resolution, '// &
-               'or model = ''simple''')
+        if (.not. exists) then
+          if (cfg%radius == 1.0_dp) then
+            call input_error(cfg%deck_file, 'lubrication', 'model', 'the full model has no table for '// &
+                 'cells_per_radius = '//trim(number(cfg%domain%cells_per_radius))//' ('//path//' is missing): '// &
+                 'calibrate it (make calibrate CELLS_PER_RADIUS=n), use a calibrated resolution, '// &
+                 'or model = ''simple''')
+          else
+            call input_error(cfg%deck_file, 'lubrication', 'model', 'the full model has no table for '// &
+                 'spheres of radius '//trim(number(cfg%radius))//' at cells_per_radius = '// &
+                 trim(number(cfg%domain%cells_per_radius))//', a/Delta = '//trim(number(resolution))//' ('//path// &
+                 ' is missing): calibrate it (scripts/calibrate.py), or model = ''simple''')
+          end if
+        end if
       else
         inquire(file=path, exist=exists)
         if (.not. exists) call input_error(cfg%deck_file, 'lubrication', 'table', '"'//path//'" does not exist')
@@ -135,7 +139,13 @@ contains
       message = ''
       dims = 0
       call log_line('lubrication table: '//path)
-      if (is_root()) call read_table(path, cfg, pair, wall, message)
+      if (is_root()) then
+        if (cfg%radius == 1.0_dp) then
+          call read_table(path, cfg, pair, wall, message)
+        else
+          call read_table(path, cfg, pair, wall, message, cells_per_radius=resolution)
+        end if
+      end if
       call file_error_from_root(path, 'lubrication table', message)
       if (is_root()) dims = [size(pair, 2), size(wall, 2)]
       call MPI_Bcast(dims, 2, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
@@ -147,7 +157,7 @@ contains
       lub%wall_gap = wall(1, :)
       lub%wall_resolved = transpose(wall(2:, :))
     end if
-    call lub_setup(lub, model, cfg%radius, 1.0_dp, cfg%domain%cells_per_radius, cfg%lubrication%outer_cutoff, cfg%lubrication%inner_cutoff)
+    call lub_setup(lub, model, cfg%radius, 1.0_dp, resolution, cfg%lubrication%outer_cutoff, cfg%lubrication%inner_cutoff)
     lub%wall_floor = lub_wall_floor(cfg%fluid%reynolds, cfg%time%dt, cfg%radius)
   end subroutine lubrication_load
 
