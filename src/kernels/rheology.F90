@@ -63,8 +63,9 @@ module mod_rheology
   ! per-species values of a record: stress_hydro(5), stress_contact(5), phi_core,s
   integer, parameter :: NQS = 11
   ! partial g(r): bins of radial_width [a], up to the box's half periodic length less the search
-  ! skin and at most radial_cap [a]
-  real(dp), parameter :: radial_width = 0.05_dp, radial_cap = 8.0_dp
+  ! skin and at most radial_cap [a] (past the second shell of radii 1 and 1.4, 5.6 a; the cap keeps
+  ! the pair search O(N) in large boxes)
+  real(dp), parameter :: radial_width = 0.05_dp, radial_cap = 6.0_dp
 
   public :: species_summary_t, rheo_summarise_species, rheo_species_quantities, NSPECIES_Q, NQS, species_names
   public :: rheology_settings_t, rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, rheo_quantities, rheo_block_of, &
