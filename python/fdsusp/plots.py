@@ -21,7 +21,7 @@ from .rheology import setup_key, stick_number
 
 def run_figures(runs, directory):
     """Per run: <name>_run.png (core stress against strain, phi(y) and u_x(y), g(theta) and
-    g_c(theta)); over two runs or more: rheology_vs_phi.png (eta_r, N1/tau, N2/tau against phi_core,
+    g_c(theta)); for a mixture also <name>_species.png (species_figure); over two runs or more: rheology_vs_phi.png (eta_r, N1/tau, N2/tau against phi_core,
     one series per friction coefficient)."""
     import matplotlib
     matplotlib.use('Agg')

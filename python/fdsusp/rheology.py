@@ -8,6 +8,8 @@ standard deviation over the complete blocks (ddof 1) / sqrt(blocks). No plotting
     summ = rheology.summarise(a, s)               # or summarise(with_window(a, 2, 20, 5), s)
     summ['quantities']['eta_r']                   # {'value': ..., 'error': ...}
     rheology.compare(summ, 'out/demo/summary.json')   # [] when the program agrees to 1e-10
+    summ['species']                               # a mixture's (doc/RHEOLOGY.md "Per species"):
+                                                  # shares of the quantities, phi_s(y), g_ab(r)
 """
 import json
 import math
