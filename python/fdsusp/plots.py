@@ -21,7 +21,7 @@ from .rheology import setup_key, stick_number
 
 def run_figures(runs, directory):
     """Per run: <name>_run.png (core stress against strain, phi(y) and u_x(y), g(theta) and
-    g_c(theta)); over two runs or more: rheology_vs_phi.png (eta_r, N1/tau, N2/tau against phi_core,
+    g_c(theta)); for a mixture also <name>_species.png (species_figure); over two runs or more: rheology_vs_phi.png (eta_r, N1/tau, N2/tau against phi_core,
     one series per friction coefficient)."""
     import matplotlib
     matplotlib.use('Agg')
@@ -79,6 +79,8 @@ def run_figures(runs, directory):
         fig.tight_layout()
         fig.savefig(os.path.join(directory, f'{name}_run.png'), dpi=110)
         plt.close(fig)
+        if 'species' in summ:
+            species_figure(plt, name, a, summ, directory)
     if len(runs) > 1:
         fig, ax = plt.subplots(1, 3, figsize=(15, 4))
         frictions = sorted({a.get('friction', 0.0) for _, a, _, _ in runs})
@@ -100,6 +102,53 @@ def run_figures(runs, directory):
         fig.tight_layout()
         fig.savefig(os.path.join(directory, 'rheology_vs_phi.png'), dpi=110)
         plt.close(fig)
+
+
+def species_figure(plt, name, a, summ, directory):
+    """A mixture's <name>_species.png (doc/RHEOLOGY.md "Per species"): phi_s(y) of each species with
+    the pooled phi(y) (segregation across the gap), the partial pair distributions g_ab(r) with
+    their block errors, and each species' share of eta_r - 1, N1/tau, N2/tau, Pi/tau."""
+    sp = summ['species']
+    radius = sp['radius']
+    ns = len(radius)
+    fig, ax = plt.subplots(1, 3, figsize=(16, 4.2))
+    p = summ['profiles']
+    ax[0].plot(p['y'], p['solid_fraction'], 'k', lw=1.2, label=r'$\phi(y)$, all')
+    for j in range(ns):
+        ax[0].plot(p['y'], sp['profiles']['solid_fraction'][j], label=rf'$\phi_{j + 1}(y)$, a = {radius[j]:g}')
+    if a['core_lo'] > 0:
+        ax[0].axvspan(a['core_lo'], a['core_hi'], color='0.92')
+    ax[0].set_xlabel('y / a')
+    ax[0].set_ylabel('volume fraction')
+    ax[0].legend(fontsize=7)
+    pd = sp['pair_distribution']
+    r = np.asarray(pd['r'], dtype=float)
+    g = np.asarray(pd['g'], dtype=float)
+    ge = np.asarray(pd['g_error'], dtype=float)
+    for i in range(ns):
+        for j in range(i, ns):
+            line, = ax[1].plot(r, g[i, j], lw=1, label=rf'$g_{{{i + 1}{j + 1}}}(r)$')
+            ax[1].fill_between(r, g[i, j] - ge[i, j], g[i, j] + ge[i, j], color=line.get_color(), alpha=0.25, lw=0)
+            ax[1].axvline(radius[i] + radius[j], color=line.get_color(), ls=':', lw=0.8)
+    ax[1].axhline(1.0, color='k', lw=0.6)
+    ax[1].set_xlabel('r / a (a the smallest radius; dotted: contact)')
+    ax[1].set_ylabel('partial pair distribution')
+    ax[1].legend(fontsize=7)
+    names = ['eta_r-1', 'N1/tau', 'N2/tau', 'Pi/tau']
+    x = np.arange(len(names))
+    width = 0.8 / ns
+    for j in range(ns):
+        ax[2].bar(x + (j - (ns - 1) / 2) * width, [sp['quantities'][n]['value'][j] for n in names], width,
+                  yerr=[sp['quantities'][n]['error'][j] for n in names], capsize=3, label=f'a = {radius[j]:g}')
+    ax[2].set_xticks(x)
+    ax[2].set_xticklabels(names)
+    ax[2].axhline(0.0, color='k', lw=0.6)
+    ax[2].set_ylabel('share of the particle stress')
+    ax[2].legend(fontsize=7)
+    fig.suptitle(f'{name}: per species (shares add up to the pooled values)')
+    fig.tight_layout()
+    fig.savefig(os.path.join(directory, f'{name}_species.png'), dpi=110)
+    plt.close(fig)
 
 
 def strain_figure(paths, directory):

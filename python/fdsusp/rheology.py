@@ -8,6 +8,8 @@ standard deviation over the complete blocks (ddof 1) / sqrt(blocks). No plotting
     summ = rheology.summarise(a, s)               # or summarise(with_window(a, 2, 20, 5), s)
     summ['quantities']['eta_r']                   # {'value': ..., 'error': ...}
     rheology.compare(summ, 'out/demo/summary.json')   # [] when the program agrees to 1e-10
+    summ['species']                               # a mixture's (doc/RHEOLOGY.md "Per species"):
+                                                  # shares of the quantities, phi_s(y), g_ab(r)
 """
 import json
 import math
@@ -30,6 +32,13 @@ NAMES = ['eta_r', 'eta_h', 'eta_c', 'N1/tau', 'N2/tau', 'Pi/tau',
          'I_v', 'mu', 'mu_h', 'mu_c', 'phi_core', 'gamma_dot_core', 'tau',
          'Sigma_xy/tau', 'Sigma_xy_c/tau', 'Pi_h/tau', 'N1_h/tau', 'gamma_dot_flow']
 
+
+# a mixture's per-species shares of the pooled quantities, as mod_rheology::rheo_species_quantities
+SPECIES_NAMES = ['eta_r-1', 'eta_h-1', 'eta_c', 'N1/tau', 'N2/tau', 'Pi/tau', 'N1_h/tau', 'N2_h/tau', 'Pi_h/tau',
+                 'N1_c/tau', 'N2_c/tau', 'Pi_c/tau', 'phi_core']
+# a mixture's per-species series columns (doc/RHEOLOGY.md "Per species")
+SPECIES_COLUMNS = ['species/stress_hydro', 'species/stress_contact', 'species/solid_fraction', 'species/references',
+                   'species/profile_solid_fraction', 'species/pair_counts', 'species/pair_volumes']
 
 NAN = float('nan')
 
@@ -84,6 +93,100 @@ def quantities(m, shear_rate):
     return np.array(q)
 
 
+def species_quantities(m, ms):
+    """One species' shares of the pooled quantities: m the 21 pooled (block-)mean values, ms the
+    species' 11 (stress_hydro 5, stress_contact 5, phi_core,s); stresses over the pooled
+    gamma_dot_core and tau, so that the species' shares add up to the pooled eta_r - 1, N1/tau, ..."""
+    gd = slope(m[11:16])
+    tau = (1.0 + (m[3] + m[8]) / gd) * gd
+    sh, sc = np.asarray(ms[0:5]), np.asarray(ms[5:10])
+    sp = sh + sc
+    q = [sp[3] / gd, sh[3] / gd, sc[3] / gd]
+    for t in (sp, sh, sc):
+        q += [(t[0] - t[1]) / tau, (t[1] - t[2]) / tau, -t[4] / 3.0 / tau]
+    return np.array(q + [ms[10]])
+
+
+def species_values(s):
+    """Per record and species, the 11 values species_quantities() takes: shape (records, species, 11)."""
+    return np.concatenate([s['species/stress_hydro'], s['species/stress_contact'], s['species/solid_fraction'][:, :, None]],
+                          axis=2)
+
+
+def partial_g(a, counts, references, phi_core, volumes=None):
+    """g[a, b, k] = C_ab(k) / (n_b S_ab(k)), n_b = (phi_core,b / v_b) (N_b - delta_ab) / N_b (the core's
+    number density of species b without the reference itself), S_ab(k) the shell volume around the
+    references where a centre of b can be: R_a V_k, or between walls the sampled volumes[a, b, k];
+    counts[a, b, k]."""
+    ns, nr = counts.shape[0], counts.shape[2]
+    width = a['radial_width'] * a['radius']
+    k = np.arange(1, nr + 1)
+    shell = 4.0 / 3.0 * math.pi * width ** 3 * (k ** 3 - (k - 1) ** 3)
+    if volumes is None:
+        volumes = references[:, None, None] * np.ones((ns, ns, 1)) * shell
+    radius = np.array([a['species_radius_%d' % (j + 1)] for j in range(ns)]) * a['radius']
+    count = np.array([a['species_count_%d' % (j + 1)] for j in range(ns)])
+    g = np.full(counts.shape, NAN)
+    for i in range(ns):
+        for j in range(ns):
+            density = phi_core[j] / (4.0 / 3.0 * math.pi * radius[j] ** 3) * (count[j] - (i == j)) / count[j]
+            if density > 0 and np.all(volumes[i, j] > 0):
+                g[i, j] = counts[i, j] / (density * volumes[i, j])
+    return g
+
+
+def summarise_species(a, s, block, complete, nrec):
+    """The per-species summary of a mixture (mod_rheology::rheo_summarise_species): quantities
+    (value, error per species), profiles phi_s(y), their block errors and n_s(y), and g_ab(r)
+    with its block errors, over the complete blocks."""
+    ns = int(a['species'])
+    radius = np.array([a['species_radius_%d' % (j + 1)] for j in range(ns)]) * a['radius']
+    values, sv = core_values(s), species_values(s)
+    counts = s.get('species/pair_counts')
+    nr = counts.shape[3] if counts is not None else 0
+    out = {'radius': [a['species_radius_%d' % (j + 1)] for j in range(ns)],
+           'count': [a['species_count_%d' % (j + 1)] for j in range(ns)],
+           'quantities': {n: {'value': np.full(ns, NAN), 'error': np.full(ns, NAN)} for n in SPECIES_NAMES},
+           'profiles': {}, 'pair_distribution': {'radial_width': a['radial_width'],
+                                                 'r': (np.arange(nr) + 0.5) * a['radial_width']}}
+    nbins = s['species/profile_solid_fraction'].shape[2]
+    nan_prof = np.full((ns, nbins), NAN)
+    out['profiles'] = {'solid_fraction': nan_prof, 'solid_fraction_error': nan_prof, 'number_density': nan_prof}
+    out['pair_distribution'].update({'g': np.full((ns, ns, nr), NAN), 'g_error': np.full((ns, ns, nr), NAN)})
+    if complete == 0:
+        return out
+    sel = [block == b for b in range(complete)]
+    means = [values[m].mean(axis=0) for m in sel]
+    smeans = [sv[m].mean(axis=0) for m in sel]
+    per_block = np.array([[species_quantities(m, ms[j]) for j in range(ns)] for m, ms in zip(means, smeans)])
+    mean, smean = np.mean(means, axis=0), np.mean(smeans, axis=0)
+    value = np.array([species_quantities(mean, smean[j]) for j in range(ns)])
+    error = per_block.std(axis=0, ddof=1) / math.sqrt(complete) if complete > 1 else np.full(value.shape, NAN)
+    for k, n in enumerate(SPECIES_NAMES):
+        out['quantities'][n] = {'value': value[:, k], 'error': error[:, k]}
+    prof = s['species/profile_solid_fraction']
+    inside = (block >= 0) & (block < complete)
+    phi = prof[inside].sum(axis=0) / nrec
+    phi_blocks = np.array([prof[m].mean(axis=0) for m in sel])
+    out['profiles'] = {'solid_fraction': phi,
+                       'solid_fraction_error': phi_blocks.std(axis=0, ddof=1) / math.sqrt(complete)
+                       if complete > 1 else nan_prof,
+                       'number_density': phi / (4.0 / 3.0 * math.pi * radius[:, None] ** 3)}
+    if nr > 0:
+        refs = s['species/references']
+        vol = s.get('species/pair_volumes')     # between walls: the sampled shell volumes
+
+        def volumes(m):
+            return vol[m].sum(axis=0) if vol is not None else None
+        g = partial_g(a, counts[inside].sum(axis=0), refs[inside].sum(axis=0), smean[:, 10], volumes(inside))
+        g_blocks = np.array([partial_g(a, counts[m].sum(axis=0), refs[m].sum(axis=0), ms[:, 10], volumes(m))
+                             for m, ms in zip(sel, smeans)])
+        out['pair_distribution']['g'] = g
+        if complete > 1:
+            out['pair_distribution']['g_error'] = g_blocks.std(axis=0, ddof=1) / math.sqrt(complete)
+    return out
+
+
 def load(outdir):
     """(a, s): the settings of a run (attributes written by fdsusp, as numbers) and its series
     (the columns the statistics use); records still in series.parts/ (a running or killed run)
@@ -94,8 +197,11 @@ def load(outdir):
     # the crystalline order, when the run measured it (doc/RHEOLOGY.md "Order")
     order = ['structure/q6', 'structure/q6_local']
     try:
-        if all(n in series.names(outdir) for n in order):
+        present = series.names(outdir)
+        if all(n in present for n in order):
             names += order
+        # a mixture's per-species columns (doc/RHEOLOGY.md "Per species")
+        names += [n for n in SPECIES_COLUMNS if n in present]
         s, attrs = series.read(outdir, names)
     except KeyError:
         raise NoRheology(f'{outdir}/series.h5 holds no core statistics: the run had no &rheology')
@@ -146,8 +252,10 @@ def strain_windows(a, s, width, names):
 def as_json(a, summ):
     """A recomputed summary with the keys of fdsusp's summary.json (NaN as null)."""
     def clean(x):
+        if np.ndim(x) > 1:
+            return [clean(v) for v in x]
         return [None if not math.isfinite(v) else float(v) for v in x]
-    return {'program': 'scripts/rheology.py', 'complete': summ['blocks_complete'] == summ['blocks'],
+    out = {'program': 'scripts/rheology.py', 'complete': summ['blocks_complete'] == summ['blocks'],
             'blocks': summ['blocks'], 'blocks_complete': summ['blocks_complete'],
             'discard_step': int(a['discard_step']), 'block_steps': int(a['block_steps']),
             'last_step': summ['last_step'], 'records_per_block': summ['records_per_block'], 'core': [a['core_lo'], a['core_hi']], 'shear_rate': a['shear_rate'],
@@ -156,6 +264,14 @@ def as_json(a, summ):
             'profiles': {k: clean(v) for k, v in summ['profiles'].items()},
             'pair_distribution': {'r_outer': a['pair_radius'], 'r_contact': a['contact_radius'],
                                   **{k: clean(v) for k, v in summ['pair_distribution'].items()}}}
+    if 'species' in summ:
+        sp = summ['species']
+        out['species'] = {'radius': sp['radius'], 'count': sp['count'],
+                          'quantities': {n: {k: clean(v) for k, v in q.items()} for n, q in sp['quantities'].items()},
+                          'profiles': {k: clean(v) for k, v in sp['profiles'].items()},
+                          'pair_distribution': {k: (clean(v) if np.ndim(v) else v)
+                                                for k, v in sp['pair_distribution'].items()}}
+    return out
 
 
 def summarise(a, s):
@@ -192,6 +308,12 @@ def summarise(a, s):
         phi = phi_sum / nrec
         dtheta = 2 * math.pi / nang
         n_core = value[25] / (4.0 / 3.0 * math.pi * a['radius'] ** 3)
+        if a.get('species', 1) > 1:
+            # a mixture: the core's number density from the mean sphere volume (doc/RHEOLOGY.md)
+            ns = int(a['species'])
+            count = [a['species_count_%d' % (j + 1)] for j in range(ns)]
+            volume = [4.0 / 3.0 * math.pi * (a['species_radius_%d' % (j + 1)] * a['radius']) ** 3 for j in range(ns)]
+            n_core = value[25] / (np.dot(count, volume) / sum(count))
         refs = s['pairs/references'][inside].sum()
         shells = [(r ** 3 - (2 * a['radius']) ** 3) / 3.0 * dtheta * 2 * math.sin(0.5 * dtheta)
                   for r in (a['pair_radius'], a['contact_radius'])]
@@ -200,11 +322,14 @@ def summarise(a, s):
     else:
         phi = velocity = np.full(nbins, NAN)
         g = gc = np.full(nang, NAN)
-    return {'blocks': blocks, 'blocks_complete': complete, 'last_step': last_step,
-            'records_per_block': [float(r) for r in records],
-            'quantities': {n: {'value': v, 'error': e} for n, v, e in zip(NAMES, value, error)},
-            'profiles': {'y': y, 'solid_fraction': phi, 'velocity': velocity},
-            'pair_distribution': {'theta': theta, 'g': g, 'g_contact': gc}}
+    out = {'blocks': blocks, 'blocks_complete': complete, 'last_step': last_step,
+           'records_per_block': [float(r) for r in records],
+           'quantities': {n: {'value': v, 'error': e} for n, v, e in zip(NAMES, value, error)},
+           'profiles': {'y': y, 'solid_fraction': phi, 'velocity': velocity},
+           'pair_distribution': {'theta': theta, 'g': g, 'g_contact': gc}}
+    if a.get('species', 1) > 1:
+        out['species'] = summarise_species(a, s, block, complete, nrec)
+    return out
 
 
 def differs(x, y, tol=1e-10):
@@ -233,6 +358,25 @@ def compare(ours, path):
             for i, (x, y) in enumerate(zip(theirs[group][k], ours[group][k])):
                 if differs(x, y):
                     bad.append(f'{group}/{k}[{i}]: {x} vs {y}')
+                    break
+    if ('species' in theirs) != ('species' in ours):
+        bad.append('species: in one summary only')
+    elif 'species' in ours:
+        a, b = theirs['species'], ours['species']
+        pairs = [(f'species {n} {part}', a['quantities'][n][part], b['quantities'][n][part])
+                 for n in SPECIES_NAMES for part in ('value', 'error')]
+        pairs += [(f'species profiles/{k}', a['profiles'][k], b['profiles'][k]) for k in a['profiles']]
+        pairs += [(f'species pair_distribution/{k}', a['pair_distribution'][k], b['pair_distribution'][k])
+                  for k in ('r', 'g', 'g_error')]
+        for what, x, y in pairs:
+            x = np.array([np.nan if v is None else v for v in np.ravel(np.array(x, dtype=object))], dtype=float)
+            y = np.ravel(np.asarray(y, dtype=float))
+            if x.shape != y.shape:
+                bad.append(f'{what}: shapes {x.shape} vs {y.shape}')
+                continue
+            for i, (u, v) in enumerate(zip(x, y)):
+                if differs(u, v):
+                    bad.append(f'{what}[{i}]: {u} vs {v}')
                     break
     return bad
 

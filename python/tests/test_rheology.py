@@ -129,3 +129,71 @@ def test_records_helpers(tmp_path):
     q.write_text(json.dumps({'complete': True}))
     recs = rheology.load_records([str(p), str(q)])
     assert [r[0] for r in recs] == ['r1']
+
+
+def mixture(outdir, walls=False):
+    """The synthetic series as a mixture of two species (radii 1 and 1.4, 30 and 10 spheres):
+    species 1 carries 0.3 of every stress and phi, species 2 0.7; the pair counts are the ideal
+    mixture's expected counts exactly (n_b (N_b - delta_ab)/N_b times the references' shells), so
+    every g_ab is 1. walls: the shells given as sampled volumes (species/pair_volumes) instead."""
+    attrs = dict(ATTRS, species=2.0, radial_width=0.05, species_radius_1=1.0, species_radius_2=1.4,
+                 species_count_1=30.0, species_count_2=10.0)
+    synthetic(outdir, attrs=attrs)
+    path = os.path.join(outdir, 'series.h5')
+    cols, _ = rheology.series.read(outdir)
+    n, nr = len(cols['step']), 20
+    share = np.array([0.3, 0.7])
+    refs = np.tile([6.0, 4.0], (n, 1))
+    k = np.arange(1, nr + 1)
+    shell = 4.0 / 3.0 * math.pi * 0.05 ** 3 * (k ** 3 - (k - 1) ** 3)
+    volume = 4.0 / 3.0 * math.pi * np.array([1.0, 1.4]) ** 3
+    phi = 0.4 * share
+    counts = np.zeros((n, 2, 2, nr))
+    volumes = np.zeros((n, 2, 2, nr))
+    for a in range(2):
+        for b in range(2):
+            density = phi[b] / volume[b] * ([30.0, 10.0][b] - (a == b)) / [30.0, 10.0][b]
+            volumes[:, a, b] = refs[:, a, None] * shell * (0.8 if walls else 1.0)
+            counts[:, a, b] = density * volumes[:, a, b]
+    cols.update({'species/stress_hydro': cols['core/stress_hydro'][:, None, :] * share[None, :, None],
+                 'species/stress_contact': cols['core/stress_contact'][:, None, :] * share[None, :, None],
+                 'species/solid_fraction': np.tile(phi, (n, 1)), 'species/references': refs,
+                 'species/profile_solid_fraction': cols['profiles/solid_fraction'][:, None, :] * share[None, :, None],
+                 'species/pair_counts': counts})
+    if walls:
+        cols['species/pair_volumes'] = volumes
+    write_series(path, cols, attrs)
+    return outdir
+
+
+@pytest.mark.parametrize('walls', [False, True])
+def test_species(tmp_path, walls):
+    d = mixture(str(tmp_path), walls)
+    a, s = rheology.load(d)
+    summ = rheology.summarise(a, s)
+    sp = summ['species']
+    q = summ['quantities']
+    # the species' shares add up to the pooled quantities, 0.3 and 0.7 of them
+    assert sum(sp['quantities']['eta_r-1']['value']) == pytest.approx(q['eta_r']['value'] - 1, rel=1e-14)
+    assert sp['quantities']['eta_c']['value'] == pytest.approx([0.15, 0.35], rel=1e-14)
+    assert sum(sp['quantities']['N2/tau']['value']) == pytest.approx(q['N2/tau']['value'], rel=1e-14)
+    assert sum(sp['quantities']['phi_core']['value']) == pytest.approx(q['phi_core']['value'], rel=1e-14)
+    assert np.allclose(np.sum(sp['profiles']['solid_fraction'], axis=0), summ['profiles']['solid_fraction'], rtol=1e-14)
+    assert np.allclose(sp['profiles']['number_density'][1], 0.28 / (4.0 / 3.0 * math.pi * 1.4 ** 3), rtol=1e-14)
+    # the ideal mixture's counts give g_ab = 1, with no scatter over the blocks
+    assert np.allclose(sp['pair_distribution']['g'], 1.0, rtol=1e-12)
+    assert np.allclose(sp['pair_distribution']['g_error'], 0.0, atol=1e-12)
+    # summary.json round trip with the species object; a changed g is found
+    with open(os.path.join(d, 'summary.json'), 'w') as f:
+        json.dump(rheology.as_json(a, summ), f)
+    assert rheology.compare(summ, os.path.join(d, 'summary.json')) == []
+    sp['pair_distribution']['g'][1, 0, 3] *= 1 + 1e-9
+    assert rheology.compare(summ, os.path.join(d, 'summary.json'))[0].startswith('species pair_distribution/g')
+
+
+def test_species_figure(tmp_path):
+    from fdsusp import plots
+    d = mixture(str(tmp_path / 'mix'))
+    a, s = rheology.load(d)
+    plots.run_figures([(d, a, s, rheology.summarise(a, s))], str(tmp_path / 'plots'))
+    assert os.path.exists(os.path.join(str(tmp_path / 'plots'), 'mix_species.png'))

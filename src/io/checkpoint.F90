@@ -610,7 +610,8 @@ contains
     end if
     call dataset_dims(file, 'rheology/accumulators', rank, dims)
     if (rank /= 2 .or. dims(1) /= size(rheo_state(rh)) .or. dims(2) /= 1) &
-      message = 'does not fit this deck''s &rheology (blocks, profile_bins or angle_bins differ)'
+      message = 'does not fit this deck''s &rheology (blocks, profile_bins or angle_bins differ, or a mixture''s '// &
+                'checkpoint predates the per-species statistics, doc/RHEOLOGY.md "Per species")'
   end subroutine rheology_verdict
 
   ! Restore STATE from the checkpoint PATH (checked before by checkpoint_check). The statistics of

@@ -23,7 +23,8 @@ module mod_run_output
   use mod_particles_io, only: particles_snapshot
   use mod_particle_contacts, only: particle_contacts_t, particle_contacts_columns
   use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_columns
-  use mod_rheology, only: rheology_t, rheo_accumulate, rheo_summarise, rheo_columns, summary_names, NSUMMARY
+  use mod_rheology, only: rheology_t, rheo_accumulate, rheo_summarise, rheo_columns, summary_names, NSUMMARY, &
+                          species_summary_t, rheo_summarise_species
   use mod_summary_io, only: summary_write
   use mod_lees_edwards, only: lees_edwards_t, le_columns
   implicit none
@@ -70,6 +71,9 @@ contains
     type(particle_lubrication_t), target, intent(in), optional :: lubrication
     type(rheology_t), target, intent(in), optional :: rheology
     real(dp) :: friction, roughness
+    character(len=32), allocatable :: names(:)
+    real(dp), allocatable :: values(:)
+    integer :: k
     out%cfg = cfg
     out%state = state
     out%checkpoint_path = trim(cfg%output%directory)//'/checkpoint.h5'
@@ -92,17 +96,38 @@ contains
         friction = cfg%contact%friction
         roughness = cfg%contact%roughness
       end if
-      call series_attributes(out%series, [character(len=32) :: 'box_x', 'box_y', 'box_z', 'radius', 'shear_rate', &
+      names = [character(len=32) :: 'box_x', 'box_y', 'box_z', 'radius', 'shear_rate', &
            'dt', 'core_lo', 'core_hi', 'pair_radius', 'contact_radius', 'blocks', 'discard_step', 'block_steps', &
-           'series_every', 'friction', 'roughness'], [cfg%domain%box, cfg%radius, cfg%domain%shear_rate, &
+           'series_every', 'friction', 'roughness']
+      values = [cfg%domain%box, cfg%radius, cfg%domain%shear_rate, &
            cfg%time%dt, out%rheology%core, out%rheology%r_outer, out%rheology%r_contact, &
            real([cfg%rheology%blocks, cfg%discard_step, cfg%block_steps, cfg%output%series_every], dp), &
-           friction, roughness])
+           friction, roughness]
+      if (out%rheology%nspecies > 1) then
+        ! a mixture's species (radius [a] and number of spheres) and the bins of g_ab(r)
+        ! (doc/RHEOLOGY.md "Per species"); equal spheres have none of these
+        names = [names, [character(len=32) :: 'species', 'radial_width']]
+        values = [values, real(out%rheology%nspecies, dp), out%rheology%radial_width / out%rheology%radius]
+        do k = 1, out%rheology%nspecies
+          names = [names, [character(len=32) :: species_attribute('species_radius_', k), &
+                                                species_attribute('species_count_', k)]]
+          values = [values, out%rheology%species_radius(k) / out%rheology%radius, out%rheology%species_count(k)]
+        end do
+      end if
+      call series_attributes(out%series, names, values)
     end if
     ! from the start: an empty series; from a checkpoint: its records up to the checkpoint's step
     call series_open(out%series, cfg%output%directory, merge(step, -1, restarting), &
                      (cfg%time%steps - step) / cfg%output%series_every)
   end subroutine run_output_open
+
+  ! name_k, the attribute of species k
+  pure function species_attribute(name, k) result(s)
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: k
+    character(len=32) :: s
+    write(s, '(a,i0)') name, k
+  end function species_attribute
 
   ! The output of step (time), on the deck's &output cadences.
   subroutine run_output_step(out, step, time, ierr)
@@ -248,6 +273,7 @@ contains
     integer :: err, k, q, complete
     real(dp) :: value(NSUMMARY), error(NSUMMARY)
     real(dp), allocatable :: profile(:, :), angles(:, :)
+    type(species_summary_t) :: species
     character(len=1100) :: path
     character(len=200) :: text
     character(len=20), parameter :: shown(14) = [character(len=20) :: 'eta_r', 'eta_h', 'eta_c', 'N1/tau', &
@@ -255,7 +281,12 @@ contains
     if (.not. is_root()) return
     path = trim(out%cfg%output%directory)//'/summary.json'
     call rheo_summarise(out%rheology, step, complete, value, error, profile, angles)
-    call summary_write(out%rheology, path, step, complete, value, error, profile, angles, err)
+    if (out%rheology%nspecies > 1) then
+      call rheo_summarise_species(out%rheology, step, species)
+      call summary_write(out%rheology, path, step, complete, value, error, profile, angles, err, species)
+    else
+      call summary_write(out%rheology, path, step, complete, value, error, profile, angles, err)
+    end if
     if (err /= 0) call abort_run(trim(path)//' cannot be written: '// &
                                  write_failure_cause(out%cfg%output%directory, 0.0_dp))
     write(text, '(a,i0,a,i0,a)') 'rheology of the core region (', complete, ' of ', out%cfg%rheology%blocks, &

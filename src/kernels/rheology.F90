@@ -27,6 +27,17 @@
 ! r < pair_shell (a_i + a_j)/2 and r < a_i + a_j + contact_shell a, and Q6 bonds are shorter than
 ! 1.4 (a_i + a_j). Equal spheres keep the arithmetic of one radius.
 !
+! Per species (two or more distinct radii, smallest first; doc/RHEOLOGY.md "Per species"): the
+! same sums restricted to the spheres of each species s, so that they add up to the pooled ones,
+!     Sigma^h_s, Sigma^c_s = (1/V_core) sum_{i in s} w_i S_i,   phi_core,s,   phi_s(y),
+! the references (core centres) of each species, and the partial pair counts C_ab(r) (partners of
+! species b at r from the references of species a, in bins of radial_width up to radial_range, over
+! the whole box and across the periodic and sliding boundaries) that give the partial pair
+! distribution g_ab(r) = C_ab / (n_b S_ab), n_b = (phi_core,b / v_b) (N_b - delta_ab) / N_b, S_ab
+! the volume of the shells around the references of a where a centre of b can be: R_a V_shell with
+! Lees-Edwards boundaries, between walls their parts within [a_b, Ly - a_b] (kept per record).
+! Equal spheres measure none of it (no arrays, no columns, no accumulators).
+!
 ! Statistics (paper §4, "five statistically independent time-segments"): the records after
 ! discard_step are split into `blocks` blocks of block_steps steps; a block's mean is taken over
 ! its records, every summary quantity is evaluated on each complete block's means (the error: the
@@ -44,6 +55,19 @@ module mod_rheology
   ! bonds of Q6: shorter than bond_factor (a_i + a_j)
   real(dp), parameter :: bond_factor = 1.4_dp
 
+  ! per-species summary: the shares of the pooled quantities (doc/RHEOLOGY.md "Per species")
+  integer, parameter :: NSPECIES_Q = 13
+  character(len=20), parameter :: species_names(NSPECIES_Q) = [character(len=20) :: &
+       'eta_r-1', 'eta_h-1', 'eta_c', 'N1/tau', 'N2/tau', 'Pi/tau', 'N1_h/tau', 'N2_h/tau', 'Pi_h/tau', &
+       'N1_c/tau', 'N2_c/tau', 'Pi_c/tau', 'phi_core']
+  ! per-species values of a record: stress_hydro(5), stress_contact(5), phi_core,s
+  integer, parameter :: NQS = 11
+  ! partial g(r): bins of radial_width [a], up to the box's half periodic length less the search
+  ! skin and at most radial_cap [a] (past the second shell of radii 1 and 1.4, 5.6 a; the cap keeps
+  ! the pair search O(N) in large boxes)
+  real(dp), parameter :: radial_width = 0.05_dp, radial_cap = 6.0_dp
+
+  public :: species_summary_t, rheo_summarise_species, rheo_species_quantities, NSPECIES_Q, NQS, species_names
   public :: rheology_settings_t, rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, rheo_quantities, rheo_block_of, &
             rheo_state, rheo_restore, rheo_summarise, rheo_columns, NQ, NSUMMARY, summary_names, slab_volume
 
@@ -114,7 +138,43 @@ module mod_rheology
     integer :: nbond_pairs = 0, nbond_walls = 0
     integer, allocatable :: bond_pairs(:, :), bond_walls(:, :)
     real(dp) :: q6 = 0, q6_local = 0
+    ! per species (nspecies >= 2 only; doc/RHEOLOGY.md "Per species"): each species' radius and
+    ! number of spheres, each sphere's species; this record's sums restricted to a species, and
+    ! their accumulators per block
+    integer :: nspecies = 1
+    real(dp), allocatable :: species_radius(:), species_count(:)   ! (nspecies)
+    integer, allocatable :: species_of(:)                          ! (n)
+    real(dp), allocatable :: species_values(:, :)                  ! (NQS, nspecies)
+    real(dp), allocatable :: species_profile(:, :)                 ! (nbins, nspecies): phi_s(y)
+    real(dp), allocatable :: species_references(:)                 ! (nspecies)
+    real(dp), allocatable :: block_species_values(:, :, :)         ! (NQS, nspecies, blocks)
+    real(dp), allocatable :: block_species_profile(:, :, :)        ! (nbins, nspecies, blocks)
+    real(dp), allocatable :: block_species_references(:, :)        ! (nspecies, blocks)
+    ! partial pair counts (k, partner's species, reference's species), when the box allows a range
+    integer :: nradial = 0
+    real(dp) :: radial_width = 0, radial_range = 0   ! [length]
+    type(nlist_t) :: radial_list
+    integer :: nradial_pairs = 0, nradial_walls = 0
+    integer, allocatable :: radial_pairs(:, :), radial_walls(:, :)
+    real(dp), allocatable :: radial(:, :, :)                       ! (nradial, nspecies, nspecies)
+    real(dp), allocatable :: block_radial(:, :, :, :)              ! (nradial, nspecies, nspecies, blocks)
+    ! between walls, the shell volumes around the references where a partner's centre can be, as
+    ! radial (Lees-Edwards: none, every shell is whole)
+    integer :: nradial_volume = 0
+    real(dp), allocatable :: radial_volume(:, :, :)                ! (nradial_volume, nspecies, nspecies)
+    real(dp), allocatable :: block_radial_volume(:, :, :, :)       ! (nradial_volume, nspecies, nspecies, blocks)
   end type rheology_t
+
+  ! The per-species summary over the complete blocks (rheo_summarise_species): value and error of
+  ! each species' share of the pooled quantities, phi_s(y) with its block error and the number
+  ! density n_s(y) = phi_s(y) / v_s, and the partial pair distribution g(r, b, a) = g_ab(r) (a the
+  ! reference's species) with its block error.
+  type :: species_summary_t
+    real(dp), allocatable :: value(:, :), error(:, :)              ! (NSPECIES_Q, nspecies)
+    real(dp), allocatable :: phi(:, :), phi_error(:, :), number(:, :)   ! (nbins, nspecies)
+    real(dp), allocatable :: r(:)                                  ! (nradial) bin centres [a]
+    real(dp), allocatable :: g(:, :, :), g_error(:, :, :)          ! (nradial, nspecies, nspecies)
+  end type species_summary_t
 
 contains
 
@@ -172,7 +232,64 @@ contains
     call nlist_init(r%bond_list, n, box, [.true., r%le%active, .true.], r%bond_range * a_max / radius + skin, &
                     a_max + skin, skin, bond_info, r%le)
     r%order = bond_info == 0
+    if (r%sized) call create_species(r, n, a_max, skin)
   end subroutine rheo_create
+
+  ! The species of a mixture (distinct radii, smallest first), each sphere's species, and the
+  ! per-species arrays and accumulators; the range of the partial g(r) (doc/RHEOLOGY.md "Per
+  ! species"): half the smallest periodic length less the search skin (minimum image), at most
+  ! radial_cap; in bins of radial_width. No bins when that leaves none. Between walls a shell may
+  ! reach past them: its part where a partner's centre can be is summed per record instead.
+  subroutine create_species(r, n, a_max, skin)
+    type(rheology_t), intent(inout) :: r
+    integer, intent(in) :: n
+    real(dp), intent(in) :: a_max, skin
+    real(dp) :: unique(n), range
+    integer :: i, s, info
+    r%nspecies = 0
+    do i = 1, n
+      if (any(unique(1:r%nspecies) == r%radii(i))) cycle
+      r%nspecies = r%nspecies + 1
+      unique(r%nspecies) = r%radii(i)
+    end do
+    ! smallest first (a handful of species: insertion order by minloc)
+    allocate(r%species_radius(r%nspecies), r%species_count(r%nspecies), r%species_of(n))
+    do s = 1, r%nspecies
+      i = minloc(unique(1:r%nspecies), 1)
+      r%species_radius(s) = unique(i)
+      unique(i) = huge(1.0_dp)
+    end do
+    do i = 1, n
+      r%species_of(i) = findloc(r%species_radius, r%radii(i), 1)
+    end do
+    do s = 1, r%nspecies
+      r%species_count(s) = count(r%species_of == s)
+    end do
+    allocate(r%species_values(NQS, r%nspecies), r%species_profile(r%nbins, r%nspecies), &
+             r%species_references(r%nspecies), r%block_species_values(NQS, r%nspecies, r%blocks), &
+             r%block_species_profile(r%nbins, r%nspecies, r%blocks), r%block_species_references(r%nspecies, r%blocks))
+    r%species_values = 0; r%species_profile = 0; r%species_references = 0
+    r%block_species_values = 0; r%block_species_profile = 0; r%block_species_references = 0
+    r%radial_width = radial_width * r%radius
+    range = min(r%box(1), r%box(3)) / 2 - skin
+    if (r%le%active) range = min(range, r%box(2) / 2 - skin)
+    range = min(range, radial_cap * r%radius)
+    r%nradial = max(0, int(range / r%radial_width))
+    r%radial_range = r%nradial * r%radial_width
+    if (r%nradial > 0) then
+      call nlist_init(r%radial_list, n, r%box, [.true., r%le%active, .true.], r%radial_range + skin, a_max + skin, &
+                      skin, info, r%le)
+      if (info /= 0) r%nradial = 0
+    end if
+    allocate(r%radial(r%nradial, r%nspecies, r%nspecies), r%block_radial(r%nradial, r%nspecies, r%nspecies, r%blocks))
+    r%radial = 0
+    r%block_radial = 0
+    r%nradial_volume = merge(0, r%nradial, r%le%active)
+    allocate(r%radial_volume(r%nradial_volume, r%nspecies, r%nspecies), &
+             r%block_radial_volume(r%nradial_volume, r%nspecies, r%nspecies, r%blocks))
+    r%radial_volume = 0
+    r%block_radial_volume = 0
+  end subroutine create_species
 
   !> The block of a record at step (0-based), or -1 outside the averaging window.
   pure integer function rheo_block_of(r, step) result(b)
@@ -205,8 +322,8 @@ contains
     real(dp), intent(in), optional :: offset
     real(dp) :: a, vp, v_core, w, y, u, dbin, d(3), dist, theta, sin_half, gap, vshift(3), ai, vi, phi, fit
     real(dp) :: r_outer, r_contact
-    integer :: n, i, b, b1, b2, k, p, i1, i2
-    logical :: ref_i, ref_j
+    integer :: n, i, b, b1, b2, k, p, i1, i2, sp
+    logical :: ref_i, ref_j, species
 
     n = size(position, 2)
     a = r%radius
@@ -216,6 +333,12 @@ contains
     r%profile = 0
     r%angles = 0
     r%references = 0
+    species = r%nspecies > 1
+    if (species) then
+      r%species_values = 0
+      r%species_profile = 0
+      r%species_references = 0
+    end if
     dbin = r%box(2) / r%nbins
     ai = a
     vi = vp
@@ -237,20 +360,36 @@ contains
           phi = phi + w * vi
           fit = w * vi / vp
           r%values(12:16) = r%values(12:16) + fit * [1.0_dp, y, u, y * y, y * u]
+          if (species) then
+            ! the same terms, restricted to sphere i's species
+            sp = r%species_of(i)
+            r%species_values(1:5, sp) = r%species_values(1:5, sp) + w * components(stresslet_hydro(:, :, i))
+            if (present(stresslet_contact)) &
+              r%species_values(6:10, sp) = r%species_values(6:10, sp) + w * components(stresslet_contact(:, :, i))
+            r%species_values(11, sp) = r%species_values(11, sp) + w * vi
+          end if
         else
           r%values(11) = r%values(11) + w
           r%values(12:16) = r%values(12:16) + w * [1.0_dp, y, u, y * y, y * u]
         end if
       end if
-      if (y >= r%core(1) .and. y < r%core(2)) r%references = r%references + 1
+      if (y >= r%core(1) .and. y < r%core(2)) then
+        r%references = r%references + 1
+        if (species) r%species_references(r%species_of(i)) = r%species_references(r%species_of(i)) + 1
+      end if
       b1 = max(1, int((y - ai) / dbin) + 1)
       b2 = min(r%nbins, int((y + ai) / dbin) + 1)
       do b = b1, b2
         w = slab_volume(y, ai, (b - 1) * dbin, b * dbin)
         r%profile(b, 1) = r%profile(b, 1) + w
         r%profile(b, 2) = r%profile(b, 2) + w * u
+        if (species) r%species_profile(b, r%species_of(i)) = r%species_profile(b, r%species_of(i)) + w
       end do
     end do
+    if (species) then
+      r%species_values = r%species_values / v_core
+      r%species_profile = r%species_profile / (r%box(1) * r%box(3) * dbin)
+    end if
     r%values(1:11) = r%values(1:11) / v_core
     r%values(11) = r%values(11) * vp
     if (r%sized) r%values(11) = phi / v_core
@@ -292,6 +431,7 @@ contains
       if (ref_j) call count_pair(modulo(theta + pi, 2 * pi))
     end do
     if (r%order) call sample_order(r, position)
+    if (species .and. r%nradial > 0) call sample_radial(r, position)
   contains
     subroutine count_pair(angle)
       real(dp), intent(in) :: angle
@@ -336,6 +476,13 @@ contains
     r%block_angles(:, :, b) = r%block_angles(:, :, b) + r%angles
     r%block_references(b) = r%block_references(b) + r%references
     r%block_records(b) = r%block_records(b) + 1
+    if (r%nspecies > 1) then
+      r%block_species_values(:, :, b) = r%block_species_values(:, :, b) + r%species_values
+      r%block_species_profile(:, :, b) = r%block_species_profile(:, :, b) + r%species_profile
+      r%block_species_references(:, b) = r%block_species_references(:, b) + r%species_references
+      r%block_radial(:, :, :, b) = r%block_radial(:, :, :, b) + r%radial
+      r%block_radial_volume(:, :, :, b) = r%block_radial_volume(:, :, :, b) + r%radial_volume
+    end if
   end subroutine rheo_accumulate
 
   !> The summary quantities of one set of (block-)mean values m(NQ), in the order of
@@ -381,6 +528,154 @@ contains
     q(33) = line_slope(m(17:21)) / shear_rate
   end function rheo_quantities
 
+  !> One species' shares of the pooled quantities (species_names), from the pooled (block-)mean
+  !> values m(NQ) and the species' own ms(NQS): its stresses over the pooled gamma_dot_core and tau,
+  !> so that the shares of all species add up to eta_r - 1, eta_h - 1, eta_c, N1/tau, ... and
+  !> phi_core (doc/RHEOLOGY.md "Per species").
+  pure function rheo_species_quantities(m, ms) result(q)
+    real(dp), intent(in) :: m(NQ), ms(NQS)
+    real(dp) :: q(NSPECIES_Q)
+    real(dp) :: sh(5), sc(5), sp(5), gd, tau
+    gd = line_slope(m(12:16))
+    tau = (1.0_dp + (m(4) + m(9)) / gd) * gd
+    sh = ms(1:5)
+    sc = ms(6:10)
+    sp = sh + sc
+    q(1:3) = [sp(4), sh(4), sc(4)] / gd
+    q(4:6) = [sp(1) - sp(2), sp(2) - sp(3), -sp(5) / 3.0_dp] / tau
+    q(7:9) = [sh(1) - sh(2), sh(2) - sh(3), -sh(5) / 3.0_dp] / tau
+    q(10:12) = [sc(1) - sc(2), sc(2) - sc(3), -sc(5) / 3.0_dp] / tau
+    q(13) = ms(11)
+  end function rheo_species_quantities
+
+  !> The blocks complete at last_step: those whose last step <= last_step and that hold records.
+  pure integer function complete_blocks(r, last_step) result(complete)
+    type(rheology_t), intent(in) :: r
+    integer, intent(in) :: last_step
+    integer :: b
+    complete = 0
+    do b = 1, r%blocks
+      if (r%discard_step + b * r%block_steps <= last_step .and. r%block_records(b) > 0) complete = b
+    end do
+  end function complete_blocks
+
+  !> Standard error over the first nb entries of x (ddof = 1, over sqrt(nb)); NaN below 2.
+  pure real(dp) function block_error(x, nb) result(e)
+    real(dp), intent(in) :: x(:)
+    integer, intent(in) :: nb
+    e = ieee_value(1.0_dp, ieee_quiet_nan)
+    if (nb > 1) e = sqrt(sum((x(1:nb) - sum(x(1:nb)) / nb)**2) / (nb - 1)) / sqrt(real(nb, dp))
+  end function block_error
+
+  !> The per-species summary of a mixture over the blocks complete at last_step (as rheo_summarise:
+  !> values from the mean of the block means, errors the standard deviation over blocks / sqrt):
+  !> each species' shares of the pooled quantities; phi_s(y) (records pooled, as phi(y)), its error
+  !> and n_s(y) = phi_s(y) / v_s; the partial pair distribution
+  !>     g_ab(r_k) = C_ab(k) / (n_b S_ab(k)),   n_b = (phi_core,b / v_b) (N_b - delta_ab) / N_b,
+  !> C_ab the partner counts of species b around the R_a references of species a, S_ab(k) the
+  !> volume of their shells of bin k where a centre of b can be: R_a V_k, V_k = (4/3) pi
+  !> (r_k^3 - r_k-1^3), with Lees-Edwards boundaries, the sampled sums between walls; n_b is the
+  !> core's number density of species b with the reference itself taken out of its own species,
+  !> so that an ideal mixture gives 1 at any N_b.
+  !> Not allocated for equal spheres.
+  subroutine rheo_summarise_species(r, last_step, ss)
+    type(rheology_t), intent(in) :: r
+    integer, intent(in) :: last_step
+    type(species_summary_t), intent(out) :: ss
+    integer :: complete, b, s, a, k, ns
+    real(dp), allocatable :: per_block(:, :, :), mean_values(:), mean_species(:, :), g_block(:, :, :, :)
+    real(dp), allocatable :: phi_block(:, :, :), refs(:)
+    real(dp) :: nan, records, v_s(r%nspecies), shell(r%nradial)
+    if (r%nspecies < 2) return
+    nan = ieee_value(1.0_dp, ieee_quiet_nan)
+    ns = r%nspecies
+    complete = complete_blocks(r, last_step)
+    v_s = 4.0_dp / 3.0_dp * pi * r%species_radius**3
+    do k = 1, r%nradial
+      shell(k) = 4.0_dp / 3.0_dp * pi * r%radial_width**3 * (real(k, dp)**3 - real(k - 1, dp)**3)
+    end do
+    allocate(ss%value(NSPECIES_Q, ns), ss%error(NSPECIES_Q, ns), ss%phi(r%nbins, ns), ss%phi_error(r%nbins, ns), &
+             ss%number(r%nbins, ns), ss%r(r%nradial), ss%g(r%nradial, ns, ns), ss%g_error(r%nradial, ns, ns))
+    ss%r = [((k - 0.5_dp) * r%radial_width / r%radius, k = 1, r%nradial)]
+    ss%value = nan; ss%error = nan; ss%phi = nan; ss%phi_error = nan; ss%number = nan; ss%g = nan; ss%g_error = nan
+    if (complete == 0) return
+    allocate(per_block(NSPECIES_Q, ns, complete), mean_values(NQ), mean_species(NQS, ns), &
+             g_block(r%nradial, ns, ns, complete), phi_block(r%nbins, ns, complete), refs(ns))
+    mean_values = 0
+    mean_species = 0
+    do b = 1, complete
+      mean_values = mean_values + r%block_sums(:, b) / r%block_records(b)
+      mean_species = mean_species + r%block_species_values(:, :, b) / r%block_records(b)
+      do s = 1, ns
+        per_block(:, s, b) = rheo_species_quantities(r%block_sums(:, b) / r%block_records(b), &
+                                                     r%block_species_values(:, s, b) / r%block_records(b))
+      end do
+      phi_block(:, :, b) = r%block_species_profile(:, :, b) / r%block_records(b)
+      g_block(:, :, :, b) = partial_g(r%block_radial(:, :, :, b), shells(r%block_species_references(:, b), &
+                                      r%block_radial_volume(:, :, :, b:b)), &
+                                      r%block_species_values(11, :, b) / r%block_records(b))
+    end do
+    mean_values = mean_values / complete
+    mean_species = mean_species / complete
+    records = sum(r%block_records(1:complete))
+    refs = sum(r%block_species_references(:, 1:complete), 2)
+    do s = 1, ns
+      ss%value(:, s) = rheo_species_quantities(mean_values, mean_species(:, s))
+      do k = 1, NSPECIES_Q
+        ss%error(k, s) = block_error(per_block(k, s, :), complete)
+      end do
+      ss%phi(:, s) = sum(r%block_species_profile(:, s, 1:complete), 2) / records
+      ss%number(:, s) = ss%phi(:, s) / v_s(s)
+      do k = 1, r%nbins
+        ss%phi_error(k, s) = block_error(phi_block(k, s, :), complete)
+      end do
+    end do
+    ss%g = partial_g(sum(r%block_radial(:, :, :, 1:complete), 4), &
+                     shells(refs, r%block_radial_volume(:, :, :, 1:complete)), mean_species(11, :))
+    do a = 1, ns
+      do s = 1, ns
+        do k = 1, r%nradial
+          ss%g_error(k, s, a) = block_error(g_block(k, s, a, :), complete)
+        end do
+      end do
+    end do
+  contains
+    ! S(k, b, a): the references' shell volumes, R_a V_k (Lees-Edwards), or the sampled sums over
+    ! the blocks given (walls)
+    pure function shells(references, volumes) result(v)
+      real(dp), intent(in) :: references(:), volumes(:, :, :, :)
+      real(dp) :: v(r%nradial, r%nspecies, r%nspecies)
+      integer :: i, j
+      if (r%nradial_volume > 0) then
+        v = sum(volumes, 4)
+      else
+        do i = 1, r%nspecies
+          do j = 1, r%nspecies
+            v(:, j, i) = references(i) * shell
+          end do
+        end do
+      end if
+    end function shells
+    ! g(k, b, a) from the counts, the shell volumes and the core volume fractions phi_core,b (NaN
+    ! without references or partners)
+    pure function partial_g(counts, volumes, phi_core) result(g)
+      real(dp), intent(in) :: counts(:, :, :), volumes(:, :, :), phi_core(:)
+      real(dp) :: g(size(counts, 1), size(counts, 2), size(counts, 3))
+      real(dp) :: density
+      integer :: i, j
+      do i = 1, size(counts, 3)
+        do j = 1, size(counts, 2)
+          density = phi_core(j) / v_s(j) * (r%species_count(j) - merge(1.0_dp, 0.0_dp, i == j)) / r%species_count(j)
+          if (density > 0 .and. all(volumes(:, j, i) > 0)) then
+            g(:, j, i) = counts(:, j, i) / (density * volumes(:, j, i))
+          else
+            g(:, j, i) = nan
+          end if
+        end do
+      end do
+    end function partial_g
+  end subroutine rheo_summarise_species
+
   !> Slope of the least-squares line from its sums (n, sum x, sum y, sum x^2, sum x y); NaN if
   !> undefined.
   pure real(dp) function line_slope(t) result(slope)
@@ -397,6 +692,12 @@ contains
     real(dp), allocatable :: s(:)
     s = [reshape(r%block_sums, [size(r%block_sums)]), reshape(r%block_profile, [size(r%block_profile)]), &
          reshape(r%block_angles, [size(r%block_angles)]), r%block_references, r%block_records]
+    ! a mixture's per-species accumulators follow (equal spheres: none, the array as before)
+    if (r%nspecies > 1) s = [s, reshape(r%block_species_values, [size(r%block_species_values)]), &
+                             reshape(r%block_species_profile, [size(r%block_species_profile)]), &
+                             reshape(r%block_species_references, [size(r%block_species_references)]), &
+                             reshape(r%block_radial, [size(r%block_radial)]), &
+                             reshape(r%block_radial_volume, [size(r%block_radial_volume)])]
   end function rheo_state
 
   !> info: 0 ok, 1 the array does not fit this set-up.
@@ -413,7 +714,19 @@ contains
     m = size(r%block_profile); r%block_profile = reshape(s(k + 1:k + m), shape(r%block_profile)); k = k + m
     m = size(r%block_angles); r%block_angles = reshape(s(k + 1:k + m), shape(r%block_angles)); k = k + m
     m = r%blocks; r%block_references = s(k + 1:k + m); k = k + m
-    r%block_records = s(k + 1:k + m)
+    r%block_records = s(k + 1:k + m); k = k + m
+    if (r%nspecies > 1) then
+      m = size(r%block_species_values)
+      r%block_species_values = reshape(s(k + 1:k + m), shape(r%block_species_values)); k = k + m
+      m = size(r%block_species_profile)
+      r%block_species_profile = reshape(s(k + 1:k + m), shape(r%block_species_profile)); k = k + m
+      m = size(r%block_species_references)
+      r%block_species_references = reshape(s(k + 1:k + m), shape(r%block_species_references)); k = k + m
+      m = size(r%block_radial)
+      r%block_radial = reshape(s(k + 1:k + m), shape(r%block_radial)); k = k + m
+      m = size(r%block_radial_volume)
+      r%block_radial_volume = reshape(s(k + 1:k + m), shape(r%block_radial_volume))
+    end if
   end subroutine rheo_restore
 
   !> The summary over the complete blocks (those whose last step <= last_step): value and
@@ -431,10 +744,7 @@ contains
     real(dp), allocatable :: per_block(:, :), mean_values(:)
     real(dp) :: shell(2), references, records, n_core, dtheta, nan
     nan = ieee_value(1.0_dp, ieee_quiet_nan)
-    complete = 0
-    do b = 1, r%blocks
-      if (r%discard_step + b * r%block_steps <= last_step .and. r%block_records(b) > 0) complete = b
-    end do
+    complete = complete_blocks(r, last_step)
     allocate(per_block(NSUMMARY, max(1, complete)), mean_values(NQ))
     mean_values = 0
     do b = 1, complete
@@ -485,7 +795,9 @@ contains
     type(rheology_t), intent(in) :: r
     type(column_t), allocatable :: c(:)
     ! element by element: an array constructor of column_t leaks their values (gfortran 12)
-    allocate(c(merge(14, 12, r%order)))
+    integer :: k
+    allocate(c(merge(14, 12, r%order) + merge(5, 0, r%nspecies > 1) + merge(1, 0, r%nspecies > 1 .and. r%nradial > 0) &
+               + merge(1, 0, r%nspecies > 1 .and. r%nradial_volume > 0)))
     c(1) = column('core/stress_hydro', r%values(1:5))
     c(2) = column('core/stress_contact', r%values(6:10))
     c(3) = column('core/solid_fraction', r%values(11))
@@ -502,7 +814,66 @@ contains
       c(13) = column('structure/q6', r%q6)
       c(14) = column('structure/q6_local', r%q6_local)
     end if
+    ! a mixture's per-species sums (doc/RHEOLOGY.md "Per species"); none for equal spheres
+    if (r%nspecies > 1) then
+      k = merge(14, 12, r%order)
+      c(k + 1) = column('species/stress_hydro', r%species_values(1:5, :))
+      c(k + 2) = column('species/stress_contact', r%species_values(6:10, :))
+      c(k + 3) = column('species/solid_fraction', r%species_values(11, :))
+      c(k + 4) = column('species/references', r%species_references)
+      c(k + 5) = column('species/profile_solid_fraction', r%species_profile)
+      if (r%nradial > 0) c(k + 6) = column('species/pair_counts', r%radial)
+      if (r%nradial_volume > 0) c(k + 7) = column('species/pair_volumes', r%radial_volume)
+    end if
   end function rheo_columns
+
+  ! The partial pair counts of this configuration (doc/RHEOLOGY.md "Per species"): for every pair
+  ! closer than radial_range (minimum image in x and z, across the sliding boundary with
+  ! Lees-Edwards), the partner's species in the bin of its distance, seen from each end whose
+  ! centre is in the core (the references of g(theta)). Between walls, also the volume of each
+  ! reference's shells where a centre of each species can be, y in [a_b, Ly - a_b] (exact
+  ! sphere-slab volumes): the ideal mixture's count, so that g_ab is 1 for it at any range.
+  subroutine sample_radial(r, position)
+    type(rheology_t), intent(inout) :: r
+    real(dp), intent(in) :: position(:, :)
+    real(dp) :: d(3), vshift(3), dist, inner, outer, y
+    integer :: p, i1, i2, k, s1, s2, i
+    r%radial = 0
+    if (r%nradial_volume > 0) then
+      r%radial_volume = 0
+      do i = 1, size(position, 2)
+        y = position(2, i)
+        if (y < r%core(1) .or. y >= r%core(2)) cycle
+        s1 = r%species_of(i)
+        do s2 = 1, r%nspecies
+          inner = 0
+          do k = 1, r%nradial
+            outer = slab_volume(y, k * r%radial_width, r%species_radius(s2), r%box(2) - r%species_radius(s2))
+            r%radial_volume(k, s2, s1) = r%radial_volume(k, s2, s1) + (outer - inner)
+            inner = outer
+          end do
+        end do
+      end do
+    end if
+    call nlist_candidates(r%radial_list, position, r%radial_pairs, r%nradial_pairs, r%radial_walls, r%nradial_walls, &
+                          r%le%offset)
+    do p = 1, r%nradial_pairs
+      i1 = r%radial_pairs(1, p)
+      i2 = r%radial_pairs(2, p)
+      if (r%le%active) then
+        call le_separation(r%le, position(:, i2) - position(:, i1), d, vshift)
+      else
+        d = min_image(position(:, i2) - position(:, i1), r%box, [.true., .false., .true.])
+      end if
+      dist = norm2(d)
+      if (dist >= r%radial_range) cycle
+      k = min(r%nradial, int(dist / r%radial_width) + 1)
+      s1 = r%species_of(i1)
+      s2 = r%species_of(i2)
+      if (position(2, i1) >= r%core(1) .and. position(2, i1) < r%core(2)) r%radial(k, s2, s1) = r%radial(k, s2, s1) + 1
+      if (position(2, i2) >= r%core(1) .and. position(2, i2) < r%core(2)) r%radial(k, s1, s2) = r%radial(k, s1, s2) + 1
+    end do
+  end subroutine sample_radial
 
   ! Q6 of this configuration's bonds (mod_bond_order), the whole box's, and the mean local q6 of
   ! the spheres that have bonds.

@@ -16,10 +16,26 @@ random with numpy (gaps >= 0.05 a) in a 10a Lees-Edwards cube, exact pair hydrod
    phi_core = sum_i V_i(core) / V_core with each sphere's slab volume of its own radius, computed
    here independently; 1e-12 relative (round-off of ~50 terms; measured 7e-16);
 4. the run on 2 ranks (each evaluates a share of the pair links, gathered in order,
-   mod_lubrication_links) writes the same series.h5, bitwise (wall_time excepted).
-About 8 s."""
+   mod_lubrication_links) writes the same series.h5, bitwise (wall_time excepted);
+5. the statistics per species (doc/RHEOLOGY.md "Per species") exist, are finite and add up to the
+   pooled ones: at every record the species' core stresses, phi_core,s and phi_s(y) sum to the
+   pooled columns, and in summary.json the species' shares of eta_r - 1, eta_h - 1, eta_c, N1/tau,
+   N2/tau, Pi/tau, Pi_h/tau, N1_h/tau and phi_core sum to the pooled quantities, phi_s(y) to phi(y)
+   (1e-12 of the largest magnitude: sums of ~50 terms regrouped, measured ~1e-16); g_ab(r) is zero
+   closer than contact less 0.05 a (no overlap that deep with eps_r = 5e-3) and g_12 = g_21 in the
+   Lees-Edwards box (the same pairs from both ends; 1e-12 relative); scripts/rheology.py redoes
+   the species' summary from series.h5 to 1e-10 (--compare; the pooled g(theta) with the mixture's
+   mean sphere volume);
+6. a mixture restarted at step 150 (inside the first averaging block) from its checkpoint writes
+   the same series.h5 (wall_time excepted) and summary.json as the uninterrupted run, bitwise
+   (the checkpoint carries the per-species accumulators; the restart is exact);
+7. between walls (the static case of 3) the per-species columns include the sampled shell
+   volumes of g_ab and phi_s(y) sums to phi(y) (1e-12).
+About 12 s."""
 import json
 import os
+import subprocess
+import sys
 import numpy as np
 import fdsusp_testlib as T
 
@@ -119,6 +135,63 @@ T.run(T.write_deck(d, 'le2.nml', LE.replace("directory = 'out'", "directory = 'o
 T.compare_h5(os.path.join(d, 'out', 'series.h5'), os.path.join(d, 'out2', 'series.h5'), '2 ranks against 1',
              skip=('wall_time', 'deck@output.directory'), rtol=0)
 
+# 5: per species
+def rel_max(x, y):
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    return float(np.max(np.abs(x - y)) / max(1.0, float(np.max(np.abs(y)))))
+
+
+worst = max(rel_max(s['species/stress_hydro'].sum(axis=1), s['core/stress_hydro']),
+            rel_max(s['species/stress_contact'].sum(axis=1), s['core/stress_contact']),
+            rel_max(s['species/solid_fraction'].sum(axis=1), s['core/solid_fraction'].ravel()),
+            rel_max(s['species/profile_solid_fraction'].sum(axis=1), s['profiles/solid_fraction']))
+T.check(worst <= 1e-12, 'every record: the species\' core stresses, phi_core,s and phi_s(y) add up to the pooled '
+        'columns (max rel. difference %.1e <= 1e-12)' % worst)
+sp = summary['species']
+T.check(sp['radius'] == [1.0, 1.4] and sp['count'] == [39.0, 14.0], 'summary: species radii %s, counts %s'
+        % (sp['radius'], sp['count']))
+shares = {'eta_r-1': ('eta_r', 1.0), 'eta_h-1': ('eta_h', 1.0), 'eta_c': ('eta_c', 0.0), 'N1/tau': ('N1/tau', 0.0),
+          'N2/tau': ('N2/tau', 0.0), 'Pi/tau': ('Pi/tau', 0.0), 'Pi_h/tau': ('Pi_h/tau', 0.0),
+          'N1_h/tau': ('N1_h/tau', 0.0), 'N1_c/tau': ('N1_c/tau', 0.0), 'N2_c/tau': ('N2_c/tau', 0.0),
+          'Pi_c/tau': ('Pi_c/tau', 0.0), 'phi_core': ('phi_core', 0.0)}
+finite = all(np.isfinite(np.array(sp['quantities'][n][part], dtype=float)).all() for n in shares
+             for part in ('value', 'error'))
+worst = max(abs(sum(sp['quantities'][n]['value']) - (q[p]['value'] - off)) / max(1.0, abs(q[p]['value']))
+            for n, (p, off) in shares.items())
+T.check(finite and worst <= 1e-12, 'summary: the species\' shares (value and error finite) add up to the pooled '
+        'eta_r - 1, eta_h - 1, eta_c, N1, N2, Pi (parts) and phi_core (max rel. difference %.1e <= 1e-12; eta_r - 1 = '
+        '%.3f + %.3f)' % (worst, *sp['quantities']['eta_r-1']['value']))
+worst = rel_max(np.sum(sp['profiles']['solid_fraction'], axis=0), summary['profiles']['solid_fraction'])
+T.check(worst <= 1e-12, 'summary: phi_1(y) + phi_2(y) = phi(y) (max rel. difference %.1e)' % worst)
+pd = sp['pair_distribution']
+r_bins = np.array(pd['r'])
+g = np.array(pd['g'], dtype=float)
+radius = np.array(sp['radius'])
+inside = all(np.all(g[a, b][r_bins + 0.5 * pd['radial_width'] < radius[a] + radius[b] - 0.05] == 0)
+             for a in range(2) for b in range(2))
+T.check(np.isfinite(g).all() and inside and g.shape == (2, 2, len(r_bins)) and r_bins[-1] > 4.5,
+        'g_ab(r) finite up to r = %.2f a, zero inside contact less 0.05 a; first peaks %s' %
+        (r_bins[-1] + 0.5 * pd['radial_width'],
+         ', '.join('g_%d%d %.1f at %.3f' % (a + 1, b + 1, g[a, b].max(), r_bins[np.argmax(g[a, b])])
+                   for a, b in ((0, 0), (0, 1), (1, 1)))))
+sym = float(np.max(np.abs(g[0, 1] - g[1, 0]) / np.maximum(1.0, g[0, 1])))
+T.check(sym <= 1e-12, 'Lees-Edwards: g_12 = g_21 (max rel. difference %.1e <= 1e-12)' % sym)
+p = subprocess.run([sys.executable, os.path.join(T.ROOT, 'scripts', 'rheology.py'), os.path.join(d, 'out'), '--compare'],
+                   capture_output=True, text=True)
+T.check(p.returncode == 0 and 'agrees to 1e-10' in p.stdout, 'scripts/rheology.py reproduces summary.json with its '
+        'species object to 1e-10 (%s)' % (p.stdout.strip().splitlines()[-1] if p.stdout.strip() else p.stderr[-300:]))
+
+# 6: a restart at step 150 from the checkpoint
+deck_half = LE.replace("directory = 'out'", "directory = 'out3'").replace('steps = 300', 'steps = 150')
+T.run(T.write_deck(d, 'le3.nml', deck_half), d)
+T.run(T.write_deck(d, 'le3.nml', deck_half.replace('steps = 150', 'steps = 300')), d, args=['-restart', 'out3/checkpoint.h5'])
+T.compare_h5(os.path.join(d, 'out', 'series.h5'), os.path.join(d, 'out3', 'series.h5'), 'mixture restarted at step 150',
+             skip=('wall_time', 'deck@output.directory'), rtol=0)
+with open(os.path.join(d, 'out3', 'summary.json')) as f:
+    restarted = json.load(f)
+T.check(restarted['species'] == summary['species'] and restarted['quantities'] == summary['quantities'],
+        'mixture restarted at step 150: summary.json (species object and quantities) identical')
+
 # 3: a static configuration between walls, phi_core from each sphere's own slab volume
 d = T.scratch('ld_mixture_walls')
 pos, r = place((10.0, 12.0, 10.0), radii, walls=True)
@@ -135,4 +208,9 @@ T.check(float(np.max(np.abs(got / expect - 1))) <= 1e-12 and cut > 0,
         'walls, static: phi_core = sum_i V_i(core) / V_core = %.12f with each sphere\'s own radius (%d spheres cut by '
         'the core\'s edges; max relative difference %.1e <= 1e-12)' % (expect, cut, float(np.max(np.abs(got / expect - 1)))))
 T.check(int(np.max(s['lubrication_walls'])) > 0, 'walls: %d sphere-wall links' % int(np.max(s['lubrication_walls'])))
+# 7: the per-species columns between walls
+worst = rel_max(s['species/profile_solid_fraction'].sum(axis=1), s['profiles/solid_fraction'])
+T.check('species/pair_volumes' in s and worst <= 1e-12 and float(np.min(s['species/pair_volumes'])) >= 0,
+        'walls: the sampled shell volumes of g_ab are written, phi_1(y) + phi_2(y) = phi(y) (max rel. difference %.1e)'
+        % worst)
 T.finish()
