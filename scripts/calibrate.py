@@ -246,19 +246,10 @@ def pair_motions(gap, lam, d, e1):
     zero = np.zeros(3)
     primary = {'A': ([d, -d], [d, zero]), 'A2': ([zero, zero], [zero, d]),
                'B': ([e1, -e1], [e1, zero]), 'B2': ([zero, zero], [zero, e1])}
-
-    def net_force(u, o):
-        w = np.hstack([-np.asarray(u), -np.asarray(o)])
-        F, _, _ = pb.responses(s, 1.0, lam, d, w, np.zeros((3, 3)))
-        return F[0] + F[1]
-
     motions = {}
     for mode, (u, o) in primary.items():
-        u, o = np.array(u, dtype=float), np.array(o, dtype=float)
-        base = net_force(u, o)
-        per_unit = np.array([net_force(u + np.outer([1, 1], v), o) - base for v in np.eye(3)]).T
-        v = np.linalg.solve(per_unit, -base)
-        motions[mode] = (u + np.outer([1, 1], v), o)
+        o = np.array(o, dtype=float)
+        motions[mode] = (pb.balanced(s, 1.0, lam, d, u, o), o)
     return motions
 
 
@@ -314,6 +305,9 @@ def calibrate_unequal(args):
     E = SHEAR_E
     zero = np.zeros(3)
     radii = [a1, a2]
+    # the pseudo-time relaxes over the larger sphere's diffusion time Re a2^2: its steps are set
+    # for a2 (fdsusp.resistance.deck relax_radius), so that the large sphere relaxes in the 100
+    # steps as the equal table at its resolution N a2 does, step for step in its cells
     runner = Runner(work, args.jobs)
     samples = []
     for s in range(samples_n):
@@ -326,14 +320,14 @@ def calibrate_unequal(args):
         # one body: each sphere alone at the pair's centre, spinning as in the pair runs, and
         # with the flow (its rotation and strain parts are subtracted)
         for k, a in enumerate(radii, 1):
-            one = dict(h=h, radii=[a])
+            one = dict(h=h, radii=[a], relax_radius=a2)
             runner.add(f's{s}_one{k}_A', box=(L, L, L), walls=False, shear=0.0, spheres=[(c, zero, d)], **one)
             runner.add(f's{s}_one{k}_B', box=(L, L, L), walls=False, shear=0.0, spheres=[(c, zero, e1)], **one)
             runner.add(f's{s}_one{k}_C', box=(L, LW, L), walls=True, shear=1.0, spheres=[with_flow(cc, LW)], **one)
         for g in GAPS:
             r = (a1 + a2) * (1 + g / 2)
             x1, x2 = c - 0.5 * r * d, c + 0.5 * r * d
-            pair = dict(h=h, radii=radii)
+            pair = dict(h=h, radii=radii, relax_radius=a2)
             for mode, (u, o) in pair_motions(g, lam, d, e1).items():
                 runner.add(f's{s}_g{g}_{mode}', box=(L, L, L), walls=False, shear=0.0,
                            spheres=[(x1, u[0], o[0]), (x2, u[1], o[1])], **pair)

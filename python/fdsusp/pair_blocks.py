@@ -114,3 +114,20 @@ def from_arrays(f, f2):
 def to_arrays(s):
     """mod_lubrication's f and f2 from s[k, alpha, beta]."""
     return np.concatenate([s[:, 0, 0], s[:, 0, 1]]), np.concatenate([s[:, 1, 1], s[:, 1, 0]])
+
+
+def balanced(s, a1, a2, d, u, o):
+    """The velocities u (2, 3) plus the co-moving translation that makes the net force of the
+    pair vanish for the resistance s (the exact one) with spins o (2, 3) in a fluid at rest.
+    Unequal spheres in relative motion, or a sphere spinning beside another, exert a net force,
+    and a periodic box under a net force has no steady state (its fluid accelerates); the
+    co-moving translation is a regular motion, which the grid resolves."""
+    u, o = np.array(u, dtype=float), np.array(o, dtype=float)
+
+    def net_force(uu):
+        F, _, _ = responses(s, a1, a2, d, np.hstack([-uu, -o]), np.zeros((3, 3)))
+        return F[0] + F[1]
+
+    base = net_force(u)
+    per_unit = np.array([net_force(u + np.outer([1, 1], v)) - base for v in np.eye(3)]).T
+    return u + np.outer([1, 1], np.linalg.solve(per_unit, -base))

@@ -92,12 +92,15 @@ def with_flow(x, height):
 
 
 def deck(path, out, box, walls, shear, spheres, h, model='none', vtol=1e-6, ptol=1e-8, motion='resistance',
-         radii=None):
+         radii=None, relax_radius=1.0):
     """spheres: list of (position, velocity, omega); motion: 'resistance' (the velocities imposed)
     or 'frozen' (the velocities force-free, scripts/frozen_pair.py); model: the lubrication model (calibration
     measures the resolved part alone, so 'none'); vtol, ptol: the solver tolerances; radii: each
-    sphere's radius (spheres of several sizes: &particles radius and species(i)), else radius 1.
-    Written by fdsusp.deck (floats exactly)."""
+    sphere's radius (spheres of several sizes: &particles radius and species(i)), else radius 1;
+    relax_radius: the radius R the pseudo-time is set for, dt = Re R^2/BETA: a sphere of radius R
+    then relaxes in STEPS steps as a unit sphere does at dt = Re/BETA (its diffusion time is
+    Re R^2, and the relaxed constraint's gamma ~ (Re/dt) Delta^2 is the same in its cells; the
+    steady state depends on neither). Written by fdsusp.deck (floats exactly)."""
     particles = {'number': len(spheres), 'motion': motion}
     if radii is not None and len(set(radii)) > 1:
         species = sorted(set(float(r) for r in radii))
@@ -112,7 +115,7 @@ def deck(path, out, box, walls, shear, spheres, h, model='none', vtol=1e-6, ptol
                     'y_boundary': 'walls' if walls else 'periodic', 'shear_rate': shear}),
         ('fluid', {'reynolds': REYNOLDS, 'viscous_theta': 1.0, 'initial_flow': 'shear',
                    'velocity_tolerance': vtol, 'pressure_tolerance': ptol}),
-        ('time', {'dt': REYNOLDS / BETA, 'steps': STEPS}),
+        ('time', {'dt': REYNOLDS * relax_radius ** 2 / BETA, 'steps': STEPS}),
         ('output', {'directory': out, 'progress_every': STEPS, 'series_every': EVERY}),
         ('lubrication', {'model': model}),
         ('particles', particles)]))

@@ -9,16 +9,20 @@ its own radius) within 5 % (issue 44 item 5) at gaps 0.01 (the issue's), 0.1 and
 uncorrected DNS (total minus the correction, from the same run) is printed beside it.
 
 Resistance mode (velocities imposed, configuration held), steady state by Aitken extrapolation of
-pseudo-time, as scripts/calibrate.py. The configurations are NOT those of the calibration: another
-sub-cell offset and another line of centres. Pair (periodic cube of 12a, relative motions: no net
+pseudo-time, as scripts/calibrate.py, its time step set for the large sphere (dt = Re a2^2/30,
+fdsusp.resistance.deck relax_radius): the large sphere then relaxes in 100 steps as a unit sphere
+at a/Delta = 8 does (with the unit sphere's dt the wall normal resistance at gap 0.01 came out
+14 % high, unconverged). The configurations are NOT those of the calibration: another
+sub-cell offset and another line of centres. Pair (periodic cube of 13a, relative motions: no net
 force, so the periodic images act as force dipoles, O((a/L)^3)):
-  squeeze: U_1 = d, U_2 = -d, sphere 1 spinning about d:
-    -F_1.d = 6 pi a1 XA11 - 3 pi (a1 + a2) XA12,  F_2.d = 6 pi a2 XA22 - 3 pi (a1 + a2) XA21,
-    -T_1.d = pi (2 a1)^3 XC11  (Jeffrey & Onishi's scaling: the 11 block by a1, 22 by a2, the
-    cross blocks by a1 + a2; the 22 and 21 scalars are the 11 and 12 ones at 1/lambda);
-  sliding: U_1 = e1, U_2 = -e1, sphere 1 spinning about e1: -F_1.e1, F_2.e1 as above with Y^A,
-    -T_1.e1 = pi (2 a1)^3 YC11.
-Wall (walls at rest, 12 x 10 x 12 cell, the large sphere of radius 2): W1 translates and spins
+  squeeze: U_1 = d, U_2 = -d, sphere 1 spinning about d: F_1.d, F_2.d (X^A), T_1.d (X^C);
+  sliding: U_1 = e1, U_2 = -e1, sphere 1 spinning about e1: F_1.e1, F_2.e1 (Y^A, Y^B), T_1.e1
+    (Y^C, Y^B);
+  each with the co-moving translation that zeroes the exact net force added (fdsusp.pair_blocks
+  balanced: a periodic box under a net force has no steady state), and compared with the exact
+  forces and torques of that motion (the sized blocks of the exact scalars, fdsusp.pair_blocks,
+  whose signs test_pair_blocks checks against Batchelor & Green's mobility).
+Wall (walls at rest, 13 x 20 x 13 cell, the large sphere of radius 2, gaps 0.01 and 0.1): W1 translates and spins
 along the normal (lambda_perp at its own gap over its own radius), W2 along a tangent (f_tt, f_rr);
 the other wall and the images are removed as in scripts/calibrate.py (superposed exact
 single-wall theory, the sphere at the centre of the cell as reference).
@@ -32,6 +36,7 @@ import numpy as np
 import h5py
 import fdsusp_testlib as T
 from fdsusp import resistance as R
+from fdsusp import pair_blocks as pb
 from fdsusp.resistance import sized_pair, wall_scalars, wall_excess
 
 PI = math.pi
@@ -40,7 +45,8 @@ LAM = 2.0
 A1, A2 = 1.0, LAM
 h = 1.0 / CELLS
 GAPS = [0.01, 0.1, 0.5]
-L = 12.0
+WALL_GAPS = [0.01, 0.1]
+L = 13.0   # the lubrication search reaches 2 (2 + outer_cutoff) a2 + 2 skin = 12.4
 work = T.scratch('lubrication_resistance_unequal')
 runner = R.Runner(work, 2)
 off = np.array([0.61, 0.29, 0.83]) * h
@@ -49,16 +55,32 @@ e1 = np.cross(d, [1.0, 0.0, 0.0]); e1 /= np.linalg.norm(e1)
 e2 = np.cross(d, e1)
 c = np.full(3, L / 2) + off
 zero = np.zeros(3)
-add = lambda name, **kw: runner.add(name, h=h, model='full', **kw)
+# the pseudo-time set for the large sphere, as its calibration's
+add = lambda name, **kw: runner.add(name, h=h, model='full', relax_radius=A2, **kw)
+EXCHANGE = np.array([1, 1, -1, 1, 1, -1, -1, 1, 1, 1, 1] * 2, dtype=float)
+
+
+def exact_blocks(g):
+    """The exact block scalars of the pair (one-body parts included)."""
+    return pb.from_arrays(sized_pair(g, LAM), EXCHANGE * sized_pair(g, 1.0 / LAM))
+
+
+motions = {}
 for g in GAPS:
     r = (A1 + A2) * (1 + g / 2)
     x1, x2 = c - 0.5 * r * d, c + 0.5 * r * d
-    add(f'g{g}_A', box=(L, L, L), walls=False, shear=0.0, spheres=[(x1, d, d), (x2, -d, zero)], radii=[A1, A2])
-    add(f'g{g}_B', box=(L, L, L), walls=False, shear=0.0, spheres=[(x1, e1, e1), (x2, -e1, zero)], radii=[A1, A2])
+    for mode, u, o in (('A', [d, -d], [d, zero]), ('B', [e1, -e1], [e1, zero])):
+        o = np.array(o)
+        u = pb.balanced(exact_blocks(g), A1, A2, d, u, o)
+        motions[g, mode] = (u, o)
+        add(f'g{g}_{mode}', box=(L, L, L), walls=False, shear=0.0, spheres=[(x1, u[0], o[0]), (x2, u[1], o[1])],
+            radii=[A1, A2])
 n = np.array([0.0, 1.0, 0.0])
 t = np.array([math.cos(0.4), 0.0, math.sin(0.4)])
-LW = 10.0
-for g in GAPS + ['centre']:
+# as high as the a/Delta = 8 table's cell in units of the sphere (10 a2), so that the far wall and
+# the images, removed by superposed single-wall theory, are as small as in the calibration
+LW = 20.0
+for g in WALL_GAPS + ['centre']:
     y = LW / 2 if g == 'centre' else A2 * (1.0 + g)
     x = np.array([L / 2 + off[0], y, L / 2 + off[2]])
     add(f'w{g}_W1', box=(L, LW, L), walls=True, shear=0.0, spheres=[(x, n, n)], radii=[A2])
@@ -75,25 +97,16 @@ def steady(name):
     return out[0], out[1], lub[0], lub[1]
 
 
-EXCHANGE = np.array([1, 1, -1, 1, 1, -1, -1, 1, 1, 1, 1] * 2, dtype=float)
-NAMES = ['XA', 'YA', 'YB', 'XC', 'YC', 'XG', 'YG', 'YH', 'XM', 'YM', 'ZM']
 print('radii %g and %g, a/Delta = %d (small)' % (A1, A2, CELLS))
 print('%7s %-12s %10s %10s %10s %8s' % ('gap', 'quantity', 'exact', 'fdsusp', 'no corr.', 'error'))
 for g in GAPS:
-    f1 = dict(zip([k + '11' for k in NAMES] + [k + '12' for k in NAMES], sized_pair(g, LAM)))
-    f2 = dict(zip([k + '22' for k in NAMES] + [k + '21' for k in NAMES], EXCHANGE * sized_pair(g, 1.0 / LAM)))
-    ca11, ca12, ca22 = 6 * PI * A1, 3 * PI * (A1 + A2), 6 * PI * A2
-    exact = {'-F1.d': ca11 * f1['XA11'] - ca12 * f1['XA12'], 'F2.d': ca22 * f2['XA22'] - ca12 * f2['XA21'],
-             '-T1.d': PI * (2 * A1) ** 3 * f1['XC11'],
-             '-F1.e1': ca11 * f1['YA11'] - ca12 * f1['YA12'], 'F2.e1': ca22 * f2['YA22'] - ca12 * f2['YA21'],
-             '-T1.e1': PI * (2 * A1) ** 3 * f1['YC11']}
-    dns, raw = {}, {}
-    F, Tq, Fl, Tl = steady(f'g{g}_A')
-    for out, (F_, T_) in ((dns, (F, Tq)), (raw, (F - Fl, Tq - Tl))):
-        out['-F1.d'], out['F2.d'], out['-T1.d'] = -F_[0] @ d, F_[1] @ d, -T_[0] @ d
-    F, Tq, Fl, Tl = steady(f'g{g}_B')
-    for out, (F_, T_) in ((dns, (F, Tq)), (raw, (F - Fl, Tq - Tl))):
-        out['-F1.e1'], out['F2.e1'], out['-T1.e1'] = -F_[0] @ e1, F_[1] @ e1, -T_[0] @ e1
+    exact, dns, raw = {}, {}, {}
+    for mode, axis, name in (('A', d, 'd'), ('B', e1, 'e1')):
+        u, o = motions[g, mode]
+        Fx, Tx, _ = pb.responses(exact_blocks(g), A1, A2, d, np.hstack([-u, -o]), np.zeros((3, 3)))
+        F, Tq, Fl, Tl = steady(f'g{g}_{mode}')
+        for out, (F_, T_) in ((exact, (Fx, Tx)), (dns, (F, Tq)), (raw, (F - Fl, Tq - Tl))):
+            out['F1.' + name], out['F2.' + name], out['T1.' + name] = F_[0] @ axis, F_[1] @ axis, T_[0] @ axis
     for k in exact:
         err = (dns[k] - exact[k]) / abs(exact[k])
         print('%7g %-12s %10.4f %10.4f %10.4f %+7.2f%%' % (g, k, exact[k], dns[k], raw[k], 100 * err))
@@ -115,7 +128,7 @@ def wall_values(tag, total=True):
 # the wall functions at the large sphere's own gaps (distance to a wall minus a2, over a2)
 centre = wall_values('centre')
 mid = 2.0 * wall_excess((LW / 2 - A2) / A2)[[0, 1, 3]]
-for g in GAPS:
+for g in WALL_GAPS:
     far = wall_excess((LW - A2 * (1 + g) - A2) / A2)[[0, 1, 3]]
     dns = wall_values(g) - centre - far + mid + 1.0
     raw = wall_values(g, total=False) - centre - far + mid + 1.0
