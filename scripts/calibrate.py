@@ -44,7 +44,7 @@ import numpy as np
 import h5py
 import _fdsusp_path  # noqa: F401,E402  (this checkout's python/ on sys.path)
 from fdsusp.resistance import (NAMES, WALL_NAMES, SHEAR_E, STRAIN_CONDITION, Runner, m_fit,  # noqa: E402
-                               pair_scalars, sized_pair, steady, strain_conditioning, wall_excess, with_flow)
+                               pair_scalars, steady, strain_conditioning, wall_excess, with_flow)
 from fdsusp import pair_blocks as pb  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -242,7 +242,7 @@ def pair_motions(gap, lam, d, e1):
     the end of the pseudo-time). So each run adds to both spheres the co-moving translation that
     makes the exact net force vanish (a regular motion, which the fit models like the rest); what
     is left is the grid's own imbalance."""
-    s = pb.from_arrays(sized_pair(gap, lam), EXCHANGE * sized_pair(gap, 1.0 / lam))
+    s = pb.exact_scalars(gap, lam)
     zero = np.zeros(3)
     primary = {'A': ([d, -d], [d, zero]), 'A2': ([zero, zero], [zero, d]),
                'B': ([e1, -e1], [e1, zero]), 'B2': ([zero, zero], [zero, e1])}
@@ -258,24 +258,6 @@ def ratio_tag(value):
     return ('%.6f' % value).rstrip('0').rstrip('.')
 
 
-def one_body_scalars(s):
-    """s less the one-body part of each sphere (an isolated sphere's self scalars X^A, Y^A, X^C,
-    Y^C, X^M, Y^M, Z^M are 1 in Jeffrey & Onishi's scaling)."""
-    s = np.array(s)
-    for n in ('XA', 'YA', 'XC', 'YC', 'XM', 'YM', 'ZM'):
-        for al in range(2):
-            s[pb.K[n], al, al] -= 1.0
-    return s
-
-
-def exact_pair_part(gap, lam):
-    """R_2B - R_1B of radii 1 and lam in the block scalars of fdsusp.pair_blocks, M folded."""
-    f = sized_pair(gap, lam)
-    g = sized_pair(gap, 1.0 / lam)
-    return pb.fold_strain(one_body_scalars(pb.from_arrays(f, EXCHANGE * g)), 1.0, lam)
-
-
-EXCHANGE = np.array([1, 1, -1, 1, 1, -1, -1, 1, 1, 1, 1] * 2, dtype=float)
 # the unknowns of the fit: every block scalar but the cross M slots (folded into the self slots)
 FREE = [(k, al, be) for k in range(11) for al in range(2) for be in range(2)
         if not (pb.NAMES11[k] in ('XM', 'YM', 'ZM') and al != be)]
@@ -346,7 +328,7 @@ def calibrate_unequal(args):
             for mode in 'ABC':
                 one[k, mode] = steady(os.path.join(work, f's{s}_one{k}_{mode}'))
         for gi, g in enumerate(GAPS):
-            exact = exact_pair_part(g, lam)
+            exact = pb.exact_pair_part(g, lam)
             measured = []
 
             def pair_part(mode, velocities, spins, with_flow_=False):

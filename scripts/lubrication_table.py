@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """Print a lubrication table (input/lubrication/resolved_a<N>.h5) beside the exact functions: per
 gap, the pair part the grid resolves, its scatter over the calibration samples, and the exact
-value, for the combinations that carry the lubrication singularities (doc/LUBRICATION.md).
+value, for the combinations that carry the lubrication singularities (doc/LUBRICATION.md). A
+table of an unequal pair (resolved_a<N>_ratio<R>.h5) is printed scalar by scalar for each sphere,
+beside the exact pair part folded as the table holds it (fdsusp.pair_blocks.exact_pair_part).
     scripts/lubrication_table.py [TABLE ...]"""
 import argparse
 import glob
@@ -12,6 +14,7 @@ import numpy as np
 
 import _fdsusp_path  # noqa: F401  (this checkout's python/ on sys.path)
 from fdsusp.resistance import pair_scalars, wall_excess, NAMES
+from fdsusp import pair_blocks as pb
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -25,8 +28,33 @@ COMBOS = [('XA11-XA12', lambda f: f[I['XA11']] - f[I['XA12']]),
 ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
 ap.add_argument('tables', nargs='*', metavar='TABLE', help='default: the shipped input/lubrication/resolved_a*.h5')
 args = ap.parse_args()
+UNEQUAL = ['XA', 'YA', 'YB', 'XC', 'YC', 'XG', 'XM']
+
+
+def print_unequal(path, h):
+    """Each sphere's self and cross scalars of the listed functions: resolved +- scatter, exact."""
+    lam = float(h.attrs['size_ratio'])
+    pair, scat = h['pair/resolved'][:], h['pair/scatter'][:]
+    print(f"## {os.path.basename(path)}: a/Delta = {h.attrs['cells_per_radius']} (sphere 1), size ratio {lam:g}  "
+          "(pair part; resolved +- scatter; exact)")
+    names = [(n, sl) for n in UNEQUAL for sl in ('11', '12', '22', '21') if not (n == 'XM' and sl in ('12', '21'))]
+    column = {'11': 0, '12': 11, '22': 22, '21': 33}
+    print('%-8s' % 'gap' + ''.join('%25s' % (n + sl) for n, sl in names))
+    for row, srow in zip(pair, scat):
+        g = row[0]
+        exact = np.concatenate(pb.to_arrays(pb.exact_pair_part(g, lam)))
+        cells = []
+        for n, sl in names:
+            k = 1 + column[sl] + pb.K[n]
+            cells.append('%8.3f +-%5.3f %8.3f' % (row[k], srow[k], exact[k - 1]))
+        print('%-8g' % g + ''.join('%25s' % c for c in cells))
+
+
 for path in args.tables or sorted(glob.glob(os.path.join(ROOT, 'input', 'lubrication', 'resolved_a*.h5'))):
     with h5py.File(path, 'r') as h:
+        if float(h.attrs.get('size_ratio', 1.0)) != 1.0:
+            print_unequal(path, h)
+            continue
         n = h.attrs['cells_per_radius']
         pair, scat = h['pair/resolved'][:], h['pair/scatter'][:]
         wall, wscat = h['wall/resolved'][:], h['wall/scatter'][:]

@@ -104,6 +104,27 @@ def fold_strain(s, a1, a2):
     return s
 
 
+EXCHANGE = np.array([1, 1, -1, 1, 1, -1, -1, 1, 1, 1, 1] * 2, dtype=float)
+
+
+def exact_scalars(gap, size_ratio):
+    """s[k, alpha, beta] of radii 1 and size_ratio from bin/fdsusp-resistance: sphere 1's at
+    size_ratio, sphere 2's from 1/size_ratio with the exchange signs (mod_pair_resistance_unequal)."""
+    from .resistance import sized_pair
+    return from_arrays(sized_pair(gap, size_ratio), EXCHANGE * sized_pair(gap, 1.0 / size_ratio))
+
+
+def exact_pair_part(gap, size_ratio):
+    """R_2B - R_1B of radii 1 and size_ratio, M folded: what a table of an unequal pair holds for a
+    grid that resolved everything (each sphere's one-body self scalars X^A, Y^A, X^C, Y^C, X^M,
+    Y^M, Z^M are 1 in Jeffrey & Onishi's scaling)."""
+    s = exact_scalars(gap, size_ratio)
+    for n in ('XA', 'YA', 'XC', 'YC', 'XM', 'YM', 'ZM'):
+        for al in range(2):
+            s[K[n], al, al] -= 1.0
+    return fold_strain(s, 1.0, size_ratio)
+
+
 def from_arrays(f, f2):
     """s[k, alpha, beta] from mod_lubrication's f (11, 12 scalars) and f2 (22, 21 scalars)."""
     s = np.zeros((11, 2, 2))

@@ -13,16 +13,10 @@ does not compute:
 import numpy as np
 
 from fdsusp import pair_blocks as pb
-from fdsusp.resistance import _table, sized_pair
+from fdsusp.resistance import _table
 
 E = np.array([[0.0, 0.5, 0.0], [0.5, 0.0, 0.0], [0.0, 0.0, 0.0]])
 OMEGA = np.array([0.0, 0.0, -0.5])
-EXCHANGE = np.array([1, 1, -1, 1, 1, -1, -1, 1, 1, 1, 1] * 2, dtype=float)
-
-
-def sized(gap, lam):
-    """s[k, alpha, beta] of radii 1 and lam from bin/fdsusp-resistance (f at lam, f2 from 1/lam)."""
-    return pb.from_arrays(sized_pair(gap, lam), EXCHANGE * sized_pair(gap, 1.0 / lam))
 
 
 def free_velocities(s, a1, a2, d, r):
@@ -48,7 +42,7 @@ def test_batchelor_green_mobility():
     d /= np.linalg.norm(d)
     for gap in (0.01, 0.1, 1.0):
         r = 2 + gap
-        v = free_velocities(sized(gap, 1), 1.0, 1.0, d, r)
+        v = free_velocities(pb.exact_scalars(gap, 1), 1.0, 1.0, d, r)
         rel = v[6:9] - v[0:3]
         A, B = _table('shear', [gap])[0, 1:3]
         er = E @ (r * d)
@@ -61,7 +55,7 @@ def test_exchange_of_the_spheres():
     d = rng.normal(size=3)
     d /= np.linalg.norm(d)
     lam, gap = 2.0, 0.05
-    s = sized(gap, lam)
+    s = pb.exact_scalars(gap, lam)
     # the same pair described with the large sphere first: radii (lam, 1), d reversed, scalars
     # of ratio 1/lam, blocks swapped
     s_swapped = s[:, ::-1, ::-1].copy()
@@ -80,7 +74,7 @@ def test_folding_keeps_the_stresslets():
     rng = np.random.default_rng(3)
     d = rng.normal(size=3)
     d /= np.linalg.norm(d)
-    s = sized(0.2, 1.4)
+    s = pb.exact_scalars(0.2, 1.4)
     e = rng.normal(size=(3, 3))
     e = 0.5 * (e + e.T) - np.trace(e) / 3 * np.eye(3)
     _, _, S = pb.responses(s, 1.0, 1.4, d, np.zeros((2, 6)), e)

@@ -37,7 +37,7 @@ import h5py
 import fdsusp_testlib as T
 from fdsusp import resistance as R
 from fdsusp import pair_blocks as pb
-from fdsusp.resistance import sized_pair, wall_scalars, wall_excess
+from fdsusp.resistance import wall_scalars, wall_excess
 
 PI = math.pi
 CELLS = 4
@@ -57,13 +57,6 @@ c = np.full(3, L / 2) + off
 zero = np.zeros(3)
 # the pseudo-time set for the large sphere, as its calibration's
 add = lambda name, **kw: runner.add(name, h=h, model='full', relax_radius=A2, **kw)
-EXCHANGE = np.array([1, 1, -1, 1, 1, -1, -1, 1, 1, 1, 1] * 2, dtype=float)
-
-
-def exact_blocks(g):
-    """The exact block scalars of the pair (one-body parts included)."""
-    return pb.from_arrays(sized_pair(g, LAM), EXCHANGE * sized_pair(g, 1.0 / LAM))
-
 
 motions = {}
 for g in GAPS:
@@ -71,7 +64,7 @@ for g in GAPS:
     x1, x2 = c - 0.5 * r * d, c + 0.5 * r * d
     for mode, u, o in (('A', [d, -d], [d, zero]), ('B', [e1, -e1], [e1, zero])):
         o = np.array(o)
-        u = pb.balanced(exact_blocks(g), A1, A2, d, u, o)
+        u = pb.balanced(pb.exact_scalars(g, LAM), A1, A2, d, u, o)
         motions[g, mode] = (u, o)
         add(f'g{g}_{mode}', box=(L, L, L), walls=False, shear=0.0, spheres=[(x1, u[0], o[0]), (x2, u[1], o[1])],
             radii=[A1, A2])
@@ -103,7 +96,7 @@ for g in GAPS:
     exact, dns, raw = {}, {}, {}
     for mode, axis, name in (('A', d, 'd'), ('B', e1, 'e1')):
         u, o = motions[g, mode]
-        Fx, Tx, _ = pb.responses(exact_blocks(g), A1, A2, d, np.hstack([-u, -o]), np.zeros((3, 3)))
+        Fx, Tx, _ = pb.responses(pb.exact_scalars(g, LAM), A1, A2, d, np.hstack([-u, -o]), np.zeros((3, 3)))
         F, Tq, Fl, Tl = steady(f'g{g}_{mode}')
         for out, (F_, T_) in ((exact, (Fx, Tx)), (dns, (F, Tq)), (raw, (F - Fl, Tq - Tl))):
             out['F1.' + name], out['F2.' + name], out['T1.' + name] = F_[0] @ axis, F_[1] @ axis, T_[0] @ axis
