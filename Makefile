@@ -93,7 +93,7 @@ UNIT_CHECKS_OBJ := $(call obj,$(UNIT_CHECKS_F90))
 
 PROGRAMS := $(BIN)/fdsusp $(BIN)/fdsusp-pack $(BIN)/fdsusp-resistance $(if $(REF_F90),$(BIN)/pairtraj)
 
-.PHONY: all debug check run bench extremes tradeoff pair-dns calibrate clean tests-build install layout-check
+.PHONY: all debug check run bench extremes tradeoff pair-dns calibrate calibrate-mixtures clean tests-build install layout-check
 all: $(PROGRAMS) $(UNIT_BIN) $(UNIT_PETSC_BIN)
 
 debug:
@@ -198,6 +198,13 @@ CELLS_PER_RADIUS ?= 4 5 6 8
 PYTHON := $(shell [ -x /usr/bin/python3 ] && echo /usr/bin/python3 || echo python3)
 calibrate: all
 	@for n in $(CELLS_PER_RADIUS); do $(PYTHON) scripts/calibrate.py $$n || exit 1; done
+
+# The unequal pairs of the shipped mixtures (doc/LUBRICATION.md "Tables for mixtures"): N:R makes
+# input/lubrication/resolved_a<N>_ratio<R>.h5 (sphere 1 at a/Delta = N, sphere 2 R times larger).
+# The equal tables of the larger species (a/Delta = N R) come from make calibrate.
+MIXTURE_PAIRS ?= 4:2 5:1.4
+calibrate-mixtures: all
+	@for p in $(MIXTURE_PAIRS); do $(PYTHON) scripts/calibrate.py $${p%%:*} --size-ratio $${p##*:} || exit 1; done
 
 clean:
 	rm -rf build bin
