@@ -21,6 +21,7 @@ import subprocess
 import sys
 import time
 
+import h5py
 import numpy as np
 
 from . import deck as fdeck, series
@@ -144,6 +145,16 @@ def steady(out):
     tr = np.trace(S, axis1=-2, axis2=-1)
     Sdev = S - tr[..., None, None] * np.eye(3) / 3.0
     return np.asarray(F), np.asarray(T), Sdev
+
+
+def steady_with_lubrication(out):
+    """Force and torque of each sphere, total and the lubrication correction's part, at pseudo-time
+    infinity (aitken): F, T, F_lub, T_lub (zeros when the run has no correction)."""
+    with h5py.File(os.path.join(out, 'series.h5'), 'r') as f:
+        total = [aitken(f[k][:]) for k in ('particles/force_hydro', 'particles/torque_hydro')]
+        lub = [aitken(f[k][:]) if k in f else np.zeros_like(total[0])
+               for k in ('particles/force_lubrication', 'particles/torque_lubrication')]
+    return total[0], total[1], lub[0], lub[1]
 
 
 def strain_basis(d, E):

@@ -320,7 +320,7 @@ contains
     real(dp), intent(in) :: position(:, :), velocity(:, :), stresslet_hydro(:, :, :)
     real(dp), intent(in), optional :: stresslet_contact(:, :, :)
     real(dp), intent(in), optional :: offset
-    real(dp) :: a, vp, v_core, w, y, u, dbin, d(3), dist, theta, sin_half, gap, vshift(3), ai, vi, phi, fit
+    real(dp) :: a, vp, v_core, w, y, u, dbin, d(3), dist, theta, sin_half, gap, ai, vi, phi, fit
     real(dp) :: r_outer, r_contact
     integer :: n, i, b, b1, b2, k, p, i1, i2, sp
     logical :: ref_i, ref_j, species
@@ -404,11 +404,7 @@ contains
     do p = 1, r%npairs
       i1 = r%pairs(1, p)
       i2 = r%pairs(2, p)
-      if (r%le%active) then
-        call le_separation(r%le, position(:, i2) - position(:, i1), d, vshift)
-      else
-        d = min_image(position(:, i2) - position(:, i1), r%box, [.true., .false., .true.])
-      end if
+      d = pair_separation(r, position(:, i2) - position(:, i1))
       dist = norm2(d)
       r_outer = r%r_outer
       r_contact = r%r_contact
@@ -836,7 +832,7 @@ contains
   subroutine sample_radial(r, position)
     type(rheology_t), intent(inout) :: r
     real(dp), intent(in) :: position(:, :)
-    real(dp) :: d(3), vshift(3), dist, inner, outer, y
+    real(dp) :: d(3), dist, inner, outer, y
     integer :: p, i1, i2, k, s1, s2, i
     r%radial = 0
     if (r%nradial_volume > 0) then
@@ -860,11 +856,7 @@ contains
     do p = 1, r%nradial_pairs
       i1 = r%radial_pairs(1, p)
       i2 = r%radial_pairs(2, p)
-      if (r%le%active) then
-        call le_separation(r%le, position(:, i2) - position(:, i1), d, vshift)
-      else
-        d = min_image(position(:, i2) - position(:, i1), r%box, [.true., .false., .true.])
-      end if
+      d = pair_separation(r, position(:, i2) - position(:, i1))
       dist = norm2(d)
       if (dist >= r%radial_range) cycle
       k = min(r%nradial, int(dist / r%radial_width) + 1)
@@ -877,12 +869,25 @@ contains
 
   ! Q6 of this configuration's bonds (mod_bond_order), the whole box's, and the mean local q6 of
   ! the spheres that have bonds.
+  ! The separation of a pair (centre 2 minus centre 1, dx) as the statistics see it: across the
+  ! sliding boundaries of Lees-Edwards, else the minimum image in x and z.
+  pure function pair_separation(r, dx) result(d)
+    type(rheology_t), intent(in) :: r
+    real(dp), intent(in) :: dx(3)
+    real(dp) :: d(3), vshift(3)
+    if (r%le%active) then
+      call le_separation(r%le, dx, d, vshift)
+    else
+      d = min_image(dx, r%box, [.true., .false., .true.])
+    end if
+  end function pair_separation
+
   subroutine sample_order(r, position)
     type(rheology_t), intent(inout) :: r
     real(dp), intent(in) :: position(:, :)
     integer, allocatable :: ends(:, :)
     real(dp), allocatable :: separation(:, :), local(:)
-    real(dp) :: d(3), vshift(3)
+    real(dp) :: d(3)
     integer :: p, nb, n
     n = size(position, 2)
     call nlist_candidates(r%bond_list, position, r%bond_pairs, r%nbond_pairs, r%bond_walls, r%nbond_walls, &
@@ -890,11 +895,7 @@ contains
     allocate(ends(2, r%nbond_pairs), separation(3, r%nbond_pairs), local(n))
     nb = 0
     do p = 1, r%nbond_pairs
-      if (r%le%active) then
-        call le_separation(r%le, position(:, r%bond_pairs(2, p)) - position(:, r%bond_pairs(1, p)), d, vshift)
-      else
-        d = min_image(position(:, r%bond_pairs(2, p)) - position(:, r%bond_pairs(1, p)), r%box, [.true., .false., .true.])
-      end if
+      d = pair_separation(r, position(:, r%bond_pairs(2, p)) - position(:, r%bond_pairs(1, p)))
       if (r%sized) then
         if (norm2(d) >= bond_factor * (r%radii(r%bond_pairs(1, p)) + r%radii(r%bond_pairs(2, p)))) cycle
       else

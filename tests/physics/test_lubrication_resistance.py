@@ -41,7 +41,6 @@ import numpy as np
 import fdsusp_testlib as T
 from fdsusp import resistance as R
 from fdsusp.resistance import pair_scalars, wall_scalars, wall_excess, NAMES
-import h5py
 
 PI = math.pi
 CELLS = int(sys.argv[1]) if len(sys.argv) > 1 else 5
@@ -82,11 +81,7 @@ runner.run()
 
 def steady(name):
     """Total and lubrication force/torque, extrapolated to steady state."""
-    with h5py.File(os.path.join(work, name, 'series.h5'), 'r') as f:
-        out = [R.aitken(f[k][:]) for k in ('particles/force_hydro', 'particles/torque_hydro')]
-        lub = [R.aitken(f[k][:]) if k in f else np.zeros_like(out[0])
-               for k in ('particles/force_lubrication', 'particles/torque_lubrication')]
-    return out[0], out[1], lub[0], lub[1]
+    return R.steady_with_lubrication(os.path.join(work, name))
 
 
 print('a/Delta = %d' % CELLS)

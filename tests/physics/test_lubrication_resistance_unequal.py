@@ -33,7 +33,6 @@ rotation of each sphere (1-2 %, which the pair correction by design does not tou
 import math
 import os
 import numpy as np
-import h5py
 import fdsusp_testlib as T
 from fdsusp import resistance as R
 from fdsusp import pair_blocks as pb
@@ -83,11 +82,7 @@ runner.run()
 
 def steady(name):
     """Total and lubrication force/torque, extrapolated to steady state."""
-    with h5py.File(os.path.join(work, name, 'series.h5'), 'r') as f:
-        out = [R.aitken(f[k][:]) for k in ('particles/force_hydro', 'particles/torque_hydro')]
-        lub = [R.aitken(f[k][:]) if k in f else np.zeros_like(out[0])
-               for k in ('particles/force_lubrication', 'particles/torque_lubrication')]
-    return out[0], out[1], lub[0], lub[1]
+    return R.steady_with_lubrication(os.path.join(work, name))
 
 
 print('radii %g and %g, a/Delta = %d (small)' % (A1, A2, CELLS))
