@@ -19,9 +19,28 @@ OUT = os.path.join(ROOT, 'out', 'polydisperse', 'curves')
 FIG = os.path.join(ROOT, 'doc', 'figures', 'mixture_rheology.png')
 QUANTITIES = ('eta_r', 'N1/tau', 'N2/tau', 'Pi/tau', 'eta_h', 'eta_c', 'phi_core')
 
-# Published values for the comparison on the eta_r panel (what the search found; see README.md
-# "Curves", "Published data"). Each entry: label, list of (phi, eta_r), and the source.
-PUBLISHED = []
+# Published data for the comparison (README.md "Curves", "Published data"). No mixture data set
+# with numbers could be read (the stored copies of Mari et al. 2014, Singh et al. 2018, Pednekar
+# et al. 2018 hold their abstracts only); drawn are the equal-sphere fits of fdsusp.references
+# (constants as published): Zarraga, Hill & Leighton 2000 and Boyer, Guazzelli & Pouliquen 2011
+# (experiments, eta_r), Dai, Bertevas, Qi & Tanner 2013 (experiments, N1/tau and N2/tau, phi <= 0.45).
+def published():
+    import numpy as np
+    from fdsusp import references as ref
+    phi = np.linspace(0.35, 0.58, 47)
+    iv = (0.585 / phi[phi < 0.575] - 1) ** 2
+    dphi = np.linspace(0.35, 0.45, 11)
+    n1, n2 = ref.dai_normal(dphi)
+    return [
+        dict(quantity='eta_r', label='Zarraga et al. 2000 (experiment, equal spheres)', style='k:',
+             points=[[float(x), float(y)] for x, y in zip(phi, ref.zarraga_eta(phi))]),
+        dict(quantity='eta_r', label='Boyer et al. 2011 (experiment, equal spheres, phi_m 0.585)', style='k-.',
+             points=[[float(x), float(y)] for x, y in zip(phi[phi < 0.575], ref.boyer_mu(iv) / iv)]),
+        dict(quantity='N1/tau', label='Dai et al. 2013 (experiment, equal spheres)', style='k:',
+             points=[[float(x), float(y)] for x, y in zip(dphi, n1)]),
+        dict(quantity='N2/tau', label='Dai et al. 2013 (experiment, equal spheres)', style='k:',
+             points=[[float(x), float(y)] for x, y in zip(dphi, n2)]),
+    ]
 
 
 def deck_values(name):
@@ -171,17 +190,19 @@ def figure(rows):
             for r in stopped:
                 if q == 'eta_r':
                     ax.axvline(r.get('phi_packed', r['phi_deck']), color=c, ls=ls, lw=0.6, alpha=0.6)
+        for p in published():
+            if p['quantity'] == q:
+                ax.plot([v[0] for v in p['points']], [v[1] for v in p['points']], p['style'], lw=1,
+                        label=p['label'])
         if q == 'eta_r':
-            for p in PUBLISHED:
-                ax.plot([v[0] for v in p['points']], [v[1] for v in p['points']], p.get('style', 'k^'),
-                        mfc='none', label=p['label'])
             ax.set_yscale('log')
         ax.set_xlabel(r'$\phi$ (in the run)')
         ax.set_ylabel(lab)
         ax.grid(alpha=0.3)
-    axes.flat[0].legend(fontsize=7)
+    for ax in axes.flat[:3]:
+        ax.legend(fontsize=6)
     fig.suptitle('Lubrication dynamics, Lees-Edwards cube 12a, rough spheres (eps_r 5e-3, eps_bar 0.015), '
-                 '2 strains discarded, 6 averaged\nthin vertical lines: runs that did not flow '
+                 'strains discarded + averaged: 2 + 6 (mu_d 0), 1.5 + 4.5 (mu_d 0.5)\nthin vertical lines: runs that did not flow '
                  '(refused or stopped by the overlap guard)', fontsize=9)
     fig.tight_layout()
     fig.savefig(FIG, dpi=100)
@@ -196,6 +217,6 @@ if __name__ == '__main__':
                 print(n, st['ended'], f"strain {st.get('strain_reached', 0):.2f}", st.get('wall_seconds'))
         sys.exit(0)
     rows = table()
-    json.dump({'runs': rows, 'published': PUBLISHED}, open(os.path.join(HERE, 'curves_table.json'), 'w'), indent=1)
+    json.dump({'runs': rows, 'published': published()}, open(os.path.join(HERE, 'curves_table.json'), 'w'), indent=1)
     print(markdown(rows))
     figure(rows)
