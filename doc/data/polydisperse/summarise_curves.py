@@ -49,8 +49,9 @@ def deck_values(name):
     steps = int(re.search(r'steps\s*=\s*(\d+)', text).group(1))
     mu = float(re.search(r'friction\s*=\s*([0-9.eE+-]+)', text).group(1))
     phi = float(re.search(r'solid_fraction\s*=\s*([0-9.eE+-]+)', text).group(1))
+    eps_bar = float(re.search(r'eps_bar\s*=\s*([0-9.eE+-]+)', text).group(1))
     species = 'mixture' if 'volume_share' in text else 'equal'
-    return dict(dt=dt, steps=steps, mu=mu, phi_deck=phi, species=species)
+    return dict(dt=dt, steps=steps, mu=mu, phi_deck=phi, species=species, eps_bar=eps_bar)
 
 
 def collect(name):
@@ -94,6 +95,16 @@ def collect(name):
         s = json.load(open(summ))
         complete = bool(s.get('complete'))
         shutil.copy(summ, os.path.join(CURVES, name + '.summary.json'))
+    try:   # Steinhardt Q6 of all bonds (series.h5 structure/q6): the order of the averaging window
+        from fdsusp import series
+        ser, _ = series.read(os.path.join(OUT, name), ['time', 'structure/q6'])
+        t, q6 = ser['time'], ser['structure/q6']
+        disc = s['discard_step'] * st['dt'] if os.path.exists(summ) else 0.0
+        st['q6_first_strain'] = float(q6[t < 1].mean())
+        if (t >= disc).any():
+            st['q6_window'] = float(q6[t >= disc].mean())
+    except Exception as err:   # no series (refused) or no Q6 columns
+        st['q6_note'] = str(err)[:200]
     if complete:
         st['ended'] = 'complete'
     elif os.path.exists(os.path.join(OUT, name, 'failed_state.h5')) or guard:
@@ -142,8 +153,8 @@ def fmt(q):
 
 def markdown(rows):
     head = ('| species | mu_d | phi (deck / in run) | N (small, large) | strains (discarded + averaged) | eta_r | N1/tau | '
-            'N2/tau | Pi/tau | wall time (s/strain) | ended |')
-    lines = [head, '|' + '---|' * head.count('|')[:-1] if False else '|---|---|---|---|---|---|---|---|---|---|---|']
+            'N2/tau | Pi/tau | Q6 | wall time (s/strain) | ended |')
+    lines = [head, '|' + '---|' * head.count('|')[:-1] if False else '|---|---|---|---|---|---|---|---|---|---|---|---|']
     for r in rows:
         n = str(r.get('spheres', ''))
         if r.get('species_counts'):
@@ -157,12 +168,15 @@ def markdown(rows):
         ps = r.get('wall_seconds_per_strain')
         wtxt = f"{wall:.0f} ({ps:.0f})" if wall and ps else ''
         ended = r['ended'] if r['ended'] != 'complete' else ''
+        if r['eps_bar'] != 0.015:
+            ended = (ended + '; ' if ended else '') + f"eps_bar {r['eps_bar']:g}, dt {r['dt']:g}"
         if r.get('complete'):
             vals = [fmt(r.get(q)) for q in ('eta_r', 'N1/tau', 'N2/tau', 'Pi/tau')]
         else:
             vals = ['', '', '', '']
+        q6 = f"{r['q6_window']:.3f}" if r.get('complete') and 'q6_window' in r else ''
         lines.append(f"| {r['species']} | {r['mu']:g} | {phi} | {n} | {strains} | " + ' | '.join(vals) +
-                     f" | {wtxt} | {ended} |")
+                     f" | {q6} | {wtxt} | {ended} |")
     return '\n'.join(lines)
 
 
@@ -176,7 +190,13 @@ def figure(rows):
     for ax, q, lab in zip(axes.flat, ('eta_r', 'N1/tau', 'N2/tau', 'Pi/tau'),
                           (r'$\eta_r$', r'$N_1/\tau$', r'$N_2/\tau$', r'$\Pi/\tau$')):
         for (sp, mu), (c, mk, ls) in style.items():
-            sel = [r for r in rows if r['species'] == sp and r['mu'] == mu and r.get('complete') and q in r]
+            sel = [r for r in rows if r['species'] == sp and r['mu'] == mu and r.get('complete') and q in r
+                   and r['eps_bar'] == 0.015]
+            stiff = [r for r in rows if r['species'] == sp and r['mu'] == mu and r.get('complete') and q in r
+                     and r['eps_bar'] != 0.015]
+            for r in stiff:
+                ax.errorbar([r['phi_core']['value']], [r[q]['value']], yerr=[r[q]['error']], color=c, marker='*',
+                            ms=10, ls='none', capsize=3, label=f"same, eps_bar {r['eps_bar']:g}")
             if not sel:
                 continue
             x = [r['phi_core']['value'] for r in sel]
@@ -186,7 +206,8 @@ def figure(rows):
             ax.errorbar(x, y, yerr=e, color=c, marker=mk, ls=ls, mfc='none' if sp == 'equal' else c,
                         capsize=3, label=name)
             # where a denser run of the same curve did not flow: mark it on the axis
-            stopped = [r for r in rows if r['species'] == sp and r['mu'] == mu and not r.get('complete')]
+            stopped = [r for r in rows if r['species'] == sp and r['mu'] == mu and not r.get('complete')
+                       and r['ended'] != 'unfinished (max_wall_hours or killed): continue with -continue']
             for r in stopped:
                 if q == 'eta_r':
                     ax.axvline(r.get('phi_packed', r['phi_deck']), color=c, ls=ls, lw=0.6, alpha=0.6)
