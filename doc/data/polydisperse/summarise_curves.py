@@ -50,8 +50,9 @@ def deck_values(name):
     mu = float(re.search(r'friction\s*=\s*([0-9.eE+-]+)', text).group(1))
     phi = float(re.search(r'solid_fraction\s*=\s*([0-9.eE+-]+)', text).group(1))
     eps_bar = float(re.search(r'eps_bar\s*=\s*([0-9.eE+-]+)', text).group(1))
+    seed = int(re.search(r'seed\s*=\s*(\d+)', text).group(1))
     species = 'mixture' if 'volume_share' in text else 'equal'
-    return dict(dt=dt, steps=steps, mu=mu, phi_deck=phi, species=species, eps_bar=eps_bar)
+    return dict(dt=dt, steps=steps, mu=mu, phi_deck=phi, species=species, eps_bar=eps_bar, seed=seed)
 
 
 def collect(name):
@@ -100,7 +101,8 @@ def collect(name):
         ser, _ = series.read(os.path.join(OUT, name), ['time', 'structure/q6'])
         t, q6 = ser['time'], ser['structure/q6']
         disc = s['discard_step'] * st['dt'] if os.path.exists(summ) else 0.0
-        st['q6_first_strain'] = float(q6[t < 1].mean())
+        if (t < 1).any():
+            st['q6_first_strain'] = float(q6[t < 1].mean())
         if (t >= disc).any():
             st['q6_window'] = float(q6[t >= disc].mean())
     except Exception as err:   # no series (refused) or no Q6 columns
@@ -141,7 +143,8 @@ def table():
         if row.get('wall_seconds_stepping') and row.get('strain_reached'):
             row['wall_seconds_per_strain'] = row['wall_seconds_stepping'] / row['strain_reached']
         rows.append(row)
-    rows.sort(key=lambda r: (r['species'] != 'mixture', r['mu'], r['phi_deck']))
+    rows.sort(key=lambda r: (r['species'] != 'mixture', r['mu'], r['phi_deck'], r['eps_bar'] != 0.015,
+                             r.get('seed', 3)))
     return rows
 
 
@@ -170,6 +173,8 @@ def markdown(rows):
         ended = r['ended'] if r['ended'] != 'complete' else ''
         if r['eps_bar'] != 0.015:
             ended = (ended + '; ' if ended else '') + f"eps_bar {r['eps_bar']:g}, dt {r['dt']:g}"
+        if r.get('seed', 3) != 3:
+            ended = (ended + '; ' if ended else '') + f"seed {r['seed']}"
         if r.get('complete'):
             vals = [fmt(r.get(q)) for q in ('eta_r', 'N1/tau', 'N2/tau', 'Pi/tau')]
         else:
@@ -191,12 +196,14 @@ def figure(rows):
                           (r'$\eta_r$', r'$N_1/\tau$', r'$N_2/\tau$', r'$\Pi/\tau$')):
         for (sp, mu), (c, mk, ls) in style.items():
             sel = [r for r in rows if r['species'] == sp and r['mu'] == mu and r.get('complete') and q in r
-                   and r['eps_bar'] == 0.015]
-            stiff = [r for r in rows if r['species'] == sp and r['mu'] == mu and r.get('complete') and q in r
-                     and r['eps_bar'] != 0.015]
-            for r in stiff:
-                ax.errorbar([r['phi_core']['value']], [r[q]['value']], yerr=[r[q]['error']], color=c, marker='*',
-                            ms=10, ls='none', capsize=3, label=f"same, eps_bar {r['eps_bar']:g}")
+                   and r['eps_bar'] == 0.015 and r.get('seed', 3) == 3]
+            other = [r for r in rows if r['species'] == sp and r['mu'] == mu and r.get('complete') and q in r
+                     and (r['eps_bar'] != 0.015 or r.get('seed', 3) != 3)]
+            for r in other:
+                what = f"eps_bar {r['eps_bar']:g}" if r['eps_bar'] != 0.015 else f"seed {r['seed']}"
+                ax.errorbar([r['phi_core']['value']], [r[q]['value']], yerr=[r[q]['error']], color=c,
+                            marker='*' if r['eps_bar'] != 0.015 else 'x', ms=9, ls='none', capsize=3,
+                            label=f"{'mixture' if sp == 'mixture' else 'equal'}, mu_d {mu:g}, {what}")
             if not sel:
                 continue
             x = [r['phi_core']['value'] for r in sel]
@@ -224,7 +231,7 @@ def figure(rows):
         ax.legend(fontsize=6)
     fig.suptitle('Lubrication dynamics, Lees-Edwards cube 12a, rough spheres (eps_r 5e-3, eps_bar 0.015), '
                  'strains discarded + averaged: 2 + 6 (mu_d 0), 1.5 + 4.5 (mu_d 0.5)\nthin vertical lines: runs that did not flow '
-                 '(refused or stopped by the overlap guard)', fontsize=9)
+                 '(refused or stopped by the overlap guard)', fontsize=8)
     fig.tight_layout()
     fig.savefig(FIG, dpi=100)
 
