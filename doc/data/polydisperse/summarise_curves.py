@@ -199,11 +199,15 @@ def figure(rows):
                    and r['eps_bar'] == 0.015 and r.get('seed', 3) == 3]
             other = [r for r in rows if r['species'] == sp and r['mu'] == mu and r.get('complete') and q in r
                      and (r['eps_bar'] != 0.015 or r.get('seed', 3) != 3)]
+            labelled = set()
             for r in other:
                 what = f"eps_bar {r['eps_bar']:g}" if r['eps_bar'] != 0.015 else f"seed {r['seed']}"
+                # one legend entry per kind of extra run (the other packings share one)
+                label = f"{'mixture' if sp == 'mixture' else 'equal'}, mu_d {mu:g}, {what}"
                 ax.errorbar([r['phi_core']['value']], [r[q]['value']], yerr=[r[q]['error']], color=c,
                             marker='*' if r['eps_bar'] != 0.015 else 'x', ms=9, ls='none', capsize=3,
-                            label=f"{'mixture' if sp == 'mixture' else 'equal'}, mu_d {mu:g}, {what}")
+                            label=None if label in labelled else label)
+                labelled.add(label)
             if not sel:
                 continue
             x = [r['phi_core']['value'] for r in sel]
