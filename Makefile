@@ -202,7 +202,7 @@ calibrate: all
 # The unequal pairs of the shipped mixtures (doc/LUBRICATION.md "Tables for mixtures"): N:R makes
 # input/lubrication/resolved_a<N>_ratio<R>.h5 (sphere 1 at a/Delta = N, sphere 2 R times larger).
 # The equal tables of the larger species (a/Delta = N R) come from make calibrate.
-MIXTURE_PAIRS ?= 4:2 5:1.4
+MIXTURE_PAIRS ?= 4:2 5:1.4 5:2
 calibrate-mixtures: all
 	@for p in $(MIXTURE_PAIRS); do $(PYTHON) scripts/calibrate.py $${p%%:*} --size-ratio $${p##*:} || exit 1; done
 
