@@ -299,38 +299,15 @@ contains
     type(mac_block_t) :: block
     type(face_list_t) :: faces
     real(dp), allocatable :: rigid(:, :, :)
-    real(dp) :: positions(3, 2), a(2), x(3), worst_rule, worst_sym
-    integer :: f, g, c, q, n_shared
-    integer, allocatable :: seen(:, :, :, :)
+    real(dp) :: positions(3, 2), worst_rule, worst_sym
+    integer :: c, n_shared
     logical :: disjoint
     block = periodic_block(5, 30)
     ! gap 0.1 h between the spheres, the inflated spheres of the code would overlap further
     positions(:, 1) = [15 * block%h - radius - 0.05_dp * block%h, 2.03_dp, 1.97_dp]
     positions(:, 2) = [15 * block%h + radius + 0.05_dp * block%h, 2.03_dp, 1.97_dp]
     call build(block, positions, faces, rigid, 3.0_dp, .true.)
-    allocate(seen(0:29, 0:29, 0:29, 4))
-    seen = 0
-    disjoint = .true.
-    worst_rule = 0.0_dp
-    n_shared = 0
-    do f = 1, faces%nf
-      c = comp_of(faces, f)
-      q = faces%run_part(run_of(faces, f))
-      if (seen(faces%ijk(1, f), faces%ijk(2, f), faces%ijk(3, f), c) /= 0) disjoint = .false.
-      seen(faces%ijk(1, f), faces%ijk(2, f), faces%ijk(3, f), c) = q
-      ! the rule of §3.4 recomputed from cube_fraction of both spheres
-      do g = 1, 2
-        x = (faces%ijk(:, f) + STAGGER(:, c)) * block%h - positions(:, g)
-        x = x - block%box * nint(x / block%box)
-        a(g) = cube_fraction(x, radius, block%h)
-      end do
-      if (a(3 - q) > 0.0_dp) n_shared = n_shared + 1
-      if (a(q) < a(3 - q)) then
-        worst_rule = huge(1.0_dp)
-      else
-        worst_rule = max(worst_rule, abs(faces%alpha(f) - (a(q) - a(3 - q))))
-      end if
-    end do
+    call audit_pair(block, faces, positions, [radius, radius], disjoint, n_shared, worst_rule)
     call check(disjoint, 'close pair: the two spheres list disjoint unknowns')
     call check(n_shared > 0, 'close pair: both spheres reach some unknowns (the rule is exercised)')
     call check_below('close pair: owner = larger cover, weight = excess over the other''s', worst_rule, 1.0e-15_dp)
@@ -341,38 +318,21 @@ contains
     call check_below('close pair mirrored about a grid plane: the same total weight per component', worst_sym, 1.0e-12_dp)
   end subroutine close_pair
 
-  ! 11. spheres of two sizes (radii R and 2R, a mixture): alone, each covers its own volume
-  ! 4/3 pi R_i^3 within 3e-3 (the planar ramp's error, as in 2); 0.1 h apart, they list disjoint
-  ! unknowns, the owner of a contested one is the sphere with the larger cube_fraction of its OWN
-  ! radius and its weight is the excess, to 1e-13 (the large sphere crosses the periodic boundary:
-  ! its wrapped offsets differ from the visit's unwrapped ones by ~1 ulp of the box, 1e-15, and
-  ! alpha moves by at most 4 |dr|/h, 2e-14 at h = 0.2); and the
-  ! small sphere keeps unknowns the large one reaches (the rival test uses each sphere's reach:
-  ! with the small sphere's reach in its place the large sphere would miss unknowns it contests,
-  ! which the disjointness check would catch).
-  subroutine unequal_pair()
-    type(mac_block_t) :: block
-    type(face_list_t) :: faces
-    real(dp), allocatable :: rigid(:, :, :)
-    real(dp) :: positions(3, 2), radii(2), a(2), x(3), worst_rule, worst_vol
-    integer :: f, g, c, q, n_shared
+  ! The ownership of a pair's faces audited against §3.4 recomputed from cube_fraction of both
+  ! spheres (each with its own radius): disjoint, no unknown listed twice; n_shared, the listed
+  ! unknowns both spheres cover; worst_rule, the largest difference between a listed weight and
+  ! the owner's cover less the other's (huge when the smaller cover owns one).
+  subroutine audit_pair(block, faces, positions, radii, disjoint, n_shared, worst_rule)
+    type(mac_block_t), intent(in) :: block
+    type(face_list_t), intent(in) :: faces
+    real(dp), intent(in) :: positions(3, 2), radii(2)
+    logical, intent(out) :: disjoint
+    integer, intent(out) :: n_shared
+    real(dp), intent(out) :: worst_rule
     integer, allocatable :: seen(:, :, :, :)
-    logical :: disjoint
-    block = periodic_block(5, 40)
-    radii = [radius, 2.0_dp * radius]
-    positions(:, 1) = [4.03_dp, 4.01_dp, 3.97_dp]
-    positions(:, 2) = [4.03_dp + 3.0_dp * radius + 0.1_dp * block%h, 4.01_dp, 3.97_dp]
-    ! alone (no rivals): each sphere's own volume, component by component
-    call build(block, positions, faces, rigid, 3.0_dp, .false., radii)
-    worst_vol = 0.0_dp
-    do c = 1, 4
-      do q = 1, 2
-        worst_vol = max(worst_vol, abs(alpha_sum(faces, c, q) * block%h**3 / (4.0_dp / 3.0_dp * pi * radii(q)**3) - 1))
-      end do
-    end do
-    call check_below('radii R and 2R, alone: sum alpha h^3 / (4/3 pi R_i^3) - 1', worst_vol, 3.0e-3_dp)
-    call build(block, positions, faces, rigid, 3.0_dp, .true., radii)
-    allocate(seen(0:39, 0:39, 0:39, 4))
+    real(dp) :: a(2), x(3)
+    integer :: f, g, c, q
+    allocate(seen(0:block%n(1) - 1, 0:block%n(2) - 1, 0:block%n(3) - 1, 4))
     seen = 0
     disjoint = .true.
     worst_rule = 0.0_dp
@@ -394,6 +354,39 @@ contains
         worst_rule = max(worst_rule, abs(faces%alpha(f) - (a(q) - a(3 - q))))
       end if
     end do
+  end subroutine audit_pair
+
+  ! 11. spheres of two sizes (radii R and 2R, a mixture): alone, each covers its own volume
+  ! 4/3 pi R_i^3 within 3e-3 (the planar ramp's error, as in 2); 0.1 h apart, they list disjoint
+  ! unknowns, the owner of a contested one is the sphere with the larger cube_fraction of its OWN
+  ! radius and its weight is the excess, to 1e-13 (the large sphere crosses the periodic boundary:
+  ! its wrapped offsets differ from the visit's unwrapped ones by ~1 ulp of the box, 1e-15, and
+  ! alpha moves by at most 4 |dr|/h, 2e-14 at h = 0.2); and the
+  ! small sphere keeps unknowns the large one reaches (the rival test uses each sphere's reach:
+  ! with the small sphere's reach in its place the large sphere would miss unknowns it contests,
+  ! which the disjointness check would catch).
+  subroutine unequal_pair()
+    type(mac_block_t) :: block
+    type(face_list_t) :: faces
+    real(dp), allocatable :: rigid(:, :, :)
+    real(dp) :: positions(3, 2), radii(2), worst_rule, worst_vol
+    integer :: c, q, n_shared
+    logical :: disjoint
+    block = periodic_block(5, 40)
+    radii = [radius, 2.0_dp * radius]
+    positions(:, 1) = [4.03_dp, 4.01_dp, 3.97_dp]
+    positions(:, 2) = [4.03_dp + 3.0_dp * radius + 0.1_dp * block%h, 4.01_dp, 3.97_dp]
+    ! alone (no rivals): each sphere's own volume, component by component
+    call build(block, positions, faces, rigid, 3.0_dp, .false., radii)
+    worst_vol = 0.0_dp
+    do c = 1, 4
+      do q = 1, 2
+        worst_vol = max(worst_vol, abs(alpha_sum(faces, c, q) * block%h**3 / (4.0_dp / 3.0_dp * pi * radii(q)**3) - 1))
+      end do
+    end do
+    call check_below('radii R and 2R, alone: sum alpha h^3 / (4/3 pi R_i^3) - 1', worst_vol, 3.0e-3_dp)
+    call build(block, positions, faces, rigid, 3.0_dp, .true., radii)
+    call audit_pair(block, faces, positions, radii, disjoint, n_shared, worst_rule)
     call check(disjoint, 'radii R and 2R 0.1 h apart: the two spheres list disjoint unknowns')
     call check(n_shared > 0, 'radii R and 2R: both spheres reach some unknowns (the rule is exercised)')
     call check_below('radii R and 2R: owner = larger cover of its own radius, weight = the excess', worst_rule, &
