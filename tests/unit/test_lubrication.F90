@@ -25,7 +25,7 @@ program test_lubrication
        i_yc11, i_xm11, i_ym11, i_zm11, i_xm12, i_ym12, i_zm12
   use mod_lubrication, only: lubrication_t, lub_setup, lub_pair_scalars, lub_wall_scalars, lub_pair_link, &
        lub_wall_link, lub_pair_stresslets, clip_to_psd, LUB_SIMPLE, LUB_FULL
-  use mod_unit_checks, only: check, finish
+  use mod_unit_checks, only: check, finish, min_eig
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_nan
   implicit none
   integer :: info
@@ -184,17 +184,6 @@ contains
       end if
     end do
   end function psd_everywhere
-
-  ! smallest eigenvalue of a symmetric matrix (LAPACK dsyev)
-  real(dp) function min_eig(m)
-    real(dp), intent(in) :: m(:, :)
-    real(dp) :: v(size(m, 1), size(m, 1)), ev(size(m, 1)), work(64 * size(m, 1))
-    integer :: info
-    external :: dsyev
-    v = m
-    call dsyev('N', 'U', size(m, 1), v, size(m, 1), ev, work, size(work), info)
-    min_eig = ev(1)
-  end function min_eig
 
   function spd6() result(m)
     real(dp) :: m(6, 6), g(6, 6)

@@ -40,7 +40,7 @@ program test_lubrication_mixture
        lub_wall_link, lub_species_wall_floor, LUB_FULL
   use mod_resistance_blocks, only: pair_resistance_fu_sized, pair_resistance_fe_sized, pair_stresslets_sized
   use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_create, particle_lubrication_links
-  use mod_unit_checks, only: check, check_below, finish
+  use mod_unit_checks, only: check, check_below, finish, min_eig
   implicit none
   integer, parameter :: ng = 8
   real(dp), parameter :: table_gaps(ng) = [0.001_dp, 0.01_dp, 0.05_dp, 0.1_dp, 0.2_dp, 0.35_dp, 0.6_dp, 1.0_dp]
@@ -445,16 +445,5 @@ contains
     call lub_sized_scalars(mix, gap, f, f2, s1, s2)
     call lub_pair_link_sized(mix, f, f2, dd, a1, a2, u, om, e, spread(1.0_dp, 1, 12), r, drive)
   end subroutine direct
-
-  ! smallest eigenvalue of a symmetric matrix (LAPACK dsyev)
-  real(dp) function min_eig(m)
-    real(dp), intent(in) :: m(:, :)
-    real(dp) :: v(size(m, 1), size(m, 1)), ev(size(m, 1)), work(64 * size(m, 1))
-    integer :: info
-    external :: dsyev
-    v = m
-    call dsyev('N', 'U', size(m, 1), v, size(m, 1), ev, work, size(work), info)
-    min_eig = ev(1)
-  end function min_eig
 
 end program test_lubrication_mixture

@@ -5,7 +5,7 @@ module mod_unit_checks
   use mod_kinds, only: dp
   implicit none
   private
-  public :: failures, checks, check, check_below, fail, finish
+  public :: failures, checks, check, check_below, fail, finish, min_eig
 
   !> failed checks so far (a test may also count its own failures here)
   integer :: failures = 0
@@ -57,4 +57,15 @@ contains
     end if
     print '(a,a,i0,a)', name, ': all ', checks, ' checks passed'
   end subroutine finish
+  !> The smallest eigenvalue of a symmetric matrix (LAPACK dsyev), for the tests' definiteness checks.
+  real(dp) function min_eig(m)
+    real(dp), intent(in) :: m(:, :)
+    real(dp) :: v(size(m, 1), size(m, 1)), ev(size(m, 1)), work(64 * size(m, 1))
+    integer :: info
+    external :: dsyev
+    v = m
+    call dsyev('N', 'U', size(m, 1), v, size(m, 1), ev, work, size(work), info)
+    min_eig = ev(1)
+  end function min_eig
+
 end module mod_unit_checks
