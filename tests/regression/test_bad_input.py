@@ -7,6 +7,7 @@ A run refused at input checking leaves nothing it created: an output directory (
 made by the refused run is removed again when it holds nothing but the lock file, so a fresh
 &output directory does not exist after the refusal (exact check, no tolerance)."""
 import os
+import shutil
 import fdsusp_testlib as T
 
 GOOD = """&domain box = 3.2, 3.2, 3.2, cells_per_radius = 5 /
@@ -101,7 +102,8 @@ cases = [
     ('unknown lubrication model', GOOD + "&lubrication model = 'exact' /\n", [], ['bad.nml', '&lubrication', 'model']),
     ('lubrication cut-offs crossed', GOOD + "&lubrication outer_cutoff = 1e-5 /\n", [],
      ['bad.nml', '&lubrication', 'outer_cutoff', 'inner_cutoff']),
-    ('resolution with no lubrication table', GOOD.replace('cells_per_radius = 5', 'cells_per_radius = 10') +
+    # a/Delta 9: no table is shipped at that resolution (input/lubrication has 4-8 and 10)
+    ('resolution with no lubrication table', GOOD.replace('3.2, 3.2, 3.2, cells_per_radius = 5', '4, 4, 4, cells_per_radius = 9') +
      '&particles number = 1, position(:,1) = 1.6, 1.6, 1.6 /\n', [], ['bad.nml', '&lubrication', 'model', 'no table']),
     ('lubrication table of another fictitious domain', GOOD +
      '&particles number = 1, position(:,1) = 1.6, 1.6, 1.6, radius_offset = 0.3 /\n', [],
@@ -144,6 +146,8 @@ cases = [
      ['bad.nml', '&rheology', 'average_strain', 'series_every']),
 ]
 for name, text, args, words in cases:
+    # each case starts without an output directory, so one case that ran cannot fail the next
+    shutil.rmtree(os.path.join(d, 'out'), ignore_errors=True)
     deck = os.path.join(d, 'bad.nml')
     if os.path.exists(deck):
         os.remove(deck)

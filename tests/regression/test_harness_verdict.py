@@ -74,7 +74,9 @@ for name, body, want, what in (('none', '', 1, 'finish without a check'),
     src = T.write_deck(d, 'unit_%s.f90' % name, 'program unit_%s\n  use mod_unit_checks, only: check, finish\n'
                        '  implicit none\n%s  call finish("unit_%s")\nend program unit_%s\n' % (name, body, name, name))
     exe = os.path.join(d, 'unit_' + name)
-    c = subprocess.run([fc, '-I', build, src] + objects + ['-o', exe], cwd=d, capture_output=True, text=True)
+    # linked as the Makefile links the unit tests: mod_unit_checks' min_eig calls LAPACK's dsyev
+    c = subprocess.run([fc, '-I', build, src] + objects + ['-o', exe, '-llapack', '-lblas'], cwd=d,
+                       capture_output=True, text=True)
     T.check(c.returncode == 0, 'Fortran: unit_%s compiles (%s)' % (name, c.stderr.strip()[-200:]))
     if c.returncode == 0:
         status_of([exe], 'Fortran, ' + what, want)
