@@ -193,8 +193,9 @@ pair-dns: all
 	$(PYTHON) scripts/pair_dns.py $(PAIR_DNS_ARGS)
 
 # Lubrication tables (doc/LUBRICATION.md): the resolved resistance measured at each a/Delta and
-# written to input/lubrication/resolved_a<N>.h5. CELLS_PER_RADIUS="5" redoes one resolution.
-CELLS_PER_RADIUS ?= 4 5 6 8
+# written to input/lubrication/resolved_a<N>.h5. CELLS_PER_RADIUS="5" redoes one resolution; 5.6, 7
+# and 10 are the larger species of the shipped mixtures (1.4 x 4, 1.4 x 5, 2 x 5).
+CELLS_PER_RADIUS ?= 4 5 5.6 6 7 8 10
 PYTHON := $(shell [ -x /usr/bin/python3 ] && echo /usr/bin/python3 || echo python3)
 calibrate: all
 	@for n in $(CELLS_PER_RADIUS); do $(PYTHON) scripts/calibrate.py $$n || exit 1; done
@@ -202,7 +203,7 @@ calibrate: all
 # The unequal pairs of the shipped mixtures (doc/LUBRICATION.md "Tables for mixtures"): N:R makes
 # input/lubrication/resolved_a<N>_ratio<R>.h5 (sphere 1 at a/Delta = N, sphere 2 R times larger).
 # The equal tables of the larger species (a/Delta = N R) come from make calibrate.
-MIXTURE_PAIRS ?= 4:2 5:1.4 5:2
+MIXTURE_PAIRS ?= 4:1.4 4:2 5:1.4 5:2
 calibrate-mixtures: all
 	@for p in $(MIXTURE_PAIRS); do $(PYTHON) scripts/calibrate.py $${p%%:*} --size-ratio $${p##*:} || exit 1; done
 

@@ -79,7 +79,8 @@ def frame(rng):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument('cells_per_radius', type=int)
+    ap.add_argument('cells_per_radius', type=float,
+                    help='a/Delta; not an integer for the larger species of a mixture (5.6 = 1.4 x 4)')
     ap.add_argument('--samples', type=int, default=None, help='samples per gap (default: SAMPLES, else 2)')
     ap.add_argument('--jobs', type=int, default=2)
     ap.add_argument('--work', default=None)
@@ -92,15 +93,19 @@ def main():
         return
     if args.samples is None:
         args.samples = SAMPLES.get(args.cells_per_radius, 2)
+    if args.size_ratio is None and args.cells_per_radius == int(args.cells_per_radius):
+        args.cells_per_radius = int(args.cells_per_radius)
     if args.samples < 2:
         ap.error('--samples must be at least 2 (the table keeps the scatter)')
     n = args.cells_per_radius
     h = 1.0 / n
-    work = args.work or os.path.join(ROOT, 'out', f'calibrate_a{n}')
+    work = args.work or os.path.join(ROOT, 'out', f'calibrate_a{ratio_tag(n)}')
     os.makedirs(work, exist_ok=True)
-    rng = np.random.default_rng(20261123 + n)
-    L = 8.0
-    LW = 10.0
+    # the seed of the integer tables; a non-integer resolution seeds with 1000 n
+    rng = np.random.default_rng(20261123 + (n if isinstance(n, int) else int(round(1000 * n))))
+    # the periodic cube (8a) and the Couette cell (10a) in whole cells (8 and 10 exactly when n is an integer)
+    L = round(8.0 * n) / n
+    LW = round(10.0 * n) / n
     E = SHEAR_E
     zero = np.zeros(3)
     runner = Runner(work, args.jobs)
@@ -111,7 +116,7 @@ def main():
         rng.uniform(0, 2 * PI)   # a discarded draw: it keeps the random stream, hence the tables' samples
         ang = rng.uniform(0, 2 * PI)
         t = np.array([math.cos(ang), 0.0, math.sin(ang)])
-        dc = strain_direction(d, E, seed=20261125 + 100 * n + s)
+        dc = strain_direction(d, E, seed=int(round(20261125 + 100 * n)) + s)
         samples.append((off, d, e1, e2, t, dc))
         c = np.array([L / 2, L / 2, L / 2]) + off
         cc = np.array([L / 2, LW / 2, L / 2]) + off
@@ -203,13 +208,13 @@ def main():
             far = wall_excess(LW - 2.0 - g)
             mid = 2.0 * wall_excess(LW / 2 - 1.0)
             wall[s, k] = wall_values(g) - centre - far + mid
-    out = args.output or os.path.join(ROOT, 'input', 'lubrication', f'resolved_a{n}.h5')
+    out = args.output or os.path.join(ROOT, 'input', 'lubrication', f'resolved_a{ratio_tag(n)}.h5')
     os.makedirs(os.path.dirname(out), exist_ok=True)
     with h5py.File(out, 'w') as f:
         f.attrs['cells_per_radius'] = n
         f.attrs['radius_offset'] = 0.38
         f.attrs['slip_kappa'] = 0.5
-        f.attrs['command'] = f'scripts/calibrate.py {n} --samples {args.samples}'
+        f.attrs['command'] = f'scripts/calibrate.py {ratio_tag(n)} --samples {args.samples}'
         f.attrs['description'] = ('resolved pair part R~2B - R~1B of the 22 equal-sphere scalars '
                                   '(Kim & Karrila normalisation; M sums in the 11 slots) and of the '
                                   'sphere-wall functions, measured by fdsusp in resistance mode')
@@ -270,16 +275,17 @@ def calibrate_unequal(args):
     the equal calibration, each sphere spun in turn, fitted with fdsusp.pair_blocks (see
     fit_pair), the regular co-moving translations held at their exact values."""
     n, lam = args.cells_per_radius, args.size_ratio
+    n = int(n) if n == int(n) else n
     if lam < 1.0:
         sys.exit('calibrate: --size-ratio is the larger sphere over the smaller, >= 1 (1: the equal pair '
                  'by this method, a check of it against the equal table)')
     samples_n = args.samples or 2
     h = 1.0 / n
     a1, a2 = 1.0, lam
-    tag = f'a{n}_ratio{ratio_tag(lam)}'
+    tag = f'a{ratio_tag(n)}_ratio{ratio_tag(lam)}'
     work = args.work or os.path.join(ROOT, 'out', f'calibrate_{tag}')
     os.makedirs(work, exist_ok=True)
-    rng = np.random.default_rng(20261127 + n + int(round(100 * lam)))
+    rng = np.random.default_rng(int(round(20261127 + n + 100 * lam)))
     # the periodic cube and the Couette cell scaled with the pair (8a and 10a for equal spheres),
     # whole cells
     L = round(4.0 * (a1 + a2) * n) / n
@@ -295,7 +301,7 @@ def calibrate_unequal(args):
     for s in range(samples_n):
         off = rng.uniform(0, h, size=3)
         d, e1, e2 = frame(rng)
-        dc = strain_direction(d, E, seed=20261127 + 100 * n + s)
+        dc = strain_direction(d, E, seed=int(round(20261127 + 100 * n)) + s)
         samples.append((off, d, e1, e2, dc))
         c = np.array([L / 2, L / 2, L / 2]) + off
         cc = np.array([L / 2, LW / 2, L / 2]) + off
@@ -378,7 +384,7 @@ def calibrate_unequal(args):
         fh.attrs['size_ratio'] = float(lam)
         fh.attrs['radius_offset'] = 0.38
         fh.attrs['slip_kappa'] = 0.5
-        fh.attrs['command'] = f'scripts/calibrate.py {n} --size-ratio {ratio_tag(lam)} --samples {samples_n}'
+        fh.attrs['command'] = f'scripts/calibrate.py {ratio_tag(n)} --size-ratio {ratio_tag(lam)} --samples {samples_n}'
         fh.attrs['description'] = ('resolved pair part R~2B - R~1B of two spheres of radii 1 and size_ratio '
                                    '(Jeffrey & Onishi scaling; sphere 1: 11 and 12 scalars, sphere 2: 22 and 21 '
                                    'with exchange signs; M folded into the self slots), measured by fdsusp in '

@@ -92,6 +92,14 @@ def with_flow(x, height):
     return (x, np.array([x[1] - height / 2, 0.0, 0.0]), SHEAR_OMEGA)
 
 
+def cells_per_radius(h):
+    """a/Delta of a cell size h: an integer when it is one (the decks of the integer tables), else
+    its value to 6 decimals (5.6 for the 1.4 species of a mixture at a/Delta 4), as table names
+    write it."""
+    n = round(1.0 / h, 6)
+    return int(n) if n == int(n) else n
+
+
 def deck(path, out, box, walls, shear, spheres, h, model='none', vtol=1e-6, ptol=1e-8, motion='resistance',
          radii=None, relax_radius=1.0):
     """spheres: list of (position, velocity, omega); motion: 'resistance' (the velocities imposed)
@@ -112,7 +120,7 @@ def deck(path, out, box, walls, shear, spheres, h, model='none', vtol=1e-6, ptol
         particles.update({'position(:,%d)' % i: [float(c) for c in x], 'velocity(:,%d)' % i: [float(c) for c in u],
                           'omega(:,%d)' % i: [float(c) for c in w]})
     fdeck.write(path, fdeck.text([
-        ('domain', {'box': list(box), 'cells_per_radius': round(1 / h),
+        ('domain', {'box': list(box), 'cells_per_radius': cells_per_radius(h),
                     'y_boundary': 'walls' if walls else 'periodic', 'shear_rate': shear}),
         ('fluid', {'reynolds': REYNOLDS, 'viscous_theta': 1.0, 'initial_flow': 'shear',
                    'velocity_tolerance': vtol, 'pressure_tolerance': ptol}),

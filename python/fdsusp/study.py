@@ -43,9 +43,11 @@ ROOT = checkout()
 # a/Delta = 4, bulk phi 0.40 (seed 1), eps_r 5e-3, implicit contacts, full lubrication, dt 2e-3,
 # 2 strains discarded and 20 averaged in 5 blocks, the resolved fluid, the model's own lubrication
 # cut-off (&lubrication outer_cutoff).
+# species: None (equal spheres of radius 1) or ((radius, volume share), ...) of a mixture, the
+# smallest radius 1 (the unit of length and of cells_per_radius).
 BASE = dict(box=(8, 20, 8), cells=4, phi=0.40, seed=1, eps_r=5e-3, eps_bar=0.05, dt=2e-3,
             discard=2.0, average=20.0, blocks=5, min_gap=None, implicit=True,
-            model='resolved', boundary='walls', cutoff=None)
+            model='resolved', boundary='walls', cutoff=None, species=None)
 
 def run_name(row, mu):
     return '%s_mu%g' % (row, mu)
@@ -120,7 +122,9 @@ class Study:
                        'initial_flow': 'shear'}),
             ('time', {'dt': s['dt']}),
             ('output', {'directory': 'out', 'progress_every': 500, 'series_every': 5, 'checkpoint_every': 2500}),
-            ('particles', {'solid_fraction': s['phi'], 'seed': s['seed'], 'packing_min_gap': s['min_gap']}),
+            ('particles', {'radius': [r for r, _ in s['species']] if s['species'] else None,
+                           'volume_share': [v for _, v in s['species']] if s['species'] else None,
+                           'solid_fraction': s['phi'], 'seed': s['seed'], 'packing_min_gap': s['min_gap']}),
             ('contact', {'roughness': s['eps_r'], 'eps_bar': s['eps_bar'], 'friction': mu,
                          'implicit': None if s['implicit'] else False}),
             ('lubrication', {'model': 'full', 'outer_cutoff': s['cutoff']}),
@@ -202,6 +206,7 @@ class Study:
             'fluid_model': st['model'], 'spheres': spheres[-1] if spheres else None,
             'box': list(st['box']), 'cells_per_radius': st['cells'], 'y_boundary': st['boundary'],
             'solid_fraction_bulk': st['phi'], 'seed': st['seed'], 'friction': mu,
+            'species': [{'radius': r, 'volume_share': v} for r, v in st['species']] if st['species'] else None,
             'roughness': st['eps_r'], 'eps_bar': st['eps_bar'], 'implicit_contacts': st['implicit'],
             'dt': st['dt'], 'reynolds': 0.01,
             'lubrication': 'full', 'lubrication_outer_cutoff': st['cutoff'], 'strain_discarded': discard, 'strain_averaged': average,
