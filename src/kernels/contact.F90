@@ -59,6 +59,9 @@ module mod_contact
   ! mu_d >= SHEAR_JAM_WARN_MU it was measured from SHEAR_JAM_WARN_PHI on, between walls
   real(dp), parameter :: SHEAR_JAM_MU = 0.2_dp, SHEAR_JAM_PHI = 0.545_dp
   real(dp), parameter :: SHEAR_JAM_WARN_MU = 0.5_dp, SHEAR_JAM_WARN_PHI = 0.52_dp
+  ! smooth spheres (h_r = 0) stop when an overlap exceeds this fraction of their radius
+  ! (mod_particle_contacts overlap_limit; doc/CONTACT.md "Overlap guard")
+  real(dp), parameter, public :: SMOOTH_OVERLAP_BOUND = 0.05_dp
 
   type :: contact_params_t
     real(dp) :: a = 1                   ! sphere radius [a]
@@ -176,10 +179,18 @@ contains
   !> to it) and roughness that would flatten completely (doc/VALIDATION.md §6).
   !> dt: the time step; implicit: the contacts are taken implicitly; eps_bar: the deck's;
   !> stiffness_prescribed: k_n is the deck's normal_stiffness (the item a refusal names).
-  function contact_limits(p, dt, implicit, sheared, phi, eps_bar, stiffness_prescribed) result(findings)
+  !> largest_radius (a mixture: the largest species' radius over the smallest, p's): the overlap
+  !> estimate is that of the largest pair. A contact of two spheres of radius r carries a force
+  !> ~ r^2 on a Hertz stiffness ~ r^(1/2), so its overlap grows like r (doc/CONTACT.md "Spheres of
+  !> several sizes": 1.40-1.50 times the small pairs' in a 1:1.4 mixture). The chatter and stick
+  !> numbers stay the unit pair's: the chatter's lubricated resistance grows faster (r^2) than the
+  !> stiffness, and slip per step and sticking length both grow like r.
+  function contact_limits(p, dt, implicit, sheared, phi, eps_bar, stiffness_prescribed, largest_radius) &
+       result(findings)
     type(contact_params_t), intent(in) :: p
     real(dp), intent(in) :: dt, phi, eps_bar
     logical, intent(in) :: implicit, sheared, stiffness_prescribed
+    real(dp), intent(in), optional :: largest_radius
     type(limit_finding_t), allocatable :: findings(:)
     real(dp) :: chatter, stick, expected_overlap
     logical :: shear_jamming   ! the jamming checks apply: rough contacts under shear
@@ -233,6 +244,7 @@ contains
     ! the roughness of a dense suspension flattens under its force chains (doc/VALIDATION.md §6)
     if (sheared) then
       expected_overlap = flattening_estimate(p, phi)
+      if (present(largest_radius)) expected_overlap = expected_overlap * max(1.0_dp, largest_radius)
       if (expected_overlap > 1.0_dp) then
         write(text, '(a,f6.2,a,f5.3,a,es9.2,a)') 'the roughness would flatten completely: expected largest overlap ', &
              expected_overlap, ' h_r at phi = ', phi, ' (doc/VALIDATION.md §6); stiffer contacts, eps_bar <= ', &
@@ -247,22 +259,31 @@ contains
     end if
   end function contact_limits
 
-  !> A run's largest contact overlap grows from largest_before to overlap at step: warned once, when
-  !> it passes h_r/2, the bound the extreme scenes hold (doc/VALIDATION.md §6).
+  !> A run's largest contact overlap grows from largest_before to overlap at step (both in a): warned
+  !> once, when it passes half the guard's bound, h_r/2 for rough spheres (the bound the extreme
+  !> scenes hold, doc/VALIDATION.md §6) and 0.025 a for smooth ones (their guard stops at 0.05 a).
   function overlap_limit(p, largest_before, overlap, step) result(findings)
     type(contact_params_t), intent(in) :: p
     real(dp), intent(in) :: largest_before, overlap
     integer, intent(in) :: step
     type(limit_finding_t), allocatable :: findings(:)
     character(len=400) :: text
+    real(dp) :: bound
     allocate(findings(0))
-    if (largest_before <= 0.5_dp * p%h_r .and. overlap > 0.5_dp * p%h_r) then
+    bound = p%h_r
+    if (bound <= 0) bound = SMOOTH_OVERLAP_BOUND * p%a
+    if (largest_before > 0.5_dp * bound .or. overlap <= 0.5_dp * bound) return
+    if (p%h_r > 0) then
       write(text, '(a,i0,a,f6.3,a)') 'at step ', step, ' a contact overlap reaches ', &
            overlap / p%h_r, ' h_r (> h_r/2): stiffer contacts (a smaller &contact eps_bar '// &
            'or a larger normal_stiffness, with dt gamma_dot h_r/delta_0 within its limit, doc/CONTACT.md) keep the '// &
            'roughness from flattening'
-      call add_finding(findings, LIMIT_WARN, text)
+    else
+      write(text, '(a,i0,a,es9.2,a,f5.3,a)') 'at step ', step, ' a contact overlap of smooth spheres reaches ', &
+           overlap / p%a, ' a (> ', 0.5_dp * SMOOTH_OVERLAP_BOUND, &
+           ' a, half the bound at which the run stops): a larger &contact normal_stiffness keeps them apart'
     end if
+    call add_finding(findings, LIMIT_WARN, text)
   end function overlap_limit
 
   !> delta_0 = (6 pi eta gamma_dot a^2 / k_n)^(2/3): the Hertz overlap under the force scale

@@ -22,7 +22,8 @@
 module mod_particle_contacts
   use mod_kinds, only: dp
   use mod_contact, only: contact_params_t, contact_setup, contact_stats_t, contact_history_t, &
-                         contact_forces, contact_links_t, contact_stiffness, contact_stresslet
+                         contact_forces, contact_links_t, contact_stiffness, contact_stresslet, &
+                         SMOOTH_OVERLAP_BOUND
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates
   use mod_lees_edwards, only: lees_edwards_t
   use mod_particle_system, only: particle_system_t, particle_system_add_diagonal, particle_system_add_pair
@@ -117,7 +118,7 @@ contains
     end if
     ! far beyond the roughness: the true surfaces overlap (smooth spheres: 5 % of the radius)
     pc%overlap_limit = pc%params%h_r
-    if (pc%overlap_limit <= 0) pc%overlap_limit = 0.05_dp * a
+    if (pc%overlap_limit <= 0) pc%overlap_limit = SMOOTH_OVERLAP_BOUND * a
     if (present(le)) pc%le = le
     ! the largest sphere's contacts (conservative for the smaller ones; unit spheres: a exactly)
     a_max = a

@@ -243,7 +243,7 @@ contains
       if (cfg%species > 1) solid_fraction = sum((4.0_dp / 3.0_dp) * pi * parts%radii**3) / product(cfg%domain%box)
       call report_limits(cfg%deck_file, contact_limits(pc%params, cfg%time%dt, pc%implicit, &
                          cfg%walls .or. cfg%lees_edwards, solid_fraction, cfg%contact%eps_bar, &
-                         cfg%contact%normal_stiffness > 0.0_dp))
+                         cfg%contact%normal_stiffness > 0.0_dp, maxval(parts%radii) / parts%radius))
     end if
   end subroutine make_lubrication
 

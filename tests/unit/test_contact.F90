@@ -34,6 +34,11 @@
 !      contact_limits refuses phi 0.5485 with mu_d 0.5 in a sheared cell, naming &contact friction,
 !      warns at phi 0.53 with mu_d 0.5, and lets phi 0.5485 pass frictionless (measured to flow),
 !      with mu_d 0.1, or without shear (no sliding boundary, or walls at rest).
+!  15. A mixture's overlap estimate is its largest pair's (doc/CONTACT.md "Spheres of several
+!      sizes": overlaps grow like the radius, measured 1.40-1.50 for 1:1.4): at phi 0.4 with
+!      eps_bar 0.06 the unit estimate 0.41 h_r passes, 1.4 times it (0.58) warns; eps_bar 0.09
+!      (0.62) warns, twice it (1.24) is refused naming &contact eps_bar; largest_radius 1 is the
+!      equal-sphere result.
 program test_contact
   use mod_kinds, only: dp, pi
   use mod_vector, only: cross
@@ -272,6 +277,21 @@ program test_contact
   call contact_setup(p0, 1.0_dp, 5.0e-3_dp, 0.0_dp, 0.01_dp, 0.0_dp, 1.0_dp, 1.0_dp, info, msg)
   found = contact_limits(p0, 1.0e-3_dp, .true., .true., 0.5485_dp, 0.01_dp, .false.)
   call check(count(found%level == LIMIT_REFUSE) == 0, 'frictionless at phi 0.5485: no refusal')
+
+  ! 15. a mixture's largest pair
+  call contact_setup(p0, 1.0_dp, 5.0e-3_dp, 0.0_dp, 0.06_dp, 0.0_dp, 1.0_dp, 1.0_dp, info, msg)
+  found = contact_limits(p0, 1.0e-3_dp, .true., .true., 0.4_dp, 0.06_dp, .false., 1.0_dp)
+  call check(size(found) == 0, 'eps_bar 0.06 at phi 0.4, equal spheres: no finding')
+  found = contact_limits(p0, 1.0e-3_dp, .true., .true., 0.4_dp, 0.06_dp, .false., 1.4_dp)
+  call check(count(found%level == LIMIT_WARN) == 1 .and. any(index(found%text, '0.58 h_r') > 0), &
+             'the same with a 1:1.4 mixture: a warning at 0.58 h_r')
+  call contact_setup(p0, 1.0_dp, 5.0e-3_dp, 0.0_dp, 0.09_dp, 0.0_dp, 1.0_dp, 1.0_dp, info, msg)
+  found = contact_limits(p0, 1.0e-3_dp, .true., .true., 0.4_dp, 0.09_dp, .false.)
+  call check(count(found%level == LIMIT_WARN) == 1 .and. count(found%level == LIMIT_REFUSE) == 0, &
+             'eps_bar 0.09 at phi 0.4, equal spheres: a warning')
+  found = contact_limits(p0, 1.0e-3_dp, .true., .true., 0.4_dp, 0.09_dp, .false., 2.0_dp)
+  call check(count(found%level == LIMIT_REFUSE) == 1 .and. any(found%group == 'contact' .and. found%key == 'eps_bar'), &
+             'the same with a 1:2 mixture: refused, naming &contact eps_bar')
 
   call finish('test_contact')
 
