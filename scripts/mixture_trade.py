@@ -10,7 +10,7 @@ The set-up is §8.7's (fdsusp.study BASE: 8a x 20a x 8a Couette cell, 9a x 20a x
 mixture (MIXTURE_BOX), the small spheres at a/Delta 4, so the large ones at 5.6, eps_r 5e-3, implicit contacts, full lubrication, seed 1) with
 2 strains discarded and 10 averaged in 5 blocks, eps_bar 0.02 (STUDY_BASE). Frictional rows (suffix
 _eb002) take dt 8e-4 with it, as §8.7's DNS at phi 0.45 (eps_bar 0.05 reached the overlap guard),
-and average 6 strains in 3 blocks (2.5 times the steps per strain).
+and discard 1.5 strains and average 4.5 in 3 blocks (2.5 times the steps per strain).
 Runs are made, resumed and recorded as by fdsusp.study (doc/data/mixture_trade/<row>_mu<mu>/).
 --table prints per phi and mu_d: the mixture's DNS and LD, and the equal spheres' DNS (§8.7's
 records, and this study's at phi 0.5), with the mixture-to-equal and LD-to-DNS ratios.
@@ -25,8 +25,8 @@ from fdsusp.study import BASE, Study, load, run_name  # noqa: E402
 ROOT = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), '..'))
 MIXTURE = ((1.0, 0.5), (1.4, 0.5))
 LD = dict(model='none')
-# frictional rows: 2.5 times the steps, so 6 strains averaged in 3 blocks
-FRICTIONAL = dict(dt=8e-4, average=6.0, blocks=3)
+# frictional rows: 2.5 times the steps, so 1.5 strains discarded and 4.5 averaged in 3 blocks
+FRICTIONAL = dict(dt=8e-4, discard=1.5, average=4.5, blocks=3)
 
 # the 1.4 spheres' neighbour search needs periods of at least 2 (2 x 1.4 + 1.4 + 0.2) = 8.8 (the pair
 # cut-off is the table's largest gap, 1, in units of the pair's mean radius): the mixture's cell is
