@@ -59,7 +59,16 @@ contains
     n = 0
     contacts = particles > 0 .and. cfg%contact_group
     call text_item('domain', 'y_boundary', MUST_MATCH, cfg%domain%y_boundary)
+    ! the reference rate, under its older name (as checkpoints before &shear record it), and the
+    ! protocol (doc/INPUT.md "&shear")
     call real_item('domain', 'shear_rate', MUST_MATCH, [cfg%domain%shear_rate], legacy='shear_rate')
+    call text_item('shear', 'control', MUST_MATCH, cfg%shear%control)
+    call text_item('shear', 'protocol', MUST_MATCH, cfg%shear%protocol)
+    if (cfg%shear%protocol == 'reversal') call real_item('shear', 'reversal_strain', MUST_MATCH, [cfg%shear%reversal_strain])
+    if (cfg%shear%protocol == 'oscillatory') then
+      call real_item('shear', 'strain_amplitude', MUST_MATCH, [cfg%shear%strain_amplitude])
+      call real_item('shear', 'period', MUST_MATCH, [cfg%shear%period])
+    end if
     if (cfg%resolved) then
       call real_item('fluid', 'reynolds', MUST_MATCH, [cfg%fluid%reynolds], legacy='reynolds')
       call real_item('fluid', 'body_force', MUST_MATCH, cfg%fluid%body_force)
