@@ -746,6 +746,11 @@ contains
     if (cfg%shear%protocol == 'steady') return
     if (cfg%shear%rate == 0.0_dp) call input_error(cfg%deck_file, trim(cfg%rate_group), trim(cfg%rate_name), &
          'protocol = '''//trim(cfg%shear%protocol)//''' needs a non-zero rate')
+    ! what presumes a steady imposed flow
+    if (cfg%time%steady_tolerance > 0.0_dp) call input_error(cfg%deck_file, 'time', 'steady_tolerance', &
+         'stops the run on a steady flow, which &shear protocol = '''//trim(cfg%shear%protocol)//''' never reaches: set 0')
+    if (cfg%verification%manufactured_solution) call input_error(cfg%deck_file, 'verification', &
+         'manufactured_solution', 'is a steady solution under a steady rate: needs &shear protocol = ''steady''')
     if (cfg%shear%protocol == 'reversal') then
       call check_real(cfg, 'shear', 'reversal_strain', cfg%shear%reversal_strain, 0.0_dp, 1.0e9_dp, .true.)
       if (cfg%shear%reversal_strain < abs(cfg%shear%rate) * cfg%time%dt) then

@@ -164,6 +164,8 @@ cases = [
      ['bad.nml', '&shear', 'period', 'out of range']),
     ('non-positive amplitude', GOOD + "&shear protocol = 'oscillatory', strain_amplitude = -0.1, period = 1 /\n", [],
      ['bad.nml', '&shear', 'strain_amplitude', 'out of range']),
+    ('steady tolerance with a reversal', GOOD.replace('steps = 4', 'steps = 4, steady_tolerance = 1e-3') +
+     "&shear protocol = 'reversal', reversal_strain = 1 /\n", [], ['bad.nml', '&time', 'steady_tolerance', 'reversal']),
     ('rate with an oscillation', GOOD + "&shear protocol = 'oscillatory', rate = 2, strain_amplitude = 0.1, period = 1 /\n",
      [], ['bad.nml', '&shear', 'rate', 'strain_amplitude']),
 ]
