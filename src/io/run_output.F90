@@ -307,6 +307,8 @@ contains
     write(text, '(a,i0,a,i0,a)') 'rheology of the core region (', complete, ' of ', out%cfg%rheology%blocks, &
          ' blocks complete; value +- standard error; doc/RHEOLOGY.md):'
     call log_line(text)
+    if (out%rheology%raw_stress) call log_line('  (a rate that varies: stresses over eta*|reference rate|, not over '// &
+         'the measured rate; doc/RHEOLOGY.md "Protocols")')
     do k = 1, size(shown)
       q = findloc(summary_names, shown(k), 1)
       write(text, '(2x,a16,es13.5,a,es10.3)') shown(k), value(q), ' +- ', error(q)
