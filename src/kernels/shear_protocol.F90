@@ -12,7 +12,10 @@
 ! The reference rate (the unit of time and of stress, doc/INPUT.md "&shear") is rate (steady,
 ! reversal: signed, as given) or gamma_0 omega (oscillatory): the rate at t = 0 in every protocol.
 ! The state (time, strain, accumulated |strain|, sign, reversals) is what a checkpoint holds
-! (shear_protocol_state / shear_protocol_restore): a restart continues it exactly.
+! (shear_protocol_state / shear_protocol_restore): a restart continues it exactly. A branch starts
+! the protocol afresh from the checkpoint's configuration (shear_protocol_begin_at): its time,
+! accumulated |strain| and reversals from zero, its strain from the strain reached (the origin), so
+! that a reversal or an oscillation can follow a steady pre-shear.
 module mod_shear_protocol
   use mod_kinds, only: dp, pi
   use mod_columns, only: column_t, column
@@ -20,11 +23,11 @@ module mod_shear_protocol
   private
   public :: shear_protocol_t, shear_protocol_create, shear_protocol_begin_step, shear_protocol_end_step, &
             shear_protocol_varies, shear_protocol_state, shear_protocol_restore, shear_protocol_columns, &
-            shear_protocol_kind, shear_protocol_reference_rate
+            shear_protocol_kind, shear_protocol_reference_rate, shear_protocol_begin_at
   public :: PROTOCOL_STEADY, PROTOCOL_REVERSAL, PROTOCOL_OSCILLATORY, PROTOCOL_STATE_SIZE
 
   integer, parameter :: PROTOCOL_STEADY = 1, PROTOCOL_REVERSAL = 2, PROTOCOL_OSCILLATORY = 3
-  integer, parameter :: PROTOCOL_STATE_SIZE = 6
+  integer, parameter :: PROTOCOL_STATE_SIZE = 7
   ! a reversal is due when the accumulated |strain| is within this share of one step's strain of it
   real(dp), parameter :: reversal_slack = 1.0e-9_dp
 
@@ -38,6 +41,7 @@ module mod_shear_protocol
     ! the state at the start of the next step (t_n), as checkpointed
     real(dp) :: time = 0.0_dp             ! t_n
     real(dp) :: strain = 0.0_dp           ! gamma(t_n): the signed strain imposed since t = 0
+    real(dp) :: origin = 0.0_dp           ! the strain at t = 0 (a branch: the strain the checkpoint reached)
     real(dp) :: travel = 0.0_dp           ! the accumulated |strain| since t = 0
     real(dp) :: direction = 1.0_dp        ! +1, or -1 after an odd number of reversals
     integer :: reversals = 0
@@ -119,18 +123,19 @@ contains
     p%time = p%time + p%dt
     select case (p%kind)
     case (PROTOCOL_OSCILLATORY)
-      p%strain = p%strain_amplitude * sin(2.0_dp * pi * p%time / p%period)
+      p%strain = p%origin + p%strain_amplitude * sin(2.0_dp * pi * p%time / p%period)
     case default
       p%strain = p%strain + p%rate * p%dt
     end select
     p%travel = p%travel + abs(p%rate) * p%dt
   end subroutine shear_protocol_end_step
 
-  !> The state a checkpoint holds: time, strain, travel, direction, reversals, the last step's rate.
+  !> The state a checkpoint holds: time, strain, travel, direction, reversals, the last step's rate,
+  !> the strain's origin.
   pure function shear_protocol_state(p) result(s)
     type(shear_protocol_t), intent(in) :: p
     real(dp) :: s(PROTOCOL_STATE_SIZE)
-    s = [p%time, p%strain, p%travel, p%direction, real(p%reversals, dp), p%rate]
+    s = [p%time, p%strain, p%travel, p%direction, real(p%reversals, dp), p%rate, p%origin]
   end function shear_protocol_state
 
   !> Restore the state of shear_protocol_state (a restart).
@@ -143,8 +148,24 @@ contains
     p%direction = s(4)
     p%reversals = nint(s(5))
     p%rate = s(6)
+    p%origin = s(7)
     p%step_strain = p%strain
   end subroutine shear_protocol_restore
+
+  !> A branch: the protocol starts afresh (time 0, no accumulated |strain|, no reversal, the first
+  !> direction) from the strain the checkpoint's configuration reached.
+  pure subroutine shear_protocol_begin_at(p, strain)
+    type(shear_protocol_t), intent(inout) :: p
+    real(dp), intent(in) :: strain
+    p%time = 0.0_dp
+    p%origin = strain
+    p%strain = strain
+    p%step_strain = strain
+    p%travel = 0.0_dp
+    p%direction = 1.0_dp
+    p%reversals = 0
+    p%rate = p%reference_rate
+  end subroutine shear_protocol_begin_at
 
   !> The protocol's columns of the series (doc/RHEOLOGY.md "Protocols"): the imposed rate of the
   !> step the record's statistics were sampled in, and the strain gamma(t_n) of that configuration.

@@ -32,7 +32,8 @@ program fdsusp
   use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_create
   use mod_rheology, only: rheology_t, rheo_create
   use mod_lees_edwards, only: lees_edwards_t, le_create
-  use mod_shear_protocol, only: shear_protocol_t, shear_protocol_create, shear_protocol_kind, shear_protocol_varies
+  use mod_shear_protocol, only: shear_protocol_t, shear_protocol_create, shear_protocol_kind, shear_protocol_varies, &
+                                shear_protocol_begin_at
   use mod_fictitious_domain, only: fictitious_domain_t, fictitious_domain_create, fictitious_domain_destroy, &
                                    fictitious_domain_pair_lag_limit, fictitious_domain_stresslet_lag_limit
   use mod_lubrication_dynamics, only: lubrication_dynamics_t, lubrication_dynamics_create
@@ -138,6 +139,20 @@ program fdsusp
     PetscCallA(checkpoint_read(restart, state, statistics_afresh, ierr))
     if (statistics_afresh) call log_line('statistics: the &rheology window begins after the checkpoint''s step; '// &
          'they start from zero there (nothing the checkpoint accumulated is carried over)')
+    ! a branch starts the deck's protocol afresh from the configuration reached (its strain: with
+    ! Lees-Edwards boundaries the checkpoint's offset, which the boundary continues from)
+    if (branching) then
+      if (cfg%lees_edwards) then
+        call shear_protocol_begin_at(protocol, le%offset / cfg%domain%box(2))
+      else
+        call shear_protocol_begin_at(protocol, protocol%strain)
+      end if
+      call log_line('branch: &shear protocol '''//trim(cfg%shear%protocol)//''' starts afresh here (time 0 of '// &
+           'the protocol, no reversal yet; doc/INPUT.md "&shear")')
+      ! the rate may jump here: the spheres' Adams-Bashforth extrapolation starts afresh, as after
+      ! a reversal (a steady branch keeps it, as branches did before &shear)
+      if (shear_protocol_varies(protocol) .and. has_particles) parts%have_prev = .false.
+    end if
   end if
   ! what the run writes, and when, over the pieces it has (disassociated pointers are absent)
   call run_output_open(out, cfg, state, step, restarting, wall_start, grid_p, fluid_p, le_p, parts_p, contacts_p, &

@@ -10,7 +10,13 @@ steady runs). Cases, each stopped in the middle of what the protocol does:
 - a reversal in lubrication dynamics between walls (G = 60 steps' strain), 150 against 75 + 75:
   the reversals at steps 60 and 120 lie on either side of the restart;
 - an oscillation of the pure fluid in the DNS on 2 ranks (T = 40 steps), 60 against 30 + 30.
+A branch (-branch) starts the deck's protocol afresh from the checkpoint's configuration: after a
+steady pre-shear of 100 steps in lubrication dynamics (Lees-Edwards), a reversal every 0.25 strain
+flips at the steps 50, 100, 150 after the branch, and both it and an oscillation continue the
+boundary offset from the checkpoint's (its next step's strain added, to 1e-12 a), the oscillation's
+strain starting from the strain the pre-shear reached (offset / Ly).
 A few seconds on 2 cores."""
+import math
 import os
 import numpy as np
 import fdsusp_testlib as T
@@ -32,6 +38,14 @@ REV = """&domain box = 8.0, 8.0, 8.0, y_boundary = 'walls' /
 &particles solid_fraction = 0.35, seed = 4 /
 &contact roughness = 5.0e-3, friction = 0.5 /
 &rheology discard_strain = 0.0, average_strain = 0.7, blocks = 2 /
+"""
+STEADY = """&domain box = 8.0, 8.0, 8.0, y_boundary = 'lees-edwards' /
+&shear {shear} /
+&fluid model = 'none' /
+&time dt = 5.0e-3, steps = {steps} /
+&output directory = 'out', progress_every = 1000 /
+&particles solid_fraction = 0.35, seed = 5 /
+&contact roughness = 5.0e-3, friction = 0.5 /
 """
 FLUID = """&domain box = 4.0, 4.0, 4.0, cells_per_radius = 2 /
 &shear protocol = 'oscillatory', strain_amplitude = 0.5, period = 0.4 /
@@ -63,4 +77,32 @@ s = split('reversal', REV, 150)
 flips = s['step'][1:][np.sign(s['shear/rate'][1:]) != np.sign(s['shear/rate'][:-1])]
 T.check(list(flips) == [61, 121], 'reversal: the rate flips at steps 61 and 121, across the restart: %s' % list(flips))
 split('fluid', FLUID, 60, ranks=2)
+
+# a branch starts the deck's protocol afresh from the configuration reached: a steady pre-shear of
+# 100 steps (Lees-Edwards), then a reversal every 50 steps' strain, and an oscillation
+b = T.scratch('protocol_restart_branch')
+T.run(T.write_deck(b, 'steady.nml', STEADY.format(steps=100, shear='rate = 1.0')), b)
+pre = T.series(os.path.join(b, 'out'))
+for name, shear, steps in (('reversal', "rate = 1.0, protocol = 'reversal', reversal_strain = 0.25", 260),
+                           ('oscillation', "protocol = 'oscillatory', strain_amplitude = 0.05, period = 0.3", 160)):
+    _, out, _ = T.run(T.write_deck(b, name + '.nml', STEADY.format(steps=steps, shear=shear).replace(
+        "directory = 'out'", "directory = '%s'" % name)), b, args=['-branch', 'out/checkpoint.h5'])
+    T.check("&shear protocol '%s' starts afresh" % ('reversal' if name == 'reversal' else 'oscillatory') in out
+            and "&shear protocol changed from 'steady'" in out, '%s branch: the log names the change of protocol' % name)
+    s = T.series(os.path.join(b, name))
+    offset = s['lees_edwards_offset']
+    first = s['step'][0]
+    if name == 'reversal':
+        flips = s['step'][1:][np.sign(s['shear/rate'][1:]) != np.sign(s['shear/rate'][:-1])]
+        T.check(first == 101 and list(flips) == [151, 201, 251] and s['shear/rate'][0] == 1.0,
+                'reversal branch: from step 101, flips at 151, 201, 251 (50 steps after the branch, then every 50): %s'
+                % list(flips))
+        expected = (pre['lees_edwards_offset'][-1] + 1.0 * 8.0 * 5.0e-3) % 8.0
+    else:
+        expected = (pre['lees_edwards_offset'][-1] + 0.05 * math.sin(2 * math.pi * 5.0e-3 / 0.3) * 8.0) % 8.0
+        T.check(abs(s['shear/strain'][0] - pre['lees_edwards_offset'][-1] / 8.0) < 1e-12,
+                'oscillation branch: the strain starts where the pre-shear left the boundary (offset / Ly)')
+    T.check(abs(offset[0] - expected) < 1e-12,
+            '%s branch: the boundary offset continues from the checkpoint\'s (%.12f, expected %.12f)'
+            % (name, offset[0], expected))
 T.finish()
