@@ -80,8 +80,9 @@ contains
   ! The step of a run: fluid (grid, fluid), spheres (parts) with, when resolved, their fictitious
   ! domain fd, or, without a fluid, their lubrication dynamics (ld, ld_solver); contacts,
   ! lubrication and rheology where the run has them; le: the Lees-Edwards boundaries (offset 0
-  ! when inactive); protocol: the imposed shear as a function of time. walls: walls in y. Options: -fd_carry_lambda, -fault_nan_step. Collective
-  ! (resolved: the geometry of X^n is built here).
+  ! when inactive); protocol: the imposed shear in time (mod_shear_protocol). walls: walls in y.
+  ! Options: -fd_carry_lambda, -fault_nan_step. Collective (resolved: the geometry of X^n is built
+  ! here).
   subroutine time_step_create(ts, dt, box, walls, le, protocol, ierr, grid, fluid, fd, parts, ld, ld_solver, &
                               contacts, lubrication, rheology)
     type(time_step_t), intent(out) :: ts
