@@ -5,6 +5,8 @@
     fdsusp.run          where the programs are (FDSUSP_BIN, the checkout, the install, PATH),
                         running fdsusp, the job pool of the studies
     fdsusp.rheology     the statistics of a run's core region (src/kernels/rheology.F90 redone)
+    fdsusp.protocols    the analysis of the &shear protocols: the transient after reversals, the
+                        moduli of an oscillation, the stroboscopic displacement between its cycles
     fdsusp.references   the literature fits the paper compares with
     fdsusp.plots        the matplotlib figures (imports matplotlib; nothing else does)
     fdsusp.study        the resumable studies of scripts/friction_study.py and scripts/model_trade.py

@@ -53,12 +53,13 @@ def slope(t):
     return (t[0] * t[4] - t[1] * t[2]) / den if den > 0 else NAN
 
 
-def quantities(m, shear_rate):
+def quantities(m, shear_rate, fixed_rate=None):
     """m: the 21 block-mean values (stress_hydro 5, stress_contact 5, phi_core, particle velocity
-    fit 5, suspension flow fit 5)."""
+    fit 5, suspension flow fit 5). fixed_rate: the rate the stresses are divided by instead of the
+    measured core rate (a protocol whose rate varies: |reference rate|, doc/RHEOLOGY.md "Protocols")."""
     sh, sc = m[0:5], m[5:10]
     sp = sh + sc
-    gd = slope(m[11:16])
+    gd = slope(m[11:16]) if fixed_rate is None else fixed_rate
     eta_r = 1.0 + div(sp[3], gd)
     eta_h = 1.0 + div(sh[3], gd)
     eta_c = div(sc[3], gd)
@@ -83,7 +84,7 @@ def quantities(m, shear_rate):
     if p > 0:
         q[21:25] = [gd / p, tau / p, eta_h * gd / p, eta_c * gd / p]
     q[25] = m[10]
-    q[26] = gd / shear_rate
+    q[26] = slope(m[11:16]) / shear_rate   # measured, also under a fixed_rate
     q[27] = tau / shear_rate
     q[28] = div(sp[3], tau)
     q[29] = div(sc[3], tau)
@@ -91,6 +92,12 @@ def quantities(m, shear_rate):
     q[31] = div(sh[0] - sh[1], tau)
     q[32] = slope(m[16:21]) / shear_rate
     return np.array(q)
+
+
+def _fixed_rate(a):
+    """|reference rate| when the run's protocol varies the rate (series attribute shear_protocol),
+    else None: the summary's stresses are then over it (doc/RHEOLOGY.md "Protocols")."""
+    return abs(a['shear_rate']) if a.get('shear_protocol', 1) > 1 else None
 
 
 def species_quantities(m, ms):
@@ -241,7 +248,7 @@ def strain_windows(a, s, width, names):
         m = on_grid & (strain > k * width + 1e-9) & (strain <= (k + 1) * width + 1e-9)
         if not m.any():
             continue
-        q = quantities(values[m].mean(axis=0), a['shear_rate'])
+        q = quantities(values[m].mean(axis=0), a['shear_rate'], _fixed_rate(a))
         out['strain_start'].append(k * width)
         for n in names:
             v = q[NAMES.index(n)]
@@ -289,10 +296,11 @@ def summarise(a, s):
         if discard + b * block_steps <= last_step and records[b - 1] > 0:
             complete = b
     means = [values[block == b].sum(axis=0) / records[b] for b in range(complete)]
-    value = quantities(np.mean(means, axis=0), a['shear_rate']) if complete > 0 else np.full(len(NAMES), NAN)
+    fixed = _fixed_rate(a)
+    value = quantities(np.mean(means, axis=0), a['shear_rate'], fixed) if complete > 0 else np.full(len(NAMES), NAN)
     error = np.full(len(NAMES), NAN)
     if complete > 1:
-        per_block = np.array([quantities(m, a['shear_rate']) for m in means])
+        per_block = np.array([quantities(m, a['shear_rate'], fixed) for m in means])
         error = per_block.std(axis=0, ddof=1) / math.sqrt(complete)
     inside = (block >= 0) & (block < complete)
     nrec = np.count_nonzero(inside)

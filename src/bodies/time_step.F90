@@ -24,7 +24,9 @@ module mod_time_step
   use mod_particle_contacts, only: particle_contacts_t, particle_contacts_step
   use mod_particle_lubrication, only: particle_lubrication_t
   use mod_rheology, only: rheology_t, rheo_sample, rheo_sample_flow
-  use mod_lees_edwards, only: lees_edwards_t, le_wrap, le_advance
+  use mod_lees_edwards, only: lees_edwards_t, le_wrap, le_advance, le_set_strain
+  use mod_shear_protocol, only: shear_protocol_t, shear_protocol_begin_step, shear_protocol_end_step, &
+                                shear_protocol_varies, PROTOCOL_OSCILLATORY
   use mod_lubrication_dynamics, only: lubrication_dynamics_t
   use mod_fictitious_domain, only: fictitious_domain_t, fictitious_domain_geometry, fictitious_domain_follow, &
                                    fictitious_domain_moments, fictitious_domain_solve_motion, fictitious_domain_update
@@ -68,6 +70,7 @@ module mod_time_step
     type(lees_edwards_t), pointer :: le => null()
     type(lubrication_dynamics_t), pointer :: ld => null()
     type(particle_solver_t), pointer :: ld_solver => null()
+    type(shear_protocol_t), pointer :: protocol => null()   ! the imposed shear (&shear)
     real(dp), allocatable :: mean_flow(:)          ! x-z plane means of u per cell row (statistics)
     real(dp), allocatable :: position_before(:, :) ! X^n, then X^{n+1} - X^n
   end type time_step_t
@@ -77,14 +80,16 @@ contains
   ! The step of a run: fluid (grid, fluid), spheres (parts) with, when resolved, their fictitious
   ! domain fd, or, without a fluid, their lubrication dynamics (ld, ld_solver); contacts,
   ! lubrication and rheology where the run has them; le: the Lees-Edwards boundaries (offset 0
-  ! when inactive). walls: walls in y. Options: -fd_carry_lambda, -fault_nan_step. Collective
-  ! (resolved: the geometry of X^n is built here).
-  subroutine time_step_create(ts, dt, box, walls, le, ierr, grid, fluid, fd, parts, ld, ld_solver, &
+  ! when inactive); protocol: the imposed shear in time (mod_shear_protocol). walls: walls in y.
+  ! Options: -fd_carry_lambda, -fault_nan_step. Collective (resolved: the geometry of X^n is built
+  ! here).
+  subroutine time_step_create(ts, dt, box, walls, le, protocol, ierr, grid, fluid, fd, parts, ld, ld_solver, &
                               contacts, lubrication, rheology)
     type(time_step_t), intent(out) :: ts
     real(dp), intent(in) :: dt, box(3)
     logical, intent(in) :: walls
     type(lees_edwards_t), target, intent(in) :: le
+    type(shear_protocol_t), target, intent(in) :: protocol
     PetscErrorCode, intent(out) :: ierr
     type(grid_t), target, intent(in), optional :: grid
     type(fluid_t), target, intent(in), optional :: fluid
@@ -106,6 +111,7 @@ contains
     PetscCall(PetscOptionsGetInt(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-fault_nan_step', fault_step, set, ierr))
     ts%fault_nan_step = fault_step
     ts%le => le
+    ts%protocol => protocol
     if (present(grid)) ts%grid => grid
     if (present(fluid)) ts%fluid => fluid
     if (present(fd)) ts%fd => fd
@@ -141,10 +147,14 @@ contains
     integer :: info
     ierr = 0
     ts%failure = ''
+    ! the imposed rate of this step, gamma_dot(t_n), in every piece that uses it
+    call shear_protocol_begin_step(ts%protocol)
+    if (shear_protocol_varies(ts%protocol)) call impose_rate(ts)
     if (ts%variant == TIME_STEP_FLUID) then
       PetscCall(stage_push(STAGE_FLUID, ierr))
       PetscCall(fluid_step(ts%grid, ts%fluid, ierr))
       PetscCall(stage_pop(ierr))
+      call shear_protocol_end_step(ts%protocol)
       call count_step(ts, step)
       return
     end if
@@ -202,10 +212,19 @@ contains
         end if
       end if
       ts%position_before = parts%position
+      ! a reversal is a jump of the rate: the Adams-Bashforth extrapolation across it would carry
+      ! the old direction on, so the step after it starts afresh (Euler, as the first step does)
+      if (ts%protocol%reversed) parts%have_prev = .false.
       call advance_positions(parts, ts%dt, ts%box, [.true., .not. (ts%walls .or. le%active), .true.])
+      call shear_protocol_end_step(ts%protocol)
       if (le%active) then
-        ! the boundary slides on; spheres that left through y = 0 or Ly re-enter from the image
-        call le_advance(le, ts%dt)
+        ! the boundary slides on (by the strain of the step, exactly: an oscillation's offset is
+        ! gamma(t_{n+1}) Ly); spheres that left through y = 0 or Ly re-enter from the image
+        if (ts%protocol%kind == PROTOCOL_OSCILLATORY) then
+          call le_set_strain(le, ts%protocol%strain)
+        else
+          call le_advance(le, ts%dt)
+        end if
         call le_wrap(le, parts%position, parts%velocity, parts%velocity_prev)
       end if
       if (ts%variant == TIME_STEP_RESOLVED) then
@@ -220,6 +239,32 @@ contains
     end associate
     call count_step(ts, step)
   end subroutine time_step_advance
+
+  ! The rate of the step, gamma_dot(t_n) = ts%protocol%rate, given to every piece that uses the
+  ! imposed shear (doc/RHEOLOGY.md "Protocols"): the walls of the fluid, of the lubrication and of
+  ! the contacts (-+ gamma_dot Ly/2), the undisturbed flow of lubrication dynamics and of the
+  ! lubrication links, the velocity of the Lees-Edwards images (the boundaries' own copy and those
+  ! of the contacts and the lubrication). Only for a rate that varies: a steady run keeps the
+  ! values its pieces were made with.
+  subroutine impose_rate(ts)
+    type(time_step_t), intent(inout) :: ts
+    real(dp) :: rate
+    rate = ts%protocol%rate
+    if (associated(ts%fluid) .and. ts%walls) ts%fluid%wall_speed = 0.5_dp * rate * ts%box(2)
+    if (associated(ts%ld)) ts%ld%shear_rate = rate
+    if (associated(ts%lubrication)) then
+      ts%lubrication%shear_rate = rate
+      ts%lubrication%le%shear_rate = rate
+    end if
+    if (associated(ts%contacts)) then
+      if (ts%walls) then
+        ts%contacts%wall_velocity(1, 1) = -0.5_dp * rate * ts%box(2)
+        ts%contacts%wall_velocity(1, 2) = 0.5_dp * rate * ts%box(2)
+      end if
+      ts%contacts%le%shear_rate = rate
+    end if
+    ts%le%shear_rate = rate
+  end subroutine impose_rate
 
   ! The account of a step taken: the fluid solvers' iterations, and a new largest contact overlap
   ! of the run, warned once past h_r/2 (mod_contact::overlap_limit).

@@ -17,7 +17,9 @@
 !             rheology_sampling (series_every: the records the statistics take)
 !   attributes format_version, step, time, cells, box, walls, reynolds, dt, shear_rate, star_history,
 !             fluid_resolved (1, or 0 for lubrication dynamics, which writes no fields), and
-!             with Lees-Edwards boundaries lees_edwards_offset (the boundary offset delta, exactly)
+!             with Lees-Edwards boundaries lees_edwards_offset (the boundary offset delta, exactly);
+!             shear_protocol_state (mod_shear_protocol: time, strain, accumulated |strain|, sign,
+!             reversals, last rate of the imposed shear, exactly; doc/INPUT.md "&shear")
 !   group /deck: the deck's variables, one attribute each (mod_restart_deck), which a restart
 !             compares with its own deck before any work (doc/INPUT.md "Restart")
 ! Checksums: every dataset written through mod_h5util (particles, contacts, statistics) carries
@@ -52,6 +54,8 @@ module mod_checkpoint
   use mod_contact, only: contact_history_t
   use mod_contacts_io, only: contacts_write, contacts_read
   use mod_rheology, only: rheology_t, rheo_state, rheo_restore
+  use mod_shear_protocol, only: shear_protocol_t, shear_protocol_state, shear_protocol_restore, shear_protocol_varies, &
+                                PROTOCOL_STATE_SIZE
   implicit none
   private
   public :: checkpoint_state_t, checkpoint_write, checkpoint_check, checkpoint_read, checkpoint_format_version
@@ -69,6 +73,7 @@ module mod_checkpoint
     type(contact_history_t), pointer :: history => null()   ! the contacts' springs (with the particles)
     type(rheology_t), pointer :: rh => null()               ! &rheology: its accumulators (rheo_state)
     real(dp), pointer :: offset => null()                   ! the Lees-Edwards offset (y_boundary = 'lees-edwards')
+    type(shear_protocol_t), pointer :: protocol => null()   ! the imposed shear's state (&shear)
   end type checkpoint_state_t
 
 contains
@@ -141,6 +146,7 @@ contains
       call put_int('star_history', [stars])
       call put_int('fluid_resolved', [merge(1, 0, associated(state%fl))])
       if (associated(state%offset)) call put_real('lees_edwards_offset', [state%offset])
+      if (associated(state%protocol)) call put_real('shear_protocol_state', shear_protocol_state(state%protocol))
       if (associated(state%parts)) then
         call deck_record(file, cfg, state%parts%n, err)
       else
@@ -625,7 +631,8 @@ contains
     PetscErrorCode, intent(out) :: ierr
     PetscViewer :: viewer
     integer :: k, err, stars(1), info, afresh(1)
-    real(dp) :: delta(1)
+    real(dp) :: delta(1), protocol(PROTOCOL_STATE_SIZE)
+    integer :: has_protocol
     integer(HID_T) :: file
     character(len=600) :: message
     character(len=40) :: group, variable
@@ -648,6 +655,28 @@ contains
     if (associated(state%offset)) then
       call MPI_Bcast(delta, 1, MPI_DOUBLE_PRECISION, 0, PETSC_COMM_WORLD, ierr)
       state%offset = delta(1)
+    end if
+    if (associated(state%protocol)) then
+      ! the imposed shear's state; a checkpoint written before &shear has none, which only a
+      ! steady protocol (its state is not used) can continue
+      message = ''
+      protocol = 0.0_dp
+      has_protocol = 0
+      if (is_root()) then
+        call h5fopen_f(trim(path), H5F_ACC_RDONLY_F, file, err)
+        if (has_attribute(file, 'shear_protocol_state')) then
+          call read_attribute(file, 'shear_protocol_state', protocol, err)
+          if (err /= 0) message = 'cannot be read'
+          has_protocol = 1
+        else if (shear_protocol_varies(state%protocol)) then
+          message = 'is not in this checkpoint (written before &shear protocols): it cannot continue a protocol'
+        end if
+        call h5fclose_f(file, err)
+      end if
+      call file_error_from_root(path, 'shear_protocol_state', message)
+      call MPI_Bcast(protocol, PROTOCOL_STATE_SIZE, MPI_DOUBLE_PRECISION, 0, PETSC_COMM_WORLD, ierr)
+      call MPI_Bcast(has_protocol, 1, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
+      if (has_protocol == 1) call shear_protocol_restore(state%protocol, protocol)
     end if
     if (associated(state%fl)) then
       call MPI_Bcast(stars, 1, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)

@@ -8,7 +8,8 @@
 !                 named in the run log; one the checkpoint does not record (written before
 !                 2026-11-27) cannot be checked, and the log says so. A branch (-branch: the
 !                 checkpoint's state, this deck's physics) may also change the contact and
-!                 lubrication models and the particles' loads (BRANCH_MAY_CHANGE), each change
+!                 lubrication models, the particles' loads and the imposed shear (&shear, the
+!                 rate) (BRANCH_MAY_CHANGE), each change
 !                 named in the run log
 ! Only the variables the run uses are recorded and compared (the fluid's only with a resolved
 ! fluid, the particles' only with particles, the contacts' only with contacts). Values are compared
@@ -59,7 +60,18 @@ contains
     n = 0
     contacts = particles > 0 .and. cfg%contact_group
     call text_item('domain', 'y_boundary', MUST_MATCH, cfg%domain%y_boundary)
-    call real_item('domain', 'shear_rate', MUST_MATCH, [cfg%domain%shear_rate], legacy='shear_rate')
+    ! the reference rate, under its older name (as checkpoints before &shear record it), and the
+    ! protocol (doc/INPUT.md "&shear"): a branch may change them (a reversal or an oscillation
+    ! after a steady pre-shear), and starts the deck's protocol afresh
+    call real_item('domain', 'shear_rate', BRANCH_MAY_CHANGE, [cfg%domain%shear_rate], legacy='shear_rate')
+    call text_item('shear', 'control', BRANCH_MAY_CHANGE, cfg%shear%control)
+    call text_item('shear', 'protocol', BRANCH_MAY_CHANGE, cfg%shear%protocol)
+    if (cfg%shear%protocol == 'reversal') &
+      call real_item('shear', 'reversal_strain', BRANCH_MAY_CHANGE, [cfg%shear%reversal_strain])
+    if (cfg%shear%protocol == 'oscillatory') then
+      call real_item('shear', 'strain_amplitude', BRANCH_MAY_CHANGE, [cfg%shear%strain_amplitude])
+      call real_item('shear', 'period', BRANCH_MAY_CHANGE, [cfg%shear%period])
+    end if
     if (cfg%resolved) then
       call real_item('fluid', 'reynolds', MUST_MATCH, [cfg%fluid%reynolds], legacy='reynolds')
       call real_item('fluid', 'body_force', MUST_MATCH, cfg%fluid%body_force)

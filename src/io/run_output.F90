@@ -27,6 +27,7 @@ module mod_run_output
                           species_summary_t, rheo_summarise_species
   use mod_summary_io, only: summary_write
   use mod_lees_edwards, only: lees_edwards_t, le_columns
+  use mod_shear_protocol, only: shear_protocol_columns, shear_protocol_varies
   implicit none
   private
   public :: run_output_t, run_output_open, run_output_step, run_output_checkpoint, run_output_fail, run_output_close
@@ -114,8 +115,19 @@ contains
           values = [values, out%rheology%species_radius(k) / out%rheology%radius, out%rheology%species_count(k)]
         end do
       end if
-      call series_attributes(out%series, names, values)
     end if
+    ! a rate that varies: the protocol, for the analysis of fdsusp.protocols (doc/RHEOLOGY.md "Protocols")
+    if (associated(out%state%protocol)) then
+      if (shear_protocol_varies(out%state%protocol)) then
+        if (.not. allocated(names)) allocate(names(0), values(0))
+        names = [names, [character(len=32) :: 'shear_protocol', 'shear_reference_rate', 'shear_reversal_strain', &
+                         'shear_strain_amplitude', 'shear_period', 'shear_dt']]
+        values = [values, real(out%state%protocol%kind, dp), out%state%protocol%reference_rate, &
+                  out%state%protocol%reversal_strain, out%state%protocol%strain_amplitude, out%state%protocol%period, &
+                  cfg%time%dt]
+      end if
+    end if
+    if (allocated(names)) call series_attributes(out%series, names, values)
     ! from the start: an empty series; from a checkpoint: its records up to the checkpoint's step
     call series_open(out%series, cfg%output%directory, merge(step, -1, restarting), &
                      (cfg%time%steps - step) / cfg%output%series_every)
@@ -249,6 +261,9 @@ contains
     ! the verification's
     if (associated(out%fluid)) call series_add(out%series, fluid_columns(out%fluid))
     if (associated(out%le)) call series_add(out%series, le_columns(out%le))
+    ! the imposed shear of the record's step (mod_shear_protocol), when the flow is sheared
+    if (associated(out%state%protocol) .and. (out%cfg%walls .or. out%cfg%lees_edwards)) &
+      call series_add(out%series, shear_protocol_columns(out%state%protocol))
     if (out%cfg%verification%manufactured_solution) then
       PetscCallA(fluid_errors_vs_manufactured(out%grid, out%fluid, out%cfg%domain%shear_rate, err_vel, err_p_max, err_p_rms, ierr))
       call series_column(out%series, 'mms_error_velocity_max', err_vel)
@@ -292,6 +307,8 @@ contains
     write(text, '(a,i0,a,i0,a)') 'rheology of the core region (', complete, ' of ', out%cfg%rheology%blocks, &
          ' blocks complete; value +- standard error; doc/RHEOLOGY.md):'
     call log_line(text)
+    if (out%rheology%raw_stress) call log_line('  (a rate that varies: stresses over eta*|reference rate|, not over '// &
+         'the measured rate; doc/RHEOLOGY.md "Protocols")')
     do k = 1, size(shown)
       q = findloc(summary_names, shown(k), 1)
       write(text, '(2x,a16,es13.5,a,es10.3)') shown(k), value(q), ' +- ', error(q)

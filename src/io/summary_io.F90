@@ -45,6 +45,8 @@ contains
          ', "last_step": ', last_step, ','
     write(u, '(a,a,a)', err=90) '  "records_per_block": ', trim(json_array(r%block_records(1:max(1, complete)))), ','
     write(u, '(a,2(a,a),a)', err=90) '  "core": ', trim(json_array(r%core)), ', "shear_rate": ', trim(json_number(r%shear_rate)), ','
+    ! a rate that varies (&shear protocol): the quantities are stresses over eta*|shear_rate|
+    if (r%raw_stress) write(u, '(a)', err=90) '  "stresses_over_reference_rate": true,'
     write(u, '(a)', err=90) '  "quantities": {'
     do k = 1, NSUMMARY
       write(u, '(5a)', err=90) '    "', trim(summary_names(k)), '": {"value": ', trim(json_number(value(k))), &

@@ -13,7 +13,7 @@ module mod_lees_edwards
   use mod_columns, only: column_t, column
   implicit none
   private
-  public :: lees_edwards_t, le_create, le_separation, le_wrap, le_advance, le_columns
+  public :: lees_edwards_t, le_create, le_separation, le_wrap, le_advance, le_set_strain, le_columns
 
   type :: lees_edwards_t
     logical :: active = .false.
@@ -80,6 +80,14 @@ contains
     real(dp), intent(in) :: dt
     le%offset = modulo(le%offset + le%shear_rate * le%box(2) * dt, le%box(1))
   end subroutine le_advance
+
+  !> delta = gamma Ly, kept in [0, Lx): the offset of an imposed strain gamma(t) known exactly (an
+  !> oscillation, mod_shear_protocol), rather than summed step by step as le_advance does.
+  pure subroutine le_set_strain(le, strain)
+    type(lees_edwards_t), intent(inout) :: le
+    real(dp), intent(in) :: strain
+    le%offset = modulo(strain * le%box(2), le%box(1))
+  end subroutine le_set_strain
 
   !> The boundaries' column of the series: the offset delta of the image above.
   function le_columns(le) result(c)

@@ -100,6 +100,10 @@ module mod_rheology
 
   type :: rheology_t
     real(dp) :: box(3) = 0, radius = 1, shear_rate = 1
+    ! a rate that varies in time (&shear protocol 'reversal', 'oscillatory'): the summary's stresses
+    ! are block means over eta*|shear_rate| (the reference rate), never over the measured rate, which
+    ! averages to zero or changes sign (doc/RHEOLOGY.md "Protocols")
+    logical :: raw_stress = .false.
     ! spheres of several sizes: each sphere's radius [a] (allocated only then), and the mean
     ! sphere volume (the core's number density from phi_core)
     logical :: sized = .false.
@@ -485,8 +489,11 @@ contains
   !> summary_names; NaN where undefined (no contact pressure, no contact stress).
   !> gamma_dot_core is the particle-phase slope over the core (the paper's, m(12:16));
   !> gamma_dot_flow, the slope of the suspension's mean velocity (m(17:21)), is reported beside it.
-  pure function rheo_quantities(m, shear_rate) result(q)
+  !> fixed_rate: the rate the stresses are divided by instead of gamma_dot_core (a rate that varies:
+  !> the reference rate, so that 'eta_r' - 1 is the mean particle shear stress over eta*rate).
+  pure function rheo_quantities(m, shear_rate, fixed_rate) result(q)
     real(dp), intent(in) :: m(NQ), shear_rate
+    real(dp), intent(in), optional :: fixed_rate
     real(dp) :: q(NSUMMARY)
     real(dp) :: sh(5), sc(5), sp(5), gd, tau, eta_r, eta_h, eta_c, p, nan
     nan = ieee_value(1.0_dp, ieee_quiet_nan)
@@ -494,6 +501,7 @@ contains
     sc = m(6:10)
     sp = sh + sc
     gd = line_slope(m(12:16))
+    if (present(fixed_rate)) gd = fixed_rate
     eta_r = 1.0_dp + sp(4) / gd
     eta_h = 1.0_dp + sh(4) / gd        ! the solvent is lumped into the hydrodynamic part (paper §4.1)
     eta_c = sc(4) / gd
@@ -515,7 +523,7 @@ contains
     q(21) = -sc(1) / gd
     if (p > 0) q(22:25) = [gd / p, tau / p, eta_h * gd / p, eta_c * gd / p]
     q(26) = m(11)
-    q(27) = gd / shear_rate
+    q(27) = line_slope(m(12:16)) / shear_rate   ! measured, also under a fixed_rate
     q(28) = tau / shear_rate
     q(29) = sp(4) / tau
     q(30) = sc(4) / tau
@@ -744,14 +752,22 @@ contains
     allocate(per_block(NSUMMARY, max(1, complete)), mean_values(NQ))
     mean_values = 0
     do b = 1, complete
-      per_block(:, b) = rheo_quantities(r%block_sums(:, b) / r%block_records(b), r%shear_rate)
+      if (r%raw_stress) then
+        per_block(:, b) = rheo_quantities(r%block_sums(:, b) / r%block_records(b), r%shear_rate, abs(r%shear_rate))
+      else
+        per_block(:, b) = rheo_quantities(r%block_sums(:, b) / r%block_records(b), r%shear_rate)
+      end if
       mean_values = mean_values + r%block_sums(:, b) / r%block_records(b)
     end do
     value = nan
     err = nan
     if (complete > 0) then
       mean_values = mean_values / complete
-      value = rheo_quantities(mean_values, r%shear_rate)
+      if (r%raw_stress) then
+        value = rheo_quantities(mean_values, r%shear_rate, abs(r%shear_rate))
+      else
+        value = rheo_quantities(mean_values, r%shear_rate)
+      end if
     end if
     if (complete > 1) then
       do k = 1, NSUMMARY

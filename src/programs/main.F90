@@ -32,6 +32,8 @@ program fdsusp
   use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_create
   use mod_rheology, only: rheology_t, rheo_create
   use mod_lees_edwards, only: lees_edwards_t, le_create
+  use mod_shear_protocol, only: shear_protocol_t, shear_protocol_create, shear_protocol_kind, shear_protocol_varies, &
+                                shear_protocol_begin_at
   use mod_fictitious_domain, only: fictitious_domain_t, fictitious_domain_create, fictitious_domain_destroy, &
                                    fictitious_domain_pair_lag_limit, fictitious_domain_stresslet_lag_limit
   use mod_lubrication_dynamics, only: lubrication_dynamics_t, lubrication_dynamics_create
@@ -53,6 +55,7 @@ program fdsusp
   type(particle_lubrication_t), allocatable, target :: pl ! allocated when lubrication is on
   type(rheology_t), allocatable, target :: rh       ! allocated when the deck has &rheology
   type(lees_edwards_t), target :: le                ! y_boundary = 'lees-edwards' (le%active), its offset
+  type(shear_protocol_t), target :: protocol        ! the imposed shear in time (&shear)
   type(lubrication_dynamics_t), target :: ld        ! &fluid model = 'none': the spheres alone
   type(particle_solver_t), target :: ld_solver      ! its sparse 6N solve
   type(checkpoint_state_t) :: state                 ! what the checkpoints hold: the pieces this run has
@@ -97,6 +100,10 @@ program fdsusp
   ! sliding periodic boundaries in y (lubrication dynamics): the offset starts at 0, a restart
   ! reads it from the checkpoint
   if (cfg%lees_edwards) le = le_create(cfg%domain%box, cfg%domain%shear_rate, 0.0_dp)
+  ! the imposed shear as a function of time (doc/INPUT.md "&shear"); the pieces below are made with
+  ! its reference rate, the rate at t = 0, and the step gives them the rate of each step
+  protocol = shear_protocol_create(shear_protocol_kind(cfg%shear%protocol), cfg%shear%rate, cfg%time%dt, &
+                                   cfg%shear%reversal_strain, cfg%shear%strain_amplitude, cfg%shear%period)
   call make_contacts()
   call make_lubrication()
   call make_statistics()
@@ -132,6 +139,20 @@ program fdsusp
     PetscCallA(checkpoint_read(restart, state, statistics_afresh, ierr))
     if (statistics_afresh) call log_line('statistics: the &rheology window begins after the checkpoint''s step; '// &
          'they start from zero there (nothing the checkpoint accumulated is carried over)')
+    ! a branch starts the deck's protocol afresh from the configuration reached (its strain: with
+    ! Lees-Edwards boundaries the checkpoint's offset, which the boundary continues from)
+    if (branching) then
+      if (cfg%lees_edwards) then
+        call shear_protocol_begin_at(protocol, le%offset / cfg%domain%box(2))
+      else
+        call shear_protocol_begin_at(protocol, protocol%strain)
+      end if
+      call log_line('branch: &shear protocol '''//trim(cfg%shear%protocol)//''' starts afresh here (time 0 of '// &
+           'the protocol, no reversal yet; doc/INPUT.md "&shear")')
+      ! the rate may jump here: the spheres' Adams-Bashforth extrapolation starts afresh, as after
+      ! a reversal (a steady branch keeps it, as branches did before &shear)
+      if (shear_protocol_varies(protocol) .and. has_particles) parts%have_prev = .false.
+    end if
   end if
   ! what the run writes, and when, over the pieces it has (disassociated pointers are absent)
   call run_output_open(out, cfg, state, step, restarting, wall_start, grid_p, fluid_p, le_p, parts_p, contacts_p, &
@@ -257,6 +278,8 @@ contains
                      cfg%discard_step, cfg%block_steps, info, le, mixture_radii)
     if (info /= 0) call input_error(cfg%deck_file, 'domain', 'box', &
          'with &rheology every periodic length must be >= 2 (pair_shell + 0.3) a')
+    ! a rate that varies: stresses over eta*|reference rate| (doc/RHEOLOGY.md "Protocols")
+    rh%raw_stress = shear_protocol_varies(protocol)
     write(text, '(a,i0,a,i0,a,i0,a,i0)') 'statistics: discard ', cfg%discard_step, ' steps, then ', &
          cfg%rheology%blocks, ' blocks of ', cfg%block_steps, ' steps, ending at step ', &
          cfg%discard_step + cfg%rheology%blocks * cfg%block_steps
@@ -277,10 +300,10 @@ contains
   subroutine make_time_step(ierr)
     PetscErrorCode, intent(out) :: ierr
     if (cfg%resolved) then
-      call time_step_create(ts, cfg%time%dt, cfg%domain%box, cfg%walls, le, ierr, grid=grid_p, fluid=fluid_p, &
+      call time_step_create(ts, cfg%time%dt, cfg%domain%box, cfg%walls, le, protocol, ierr, grid=grid_p, fluid=fluid_p, &
                             fd=fd, parts=parts_p, contacts=contacts_p, lubrication=lubrication_p, rheology=rheology_p)
     else
-      call time_step_create(ts, cfg%time%dt, cfg%domain%box, cfg%walls, le, ierr, parts=parts_p, ld=ld, &
+      call time_step_create(ts, cfg%time%dt, cfg%domain%box, cfg%walls, le, protocol, ierr, parts=parts_p, ld=ld, &
                             ld_solver=ld_solver, contacts=contacts_p, lubrication=lubrication_p, rheology=rheology_p)
     end if
     CHKERRQ(ierr)
@@ -297,6 +320,7 @@ contains
       le_p => le
       state%offset => le%offset
     end if
+    state%protocol => protocol
     if (has_particles) then
       parts_p => parts
       state%parts => parts

@@ -23,27 +23,41 @@ module mod_params
   use mod_packing_geometry, only: phi_max
   use mod_particle_contacts, only: particle_contacts_settings_t
   use mod_rheology, only: rheology_settings_t
+  use mod_shear_protocol, only: shear_protocol_kind, shear_protocol_reference_rate, PROTOCOL_OSCILLATORY
   implicit none
   private
   public :: config_t, read_deck, echo_deck, max_line, max_inline_particles, max_species
-  public :: domain_settings_t, fluid_settings_t, time_settings_t, output_settings_t, run_settings_t, &
+  public :: domain_settings_t, shear_settings_t, fluid_settings_t, time_settings_t, output_settings_t, run_settings_t, &
             verification_settings_t, particles_settings_t, lubrication_settings_t
 
   integer, parameter :: max_line = deck_line_length
   integer, parameter :: max_inline_particles = 64
   integer, parameter :: max_species = 8           ! sphere sizes of a mixture (&particles radius)
-  integer, parameter :: ngroups = 10
+  integer, parameter :: ngroups = 11
   character(len=16), parameter :: known_groups(ngroups) = [character(len=16) :: &
-       'domain', 'fluid', 'time', 'output', 'run', 'verification', 'particles', 'contact', 'lubrication', &
+       'domain', 'shear', 'fluid', 'time', 'output', 'run', 'verification', 'particles', 'contact', 'lubrication', &
        'rheology']
+  ! a rate the deck did not give (&domain shear_rate, &shear rate): one of them may give it
+  real(dp), parameter :: rate_not_given = -huge(1.0_dp)
 
   ! &domain
   type :: domain_settings_t
     real(dp) :: box(3) = [20.0_dp, 20.0_dp, 20.0_dp]   ! box lengths Lx, Ly, Lz [a]
     real(dp) :: cells_per_radius = 5.0_dp               ! a/Delta [-]
     character(len=16) :: y_boundary = 'walls'           ! 'walls' (Couette), 'periodic' or 'lees-edwards'
-    real(dp) :: shear_rate = 1.0_dp                     ! walls move at +-shear_rate*Ly/2 [gamma_dot]
+    ! the older name of &shear rate (doc/INPUT.md "&shear"); after validation the reference rate
+    real(dp) :: shear_rate = rate_not_given             ! walls move at +-shear_rate*Ly/2 [gamma_dot]
   end type domain_settings_t
+
+  ! &shear: the imposed flow (doc/INPUT.md "&shear"; mod_shear_protocol)
+  type :: shear_settings_t
+    real(dp) :: rate = rate_not_given                   ! the imposed rate (default 1) [gamma_dot]
+    character(len=16) :: control = 'rate'               ! 'rate' ('stress': not yet)
+    character(len=16) :: protocol = 'steady'            ! 'steady', 'reversal' or 'oscillatory'
+    real(dp) :: reversal_strain = 0.0_dp                ! 'reversal': the strain between reversals [-]
+    real(dp) :: strain_amplitude = 0.0_dp               ! 'oscillatory': gamma_0 [-]
+    real(dp) :: period = 0.0_dp                         ! 'oscillatory': T [1/gamma_dot]
+  end type shear_settings_t
 
   ! &fluid
   type :: fluid_settings_t
@@ -122,6 +136,7 @@ module mod_params
   type :: config_t
     character(len=max_line) :: deck_file = ''
     type(domain_settings_t) :: domain
+    type(shear_settings_t) :: shear
     type(fluid_settings_t) :: fluid
     type(time_settings_t) :: time
     type(output_settings_t) :: output
@@ -143,7 +158,9 @@ module mod_params
     logical :: lees_edwards = .false.                   ! y_boundary = 'lees-edwards'
     logical :: resolved = .true.                        ! &fluid model = 'resolved'
     real(dp) :: h = 0.0_dp                              ! grid spacing Delta [a]
-    real(dp) :: wall_speed = 0.0_dp                     ! top wall +U, bottom wall -U [a*gamma_dot]
+    real(dp) :: wall_speed = 0.0_dp                     ! top wall +U, bottom wall -U at t = 0 [a*gamma_dot]
+    character(len=16) :: rate_group = 'shear'           ! the group that gave the rate: 'shear' or 'domain'
+    character(len=16) :: rate_name = 'rate'             ! and its name there: 'rate' or 'shear_rate'
   end type config_t
 
   ! state of a diagnosis in progress (read_group -> mod_deck_text -> read_into_copy)
@@ -181,7 +198,7 @@ contains
       if (.not. any(known_groups == name)) then
         write(lnum, '(i0)') l
         call input_error(deck, trim(name), '', 'unknown group (line '//trim(lnum)// &
-             '); known groups: &domain &fluid &time &output &run &verification &particles &contact &lubrication '// &
+             '); known groups: &domain &shear &fluid &time &output &run &verification &particles &contact &lubrication '// &
              '&rheology')
       end if
     end do
@@ -239,6 +256,7 @@ contains
     character(len=*), intent(inout), optional :: msg
     integer, intent(in), optional :: echo_unit
     type(domain_settings_t) :: domain_group
+    type(shear_settings_t) :: shear_group
     type(fluid_settings_t) :: fluid_group
     type(time_settings_t) :: time_group
     type(output_settings_t) :: output_group
@@ -249,6 +267,7 @@ contains
     type(lubrication_settings_t) :: lubrication_group
     type(rheology_settings_t) :: rheology_group
     namelist /domain/ domain_group
+    namelist /shear/ shear_group
     namelist /fluid/ fluid_group
     namelist /time/ time_group
     namelist /output/ output_group
@@ -263,6 +282,7 @@ contains
     integer :: stat
 
     domain_group = cfg%domain
+    shear_group = cfg%shear
     fluid_group = cfg%fluid
     time_group = cfg%time
     output_group = cfg%output
@@ -278,6 +298,7 @@ contains
       stat = 0
       select case (group)
       case ('domain');       read(text, nml=domain, iostat=stat, iomsg=msg)
+      case ('shear');        read(text, nml=shear, iostat=stat, iomsg=msg)
       case ('fluid');        read(text, nml=fluid, iostat=stat, iomsg=msg)
       case ('time');         read(text, nml=time, iostat=stat, iomsg=msg)
       case ('output');       read(text, nml=output, iostat=stat, iomsg=msg)
@@ -294,6 +315,7 @@ contains
         return
       end if
       cfg%domain = domain_group
+      cfg%shear = shear_group
       cfg%fluid = fluid_group
       cfg%time = time_group
       cfg%output = output_group
@@ -307,6 +329,7 @@ contains
     if (present(echo_unit)) then
       select case (group)
       case ('domain');       write(echo_unit, nml=domain)
+      case ('shear');        write(echo_unit, nml=shear)
       case ('fluid');        write(echo_unit, nml=fluid)
       case ('time');         write(echo_unit, nml=time)
       case ('output');       write(echo_unit, nml=output)
@@ -358,14 +381,17 @@ contains
       read(unit, '(a)', iostat=ios) line
       if (ios /= 0) exit
       ! '&GROUP' opens a group, ' GROUP_GROUP%NAME= values' an item, '/' closes the group; other
-      ! lines continue the last item
+      ! lines continue the last item. The rate is echoed once, as &shear rate (an oscillation's
+      ! follows from its amplitude and period, and is not echoed): the deck reads back alike
       e = index(line, '=')
       p = index(line(1:max(e, 1)), '%')
       if (len_trim(group_on_line(line)) > 0) then
         group = group_on_line(line)
       else if (line(1:1) == ' ' .and. p > 0) then
         item = to_lower(line(p + 1:e - 1))
-        inline_array = group == 'particles' .and. any(inline_arrays == item)
+        inline_array = (group == 'particles' .and. any(inline_arrays == item)) .or. &
+                       (group == 'domain' .and. item == 'shear_rate') .or. &
+                       (group == 'shear' .and. item == 'rate' .and. cfg%shear%protocol == 'oscillatory')
       else if (adjustl(line) == '/') then
         if (group == 'particles') call echo_inline_particles(cfg%particles)
         inline_array = .false.
@@ -453,11 +479,11 @@ contains
     if (cfg%lees_edwards .and. cfg%resolved) &
       call input_error(cfg%deck_file, 'domain', 'y_boundary', &
            '''lees-edwards'' needs &fluid model = ''none'' (lubrication dynamics): the resolved fluid has walls or a periodic box')
-    call check_real(cfg, 'domain', 'shear_rate', cfg%domain%shear_rate, -1.0e3_dp, 1.0e3_dp)
+    call resolve_shear_rate(cfg)
     cfg%walls = (cfg%domain%y_boundary == 'walls')
     if (.not. cfg%walls .and. .not. cfg%lees_edwards .and. cfg%domain%shear_rate /= 0.0_dp) &
-      call input_error(cfg%deck_file, 'domain', 'shear_rate', &
-           'a periodic box in y cannot be sheared by walls: set shear_rate = 0 or y_boundary = ''walls''')
+      call input_error(cfg%deck_file, trim(cfg%rate_group), trim(cfg%rate_name), &
+           'a periodic box in y cannot be sheared by walls: set '//trim(cfg%rate_name)//' = 0 or y_boundary = ''walls''')
     cfg%h = 1.0_dp / cfg%domain%cells_per_radius
     do d = 1, 3
       n = cfg%domain%box(d) * cfg%domain%cells_per_radius
@@ -493,6 +519,7 @@ contains
     call check_real(cfg, 'time', 'steady_tolerance', cfg%time%steady_tolerance, 0.0_dp, 1.0_dp)
     if (.not. cfg%resolved .and. cfg%time%steady_tolerance > 0.0_dp) &
       call input_error(cfg%deck_file, 'time', 'steady_tolerance', 'measures the fluid: needs &fluid model = ''resolved''')
+    call validate_shear(cfg)
 
     if (len_trim(cfg%output%directory) == 0) &
       call input_error(cfg%deck_file, 'output', 'directory', 'must not be empty')
@@ -662,6 +689,83 @@ contains
     end associate
   end subroutine validate_inline_species
 
+  ! The imposed rate (doc/INPUT.md "&shear"): &shear rate, or its older name &domain shear_rate,
+  ! not both; 1 when neither is given; an oscillation's is its reference rate gamma_0 2 pi/T
+  ! (validate_shear checks amplitude and period). After this cfg%domain%shear_rate and
+  ! cfg%shear%rate hold the reference rate, which every limit and the unit of stress use.
+  subroutine resolve_shear_rate(cfg)
+    type(config_t), intent(inout) :: cfg
+    logical :: old_name, new_name
+    cfg%shear%control = to_lower(cfg%shear%control)
+    cfg%shear%protocol = to_lower(cfg%shear%protocol)
+    old_name = cfg%domain%shear_rate /= rate_not_given
+    new_name = cfg%shear%rate /= rate_not_given
+    if (old_name .and. new_name) call input_error(cfg%deck_file, 'shear', 'rate', &
+         'is also given as &domain shear_rate (its older name): give the rate once, as &shear rate')
+    if (old_name) then
+      cfg%rate_group = 'domain'
+      cfg%rate_name = 'shear_rate'
+      cfg%shear%rate = cfg%domain%shear_rate
+    end if
+    if (cfg%shear%protocol == 'oscillatory') then
+      if (new_name .or. old_name) call input_error(cfg%deck_file, trim(cfg%rate_group), trim(cfg%rate_name), &
+           'is not given with protocol = ''oscillatory'': its rate follows from strain_amplitude and period '// &
+           '(reference rate strain_amplitude*2*pi/period)')
+      cfg%rate_group = 'shear'
+      cfg%rate_name = 'strain_amplitude'
+      call check_real(cfg, 'shear', 'strain_amplitude', cfg%shear%strain_amplitude, 0.0_dp, 1.0e3_dp, .true.)
+      call check_real(cfg, 'shear', 'period', cfg%shear%period, 0.0_dp, 1.0e9_dp, .true.)
+      cfg%shear%rate = shear_protocol_reference_rate(PROTOCOL_OSCILLATORY, 0.0_dp, cfg%shear%strain_amplitude, &
+                                                     cfg%shear%period)
+    else if (.not. (new_name .or. old_name)) then
+      cfg%shear%rate = 1.0_dp
+    end if
+    call check_real(cfg, trim(cfg%rate_group), trim(cfg%rate_name), cfg%shear%rate, -1.0e3_dp, 1.0e3_dp)
+    cfg%domain%shear_rate = cfg%shear%rate
+  end subroutine resolve_shear_rate
+
+  ! The protocol of &shear (doc/INPUT.md "&shear"): its name, the control, and the variables of
+  ! each protocol given with it only.
+  subroutine validate_shear(cfg)
+    type(config_t), intent(inout) :: cfg
+    character(len=200) :: text
+    if (cfg%shear%control == 'stress') call input_error(cfg%deck_file, 'shear', 'control', &
+         '''stress'' (stress control) is not implemented yet: use control = ''rate''')
+    if (cfg%shear%control /= 'rate') call input_error(cfg%deck_file, 'shear', 'control', &
+         'must be ''rate'' (''stress'' is not implemented yet), not '''//trim(cfg%shear%control)//'''')
+    if (shear_protocol_kind(cfg%shear%protocol) == 0) call input_error(cfg%deck_file, 'shear', 'protocol', &
+         'must be ''steady'', ''reversal'' or ''oscillatory'', not '''//trim(cfg%shear%protocol)//'''')
+    if (cfg%shear%protocol /= 'oscillatory') then
+      if (cfg%shear%strain_amplitude /= 0.0_dp) call input_error(cfg%deck_file, 'shear', 'strain_amplitude', &
+           'is given only with protocol = ''oscillatory''')
+      if (cfg%shear%period /= 0.0_dp) call input_error(cfg%deck_file, 'shear', 'period', &
+           'is given only with protocol = ''oscillatory''')
+    end if
+    if (cfg%shear%protocol /= 'reversal' .and. cfg%shear%reversal_strain /= 0.0_dp) &
+      call input_error(cfg%deck_file, 'shear', 'reversal_strain', 'is given only with protocol = ''reversal''')
+    if (cfg%shear%protocol == 'steady') return
+    if (cfg%shear%rate == 0.0_dp) call input_error(cfg%deck_file, trim(cfg%rate_group), trim(cfg%rate_name), &
+         'protocol = '''//trim(cfg%shear%protocol)//''' needs a non-zero rate')
+    ! what presumes a steady imposed flow
+    if (cfg%time%steady_tolerance > 0.0_dp) call input_error(cfg%deck_file, 'time', 'steady_tolerance', &
+         'stops the run on a steady flow, which &shear protocol = '''//trim(cfg%shear%protocol)//''' never reaches: set 0')
+    if (cfg%verification%manufactured_solution) call input_error(cfg%deck_file, 'verification', &
+         'manufactured_solution', 'is a steady solution under a steady rate: needs &shear protocol = ''steady''')
+    if (cfg%shear%protocol == 'reversal') then
+      call check_real(cfg, 'shear', 'reversal_strain', cfg%shear%reversal_strain, 0.0_dp, 1.0e9_dp, .true.)
+      if (cfg%shear%reversal_strain < abs(cfg%shear%rate) * cfg%time%dt) then
+        write(text, '(a,es10.3,a)') 'is shorter than the strain of one step (|rate| dt = ', &
+             abs(cfg%shear%rate) * cfg%time%dt, '): the rate would reverse every step'
+        call input_error(cfg%deck_file, 'shear', 'reversal_strain', trim(text))
+      end if
+    else
+      if (cfg%shear%period < 4.0_dp * cfg%time%dt) then
+        write(text, '(a,es10.3,a)') 'is shorter than 4 steps (dt = ', cfg%time%dt, '): the step cannot follow the oscillation'
+        call input_error(cfg%deck_file, 'shear', 'period', trim(text))
+      end if
+    end if
+  end subroutine validate_shear
+
   ! Ranges of &rheology, and the step counts of the averaging window (doc/RHEOLOGY.md).
   subroutine validate_rheology(cfg)
     type(config_t), intent(inout) :: cfg
@@ -672,7 +776,7 @@ contains
     if (.not. (cfg%walls .or. cfg%lees_edwards) .or. cfg%domain%shear_rate == 0.0_dp) &
       call input_error(cfg%deck_file, 'rheology', '', &
            'statistics are taken in the core of the sheared Couette cell (or the whole Lees-Edwards box): '// &
-           'needs y_boundary = ''walls'' or ''lees-edwards'' and shear_rate /= 0')
+           'needs y_boundary = ''walls'' or ''lees-edwards'' and a non-zero &shear rate')
     if (cfg%particles%number == 0 .and. len_trim(cfg%particles%position_file) == 0 .and. cfg%particles%solid_fraction == 0.0_dp) &
       call input_error(cfg%deck_file, 'rheology', '', 'needs particles (&particles solid_fraction, number or position_file)')
     call check_real(cfg, 'rheology', 'discard_strain', cfg%rheology%discard_strain, 0.0_dp, 1.0e6_dp)
@@ -745,7 +849,7 @@ contains
              'smooth spheres (roughness = 0) need a prescribed normal_stiffness > 0')
       if (cfg%domain%shear_rate == 0.0_dp) &
         call input_error(cfg%deck_file, 'contact', 'normal_stiffness', &
-             'k_n from eps_bar needs a non-zero &domain shear_rate: prescribe normal_stiffness > 0')
+             'k_n from eps_bar needs a non-zero &shear rate (or &domain shear_rate): prescribe normal_stiffness > 0')
     end if
     ! the neighbour search needs every periodic length >= 2 x cutoff (one image in range)
     cutoff = 2.0_dp * cfg%radius_max + cfg%contact%roughness * cfg%radius + cfg%contact%neighbour_skin

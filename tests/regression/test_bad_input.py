@@ -45,6 +45,9 @@ cases = [
      "motion = 'prescribed', velocity(:,1) = --0.1, 0, 0 /\n", [], ['bad.nml', '&particles', 'variable velocity', 'cannot read']),
     ('missing deck', None, [], ['bad.nml', 'does not exist']),
     ('periodic box with shear', GOOD.replace('cells_per_radius = 5', "cells_per_radius = 5, y_boundary = 'periodic'"),
+     [], ['bad.nml', '&shear', 'rate', 'periodic']),
+    ('periodic box with the older name of the rate', GOOD.replace('cells_per_radius = 5',
+     "cells_per_radius = 5, y_boundary = 'periodic', shear_rate = 2"),
      [], ['bad.nml', '&domain', 'shear_rate', 'periodic']),
     ('fractional cell count', GOOD.replace('box = 3.2, 3.2, 3.2', 'box = 3.3, 3.2, 3.2'), [], ['bad.nml', '&domain', 'box(x)', 'whole number']),
     ('bad y_boundary', GOOD.replace('cells_per_radius = 5', "cells_per_radius = 5, y_boundary = 'wall'"), [], ['bad.nml', '&domain', 'y_boundary']),
@@ -144,6 +147,27 @@ cases = [
     ('averaging blocks without records', GOOD + '&particles solid_fraction = 0.1 /\n'
      '&rheology average_strain = 0.01, blocks = 5 /\n', [],
      ['bad.nml', '&rheology', 'average_strain', 'series_every']),
+    # &shear (doc/INPUT.md): the protocols of rate control
+    ('rate under both names', GOOD.replace('cells_per_radius = 5', 'cells_per_radius = 5, shear_rate = 1') +
+     '&shear rate = 1 /\n', [], ['bad.nml', '&shear', 'rate', 'shear_rate']),
+    ('stress control', GOOD + "&shear control = 'stress' /\n", [], ['bad.nml', '&shear', 'control', 'not implemented yet']),
+    ('unknown protocol', GOOD + "&shear protocol = 'creep' /\n", [], ['bad.nml', '&shear', 'protocol', 'creep']),
+    ('amplitude without oscillation', GOOD + '&shear strain_amplitude = 0.1 /\n', [],
+     ['bad.nml', '&shear', 'strain_amplitude', 'oscillatory']),
+    ('period without oscillation', GOOD + "&shear protocol = 'reversal', reversal_strain = 1, period = 2 /\n", [],
+     ['bad.nml', '&shear', 'period', 'oscillatory']),
+    ('reversal strain without reversal', GOOD + '&shear reversal_strain = 1 /\n', [],
+     ['bad.nml', '&shear', 'reversal_strain', 'reversal']),
+    ('reversal strain shorter than a step', GOOD + "&shear protocol = 'reversal', reversal_strain = 0.004 /\n", [],
+     ['bad.nml', '&shear', 'reversal_strain', 'one step']),
+    ('non-positive period', GOOD + "&shear protocol = 'oscillatory', strain_amplitude = 0.1, period = 0 /\n", [],
+     ['bad.nml', '&shear', 'period', 'out of range']),
+    ('non-positive amplitude', GOOD + "&shear protocol = 'oscillatory', strain_amplitude = -0.1, period = 1 /\n", [],
+     ['bad.nml', '&shear', 'strain_amplitude', 'out of range']),
+    ('steady tolerance with a reversal', GOOD.replace('steps = 4', 'steps = 4, steady_tolerance = 1e-3') +
+     "&shear protocol = 'reversal', reversal_strain = 1 /\n", [], ['bad.nml', '&time', 'steady_tolerance', 'reversal']),
+    ('rate with an oscillation', GOOD + "&shear protocol = 'oscillatory', rate = 2, strain_amplitude = 0.1, period = 1 /\n",
+     [], ['bad.nml', '&shear', 'rate', 'strain_amplitude']),
 ]
 for name, text, args, words in cases:
     # each case starts without an output directory, so one case that ran cannot fail the next

@@ -7,6 +7,9 @@ quoted string holding '=', '!' and a variable's name, whole arrays, array sectio
 elements, logicals as F, inline particles with velocities and loads) is read into the values it
 states (checked in the echo), and its echo, run as a deck, echoes itself again line for line
 (a fixed point) and records the same deck in its checkpoint (/deck, attribute for attribute).
+The rate, given as &domain shear_rate (its older name), is echoed once, as &shear rate; a deck
+with an oscillatory &shear protocol (mixed case) echoes its protocol, amplitude and period and no
+rate, and its echo is a fixed point too.
 Exact checks: the echo prints every double with 17 significant digits, which reads back into the
 same double, so no tolerance applies."""
 import os
@@ -33,7 +36,7 @@ DECK = """! lubrication dynamics, no grid: the reader is what is tested, not the
 
 EXPECTED = {  # group, variable: the value the echo must show
     ("domain", "box"): [8.0, 8.0, 8.0], ('domain', 'y_boundary'): 'lees-edwards',
-    ('domain', 'shear_rate'): [0.5], ('fluid', 'model'): 'none', ('time', 'dt'): [2.5e-3],
+    ('shear', 'rate'): [0.5], ('fluid', 'model'): 'none', ('time', 'dt'): [2.5e-3],
     ('time', 'steps'): [2], ('run', 'title'): 'deck: dt = 9, ! not a comment, "quoted"',
     ('particles', 'number'): [3], ('contact', 'roughness'): [1e-2], ('contact', 'friction'): [0.3],
     ('contact', 'implicit'): 'F', ('contact', 'neighbour_skin'): [0.25],
@@ -95,18 +98,38 @@ def main():
             'the echo leaves out the inline arrays that are all zero (velocity, omega)')
     T.check(not any('%' in line for line in first), 'no qualified name (GROUP_group%...) left in the echo')
 
-    # the echo as a deck: only the output directory changed
-    again = '\n'.join(re.sub(r'DIRECTORY=.*', 'DIRECTORY="again",', line) for line in first) + '\n'
-    _, out2, _ = T.run(T.write_deck(d, 'again.nml', again), d)
+    T.check(not any(k == ('domain', 'shear_rate') for k in shown),
+            'the rate is echoed once, as &shear rate (not as its older name &domain shear_rate)')
+    fixed_point(d, first, 'first', 'again')
+
+    # a protocol (&shear, doc/INPUT.md): its variables read case-blind, an oscillation's rate not
+    # echoed (it follows from amplitude and period), the echo again a fixed point
+    _, out, _ = T.run(T.write_deck(d, 'protocol.nml', DECK.format(out='protocol').replace(
+        "  Shear_Rate = 0.5 /", "/\n&Shear Protocol = 'Oscillatory', strain_amplitude = 0.5, PERIOD = 6.283185307179586 /")), d)
+    protocol = echo(out)
+    shown = items(protocol)
+    for key, want in {('shear', 'protocol'): 'oscillatory', ('shear', 'strain_amplitude'): [0.5],
+                      ('shear', 'period'): [6.283185307179586], ('shear', 'control'): 'rate'}.items():
+        got = value(shown.get(key, 'missing'))
+        T.check(got == want, '%s %s: the echo shows %r (deck: %r)' % (key[0], key[1], got, want))
+    T.check(('shear', 'rate') not in shown, 'an oscillation\'s rate is not echoed')
+    fixed_point(d, protocol, 'protocol', 'protocol_again')
+    T.finish()
+
+
+def fixed_point(d, first, name, again_name):
+    """The echo FIRST of the run into d/NAME, read as a deck (only the output directory changed to
+    AGAIN_NAME), echoes itself line for line and records the same deck in its checkpoint."""
+    again = '\n'.join(re.sub(r'DIRECTORY=.*', 'DIRECTORY="%s",' % again_name, line) for line in first) + '\n'
+    _, out2, _ = T.run(T.write_deck(d, again_name + '.nml', again), d)
     second = echo(out2)
     differ = [(a, b) for a, b in zip(first, second) if a != b]
     T.check(len(first) == len(second) and [a for a, _ in differ] == [l for l in first if 'DIRECTORY=' in l],
-            'the echo read as a deck echoes itself: %d lines, only the directory differs (%s)'
-            % (len(second), differ[:2]))
-    T.compare_h5(os.path.join(d, 'first', 'checkpoint.h5'), os.path.join(d, 'again', 'checkpoint.h5'),
-                 'the checkpoints of the deck and of its echo', rtol=0,
+            '%s: the echo read as a deck echoes itself: %d lines, only the directory differs (%s)'
+            % (name, len(second), differ[:2]))
+    T.compare_h5(os.path.join(d, name, 'checkpoint.h5'), os.path.join(d, again_name, 'checkpoint.h5'),
+                 '%s: the checkpoints of the deck and of its echo' % name, rtol=0,
                  skip=('deck@output.directory', 'wall_time'))
-    T.finish()
 
 
 if __name__ == '__main__':

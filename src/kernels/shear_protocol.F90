@@ -1,0 +1,181 @@
+! The imposed shear as a function of time: the rheometer's protocols of doc/INPUT.md "&shear" under
+! rate control (doc/RHEOLOGY.md "Protocols"). The rate of a step is evaluated once, at the time
+! t_n at which the step's forces are evaluated (the start of the step, the configuration X^n), and
+! held over the step; the strain is integrated exactly over the step.
+!   steady       gamma_dot(t) = rate                       strain(t) = rate t
+!   reversal     gamma_dot = +-|rate|, the sign (that of rate at the start) flipping each time the
+!                accumulated |strain| reaches a multiple of reversal_strain G; the flip happens at the
+!                first step boundary at which it has (within 1e-9 of a step's strain, so that a G of
+!                whole steps flips after exactly G/(|rate| dt) steps despite round-off)
+!   oscillatory  gamma(t) = gamma_0 sin(omega t), gamma_dot(t) = gamma_0 omega cos(omega t),
+!                omega = 2 pi/T; the strain is gamma(t) itself, evaluated, not summed
+! The reference rate (the unit of time and of stress, doc/INPUT.md "&shear") is rate (steady,
+! reversal: signed, as given) or gamma_0 omega (oscillatory): the rate at t = 0 in every protocol.
+! The state (time, strain, accumulated |strain|, sign, reversals) is what a checkpoint holds
+! (shear_protocol_state / shear_protocol_restore): a restart continues it exactly. A branch starts
+! the protocol afresh from the checkpoint's configuration (shear_protocol_begin_at): its time,
+! accumulated |strain| and reversals from zero, its strain from the strain reached (the origin), so
+! that a reversal or an oscillation can follow a steady pre-shear.
+module mod_shear_protocol
+  use mod_kinds, only: dp, pi
+  use mod_columns, only: column_t, column
+  implicit none
+  private
+  public :: shear_protocol_t, shear_protocol_create, shear_protocol_begin_step, shear_protocol_end_step, &
+            shear_protocol_varies, shear_protocol_state, shear_protocol_restore, shear_protocol_columns, &
+            shear_protocol_kind, shear_protocol_reference_rate, shear_protocol_begin_at
+  public :: PROTOCOL_STEADY, PROTOCOL_REVERSAL, PROTOCOL_OSCILLATORY, PROTOCOL_STATE_SIZE
+
+  integer, parameter :: PROTOCOL_STEADY = 1, PROTOCOL_REVERSAL = 2, PROTOCOL_OSCILLATORY = 3
+  integer, parameter :: PROTOCOL_STATE_SIZE = 7
+  ! a reversal is due when the accumulated |strain| is within this share of one step's strain of it
+  real(dp), parameter :: reversal_slack = 1.0e-9_dp
+
+  type :: shear_protocol_t
+    integer :: kind = PROTOCOL_STEADY
+    real(dp) :: reference_rate = 1.0_dp   ! signed; the rate at t = 0 [gamma_dot]
+    real(dp) :: reversal_strain = 0.0_dp  ! G [-]
+    real(dp) :: strain_amplitude = 0.0_dp ! gamma_0 [-]
+    real(dp) :: period = 0.0_dp           ! T [1/gamma_dot]
+    real(dp) :: dt = 0.0_dp
+    ! the state at the start of the next step (t_n), as checkpointed
+    real(dp) :: time = 0.0_dp             ! t_n
+    real(dp) :: strain = 0.0_dp           ! gamma(t_n): the signed strain imposed since t = 0
+    real(dp) :: origin = 0.0_dp           ! the strain at t = 0 (a branch: the strain the checkpoint reached)
+    real(dp) :: travel = 0.0_dp           ! the accumulated |strain| since t = 0
+    real(dp) :: direction = 1.0_dp        ! +1, or -1 after an odd number of reversals
+    integer :: reversals = 0
+    ! the step in progress (shear_protocol_begin_step)
+    real(dp) :: rate = 0.0_dp             ! gamma_dot(t_n), held over the step
+    real(dp) :: step_strain = 0.0_dp      ! gamma(t_n) of the step (the record's configuration)
+    logical :: reversed = .false.         ! the direction flipped at the start of this step
+  end type shear_protocol_t
+
+contains
+
+  !> A protocol of the given kind (PROTOCOL_*): rate is the steady/reversal rate (signed), ignored
+  !> for an oscillation, whose reference rate is gamma_0 2 pi/T; dt: the time step.
+  pure function shear_protocol_create(kind, rate, dt, reversal_strain, strain_amplitude, period) result(p)
+    integer, intent(in) :: kind
+    real(dp), intent(in) :: rate, dt, reversal_strain, strain_amplitude, period
+    type(shear_protocol_t) :: p
+    p%kind = kind
+    p%dt = dt
+    p%reversal_strain = reversal_strain
+    p%strain_amplitude = strain_amplitude
+    p%period = period
+    p%reference_rate = shear_protocol_reference_rate(kind, rate, strain_amplitude, period)
+    p%rate = p%reference_rate
+  end function shear_protocol_create
+
+  !> The reference rate of a protocol (the unit): rate, or gamma_0 2 pi/T for an oscillation.
+  pure real(dp) function shear_protocol_reference_rate(kind, rate, strain_amplitude, period) result(r)
+    integer, intent(in) :: kind
+    real(dp), intent(in) :: rate, strain_amplitude, period
+    r = rate
+    if (kind == PROTOCOL_OSCILLATORY) r = strain_amplitude * (2.0_dp * pi / period)
+  end function shear_protocol_reference_rate
+
+  !> PROTOCOL_* of a deck's protocol name ('steady', 'reversal', 'oscillatory'); 0 if unknown.
+  pure integer function shear_protocol_kind(name) result(kind)
+    character(len=*), intent(in) :: name
+    select case (trim(name))
+    case ('steady');      kind = PROTOCOL_STEADY
+    case ('reversal');    kind = PROTOCOL_REVERSAL
+    case ('oscillatory'); kind = PROTOCOL_OSCILLATORY
+    case default;         kind = 0
+    end select
+  end function shear_protocol_kind
+
+  !> Does the rate change in time? (A steady protocol leaves every physics object as created.)
+  pure logical function shear_protocol_varies(p)
+    type(shear_protocol_t), intent(in) :: p
+    shear_protocol_varies = p%kind /= PROTOCOL_STEADY
+  end function shear_protocol_varies
+
+  !> The rate of the step that starts at p%time (t_n): a reversal that is due flips the direction
+  !> first (p%reversed tells the caller).
+  pure subroutine shear_protocol_begin_step(p)
+    type(shear_protocol_t), intent(inout) :: p
+    real(dp) :: due
+    p%reversed = .false.
+    p%step_strain = p%strain
+    select case (p%kind)
+    case (PROTOCOL_STEADY)
+      p%rate = p%reference_rate
+    case (PROTOCOL_REVERSAL)
+      due = (p%reversals + 1) * p%reversal_strain - reversal_slack * abs(p%reference_rate) * p%dt
+      if (p%travel >= due) then
+        p%direction = -p%direction
+        p%reversals = p%reversals + 1
+        p%reversed = .true.
+      end if
+      p%rate = p%direction * p%reference_rate
+    case (PROTOCOL_OSCILLATORY)
+      p%rate = p%reference_rate * cos(2.0_dp * pi * p%time / p%period)
+    end select
+  end subroutine shear_protocol_begin_step
+
+  !> The end of the step: time t_{n+1}, the strain integrated exactly over the step (the rate is
+  !> constant over a step of a steady or reversal protocol; an oscillation's strain is gamma(t)).
+  pure subroutine shear_protocol_end_step(p)
+    type(shear_protocol_t), intent(inout) :: p
+    p%time = p%time + p%dt
+    select case (p%kind)
+    case (PROTOCOL_OSCILLATORY)
+      p%strain = p%origin + p%strain_amplitude * sin(2.0_dp * pi * p%time / p%period)
+    case default
+      p%strain = p%strain + p%rate * p%dt
+    end select
+    p%travel = p%travel + abs(p%rate) * p%dt
+  end subroutine shear_protocol_end_step
+
+  !> The state a checkpoint holds: time, strain, travel, direction, reversals, the last step's rate,
+  !> the strain's origin.
+  pure function shear_protocol_state(p) result(s)
+    type(shear_protocol_t), intent(in) :: p
+    real(dp) :: s(PROTOCOL_STATE_SIZE)
+    s = [p%time, p%strain, p%travel, p%direction, real(p%reversals, dp), p%rate, p%origin]
+  end function shear_protocol_state
+
+  !> Restore the state of shear_protocol_state (a restart).
+  pure subroutine shear_protocol_restore(p, s)
+    type(shear_protocol_t), intent(inout) :: p
+    real(dp), intent(in) :: s(PROTOCOL_STATE_SIZE)
+    p%time = s(1)
+    p%strain = s(2)
+    p%travel = s(3)
+    p%direction = s(4)
+    p%reversals = nint(s(5))
+    p%rate = s(6)
+    p%origin = s(7)
+    p%step_strain = p%strain
+  end subroutine shear_protocol_restore
+
+  !> A branch: the protocol starts afresh (time 0, no accumulated |strain|, no reversal, the first
+  !> direction) from the strain the checkpoint's configuration reached.
+  pure subroutine shear_protocol_begin_at(p, strain)
+    type(shear_protocol_t), intent(inout) :: p
+    real(dp), intent(in) :: strain
+    p%time = 0.0_dp
+    p%origin = strain
+    p%strain = strain
+    p%step_strain = strain
+    p%travel = 0.0_dp
+    p%direction = 1.0_dp
+    p%reversals = 0
+    p%rate = p%reference_rate
+  end subroutine shear_protocol_begin_at
+
+  !> The protocol's columns of the series (doc/RHEOLOGY.md "Protocols"): the imposed rate of the
+  !> step the record's statistics were sampled in, and the strain gamma(t_n) of that configuration.
+  function shear_protocol_columns(p) result(c)
+    type(shear_protocol_t), intent(in) :: p
+    type(column_t), allocatable :: c(:)
+    ! element by element: an array constructor of column_t leaks their values (gfortran 12)
+    allocate(c(2))
+    c(1) = column('shear/rate', p%rate)
+    c(2) = column('shear/strain', p%step_strain)
+  end function shear_protocol_columns
+
+end module mod_shear_protocol

@@ -1,0 +1,108 @@
+"""Invariant: a protocol restarts exactly (doc/INPUT.md "&shear"): the checkpoint holds its state
+(shear_protocol_state: t_n, gamma(t_n), the accumulated |strain|, the direction, the reversals, the
+last rate), so N steps in one run equal N/2 steps, a checkpoint, a restart and N/2 steps: every
+dataset and attribute of the two final checkpoints and of the two series.h5 (wall_time excepted)
+agree bitwise (rtol 0: the continued run repeats the same arithmetic, as test_restart asks of
+steady runs). Cases, each stopped in the middle of what the protocol does:
+- an oscillation in lubrication dynamics (49 rough frictional spheres, phi 0.4, Lees-Edwards,
+  contacts, &rheology; gamma_0 = 0.2, T = 251.3 steps), 200 steps against 100 + 100: the restart
+  falls at 0.4 period, with contacts under load;
+- a reversal in lubrication dynamics between walls (G = 60 steps' strain), 150 against 75 + 75:
+  the reversals at steps 60 and 120 lie on either side of the restart;
+- an oscillation of the pure fluid in the DNS on 2 ranks (T = 40 steps), 60 against 30 + 30.
+A branch (-branch) starts the deck's protocol afresh from the checkpoint's configuration: after a
+steady pre-shear of 100 steps in lubrication dynamics (Lees-Edwards), a reversal every 0.25 strain
+flips at the steps 50, 100, 150 after the branch, and both it and an oscillation continue the
+boundary offset from the checkpoint's (its next step's strain added, to 1e-12 a), the oscillation's
+strain starting from the strain the pre-shear reached (offset / Ly).
+A few seconds on 2 cores."""
+import math
+import os
+import numpy as np
+import fdsusp_testlib as T
+
+OSC = """&domain box = 8.0, 8.0, 8.0, y_boundary = 'lees-edwards' /
+&shear protocol = 'oscillatory', strain_amplitude = 0.2, period = 1.2566370614359172 /
+&fluid model = 'none' /
+&time dt = 5.0e-3, steps = {steps} /
+&output directory = 'out', progress_every = 1000 /
+&particles solid_fraction = 0.4, seed = 1 /
+&contact roughness = 5.0e-3, friction = 0.5 /
+&rheology discard_strain = 0.0, average_strain = 0.95, blocks = 2 /
+"""
+REV = """&domain box = 8.0, 8.0, 8.0, y_boundary = 'walls' /
+&shear rate = -1.0, protocol = 'reversal', reversal_strain = 0.3 /
+&fluid model = 'none' /
+&time dt = 5.0e-3, steps = {steps} /
+&output directory = 'out', progress_every = 1000 /
+&particles solid_fraction = 0.35, seed = 4 /
+&contact roughness = 5.0e-3, friction = 0.5 /
+&rheology discard_strain = 0.0, average_strain = 0.7, blocks = 2 /
+"""
+STEADY = """&domain box = 8.0, 8.0, 8.0, y_boundary = 'lees-edwards' /
+&shear {shear} /
+&fluid model = 'none' /
+&time dt = 5.0e-3, steps = {steps} /
+&output directory = 'out', progress_every = 1000 /
+&particles solid_fraction = 0.35, seed = 5 /
+&contact roughness = 5.0e-3, friction = 0.5 /
+"""
+FLUID = """&domain box = 4.0, 4.0, 4.0, cells_per_radius = 2 /
+&shear protocol = 'oscillatory', strain_amplitude = 0.5, period = 0.4 /
+&fluid reynolds = 0.01, initial_flow = 'shear' /
+&time dt = 1.0e-2, steps = {steps} /
+&output directory = 'out', progress_every = 1000 /
+"""
+
+
+def split(name, deck, steps, ranks=1):
+    a = T.scratch('protocol_restart_%s_straight' % name)
+    T.run(T.write_deck(a, 'd.nml', deck.format(steps=steps)), a, np_ranks=ranks)
+    b = T.scratch('protocol_restart_%s_split' % name)
+    T.run(T.write_deck(b, 'half.nml', deck.format(steps=steps // 2)), b, np_ranks=ranks)
+    T.run(T.write_deck(b, 'd.nml', deck.format(steps=steps)), b, np_ranks=ranks,
+          args=['-restart', 'out/checkpoint.h5'])
+    T.compare_h5(os.path.join(a, 'out', 'checkpoint.h5'), os.path.join(b, 'out', 'checkpoint.h5'),
+                 '%s: %d steps against %d + restart + %d, checkpoint' % (name, steps, steps // 2, steps // 2), rtol=0)
+    T.compare_h5(os.path.join(a, 'out', 'series.h5'), os.path.join(b, 'out', 'series.h5'),
+                 '%s: series' % name, rtol=0, skip=('wall_time',))
+    s = T.series(os.path.join(b, 'out'))
+    T.check(np.array_equal(s['step'], np.arange(1, steps + 1)), '%s: series steps 1..%d, each once' % (name, steps))
+    return s
+
+
+s = split('oscillation', OSC, 200)
+T.check(np.any(s['core/stress_contact'][:, 3] != 0), 'oscillation: contacts carry stress (their springs restart too)')
+s = split('reversal', REV, 150)
+flips = s['step'][1:][np.sign(s['shear/rate'][1:]) != np.sign(s['shear/rate'][:-1])]
+T.check(list(flips) == [61, 121], 'reversal: the rate flips at steps 61 and 121, across the restart: %s' % list(flips))
+split('fluid', FLUID, 60, ranks=2)
+
+# a branch starts the deck's protocol afresh from the configuration reached: a steady pre-shear of
+# 100 steps (Lees-Edwards), then a reversal every 50 steps' strain, and an oscillation
+b = T.scratch('protocol_restart_branch')
+T.run(T.write_deck(b, 'steady.nml', STEADY.format(steps=100, shear='rate = 1.0')), b)
+pre = T.series(os.path.join(b, 'out'))
+for name, shear, steps in (('reversal', "rate = 1.0, protocol = 'reversal', reversal_strain = 0.25", 260),
+                           ('oscillation', "protocol = 'oscillatory', strain_amplitude = 0.05, period = 0.3", 160)):
+    _, out, _ = T.run(T.write_deck(b, name + '.nml', STEADY.format(steps=steps, shear=shear).replace(
+        "directory = 'out'", "directory = '%s'" % name)), b, args=['-branch', 'out/checkpoint.h5'])
+    T.check("&shear protocol '%s' starts afresh" % ('reversal' if name == 'reversal' else 'oscillatory') in out
+            and "&shear protocol changed from 'steady'" in out, '%s branch: the log names the change of protocol' % name)
+    s = T.series(os.path.join(b, name))
+    offset = s['lees_edwards_offset']
+    first = s['step'][0]
+    if name == 'reversal':
+        flips = s['step'][1:][np.sign(s['shear/rate'][1:]) != np.sign(s['shear/rate'][:-1])]
+        T.check(first == 101 and list(flips) == [151, 201, 251] and s['shear/rate'][0] == 1.0,
+                'reversal branch: from step 101, flips at 151, 201, 251 (50 steps after the branch, then every 50): %s'
+                % list(flips))
+        expected = (pre['lees_edwards_offset'][-1] + 1.0 * 8.0 * 5.0e-3) % 8.0
+    else:
+        expected = (pre['lees_edwards_offset'][-1] + 0.05 * math.sin(2 * math.pi * 5.0e-3 / 0.3) * 8.0) % 8.0
+        T.check(abs(s['shear/strain'][0] - pre['lees_edwards_offset'][-1] / 8.0) < 1e-12,
+                'oscillation branch: the strain starts where the pre-shear left the boundary (offset / Ly)')
+    T.check(abs(offset[0] - expected) < 1e-12,
+            '%s branch: the boundary offset continues from the checkpoint\'s (%.12f, expected %.12f)'
+            % (name, offset[0], expected))
+T.finish()

@@ -1,0 +1,116 @@
+! Invariants of the imposed shear in time (mod_shear_protocol, doc/INPUT.md "&shear"):
+!  1. steady: the rate of every step is the deck's rate, exactly; the strain is the sum of rate dt;
+!  2. reversal with G a whole number of steps' strain (G = 0.1, |rate| dt = 1e-3, rate -2 with
+!     dt 5e-4): the direction flips at the start of steps 100, 200, 300 and at no other, despite the
+!     round-off of the summed |strain| (the 1e-9 slack of a step); the rate keeps its magnitude, the
+!     first segment has the sign of the deck's rate, the strain is the triangle wave between 0 and
+!     -G (|gamma - triangle| < 1e-12: a sum of 400 steps of 1e-3), p%reversed marks the flip steps;
+!  3. oscillatory: the rate of the step from t_n is gamma_0 omega cos(omega t_n) and the strain
+!     after it gamma_0 sin(omega t_{n+1}) (to 1e-15: the same formula evaluated), the reference rate
+!     is gamma_0 omega, and the strain is the integral of the rate over the steps to O(dt^2) per
+!     period (the rate is held at its t_n value over a step: the sum of rate dt differs from
+!     gamma(t) by at most gamma_0 omega^2 dt^2 / 2 per step, bound checked at T/4);
+!  4. the state of shear_protocol_state restores exactly: a protocol restored half way continues
+!     bitwise as the uninterrupted one (the restart of a run).
+program test_shear_protocol
+  use mod_kinds, only: dp, pi
+  use mod_shear_protocol, only: shear_protocol_t, shear_protocol_create, shear_protocol_begin_step, &
+                                shear_protocol_end_step, shear_protocol_state, shear_protocol_restore, &
+                                shear_protocol_kind, shear_protocol_varies, PROTOCOL_STEADY, PROTOCOL_REVERSAL, &
+                                PROTOCOL_OSCILLATORY
+  use mod_unit_checks, only: check, check_below, finish
+  implicit none
+  type(shear_protocol_t) :: p, q
+  integer :: n, flips
+  logical :: all_rates, all_flips, restored_same
+  real(dp) :: worst, summed, omega, gamma_0, period, dt, triangle
+  integer, allocatable :: flip_steps(:)
+
+  ! 1. steady
+  p = shear_protocol_create(PROTOCOL_STEADY, 0.7_dp, 1.0e-3_dp, 0.0_dp, 0.0_dp, 0.0_dp)
+  all_rates = .true.
+  do n = 0, 99
+    call shear_protocol_begin_step(p)
+    all_rates = all_rates .and. p%rate == 0.7_dp .and. .not. p%reversed
+    call shear_protocol_end_step(p)
+  end do
+  call check(all_rates .and. .not. shear_protocol_varies(p), 'steady: every step at the deck''s rate, exactly')
+  call check_below('steady: strain = rate t', abs(p%strain - 0.07_dp), 1.0e-14_dp)
+  call check(shear_protocol_kind('steady') == PROTOCOL_STEADY .and. shear_protocol_kind('reversal') == PROTOCOL_REVERSAL &
+             .and. shear_protocol_kind('oscillatory') == PROTOCOL_OSCILLATORY .and. shear_protocol_kind('step') == 0, &
+             'the deck''s protocol names')
+
+  ! 2. reversal every 0.1 of strain, rate -2, dt 5e-4: 100 steps per segment
+  p = shear_protocol_create(PROTOCOL_REVERSAL, -2.0_dp, 5.0e-4_dp, 0.1_dp, 0.0_dp, 0.0_dp)
+  allocate(flip_steps(0))
+  all_rates = .true.
+  worst = 0.0_dp
+  do n = 0, 399
+    call shear_protocol_begin_step(p)
+    if (p%reversed) flip_steps = [flip_steps, n]
+    all_rates = all_rates .and. abs(p%rate) == 2.0_dp
+    if (n < 100) all_rates = all_rates .and. p%rate < 0.0_dp
+    call shear_protocol_end_step(p)
+    ! the triangle wave: from 0 to -0.1 (the deck's direction), back to 0, ... in steps of 1e-3
+    triangle = -1.0e-3_dp * real(triangle_steps(n + 1), dp)
+    worst = max(worst, abs(p%strain - triangle))
+  end do
+  call check(size(flip_steps) == 3, 'reversal: three flips in 400 steps of 100 each')
+  if (size(flip_steps) == 3) call check(all(flip_steps == [100, 200, 300]), 'reversal: at the steps 100, 200, 300')
+  call check(all_rates, 'reversal: |rate| kept, the first segment in the deck''s direction')
+  call check_below('reversal: the strain is the triangle wave', worst, 1.0e-12_dp)
+
+  ! 3. oscillation gamma_0 = 0.01, T = 0.064, dt = 1e-3 (64 steps per period)
+  gamma_0 = 0.01_dp
+  period = 0.064_dp
+  dt = 1.0e-3_dp
+  omega = 2.0_dp * pi / period
+  p = shear_protocol_create(PROTOCOL_OSCILLATORY, 5.0_dp, dt, 0.0_dp, gamma_0, period)
+  call check_below('oscillatory: reference rate gamma_0 omega', abs(p%reference_rate - gamma_0 * omega), 1.0e-15_dp)
+  worst = 0.0_dp
+  summed = 0.0_dp
+  all_flips = .true.
+  do n = 0, 127
+    call shear_protocol_begin_step(p)
+    worst = max(worst, abs(p%rate - gamma_0 * omega * cos(omega * n * dt)))
+    summed = summed + p%rate * dt
+    all_flips = all_flips .and. .not. p%reversed
+    call shear_protocol_end_step(p)
+    worst = max(worst, abs(p%strain - gamma_0 * sin(omega * (n + 1) * dt)))
+    if (n == 15) call check_below('oscillatory: sum of rate dt = gamma(T/4) to gamma_0 omega^2 dt^2/2 per step', &
+                                  abs(summed - gamma_0), 16 * 0.5_dp * gamma_0 * omega**2 * dt**2)
+  end do
+  call check_below('oscillatory: rate gamma_0 omega cos(omega t_n), strain gamma_0 sin(omega t_n+1)', worst, 1.0e-13_dp)
+  call check(all_flips .and. shear_protocol_varies(p), 'oscillatory: varies, never reverses')
+
+  ! 4. restart: run 150 steps of a reversal, restore a copy at step 70 from its state, compare
+  p = shear_protocol_create(PROTOCOL_REVERSAL, 1.0_dp, 1.0e-3_dp, 0.03_dp, 0.0_dp, 0.0_dp)
+  q = shear_protocol_create(PROTOCOL_REVERSAL, 1.0_dp, 1.0e-3_dp, 0.03_dp, 0.0_dp, 0.0_dp)
+  restored_same = .true.
+  flips = 0
+  do n = 0, 149
+    if (n == 70) call shear_protocol_restore(q, shear_protocol_state(p))
+    call shear_protocol_begin_step(p)
+    if (p%reversed) flips = flips + 1
+    call shear_protocol_end_step(p)
+    if (n >= 70) then
+      call shear_protocol_begin_step(q)
+      call shear_protocol_end_step(q)
+      restored_same = restored_same .and. all(shear_protocol_state(p) == shear_protocol_state(q))
+    end if
+  end do
+  call check(restored_same .and. flips == 4, 'restore: a protocol restored at step 70 continues bitwise (4 flips)')
+  call finish('test_shear_protocol')
+
+contains
+
+  ! the steps of strain after k steps of 100-step segments, back and forth: 0..100..0..100..
+  pure integer function triangle_steps(k) result(s)
+    integer, intent(in) :: k
+    integer :: inside
+    inside = mod(k, 100)
+    s = inside
+    if (mod(k / 100, 2) == 1) s = 100 - inside
+  end function triangle_steps
+
+end program test_shear_protocol
