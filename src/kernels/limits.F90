@@ -15,7 +15,7 @@ module mod_limits
     integer :: level = LIMIT_WARN
     character(len=16) :: group = ''           ! the deck item at fault (&group key), for a refusal
     character(len=16) :: key = ''
-    character(len=400) :: text = ''
+    character(len=800) :: text = ''
   end type limit_finding_t
 
 contains

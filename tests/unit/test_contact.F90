@@ -30,10 +30,14 @@
 !  13. The flattening estimate eps_bar g(phi) takes the measured g at its table points (6.9 at
 !      phi = 0.4, 26 at 0.55; 1e-13), is continuous at the joins (0.3, 0.5: 1e-12) and is eps_bar
 !      at phi = 0 (one pair under the force scale).
-!  14. Shear jamming (doc/VALIDATION.md §6: frictional spheres at phi 0.55 jammed in every run):
-!      contact_limits refuses phi 0.5485 with mu_d 0.5 in a sheared cell, naming &contact friction,
-!      warns at phi 0.53 with mu_d 0.5, and lets phi 0.5485 pass frictionless (measured to flow),
-!      with mu_d 0.1, or without shear (no sliding boundary, or walls at rest).
+!  14. Frictional spheres at phi >= 0.545 (doc/VALIDATION.md §6 "Shear jamming, revisited": they
+!      flow with contacts at least as stiff as eps_bar 0.005, and every softer run stopped on the
+!      overlap guard): contact_limits refuses phi 0.5485 with mu_d 0.5 and eps_bar 0.01 in a sheared
+!      cell, naming &contact eps_bar, the budget and the stiffness that flowed (eps_bar <= 0.005,
+!      normal_stiffness >= 2^1.5 k_n); a prescribed k_n as soft is refused naming normal_stiffness;
+!      eps_bar 0.005 passes with a warning; a 1:1.4 mixture at eps_bar 0.005 is refused (its
+!      largest pair's overlaps are 1.4 times); warns at phi 0.53 with mu_d 0.5, and lets phi 0.5485
+!      pass frictionless, with mu_d 0.1, or without shear (no sliding boundary, or walls at rest).
 !  15. A mixture's overlap estimate is its largest pair's (doc/CONTACT.md "Spheres of several
 !      sizes": overlaps grow like the radius, measured 1.40-1.50 for 1:1.4): at phi 0.4 with
 !      eps_bar 0.06 the unit estimate 0.41 h_r passes, 1.4 times it (0.58) warns; eps_bar 0.09
@@ -260,9 +264,21 @@ program test_contact
   ! h_r there) and dt 1e-3 (chatter number 0.1)
   call contact_setup(p0, 1.0_dp, 5.0e-3_dp, 0.5_dp, 0.01_dp, 0.0_dp, 1.0_dp, 1.0_dp, info, msg)
   found = contact_limits(p0, 1.0e-3_dp, .true., .true., 0.5485_dp, 0.01_dp, .false.)
-  call check(count(found%level == LIMIT_REFUSE) == 1, 'phi 0.5485, mu_d 0.5, sheared: refused')
-  call check(any(found%group == 'contact' .and. found%key == 'friction' .and. index(found%text, 'jam in shear') > 0), &
-             'the refusal names &contact friction and the jamming')
+  call check(count(found%level == LIMIT_REFUSE) == 1, 'phi 0.5485, mu_d 0.5, eps_bar 0.01, sheared: refused')
+  call check(any(found%group == 'contact' .and. found%key == 'eps_bar' .and. index(found%text, 'overlap budget') > 0 &
+             .and. index(found%text, 'eps_bar <=  5.00E-03') > 0), &
+             'the refusal names &contact eps_bar, the overlap budget and eps_bar <= 0.005')
+  call check(any(index(found%text, 'normal_stiffness >= ') > 0), 'and the stiffness that flowed')
+  call contact_setup(pb, 1.0_dp, 5.0e-3_dp, 0.5_dp, 0.05_dp, p0%k_n, 1.0_dp, 1.0_dp, info, msg)
+  found = contact_limits(pb, 1.0e-3_dp, .true., .true., 0.5485_dp, 0.05_dp, .true.)
+  call check(any(found%level == LIMIT_REFUSE .and. found%key == 'normal_stiffness'), &
+             'the same k_n prescribed: refused naming &contact normal_stiffness')
+  call contact_setup(pb, 1.0_dp, 5.0e-3_dp, 0.5_dp, 0.005_dp, 0.0_dp, 1.0_dp, 1.0_dp, info, msg)
+  found = contact_limits(pb, 2.0e-4_dp, .true., .true., 0.5485_dp, 0.005_dp, .false.)
+  call check(count(found%level == LIMIT_REFUSE) == 0 .and. any(found%level == LIMIT_WARN .and. &
+             index(found%text, 'Lees-Edwards cube of 498 spheres') > 0), 'eps_bar 0.005: no refusal, a warning')
+  found = contact_limits(pb, 2.0e-4_dp, .true., .true., 0.5485_dp, 0.005_dp, .false., 1.4_dp)
+  call check(count(found%level == LIMIT_REFUSE) == 1, 'eps_bar 0.005 with a 1:1.4 mixture: refused')
   found = contact_limits(p0, 1.0e-3_dp, .true., .false., 0.5485_dp, 0.01_dp, .false.)
   call check(count(found%level == LIMIT_REFUSE) == 0, 'not sheared: no refusal')
   call contact_setup(pb, 1.0_dp, 5.0e-3_dp, 0.5_dp, 0.01_dp, 1.0e8_dp, 1.0_dp, 0.0_dp, info, msg)
