@@ -58,7 +58,8 @@ module mod_contact
   ! (498 spheres at phi 0.5495, mu_d 0.5: eta_r ~ 290 with eps_bar 0.005), but its contacts press
   ! past the roughness unless they are at least as stiff as eps_bar DENSE_EPS_BAR: every run with
   ! softer contacts (eps_bar 0.01; 77, 306 spheres) stopped on the overlap guard within a strain.
-  ! Small walled cells (77 spheres, 12a) jammed even with stiffer contacts. With mu_d >=
+  ! Between walls the core packs denser (0.573-0.576 in a 15.6a cell, which flowed 2 strains with
+  ! smooth contacts); small walled cells (77 spheres, 12a) jammed even with stiffer contacts. With mu_d >=
   ! SHEAR_JAM_WARN_MU the overlap guard stopped runs from SHEAR_JAM_WARN_PHI on, between walls.
   real(dp), parameter :: SHEAR_JAM_MU = 0.2_dp, SHEAR_JAM_PHI = 0.545_dp, DENSE_EPS_BAR = 0.005_dp
   real(dp), parameter :: SHEAR_JAM_WARN_MU = 0.5_dp, SHEAR_JAM_WARN_PHI = 0.52_dp
@@ -247,9 +248,9 @@ contains
         return
       end if
       write(text, '(a,f6.4,a,f5.2,a)') 'phi = ', phi, ' with mu_d = ', p%mu_d, ' flows with contacts this stiff in '// &
-           'a Lees-Edwards cube of 498 spheres at phi 0.5495 (doc/VALIDATION.md §6), but small cells between walls '// &
-           '(77 spheres, 12a high, whose core packs denser) jammed at any stiffness, and denser packings are '// &
-           'unmeasured: the overlap guard stops a run that jams'
+           'a Lees-Edwards cube of 498 spheres at phi 0.5495 (doc/VALIDATION.md §6); between walls the core packs '// &
+           'denser (0.573-0.576 in a 15.6a cell, where it flowed 2 strains with contact stresses 250-530; cells 12a '// &
+           'high jammed at any stiffness), and denser packings are unmeasured: the overlap guard stops a run that jams'
       call add_finding(findings, LIMIT_WARN, text)
     else if (shear_jamming .and. p%mu_d >= SHEAR_JAM_WARN_MU .and. phi >= SHEAR_JAM_WARN_PHI) then
       write(text, '(a,f6.4,a,f5.2,a)') 'phi = ', phi, ' with mu_d = ', p%mu_d, ' is close to shear jamming: '// &
