@@ -59,8 +59,9 @@ module mod_contact
   ! past the roughness unless they are at least as stiff as eps_bar DENSE_EPS_BAR: every run with
   ! softer contacts (eps_bar 0.01; 77, 306 spheres) stopped on the overlap guard within a strain.
   ! Between walls the core packs denser (0.573-0.576 in a 15.6a cell, which flowed 2 strains with
-  ! smooth contacts); small walled cells (77 spheres, 12a) jammed even with stiffer contacts. With mu_d >=
-  ! SHEAR_JAM_WARN_MU the overlap guard stopped runs from SHEAR_JAM_WARN_PHI on, between walls.
+  ! smooth contacts); small walled cells (77 spheres, 12a) jammed even with stiffer contacts.
+  ! With mu_d >= SHEAR_JAM_WARN_MU the overlap guard stopped runs from SHEAR_JAM_WARN_PHI on,
+  ! between walls.
   real(dp), parameter :: SHEAR_JAM_MU = 0.2_dp, SHEAR_JAM_PHI = 0.545_dp, DENSE_EPS_BAR = 0.005_dp
   real(dp), parameter :: SHEAR_JAM_WARN_MU = 0.5_dp, SHEAR_JAM_WARN_PHI = 0.52_dp
   ! smooth spheres (h_r = 0) stop when an overlap exceeds this fraction of their radius
