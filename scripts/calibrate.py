@@ -88,13 +88,14 @@ def main():
     ap.add_argument('--size-ratio', type=float, default=None,
                     help='an unequal pair: sphere 2 of radius SIZE_RATIO times sphere 1 (of CELLS_PER_RADIUS)')
     args = ap.parse_args()
+    # an integer resolution stays one: the names, seeds and decks of the integer tables
+    n = args.cells_per_radius
+    args.cells_per_radius = int(n) if n == int(n) else n
     if args.size_ratio is not None:
         calibrate_unequal(args)
         return
     if args.samples is None:
         args.samples = SAMPLES.get(args.cells_per_radius, 2)
-    if args.size_ratio is None and args.cells_per_radius == int(args.cells_per_radius):
-        args.cells_per_radius = int(args.cells_per_radius)
     if args.samples < 2:
         ap.error('--samples must be at least 2 (the table keeps the scatter)')
     n = args.cells_per_radius
@@ -275,7 +276,6 @@ def calibrate_unequal(args):
     the equal calibration, each sphere spun in turn, fitted with fdsusp.pair_blocks (see
     fit_pair), the regular co-moving translations held at their exact values."""
     n, lam = args.cells_per_radius, args.size_ratio
-    n = int(n) if n == int(n) else n
     if lam < 1.0:
         sys.exit('calibrate: --size-ratio is the larger sphere over the smaller, >= 1 (1: the equal pair '
                  'by this method, a check of it against the equal table)')
