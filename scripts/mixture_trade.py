@@ -46,6 +46,14 @@ for model, extra in (('dns', {}), ('ld', LD)):
     ROWS['%s_phi0.5' % model] = ('%s, equal spheres, bulk phi 0.5' % model.upper(), dict(extra, phi=0.5))
     ROWS['%s_phi0.5_eb002' % model] = ('%s, equal spheres, bulk phi 0.5, eps_bar 0.02, dt 8e-4' % model.upper(),
                                        dict(extra, **FRICTIONAL, phi=0.5))
+# frictional rows with contacts stiff enough for the walls' dense core at phi 0.5 (eps_bar 0.02 stopped
+# on the overlap guard, doc/VALIDATION.md §11.3): eps_bar 0.005 (the mixture's effective 0.007), dt
+# 2e-4 (stick number 4.6 below the limit 5), 1 strain discarded and 3 averaged in 3 blocks (20000 steps)
+STIFF = dict(eps_bar=0.005, dt=2e-4, discard=1.0, average=3.0, blocks=3)
+ROWS['dns_mix_phi0.5_eb0005'] = ('DNS, 1:1.4 mixture, bulk phi 0.5, eps_bar 0.005, dt 2e-4 (for mu_d 0.5)',
+                                 dict(STIFF, species=MIXTURE, box=MIXTURE_BOX, phi=0.5))
+ROWS['dns_phi0.5_eb0005'] = ('DNS, equal spheres, bulk phi 0.5, eps_bar 0.005, dt 2e-4 (for mu_d 0.5)',
+                             dict(STIFF, phi=0.5))
 DEFAULT = list(ROWS)
 
 # eps_bar 0.02 throughout: the start-up estimate of the largest overlap refuses 0.05 for the
