@@ -20,7 +20,12 @@
 ! faster than the factorisation (doc/BENCHMARKS.md, scripts/bench_particle_solver.sh); in
 ! lubrication dynamics (no fluid mass on the diagonal) CG takes 64-97 iterations at 1000 spheres and
 ! is still the faster, ~7x at 500 spheres (doc/BENCHMARKS.md §11). Particle data is replicated, so every
-! rank assembles and solves the same sequential system and gets the same answer.
+! rank assembles the same system; the sparse solve is shared out (since 2026-11-28, issue 45): the
+! matrix and vectors live on PETSC_COMM_WORLD, each rank owns the block rows of a contiguous range of
+! spheres and sets only those, CG runs in parallel, and the shares of the solution are gathered
+! (doc/DESIGN.md "Parallelism"). One rank gives the same numbers as before, bitwise; more ranks agree
+! to the solver's tolerance (test_ld_rank_independence). The sparse Cholesky by CHOLMOD runs on one
+! rank only; -particles_pc_factor_mat_solver_type mumps factors the distributed aij matrix.
 #include <petsc/finclude/petscksp.h>
 module mod_particle_solver
   use petscksp
@@ -51,7 +56,7 @@ contains
     PetscCall(set_default_option('-particles_pc_type', 'pbjacobi', ierr))
     PetscCall(set_default_option('-particles_ksp_rtol', '1e-12', ierr))
     PetscCall(set_default_option('-particles_ksp_max_it', '10000', ierr))
-    PetscCall(KSPCreate(PETSC_COMM_SELF, ps%ksp, ierr))
+    PetscCall(KSPCreate(PETSC_COMM_WORLD, ps%ksp, ierr))
     PetscCall(KSPSetOptionsPrefix(ps%ksp, 'particles_', ierr))
     PetscCall(KSPSetFromOptions(ps%ksp, ierr))
     ps%created = .true.
@@ -120,68 +125,100 @@ contains
     PetscErrorCode, intent(out) :: ierr
     Mat :: a
     Vec :: vx, vb
-    PetscInt :: n6, row(1), col(1), its
+    PetscInt :: n6, row(1), col(1), its, owned, first
     PetscInt, parameter :: one = 1, six = 6
-    PetscInt, allocatable :: nnz(:), upper(:)
-    PetscBool :: sbaij
+    PetscInt, allocatable :: diagonal(:), off(:), upper(:), upper_off(:)
+    PetscBool :: sbaij, sbaij_parallel
     KSPType :: ksp_type
     PetscScalar, pointer :: p(:)
-    integer :: q, i, j
+    integer :: q, i, j, e, rank, ranks, lo, hi
+    integer, allocatable :: counts(:), displs(:)
 
     n6 = 6 * sys%n
-    ! block row of particle i: its diagonal block and one block per pair it belongs to
-    allocate(nnz(sys%n))
-    nnz = 1
+    ! The spheres' block rows are shared out in contiguous ranges (PETSc's split): this rank owns
+    ! spheres lo..hi. The system is replicated (every rank assembled it), so each rank sets its own
+    ! rows and nothing crosses ranks in the assembly; the solve then runs on every rank's share.
+    PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, ranks, ierr))
+    PetscCallMPI(MPI_Comm_rank(PETSC_COMM_WORLD, rank, ierr))
+    allocate(counts(ranks), displs(ranks))
+    do i = 1, ranks
+      counts(i) = sys%n / ranks + merge(1, 0, i - 1 < mod(sys%n, ranks))
+    end do
+    displs(1) = 0
+    do i = 2, ranks
+      displs(i) = displs(i - 1) + counts(i - 1)
+    end do
+    lo = displs(rank + 1) + 1
+    hi = displs(rank + 1) + counts(rank + 1)
+    owned = counts(rank + 1)
+    first = lo - 1
+    ! block rows of this rank's spheres: the diagonal block and one block per pair, in the columns
+    ! this rank owns (diagonal) or not (off); a pair may come more than once (lubrication and
+    ! contact stiffness): its blocks add up in one, and a row never holds more blocks than there
+    ! are columns. The upper triangle alone (sbaij): the pairs whose other sphere is later.
+    allocate(diagonal(lo:hi), off(lo:hi), upper(lo:hi), upper_off(lo:hi))
+    diagonal = 1
+    off = 0
+    upper = 1
+    upper_off = 0
     do q = 1, sys%npairs
-      do i = 1, 2
-        j = sys%pair(i, q)
-        nnz(j) = nnz(j) + 1
+      do e = 1, 2
+        i = sys%pair(e, q)
+        j = sys%pair(3 - e, q)
+        if (i < lo .or. i > hi) cycle
+        if (j >= lo .and. j <= hi) then
+          diagonal(i) = diagonal(i) + 1
+          if (j > i) upper(i) = upper(i) + 1
+        else
+          off(i) = off(i) + 1
+          if (j > i) upper_off(i) = upper_off(i) + 1
+        end if
       end do
     end do
-    ! a pair may come more than once (lubrication and contact stiffness): its blocks add up in
-    ! one, and a row never holds more blocks than there are particles
-    nnz = min(nnz, sys%n)
-    ! the upper triangle alone (sbaij): the diagonal block and the pairs whose other particle is later
-    allocate(upper(sys%n))
-    upper = 1
-    do q = 1, sys%npairs
-      i = min(sys%pair(1, q), sys%pair(2, q))
-      upper(i) = upper(i) + 1
-    end do
-    upper = min(upper, sys%n)
-    ! BAIJ unless -particles_mat_type says otherwise (sbaij or aij for a sparse Cholesky:
-    ! PETSc's CHOLMOD factors only those; sbaij keeps the upper triangle, the lower is ignored)
-    PetscCall(MatCreate(PETSC_COMM_SELF, a, ierr))
-    PetscCall(MatSetSizes(a, n6, n6, n6, n6, ierr))
+    diagonal = min(diagonal, owned)
+    upper = min(upper, owned)
+    off = min(off, sys%n - owned)
+    upper_off = min(upper_off, sys%n - owned)
+    ! BAIJ (sequential on one rank, distributed on more) unless -particles_mat_type says otherwise
+    ! (sbaij or aij for a sparse Cholesky on one rank: PETSc's CHOLMOD factors only those; sbaij
+    ! keeps the upper triangle, the lower is ignored)
+    PetscCall(MatCreate(PETSC_COMM_WORLD, a, ierr))
+    PetscCall(MatSetSizes(a, 6 * owned, 6 * owned, n6, n6, ierr))
     PetscCall(MatSetBlockSize(a, six, ierr))
-    PetscCall(MatSetType(a, MATSEQBAIJ, ierr))
+    PetscCall(MatSetType(a, MATBAIJ, ierr))
     PetscCall(MatSetOptionsPrefix(a, 'particles_', ierr))
     PetscCall(MatSetFromOptions(a, ierr))
-    PetscCall(MatXAIJSetPreallocation(a, six, nnz, PETSC_NULL_INTEGER, upper, PETSC_NULL_INTEGER, ierr))
+    PetscCall(MatXAIJSetPreallocation(a, six, diagonal, off, upper, upper_off, ierr))
     PetscCall(MatSetOption(a, MAT_SYMMETRIC, PETSC_TRUE, ierr))
     PetscCall(PetscObjectTypeCompare(a, MATSEQSBAIJ, sbaij, ierr))
-    if (sbaij) then
+    PetscCall(PetscObjectTypeCompare(a, MATMPISBAIJ, sbaij_parallel, ierr))
+    if (sbaij .or. sbaij_parallel) then
       PetscCall(MatSetOption(a, MAT_IGNORE_LOWER_TRIANGULAR, PETSC_TRUE, ierr))
     end if
-    do q = 1, sys%n
+    do q = lo, hi
       row(1) = q - 1
       PetscCall(MatSetValuesBlocked(a, one, row, one, row, row_major(sys%diag(:, :, q)), ADD_VALUES, ierr))
     end do
     do q = 1, sys%npairs
-      row(1) = sys%pair(1, q) - 1
-      col(1) = sys%pair(2, q) - 1
-      PetscCall(MatSetValuesBlocked(a, one, row, one, col, row_major(sys%block(:, :, q)), ADD_VALUES, ierr))
-      PetscCall(MatSetValuesBlocked(a, one, col, one, row, row_major(transpose(sys%block(:, :, q))), ADD_VALUES, ierr))
+      i = sys%pair(1, q)
+      j = sys%pair(2, q)
+      row(1) = i - 1
+      col(1) = j - 1
+      if (i >= lo .and. i <= hi) then
+        PetscCall(MatSetValuesBlocked(a, one, row, one, col, row_major(sys%block(:, :, q)), ADD_VALUES, ierr))
+      end if
+      if (j >= lo .and. j <= hi) then
+        PetscCall(MatSetValuesBlocked(a, one, col, one, row, row_major(transpose(sys%block(:, :, q))), ADD_VALUES, ierr))
+      end if
     end do
     PetscCall(MatAssemblyBegin(a, MAT_FINAL_ASSEMBLY, ierr))
     PetscCall(MatAssemblyEnd(a, MAT_FINAL_ASSEMBLY, ierr))
-    PetscCall(VecCreateSeq(PETSC_COMM_SELF, n6, vb, ierr))
-    PetscCall(VecDuplicate(vb, vx, ierr))
+    PetscCall(MatCreateVecs(a, vx, vb, ierr))
     PetscCall(VecGetArrayF90(vb, p, ierr))
-    p = reshape(rhs(:, 1:sys%n), [6 * sys%n])
+    p = reshape(rhs(:, lo:hi), [6 * owned])
     PetscCall(VecRestoreArrayF90(vb, p, ierr))
     PetscCall(VecGetArrayF90(vx, p, ierr))
-    p = reshape(x(:, 1:sys%n), [6 * sys%n])
+    p = reshape(x(:, lo:hi), [6 * owned])
     PetscCall(VecRestoreArrayF90(vx, p, ierr))
     ! a direct solve (preonly) takes no guess
     PetscCall(KSPGetType(ksp, ksp_type, ierr))
@@ -195,9 +232,14 @@ contains
     PetscCall(KSPGetConvergedReason(ksp, reason, ierr))
     PetscCall(KSPGetIterationNumber(ksp, its, ierr))
     iterations = int(its)
+    ! every rank holds every sphere's velocity (the particle state is replicated): the shares are
+    ! gathered (6 N doubles, doc/DESIGN.md "Parallelism")
     PetscCall(VecGetArrayReadF90(vx, p, ierr))
-    x(:, 1:sys%n) = reshape(p, [6, sys%n])
+    x(:, lo:hi) = reshape(p, [6, int(owned)])
     PetscCall(VecRestoreArrayReadF90(vx, p, ierr))
+    if (ranks > 1) then
+      PetscCallMPI(MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, x, 6 * counts, 6 * displs, MPI_DOUBLE_PRECISION, PETSC_COMM_WORLD, ierr))
+    end if
     PetscCall(VecDestroy(vx, ierr))
     PetscCall(VecDestroy(vb, ierr))
     PetscCall(MatDestroy(a, ierr))
