@@ -306,6 +306,8 @@ contains
     ! (direct solves keep no history: a Krylov run restarted from their checkpoint starts from u^n)
     if (.not. fl%direct) fl%star_history = min(STAR_HISTORY_FULL, fl%star_history + 1)
     PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_P), loc_p, p, ierr))
+    ! returned before the divergence borrows three: at most three ghosted work vectors at once
+    PetscCall(DMRestoreLocalVector(grid%da(FIELD_P), loc_p, ierr))
 
     ! 2. pressure increment: -lap phi = -(Re/dt) div u* (the direct solve in place in phi)
     PetscCall(divergence(grid, fl%vel_star, fl%div_star, ierr))
@@ -318,6 +320,7 @@ contains
     PetscCall(solver_solve(fl%solver(FIELD_P), rhs_p, fl%phi, ierr))
 
     ! 3. projection, with the rate of change for steady-state detection
+    PetscCall(DMGetLocalVector(grid%da(FIELD_P), loc_p, ierr))
     PetscCall(ghosted(grid, fl, FIELD_P, fl%phi, loc_p, ierr))
     PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_P), loc_p, ph, ierr))
     local_max = 0.0_dp
