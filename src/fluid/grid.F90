@@ -49,7 +49,7 @@ module mod_grid
   implicit none
   private
   public :: grid_t, grid_create, grid_destroy, grid_position, grid_fixed_row, direct_solves_wanted
-  public :: grid_create_box_layout, grid_petsc_index
+  public :: grid_create_box_layout, grid_petsc_index, ownership_index
   public :: FIELD_U, FIELD_V, FIELD_W, FIELD_P, field_names
 
   integer, parameter :: FIELD_U = 1, FIELD_V = 2, FIELD_W = 3, FIELD_P = 4
@@ -175,49 +175,49 @@ contains
     PetscCall(DMSetUp(da, ierr))
   end subroutine grid_create_box_layout
 
-  ! The PETSc (global vector) index of the point (i, j, k), 0-based, of every field: the ranks own
-  ! boxes of rank_cells_x x rank_cells_y x rank_cells_z points, numbered rank by rank (x fastest in
-  ! the process grid) and x fastest within each. What AOApplicationToPetsc of the DMDA's AO gives,
-  ! without the AO (mod_fft_solver): computed from the ownership ranges alone.
+  ! The PETSc (global vector) index of the point (i, j, k), 0-based, of every field: what
+  ! AOApplicationToPetsc of the DMDA's AO gives, without the AO (mod_fft_solver).
   pure function grid_petsc_index(grid, i, j, k) result(index)
     type(grid_t), intent(in) :: grid
     integer, intent(in) :: i, j, k
     PetscInt :: index
-    integer :: r(3), s(3), w(3), d, c
-    integer :: pos(3)
-    pos = [i, j, k]
-    do d = 1, 3
-      ! the rank r(d) along direction d owning pos(d), and its first index s(d) and width w(d)
-      s(d) = 0
-      r(d) = 0
-      do
-        w(d) = rank_width(grid, d, r(d))
-        if (pos(d) < s(d) + w(d)) exit
-        s(d) = s(d) + w(d)
-        r(d) = r(d) + 1
-      end do
-    end do
-    ! points owned by the ranks before (r(1), r(2), r(3)) in rank order: whole z-layers of ranks,
-    ! then whole y-rows of ranks within the layer, then the ranks before in the row
-    index = int(grid%n(1), kind(index)) * grid%n(2) * s(3)
-    index = index + int(grid%n(1), kind(index)) * s(2) * w(3)
-    index = index + int(s(1), kind(index)) * w(2) * w(3)
-    c = (pos(1) - s(1)) + w(1) * ((pos(2) - s(2)) + w(2) * (pos(3) - s(3)))
-    index = index + c
+    index = ownership_index(grid%rank_cells_x, grid%rank_cells_y, grid%rank_cells_z, grid%n, i, j, k)
   end function grid_petsc_index
 
-  pure integer function rank_width(grid, d, r)
-    type(grid_t), intent(in) :: grid
-    integer, intent(in) :: d, r
-    select case (d)
-    case (1)
-      rank_width = grid%rank_cells_x(r + 1)
-    case (2)
-      rank_width = grid%rank_cells_y(r + 1)
-    case default
-      rank_width = grid%rank_cells_z(r + 1)
-    end select
-  end function rank_width
+  ! The PETSc index of point (i, j, k), 0-based, of a DMDA of n(1) x n(2) x n(3) points whose
+  ! ranks own lx(r) x ly(s) x lz(t) boxes (DMDAGetOwnershipRanges), numbered rank by rank (x
+  ! fastest in the process grid) and x fastest within each: computed from the ownership ranges
+  ! alone, where an application ordering (AO) would hold the global ordering (AOBASIC, on every
+  ! rank) or need every rank in each call (AOMEMORYSCALABLE).
+  pure function ownership_index(lx, ly, lz, n, i, j, k) result(index)
+    PetscInt, intent(in) :: lx(:), ly(:), lz(:)
+    integer, intent(in) :: n(3), i, j, k
+    PetscInt :: index
+    integer :: s(3), w(3)
+    call owner_range(lx, i, s(1), w(1))
+    call owner_range(ly, j, s(2), w(2))
+    call owner_range(lz, k, s(3), w(3))
+    ! the points of the ranks before in rank order: whole z-layers of ranks, then whole y-rows of
+    ! ranks within the layer, then the ranks before in the row; then the place within the box
+    index = int(n(1), kind(index)) * n(2) * s(3) + int(n(1), kind(index)) * s(2) * w(3) &
+          + int(s(1), kind(index)) * w(2) * w(3) &
+          + (i - s(1)) + w(1) * ((j - s(2)) + w(2) * (k - s(3)))
+  end function ownership_index
+
+  ! The first index start and the width of the rank's range (widths l) that holds index p.
+  pure subroutine owner_range(l, p, start, width)
+    PetscInt, intent(in) :: l(:)
+    integer, intent(in) :: p
+    integer, intent(out) :: start, width
+    integer :: r
+    start = 0
+    width = int(l(size(l)))
+    do r = 1, size(l)
+      width = int(l(r))
+      if (p < start + width) return
+      start = start + width
+    end do
+  end subroutine owner_range
 
   ! Split nblocks blocks of size block over nproc ranks as evenly as possible.
   subroutine shares(nblocks, nproc, block, l)
