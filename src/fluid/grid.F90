@@ -36,10 +36,12 @@
 ! (about 25 B per cell each, summed over ranks), and the borrowed work vectors of every field
 ! come from one cache. The extra edge and corner ghosts it fills are never read by the fluid's
 ! operators, so the fields are bitwise the same. The Krylov path (-fluid_solver krylov) keeps four
-! star DMDAs: each KSP keeps its operator callback and multigrid options on its own DM. Every
-! DMDA's application ordering (AO), which only the Krylov path's cell-centred multigrid
-! prolongation asks for, is memory-scalable: the default AO is a copy of the global ordering on
-! every rank (16 B per cell of the whole grid on each rank, 32 GB per rank at 1e9 cells).
+! star DMDAs: each KSP keeps its operator callback and multigrid options on its own DM. fdsusp
+! itself builds no application ordering (AO): the FFT scatter and the Krylov path's cell-centred
+! prolongation number points from the ownership ranges (ownership_index). Should anything else ask
+! (a natural-order viewer), every DMDA's AO is memory-scalable: the default is a copy of the
+! global ordering on every rank (16 B per cell of the whole grid on each rank, 32 GB per rank at
+! 1e9 cells).
 #include <petsc/finclude/petscdmda.h>
 module mod_grid
   use petscdmda
