@@ -51,7 +51,7 @@ module mod_grid
   implicit none
   private
   public :: grid_t, grid_create, grid_destroy, grid_position, grid_fixed_row, direct_solves_wanted
-  public :: grid_create_box_layout, grid_petsc_index, ownership_index
+  public :: grid_create_box_layout, grid_create_star_layout, grid_petsc_index, ownership_index
   public :: FIELD_U, FIELD_V, FIELD_W, FIELD_P, field_names
 
   integer, parameter :: FIELD_U = 1, FIELD_V = 2, FIELD_W = 3, FIELD_P = 4
@@ -132,10 +132,7 @@ contains
     else
       ! star: the fluid's operators read face neighbours only (see the top of this file)
       do f = 1, 4
-        PetscCall(DMDACreate3d(PETSC_COMM_WORLD, DM_BOUNDARY_PERIODIC, DM_BOUNDARY_PERIODIC, DM_BOUNDARY_PERIODIC, DMDA_STENCIL_STAR, grid%n(1), grid%n(2), grid%n(3), m(1), m(2), m(3), 1, 1, lx, ly, lz, grid%da(f), ierr))
-        PetscCall(DMSetOptionsPrefix(grid%da(f), field_names(f)//'_', ierr))
-        PetscCall(DMDASetAOType(grid%da(f), AOMEMORYSCALABLE, ierr))
-        PetscCall(DMSetUp(grid%da(f), ierr))
+        PetscCall(grid_create_star_layout(grid, f, grid%da(f), ierr))
       end do
     end if
     PetscCall(DMDAGetCorners(grid%da(FIELD_P), xs, ys, zs, xm, ym, zm, ierr))
@@ -176,6 +173,21 @@ contains
     PetscCall(DMDASetAOType(da, AOMEMORYSCALABLE, ierr))
     PetscCall(DMSetUp(da, ierr))
   end subroutine grid_create_box_layout
+
+  ! The star-stencil DMDA of field f (options prefix u_, v_, w_ or p_) with the fields'
+  ! decomposition: each field's own in the Krylov path, and a Krylov solver's own beside the shared
+  ! layout of the direct solves (mod_solvers: a matrix made from the box layout would store 27
+  ! entries per row instead of 7). The caller destroys it. Needs grid%nprocs and grid%rank_cells_*.
+  subroutine grid_create_star_layout(grid, f, da, ierr)
+    type(grid_t), intent(in) :: grid
+    integer, intent(in) :: f
+    DM, intent(out) :: da
+    PetscErrorCode, intent(out) :: ierr
+    PetscCall(DMDACreate3d(PETSC_COMM_WORLD, DM_BOUNDARY_PERIODIC, DM_BOUNDARY_PERIODIC, DM_BOUNDARY_PERIODIC, DMDA_STENCIL_STAR, grid%n(1), grid%n(2), grid%n(3), grid%nprocs(1), grid%nprocs(2), grid%nprocs(3), 1, 1, grid%rank_cells_x, grid%rank_cells_y, grid%rank_cells_z, da, ierr))
+    PetscCall(DMSetOptionsPrefix(da, field_names(f)//'_', ierr))
+    PetscCall(DMDASetAOType(da, AOMEMORYSCALABLE, ierr))
+    PetscCall(DMSetUp(da, ierr))
+  end subroutine grid_create_star_layout
 
   ! The PETSc (global vector) index of the point (i, j, k), 0-based, of every field: what
   ! AOApplicationToPetsc of the DMDA's AO gives, without the AO (mod_fft_solver).

@@ -13,7 +13,8 @@ module mod_solvers
   use petscdmda
   use, intrinsic :: iso_c_binding, only: C_INT
   use mod_kinds, only: dp
-  use mod_grid, only: grid_t, FIELD_V, FIELD_P, field_names, direct_solves_wanted, ownership_index
+  use mod_grid, only: grid_t, FIELD_V, FIELD_P, field_names, direct_solves_wanted, ownership_index, &
+                      grid_create_star_layout
   use mod_errors, only: fatal_error, log_line
   use mod_petsc_options, only: set_default_option
   use mod_fft_solver, only: fft_solver_t, fft_create, fft_solve, fft_destroy
@@ -41,6 +42,9 @@ module mod_solvers
     real(dp) :: cell_volume = 1.0_dp   ! rows are scaled by the cell volume (see compute_operator)
     MatNullSpace :: nullspace
     logical :: direct = .false.     ! solved by fast transforms (mod_fft_solver), no KSP
+    ! a Krylov solver beside the direct solves' shared box layout has its own star DMDA (mod_grid)
+    logical :: owns_dm = .false.
+    DM :: dm
     type(fft_solver_t) :: fft
     ! the callback's context, on the heap: PETSc keeps its address, which must not move when the
     ! solver_t is copied or its holder reallocated
@@ -118,14 +122,23 @@ contains
       PetscCall(set_default_option(prefix//'mg_coarse_redundant_pc_factor_shift_type', 'nonzero', ierr))
     end if
 
+    ! the operators come from the DMDA's preallocation: a star one (7 entries per row), the
+    ! solver's own where the fields share the box layout of the direct solves (doc/DESIGN.md "One
+    ! layout with the direct solves"; e.g. the -bench_cold_poisson yardstick)
+    s%owns_dm = grid%shared_layout
+    if (s%owns_dm) then
+      PetscCall(grid_create_star_layout(grid, field, s%dm, ierr))
+    else
+      s%dm = grid%da(field)
+    end if
     PetscCall(KSPCreate(PETSC_COMM_WORLD, s%ksp, ierr))
     PetscCall(KSPSetOptionsPrefix(s%ksp, field_names(field)//'_', ierr))
-    PetscCall(KSPSetDM(s%ksp, grid%da(field), ierr))
+    PetscCall(KSPSetDM(s%ksp, s%dm, ierr))
     PetscCall(KSPSetComputeOperators(s%ksp, compute_operator, s%context, ierr))
     PetscCall(KSPSetInitialGuessNonzero(s%ksp, PETSC_TRUE, ierr))
     PetscCall(KSPSetFromOptions(s%ksp, ierr))
     if (field == FIELD_P) then
-      PetscCall(set_cell_centred_interpolation(s%ksp, grid%da(FIELD_P), s%context%walls, ierr))
+      PetscCall(set_cell_centred_interpolation(s%ksp, s%dm, s%context%walls, ierr))
     end if
     if (s%singular) then
       PetscCall(MatNullSpaceCreate(PETSC_COMM_WORLD, PETSC_TRUE, 0, PETSC_NULL_VEC, s%nullspace, ierr))
@@ -404,6 +417,10 @@ contains
       PetscCall(fft_destroy(s%fft, ierr))
     else
       PetscCall(KSPDestroy(s%ksp, ierr))
+      if (s%owns_dm) then
+        PetscCall(DMDestroy(s%dm, ierr))
+      end if
+      s%owns_dm = .false.
       if (s%singular) then
         PetscCall(MatNullSpaceDestroy(s%nullspace, ierr))
       end if
