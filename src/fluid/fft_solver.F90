@@ -74,6 +74,13 @@ module mod_fft_solver
   real(C_DOUBLE), pointer, save :: shared_data(:) => null()
   Vec, save :: shared_slab
   VecScatter, save :: shared_scatter
+  ! With a 1 x 1 x P process grid (what mod_grid picks for the direct solves) the DMDA's ranks own
+  ! whole z-planes in rank order, so its global vector is in natural order, as FFTW's slabs are:
+  ! the move is one MPI_Alltoallv of contiguous plane ranges (counts and offsets in entries, to
+  ! and from each rank), with no per-point index (the scatter's graph and set-up were ~20 B per
+  ! cell). Otherwise the VecScatter above.
+  logical, save :: shared_planes = .false.
+  integer, allocatable, save :: vec_counts(:), vec_offsets(:), slab_counts(:), slab_offsets(:)
 
 contains
 
@@ -200,6 +207,11 @@ contains
     shared_n = grid%n
     shared_users = 1
 
+    shared_planes = grid%nprocs(1) == 1 .and. grid%nprocs(2) == 1
+    if (shared_planes) then
+      call plane_exchange(grid, int(z_start), int(local_nz))
+      return
+    end if
     PetscCall(VecCreateMPIWithArray(PETSC_COMM_WORLD, 1, shared_local_full, PETSC_DECIDE, shared_data, shared_slab, ierr))
     allocate(petsc_index(max(shared_local_full, 1)))
     m = 0
@@ -218,6 +230,74 @@ contains
     PetscCall(DMRestoreGlobalVector(grid%da(FIELD_P), template, ierr))
     PetscCall(ISDestroy(from, ierr))
   end subroutine shared_acquire
+
+  ! The counts and offsets of the plane exchange (shared_planes): this rank's DMDA planes
+  ! [a, a + lz) go to each rank's FFTW slab [c, c + nz), the overlap, and come back the same way.
+  subroutine plane_exchange(grid, z_start, local_nz)
+    type(grid_t), intent(in) :: grid
+    integer, intent(in) :: z_start, local_nz
+    integer :: nranks, me, r, plane, mpierr, mine(2), lo, hi, a, b
+    integer, allocatable :: slabs(:, :), dmda_start(:)
+    call MPI_Comm_size(PETSC_COMM_WORLD, nranks, mpierr)
+    call MPI_Comm_rank(PETSC_COMM_WORLD, me, mpierr)
+    allocate(slabs(2, nranks), dmda_start(nranks + 1))
+    mine = [z_start, local_nz]
+    call MPI_Allgather(mine, 2, MPI_INTEGER, slabs, 2, MPI_INTEGER, PETSC_COMM_WORLD, mpierr)
+    dmda_start(1) = 0
+    do r = 1, nranks
+      dmda_start(r + 1) = dmda_start(r) + int(grid%rank_cells_z(r))
+    end do
+    plane = grid%n(1) * grid%n(2)
+    allocate(vec_counts(nranks), vec_offsets(nranks), slab_counts(nranks), slab_offsets(nranks))
+    a = dmda_start(me + 1)
+    b = dmda_start(me + 2)
+    do r = 1, nranks
+      ! to rank r: my DMDA planes within its slab
+      lo = max(a, slabs(1, r))
+      hi = min(b, slabs(1, r) + slabs(2, r))
+      vec_counts(r) = max(0, hi - lo) * plane
+      vec_offsets(r) = max(0, lo - a) * plane
+      ! from rank r: its DMDA planes within my slab
+      lo = max(dmda_start(r), z_start)
+      hi = min(dmda_start(r + 1), z_start + local_nz)
+      slab_counts(r) = max(0, hi - lo) * plane
+      slab_offsets(r) = max(0, lo - z_start) * plane
+    end do
+  end subroutine plane_exchange
+
+  ! The plane exchange (shared_planes) of a global vector into the slab (forward) or back.
+  subroutine move_planes(v, forward, ierr)
+    Vec, intent(in) :: v
+    logical, intent(in) :: forward
+    PetscErrorCode, intent(out) :: ierr
+    PetscScalar, pointer :: a(:)
+    PetscInt :: n
+    integer :: mpierr
+    PetscCall(VecGetLocalSize(v, n, ierr))
+    if (forward) then
+      PetscCall(VecGetArrayReadF90(v, a, ierr))
+      ! first elements, not arrays: the addresses, no copy (an empty block sends nothing)
+      if (n > 0) then
+        call MPI_Alltoallv(a(1), vec_counts, vec_offsets, MPI_DOUBLE_PRECISION, shared_data(1), slab_counts, &
+                           slab_offsets, MPI_DOUBLE_PRECISION, PETSC_COMM_WORLD, mpierr)
+      else
+        call MPI_Alltoallv(shared_data(1), vec_counts, vec_offsets, MPI_DOUBLE_PRECISION, shared_data(1), slab_counts, &
+                           slab_offsets, MPI_DOUBLE_PRECISION, PETSC_COMM_WORLD, mpierr)
+      end if
+      PetscCall(VecRestoreArrayReadF90(v, a, ierr))
+    else
+      PetscCall(VecGetArrayF90(v, a, ierr))
+      if (n > 0) then
+        call MPI_Alltoallv(shared_data(1), slab_counts, slab_offsets, MPI_DOUBLE_PRECISION, a(1), vec_counts, &
+                           vec_offsets, MPI_DOUBLE_PRECISION, PETSC_COMM_WORLD, mpierr)
+      else
+        call MPI_Alltoallv(shared_data(1), slab_counts, slab_offsets, MPI_DOUBLE_PRECISION, shared_data(1), vec_counts, &
+                           vec_offsets, MPI_DOUBLE_PRECISION, PETSC_COMM_WORLD, mpierr)
+      end if
+      PetscCall(VecRestoreArrayF90(v, a, ierr))
+    end if
+    ierr = mpierr
+  end subroutine move_planes
 
   ! 4 sin^2(pi f/n)/h^2 for the halfcomplex output index m = 0 .. n-1, f = min(m, n - m).
   pure function periodic_eigenvalues(n, h) result(eig)
@@ -244,8 +324,12 @@ contains
     data => shared_data
     result => shared_data
     full_ny = s%ny + s%first_row
-    PetscCall(VecScatterBegin(shared_scatter, b, shared_slab, INSERT_VALUES, SCATTER_FORWARD, ierr))
-    PetscCall(VecScatterEnd(shared_scatter, b, shared_slab, INSERT_VALUES, SCATTER_FORWARD, ierr))
+    if (shared_planes) then
+      PetscCall(move_planes(b, .true., ierr))
+    else
+      PetscCall(VecScatterBegin(shared_scatter, b, shared_slab, INSERT_VALUES, SCATTER_FORWARD, ierr))
+      PetscCall(VecScatterEnd(shared_scatter, b, shared_slab, INSERT_VALUES, SCATTER_FORWARD, ierr))
+    end if
     if (s%first_row > 0) then
       ! compact: drop the wall row of every plane (forward: each row moves to a lower address)
       m = 0
@@ -289,8 +373,12 @@ contains
         data(plane + 1:plane + s%first_row * s%nx) = 0.0_dp
       end do
     end if
-    PetscCall(VecScatterBegin(shared_scatter, shared_slab, x, INSERT_VALUES, SCATTER_REVERSE, ierr))
-    PetscCall(VecScatterEnd(shared_scatter, shared_slab, x, INSERT_VALUES, SCATTER_REVERSE, ierr))
+    if (shared_planes) then
+      PetscCall(move_planes(x, .false., ierr))
+    else
+      PetscCall(VecScatterBegin(shared_scatter, shared_slab, x, INSERT_VALUES, SCATTER_REVERSE, ierr))
+      PetscCall(VecScatterEnd(shared_scatter, shared_slab, x, INSERT_VALUES, SCATTER_REVERSE, ierr))
+    end if
     PetscCall(event_end(EVENT_FFT, ierr))
   end subroutine fft_solve
 
@@ -305,8 +393,13 @@ contains
     s%made = .false.
     shared_users = shared_users - 1
     if (shared_users > 0) return
-    PetscCall(VecScatterDestroy(shared_scatter, ierr))
-    PetscCall(VecDestroy(shared_slab, ierr))
+    if (shared_planes) then
+      deallocate(vec_counts, vec_offsets, slab_counts, slab_offsets)
+    else
+      PetscCall(VecScatterDestroy(shared_scatter, ierr))
+      PetscCall(VecDestroy(shared_slab, ierr))
+    end if
+    shared_planes = .false.
     call fftw_free(shared_buffer)
     shared_buffer = C_NULL_PTR
     shared_data => null()
