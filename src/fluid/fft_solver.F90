@@ -23,9 +23,10 @@
 ! VecScatter moves each field between the DMDA's global vector and a PETSc vector that wraps the
 ! FFTW buffer (no further copy). Slabs limit the ranks to the number of cells in z.
 !
-! Memory (doc/BENCHMARKS.md "Issue 45: memory per cell"): the four solvers of a fluid step run one
-! after the other, so they share one FFTW buffer, one slab vector on it and one scatter (module
-! state, counted by its users): every field moves as the whole n(1) x n(2) x n(3) block, and v
+! Memory (doc/BENCHMARKS.md §14, issue 45): the four solvers of a fluid step run
+! one after the other, so they share one FFTW buffer and one move to it (module state, counted by
+! its users): with the 1 x 1 x P layout an MPI_Alltoallv of plane ranges, otherwise a slab vector
+! on the buffer and one scatter. Every field moves as the whole n(1) x n(2) x n(3) block, and v
 ! between walls, whose transform skips the wall row j = 0, is compacted in the buffer after the
 ! move and expanded before the way back (copies, exact). The scatter's indices come from the
 ! DMDA's ownership ranges (grid_petsc_index), not from its application ordering, which would hold

@@ -17,7 +17,7 @@
 ! at the level of the Poisson solver's residual. At a steady state the scheme satisfies the
 ! discrete steady Stokes equations exactly (phi -> constant).
 !
-! Memory (doc/BENCHMARKS.md "Issue 45: memory per cell", doc/DESIGN.md "One layout"): with the
+! Memory (doc/BENCHMARKS.md §14, doc/DESIGN.md "One layout with the direct solves"): with the
 ! direct solves (the default) a solve may overwrite its right-hand side, so each right-hand side is
 ! built in the vector that receives the solution (u* in vel_star, phi in phi) and rhs, rhs_p and
 ! vel_star_old (the Krylov path's extrapolation history; its checkpoint datasets are written as

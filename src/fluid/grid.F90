@@ -28,7 +28,7 @@
 ! of its sides meet, each a rank or a periodic boundary) read stale values, and as the edges move
 ! with the rank layout, so did the answer.
 !
-! Memory (doc/BENCHMARKS.md "Issue 45: memory per cell", doc/DESIGN.md "One layout"): with the
+! Memory (doc/BENCHMARKS.md §14, doc/DESIGN.md "One layout with the direct solves"): with the
 ! direct (FFT) solves of the default path no matrix is ever made from the layout, so the star
 ! stencil buys nothing there: the four fields and the carry then share ONE box-stencil DMDA
 ! (grid%da(1:4) and grid_create_box_layout hand out the same DM, referenced once per handle).

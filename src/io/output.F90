@@ -38,7 +38,7 @@ contains
     logical :: failed
 
     ! one cell-centred component at a time, in a work vector borrowed from the layout (with the
-    ! direct solves every field's DMDA is one: doc/BENCHMARKS.md "Issue 45: memory per cell")
+    ! direct solves every field's DMDA is one: doc/BENCHMARKS.md §14)
     write(base, '(a,i8.8)') 'fields_', step
     ! written to .tmp and renamed: a snapshot on disk is whole. A failed write (a full disk) stops
     ! the run on every rank with one message naming the file and the cause, not PETSc's alone.

@@ -10,7 +10,7 @@
 ! run by run with the block's bounds, so that the compiler sees fixed strides and a run's sums
 ! stay in registers (doc/DESIGN.md "Fictitious domain", Face runs).
 ! The offset r of a face from its sphere's centre is not stored (24 B per listed unknown, ~65 B per
-! grid cell at the paper's scene; doc/BENCHMARKS.md "Issue 45: memory per cell"): each pass forms
+! grid cell at the paper's scene; doc/BENCHMARKS.md §14): each pass forms
 ! it run by run (run_offsets) from the unwrapped index, recovered from the wrapped one and the
 ! run's box, by the visit's own expression, so it is bitwise the value the visit used.
 module mod_sphere_faces

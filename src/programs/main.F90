@@ -220,7 +220,7 @@ contains
 
   ! The peak resident memory of the run (VmHWM), summed over the ranks and per grid cell: gross,
   ! the libraries' fixed cost included. scripts/bench_memory.sh takes the difference of two grids
-  ! for the cost of a cell (doc/BENCHMARKS.md "Issue 45: memory per cell").
+  ! for the cost of a cell (doc/BENCHMARKS.md §14).
   subroutine memory_line()
     real(dp) :: kb(1), total(1), largest(1), cells
     integer :: nranks, mpierr

@@ -236,7 +236,7 @@ int fdsusp_executable_dir(char *buf, int len)
 
 /* The peak resident set size of this process in kB (VmHWM of /proc/self/status: exact, where
  * getrusage and PETSc's -memory_view sample), or -1 where there is no /proc (not Linux). The
- * memory report at the end of a run (doc/BENCHMARKS.md "Issue 45: memory per cell"). */
+ * memory report at the end of a run (doc/BENCHMARKS.md §14). */
 long fdsusp_peak_resident_kb(void)
 {
   FILE *f = fopen("/proc/self/status", "r");
