@@ -22,12 +22,24 @@
 ! Parallel layout: FFTW's MPI transforms distribute z in slabs; the DMDA may be split any way, so a
 ! VecScatter moves each field between the DMDA's global vector and a PETSc vector that wraps the
 ! FFTW buffer (no further copy). Slabs limit the ranks to the number of cells in z.
+!
+! Memory (doc/BENCHMARKS.md §14, issue 45): the four solvers of a fluid step run
+! one after the other, so they share one FFTW buffer and one move to it (module state, counted by
+! its users): with the 1 x 1 x P layout an MPI_Alltoallv of plane ranges, otherwise a slab vector
+! on the buffer and one scatter. Every field moves as the whole n(1) x n(2) x n(3) block, and v
+! between walls, whose transform skips the wall row j = 0, is compacted in the buffer after the
+! move and expanded before the way back (copies, exact). The scatter's indices come from the
+! DMDA's ownership ranges (grid_petsc_index), not from its application ordering, which would hold
+! the global ordering. The operator's inverse eigenvalues are formed during the solve from the
+! three 1D eigenvalue lists (the same expression as before, so the same bits) instead of a stored
+! grid-sized array: four buffers, four scatters and four such arrays were about 130 B per cell.
 #include <petsc/finclude/petscdmda.h>
 module mod_fft_solver
   use petscdmda
   use, intrinsic :: iso_c_binding
   use mod_kinds, only: dp, pi
-  use mod_grid, only: grid_t, FIELD_V, FIELD_P
+  use mod_grid, only: grid_t, grid_petsc_index, FIELD_V, FIELD_P
+  use mod_errors, only: fatal_error
   use mod_timers, only: event_begin, event_end, EVENT_FFT
   implicit none
   private
@@ -42,17 +54,34 @@ module mod_fft_solver
     integer(C_INTPTR_T) :: local_ny = 0, y_start = 0   ! the y-slab of the transformed (transposed) layout
     integer :: local_n = 0         ! entries of this rank's z-slab
     integer :: local_spectral = 0  ! entries of this rank's y-slab of the transform
-    type(C_PTR) :: buffer = C_NULL_PTR, forward = C_NULL_PTR, backward = C_NULL_PTR
-    real(C_DOUBLE), pointer :: data(:) => null()
-    real(C_DOUBLE), pointer :: result(:) => null()   ! the same buffer: the transforms are in place
-    ! 1 / (eigenvalue of the operator x normalisation of the transform pair) in slab order;
-    ! 0 for Poisson's constant mode
-    real(dp), allocatable :: inverse(:)
-    Vec :: slab
-    VecScatter :: scatter
+    logical :: made = .false.
+    type(C_PTR) :: forward = C_NULL_PTR, backward = C_NULL_PTR
+    ! the operator mass I - diffusion lap: its eigenvalues are mass + diffusion (eig_x(i) + eig_y(j)
+    ! + eig_z(k)), formed during the solve; norm: the normalisation of the transform pair
+    real(dp) :: mass = 0.0_dp, diffusion = 0.0_dp, norm = 1.0_dp
+    real(dp), allocatable :: eig_x(:), eig_y(:), eig_z(:)
   end type fft_solver_t
 
   logical, save :: fftw_ready = .false.
+
+  ! Shared by every solver of one grid (see the top of this file): the FFTW buffer, the slab
+  ! vector on it (this rank's z-slab of the whole n(1) x n(2) x n(3) block) and the scatter from
+  ! the DMDA's global vector; made by the first fft_create, destroyed by the last fft_destroy.
+  integer, save :: shared_users = 0
+  integer, save :: shared_n(3) = 0
+  integer(C_INTPTR_T), save :: shared_size = 0
+  integer, save :: shared_local_full = 0   ! entries of the whole-block slab on this rank
+  type(C_PTR), save :: shared_buffer = C_NULL_PTR
+  real(C_DOUBLE), pointer, save :: shared_data(:) => null()
+  Vec, save :: shared_slab
+  VecScatter, save :: shared_scatter
+  ! With a 1 x 1 x P process grid (what mod_grid picks for the direct solves) the DMDA's ranks own
+  ! whole z-planes in rank order, so its global vector is in natural order, as FFTW's slabs are:
+  ! the move is one MPI_Alltoallv of contiguous plane ranges (counts and offsets in entries, to
+  ! and from each rank), with no per-point index (the scatter's graph and set-up were ~20 B per
+  ! cell). Otherwise the VecScatter above.
+  logical, save :: shared_planes = .false.
+  integer, allocatable, save :: vec_counts(:), vec_offsets(:), slab_counts(:), slab_offsets(:)
 
 contains
 
@@ -66,18 +95,14 @@ contains
     type(fft_solver_t), intent(inout) :: s
     PetscErrorCode, intent(out) :: ierr
     integer(C_FFTW_R2R_KIND) :: kind_y, inverse_y
-    real(dp), allocatable :: eig_x(:), eig_y(:), eig_z(:)
-    real(dp) :: norm, eigenvalue
-    integer :: i, j, k, m, local_n
-    PetscInt, allocatable :: natural(:)
-    AO :: ao
-    IS :: from
-    Vec :: template
+    real(C_DOUBLE), pointer :: data(:), result(:)
+    integer :: m
 
     if (.not. fftw_ready) then
       call fftw_mpi_init()
       fftw_ready = .true.
     end if
+    PetscCall(shared_acquire(grid, ierr))
     s%field = field
     s%nx = grid%n(1)
     s%nz = grid%n(3)
@@ -102,20 +127,21 @@ contains
       inverse_y = FFTW_HC2R
     end if
 
-    ! The slab of this rank and a buffer FFTW may use for its transposes. The transform is left
+    ! The slab of this rank and the room FFTW needs for its transposes (within the shared buffer,
+    ! which shared_acquire sized for every field). The transform is left
     ! transposed (y distributed instead of z: one global transpose fewer each way, FFTW 3.3 manual
     ! §6.4.3): the division by the eigenvalues does not care where a mode lives.
     s%alloc_local = fftw_mpi_local_size_3d_transposed(int(s%nz, C_INTPTR_T), int(s%ny, C_INTPTR_T), &
                         int(s%nx, C_INTPTR_T), PETSC_COMM_WORLD, s%local_nz, s%z_start, s%local_ny, s%y_start)
-    s%buffer = fftw_alloc_real(max(s%alloc_local, 1_C_INTPTR_T))
-    call c_f_pointer(s%buffer, s%data, [max(s%alloc_local, 1_C_INTPTR_T)])
-    call c_f_pointer(s%buffer, s%result, [max(s%alloc_local, 1_C_INTPTR_T)])
+    if (s%alloc_local > shared_size) call fatal_error('fdsusp: internal error: the shared FFT buffer is too small', 4)
+    data => shared_data
+    result => shared_data     ! in place: the same buffer
     ! in place, C order [z][y][x] = Fortran (x, y, z): dimension 0 is z
     s%forward = fftw_mpi_plan_r2r_3d(int(s%nz, C_INTPTR_T), int(s%ny, C_INTPTR_T), int(s%nx, C_INTPTR_T), &
-                                     s%data, s%result, PETSC_COMM_WORLD, FFTW_R2HC, kind_y, FFTW_R2HC, &
+                                     data, result, PETSC_COMM_WORLD, FFTW_R2HC, kind_y, FFTW_R2HC, &
                                      ior(flags, FFTW_MPI_TRANSPOSED_OUT))
     s%backward = fftw_mpi_plan_r2r_3d(int(s%nz, C_INTPTR_T), int(s%ny, C_INTPTR_T), int(s%nx, C_INTPTR_T), &
-                                      s%data, s%result, PETSC_COMM_WORLD, FFTW_HC2R, inverse_y, FFTW_HC2R, &
+                                      data, result, PETSC_COMM_WORLD, FFTW_HC2R, inverse_y, FFTW_HC2R, &
                                       ior(flags, FFTW_MPI_TRANSPOSED_IN))
     if (.not. (c_associated(s%forward) .and. c_associated(s%backward))) then
       ierr = PETSC_ERR_LIB
@@ -123,62 +149,156 @@ contains
     end if
 
     ! eigenvalues of -lap per direction, in the transforms' output order
-    eig_x = periodic_eigenvalues(s%nx, grid%h)
-    eig_z = periodic_eigenvalues(s%nz, grid%h)
-    norm = real(s%nx, dp) * real(s%nz, dp)
+    s%mass = mass
+    s%diffusion = diffusion
+    s%eig_x = periodic_eigenvalues(s%nx, grid%h)
+    s%eig_z = periodic_eigenvalues(s%nz, grid%h)
+    s%norm = real(s%nx, dp) * real(s%nz, dp)
     if (.not. grid%walls) then
-      eig_y = periodic_eigenvalues(s%ny, grid%h)
-      norm = norm * s%ny
+      s%eig_y = periodic_eigenvalues(s%ny, grid%h)
+      s%norm = s%norm * s%ny
     else
-      allocate(eig_y(s%ny))
+      allocate(s%eig_y(s%ny))
       do m = 0, s%ny - 1
         select case (field)
         case (FIELD_P)
-          eig_y(m + 1) = 4.0_dp * sin(pi * m / (2.0_dp * grid%n(2)))**2 / grid%h**2
+          s%eig_y(m + 1) = 4.0_dp * sin(pi * m / (2.0_dp * grid%n(2)))**2 / grid%h**2
         case default   ! DST-II for u, w; DST-I on n - 1 points for v: the same eigenvalues
-          eig_y(m + 1) = 4.0_dp * sin(pi * (m + 1) / (2.0_dp * grid%n(2)))**2 / grid%h**2
+          s%eig_y(m + 1) = 4.0_dp * sin(pi * (m + 1) / (2.0_dp * grid%n(2)))**2 / grid%h**2
         end select
       end do
-      norm = norm * 2.0_dp * grid%n(2)
+      s%norm = s%norm * 2.0_dp * grid%n(2)
     end if
-    local_n = int(s%local_nz) * s%ny * s%nx
-    s%local_n = local_n
+    s%local_n = int(s%local_nz) * s%ny * s%nx
     ! the transposed layout: C order [y][z][x], y from y_start
     s%local_spectral = int(s%local_ny) * s%nz * s%nx
-    allocate(s%inverse(max(s%local_spectral, 1)))
-    m = 0
-    do j = 1, int(s%local_ny)
-      do k = 1, s%nz
-        do i = 1, s%nx
-          m = m + 1
-          eigenvalue = mass + diffusion * (eig_x(i) + eig_y(j + int(s%y_start)) + eig_z(k))
-          s%inverse(m) = 0.0_dp
-          if (eigenvalue > 0.0_dp) s%inverse(m) = 1.0_dp / (eigenvalue * norm)
-        end do
-      end do
-    end do
-
-    ! the slab as a PETSc vector on FFTW's buffer, and the scatter from the DMDA's global vector:
-    ! slab entry (x, y, z) is natural index x + nx (y + first_row + n_y z) of the DMDA
-    PetscCall(VecCreateMPIWithArray(PETSC_COMM_WORLD, 1, local_n, PETSC_DECIDE, s%data, s%slab, ierr))
-    allocate(natural(max(local_n, 1)))
-    m = 0
-    do k = int(s%z_start), int(s%z_start + s%local_nz) - 1
-      do j = s%first_row, s%first_row + s%ny - 1
-        do i = 0, s%nx - 1
-          m = m + 1
-          natural(m) = i + grid%n(1) * (j + grid%n(2) * k)
-        end do
-      end do
-    end do
-    PetscCall(DMDAGetAO(grid%da(field), ao, ierr))
-    PetscCall(AOApplicationToPetsc(ao, local_n, natural, ierr))
-    PetscCall(ISCreateGeneral(PETSC_COMM_WORLD, local_n, natural, PETSC_COPY_VALUES, from, ierr))
-    PetscCall(DMGetGlobalVector(grid%da(field), template, ierr))
-    PetscCall(VecScatterCreate(template, from, s%slab, PETSC_NULL_IS, s%scatter, ierr))
-    PetscCall(DMRestoreGlobalVector(grid%da(field), template, ierr))
-    PetscCall(ISDestroy(from, ierr))
+    s%made = .true.
   end subroutine fft_create
+
+  ! The first solver of a grid makes the shared buffer, slab vector and scatter; the others check
+  ! that they solve on the same grid. The buffer holds this rank's z-slab of the whole block and
+  ! whatever FFTW asks for the transforms of every field (v between walls has n(2) - 1 rows).
+  ! The scatter: slab entry (x, y, z) is natural point (x, y, z_start + z) of the DMDA.
+  subroutine shared_acquire(grid, ierr)
+    type(grid_t), intent(in) :: grid
+    PetscErrorCode, intent(out) :: ierr
+    integer(C_INTPTR_T) :: local_nz, z_start, local_ny, y_start, need
+    integer :: i, j, k, m, ny
+    PetscInt, allocatable :: petsc_index(:)
+    IS :: from
+    Vec :: template
+
+    ierr = 0
+    if (shared_users > 0) then
+      if (any(shared_n /= grid%n)) call fatal_error('fdsusp: internal error: FFT solvers of two grids at once', 4)
+      shared_users = shared_users + 1
+      return
+    end if
+    need = 1
+    do ny = grid%n(2) - 1, grid%n(2)
+      need = max(need, fftw_mpi_local_size_3d_transposed(int(grid%n(3), C_INTPTR_T), int(max(ny, 1), C_INTPTR_T), &
+                 int(grid%n(1), C_INTPTR_T), PETSC_COMM_WORLD, local_nz, z_start, local_ny, y_start))
+    end do
+    ! local_nz and z_start depend on n(3) alone: the same slab for every field
+    shared_local_full = int(local_nz) * grid%n(2) * grid%n(1)
+    need = max(need, int(shared_local_full, C_INTPTR_T))
+    shared_size = need
+    shared_buffer = fftw_alloc_real(need)
+    call c_f_pointer(shared_buffer, shared_data, [need])
+    shared_n = grid%n
+    shared_users = 1
+
+    shared_planes = grid%nprocs(1) == 1 .and. grid%nprocs(2) == 1
+    if (shared_planes) then
+      call plane_exchange(grid, int(z_start), int(local_nz))
+      return
+    end if
+    PetscCall(VecCreateMPIWithArray(PETSC_COMM_WORLD, 1, shared_local_full, PETSC_DECIDE, shared_data, shared_slab, ierr))
+    allocate(petsc_index(max(shared_local_full, 1)))
+    m = 0
+    do k = int(z_start), int(z_start + local_nz) - 1
+      do j = 0, grid%n(2) - 1
+        do i = 0, grid%n(1) - 1
+          m = m + 1
+          petsc_index(m) = grid_petsc_index(grid, i, j, k)
+        end do
+      end do
+    end do
+    PetscCall(ISCreateGeneral(PETSC_COMM_WORLD, shared_local_full, petsc_index, PETSC_COPY_VALUES, from, ierr))
+    deallocate(petsc_index)
+    PetscCall(DMGetGlobalVector(grid%da(FIELD_P), template, ierr))
+    PetscCall(VecScatterCreate(template, from, shared_slab, PETSC_NULL_IS, shared_scatter, ierr))
+    PetscCall(DMRestoreGlobalVector(grid%da(FIELD_P), template, ierr))
+    PetscCall(ISDestroy(from, ierr))
+  end subroutine shared_acquire
+
+  ! The counts and offsets of the plane exchange (shared_planes): this rank's DMDA planes
+  ! [a, a + lz) go to each rank's FFTW slab [c, c + nz), the overlap, and come back the same way.
+  subroutine plane_exchange(grid, z_start, local_nz)
+    type(grid_t), intent(in) :: grid
+    integer, intent(in) :: z_start, local_nz
+    integer :: nranks, me, r, plane, mpierr, mine(2), lo, hi, a, b
+    integer, allocatable :: slabs(:, :), dmda_start(:)
+    call MPI_Comm_size(PETSC_COMM_WORLD, nranks, mpierr)
+    call MPI_Comm_rank(PETSC_COMM_WORLD, me, mpierr)
+    allocate(slabs(2, nranks), dmda_start(nranks + 1))
+    mine = [z_start, local_nz]
+    call MPI_Allgather(mine, 2, MPI_INTEGER, slabs, 2, MPI_INTEGER, PETSC_COMM_WORLD, mpierr)
+    dmda_start(1) = 0
+    do r = 1, nranks
+      dmda_start(r + 1) = dmda_start(r) + int(grid%rank_cells_z(r))
+    end do
+    plane = grid%n(1) * grid%n(2)
+    allocate(vec_counts(nranks), vec_offsets(nranks), slab_counts(nranks), slab_offsets(nranks))
+    a = dmda_start(me + 1)
+    b = dmda_start(me + 2)
+    do r = 1, nranks
+      ! to rank r: my DMDA planes within its slab
+      lo = max(a, slabs(1, r))
+      hi = min(b, slabs(1, r) + slabs(2, r))
+      vec_counts(r) = max(0, hi - lo) * plane
+      vec_offsets(r) = max(0, lo - a) * plane
+      ! from rank r: its DMDA planes within my slab
+      lo = max(dmda_start(r), z_start)
+      hi = min(dmda_start(r + 1), z_start + local_nz)
+      slab_counts(r) = max(0, hi - lo) * plane
+      slab_offsets(r) = max(0, lo - z_start) * plane
+    end do
+  end subroutine plane_exchange
+
+  ! The plane exchange (shared_planes) of a global vector into the slab (forward) or back.
+  subroutine move_planes(v, forward, ierr)
+    Vec, intent(in) :: v
+    logical, intent(in) :: forward
+    PetscErrorCode, intent(out) :: ierr
+    PetscScalar, pointer :: a(:)
+    PetscInt :: n
+    integer :: mpierr
+    PetscCall(VecGetLocalSize(v, n, ierr))
+    if (forward) then
+      PetscCall(VecGetArrayReadF90(v, a, ierr))
+      ! first elements, not arrays: the addresses, no copy (an empty block sends nothing)
+      if (n > 0) then
+        call MPI_Alltoallv(a(1), vec_counts, vec_offsets, MPI_DOUBLE_PRECISION, shared_data(1), slab_counts, &
+                           slab_offsets, MPI_DOUBLE_PRECISION, PETSC_COMM_WORLD, mpierr)
+      else
+        call MPI_Alltoallv(shared_data(1), vec_counts, vec_offsets, MPI_DOUBLE_PRECISION, shared_data(1), slab_counts, &
+                           slab_offsets, MPI_DOUBLE_PRECISION, PETSC_COMM_WORLD, mpierr)
+      end if
+      PetscCall(VecRestoreArrayReadF90(v, a, ierr))
+    else
+      PetscCall(VecGetArrayF90(v, a, ierr))
+      if (n > 0) then
+        call MPI_Alltoallv(shared_data(1), slab_counts, slab_offsets, MPI_DOUBLE_PRECISION, a(1), vec_counts, &
+                           vec_offsets, MPI_DOUBLE_PRECISION, PETSC_COMM_WORLD, mpierr)
+      else
+        call MPI_Alltoallv(shared_data(1), slab_counts, slab_offsets, MPI_DOUBLE_PRECISION, shared_data(1), vec_counts, &
+                           vec_offsets, MPI_DOUBLE_PRECISION, PETSC_COMM_WORLD, mpierr)
+      end if
+      PetscCall(VecRestoreArrayF90(v, a, ierr))
+    end if
+    ierr = mpierr
+  end subroutine move_planes
 
   ! 4 sin^2(pi f/n)/h^2 for the halfcomplex output index m = 0 .. n-1, f = min(m, n - m).
   pure function periodic_eigenvalues(n, h) result(eig)
@@ -192,24 +312,74 @@ contains
   end function periodic_eigenvalues
 
   ! x = A^{-1} b exactly (to round-off). For v between walls the wall row j = 0 is set to zero.
+  ! b and x may be the same vector (b is read whole before x is written).
   subroutine fft_solve(s, b, x, ierr)
     type(fft_solver_t), intent(inout) :: s
     Vec, intent(in) :: b
     Vec, intent(inout) :: x
     PetscErrorCode, intent(out) :: ierr
-    integer :: n
+    real(C_DOUBLE), pointer :: data(:), result(:)
+    real(dp) :: eigenvalue
+    integer :: i, j, k, m, plane, row, full_ny
     PetscCall(event_begin(EVENT_FFT, ierr))
-    PetscCall(VecScatterBegin(s%scatter, b, s%slab, INSERT_VALUES, SCATTER_FORWARD, ierr))
-    PetscCall(VecScatterEnd(s%scatter, b, s%slab, INSERT_VALUES, SCATTER_FORWARD, ierr))
-    n = s%local_spectral
-    call fftw_mpi_execute_r2r(s%forward, s%data, s%result)
-    s%data(1:n) = s%data(1:n) * s%inverse
-    call fftw_mpi_execute_r2r(s%backward, s%data, s%result)
-    if (s%first_row > 0) then
-      PetscCall(VecSet(x, 0.0_dp, ierr))
+    data => shared_data
+    result => shared_data
+    full_ny = s%ny + s%first_row
+    if (shared_planes) then
+      PetscCall(move_planes(b, .true., ierr))
+    else
+      PetscCall(VecScatterBegin(shared_scatter, b, shared_slab, INSERT_VALUES, SCATTER_FORWARD, ierr))
+      PetscCall(VecScatterEnd(shared_scatter, b, shared_slab, INSERT_VALUES, SCATTER_FORWARD, ierr))
     end if
-    PetscCall(VecScatterBegin(s%scatter, s%slab, x, INSERT_VALUES, SCATTER_REVERSE, ierr))
-    PetscCall(VecScatterEnd(s%scatter, s%slab, x, INSERT_VALUES, SCATTER_REVERSE, ierr))
+    if (s%first_row > 0) then
+      ! compact: drop the wall row of every plane (forward: each row moves to a lower address)
+      m = 0
+      do k = 0, int(s%local_nz) - 1
+        do row = s%first_row, full_ny - 1
+          plane = (k * full_ny + row) * s%nx
+          data(m + 1:m + s%nx) = data(plane + 1:plane + s%nx)
+          m = m + s%nx
+        end do
+      end do
+    end if
+    call fftw_mpi_execute_r2r(s%forward, data, result)
+    ! divide by the eigenvalues: the expression and the order of the stored inverse of before
+    m = 0
+    do j = 1, int(s%local_ny)
+      do k = 1, s%nz
+        do i = 1, s%nx
+          m = m + 1
+          eigenvalue = s%mass + s%diffusion * (s%eig_x(i) + s%eig_y(j + int(s%y_start)) + s%eig_z(k))
+          if (eigenvalue > 0.0_dp) then
+            data(m) = data(m) * (1.0_dp / (eigenvalue * s%norm))
+          else
+            data(m) = data(m) * 0.0_dp
+          end if
+        end do
+      end do
+    end do
+    call fftw_mpi_execute_r2r(s%backward, data, result)
+    if (s%first_row > 0) then
+      ! expand (backward: each row moves to a higher address), the wall row zero
+      m = s%local_n
+      do k = int(s%local_nz) - 1, 0, -1
+        do row = full_ny - 1, s%first_row, -1
+          plane = (k * full_ny + row) * s%nx
+          m = m - s%nx
+          do i = s%nx, 1, -1
+            data(plane + i) = data(m + i)
+          end do
+        end do
+        plane = k * full_ny * s%nx
+        data(plane + 1:plane + s%first_row * s%nx) = 0.0_dp
+      end do
+    end if
+    if (shared_planes) then
+      PetscCall(move_planes(x, .false., ierr))
+    else
+      PetscCall(VecScatterBegin(shared_scatter, shared_slab, x, INSERT_VALUES, SCATTER_REVERSE, ierr))
+      PetscCall(VecScatterEnd(shared_scatter, shared_slab, x, INSERT_VALUES, SCATTER_REVERSE, ierr))
+    end if
     PetscCall(event_end(EVENT_FFT, ierr))
   end subroutine fft_solve
 
@@ -217,16 +387,24 @@ contains
     type(fft_solver_t), intent(inout) :: s
     PetscErrorCode, intent(out) :: ierr
     ierr = 0
-    if (.not. c_associated(s%buffer)) return
-    PetscCall(VecScatterDestroy(s%scatter, ierr))
-    PetscCall(VecDestroy(s%slab, ierr))
+    if (.not. s%made) return
     call fftw_destroy_plan(s%forward)
     call fftw_destroy_plan(s%backward)
-    call fftw_free(s%buffer)
-    s%buffer = C_NULL_PTR
-    s%data => null()
-    s%result => null()
-    deallocate(s%inverse)      ! all fft_create made: the solver can be created again
+    deallocate(s%eig_x, s%eig_y, s%eig_z)    ! all fft_create made: the solver can be created again
+    s%made = .false.
+    shared_users = shared_users - 1
+    if (shared_users > 0) return
+    if (shared_planes) then
+      deallocate(vec_counts, vec_offsets, slab_counts, slab_offsets)
+    else
+      PetscCall(VecScatterDestroy(shared_scatter, ierr))
+      PetscCall(VecDestroy(shared_slab, ierr))
+    end if
+    shared_planes = .false.
+    call fftw_free(shared_buffer)
+    shared_buffer = C_NULL_PTR
+    shared_data => null()
+    shared_n = 0
   end subroutine fft_destroy
 
 end module mod_fft_solver

@@ -16,6 +16,14 @@
 ! The discrete Poisson operator is exactly div(grad) on this grid, so step 3 leaves div u^{n+1}
 ! at the level of the Poisson solver's residual. At a steady state the scheme satisfies the
 ! discrete steady Stokes equations exactly (phi -> constant).
+!
+! Memory (doc/BENCHMARKS.md §14, doc/DESIGN.md "One layout with the direct solves"): with the
+! direct solves (the default) a solve may overwrite its right-hand side, so each right-hand side is
+! built in the vector that receives the solution (u* in vel_star, phi in phi) and rhs, rhs_p and
+! vel_star_old (the Krylov path's extrapolation history; its checkpoint datasets are written as
+! the zeros they always held) are not made; the forcing vectors exist only when there is a
+! forcing; the ghosted work vectors are borrowed from the DMDA (DMGetLocalVector), whose cache the
+! carry of the fictitious domain shares. 9 grid vectors of the fluid's 23 remain in that path.
 #include <petsc/finclude/petscdmda.h>
 module mod_fluid
   use petscdmda
@@ -45,8 +53,8 @@ module mod_fluid
     Vec :: rhs(3), rhs_p    ! right-hand sides
     Vec :: div_star         ! div u*
     Vec :: forcing(3)       ! steady body-force density at the faces
-    Vec :: loc(4)           ! ghosted work vectors, one per field
-    logical :: has_forcing = .false.
+    logical :: has_forcing = .false.    ! forcing(3) exists (a body force or the manufactured solution)
+    logical :: direct = .false.         ! every solve direct (mod_fft_solver): no rhs, rhs_p, vel_star_old
     type(solver_t) :: solver(4)
     real(dp) :: reynolds = 0.0_dp, dt = 0.0_dp, theta = 0.5_dp, viscosity = 1.0_dp
     real(dp) :: wall_speed = 0.0_dp
@@ -72,25 +80,30 @@ contains
     fl%dt = cfg%time%dt
     fl%theta = cfg%fluid%viscous_theta
     fl%wall_speed = cfg%wall_speed
+    fl%direct = direct_solves_wanted()
+    fl%has_forcing = cfg%verification%manufactured_solution .or. any(cfg%fluid%body_force /= 0.0_dp)
     do c = 1, 3
       PetscCall(DMCreateGlobalVector(grid%da(c), fl%vel(c), ierr))
       PetscCall(VecDuplicate(fl%vel(c), fl%vel_star(c), ierr))
-      PetscCall(VecDuplicate(fl%vel(c), fl%vel_star_old(c), ierr))
-      PetscCall(VecDuplicate(fl%vel(c), fl%rhs(c), ierr))
-      PetscCall(VecDuplicate(fl%vel(c), fl%forcing(c), ierr))
+      if (.not. fl%direct) then
+        PetscCall(VecDuplicate(fl%vel(c), fl%vel_star_old(c), ierr))
+        PetscCall(VecDuplicate(fl%vel(c), fl%rhs(c), ierr))
+        PetscCall(VecSet(fl%vel_star_old(c), 0.0_dp, ierr))
+        PetscCall(PetscObjectSetName(fl%vel_star_old(c), trim(field_names(c))//'_star_old', ierr))
+      end if
+      if (fl%has_forcing) then
+        PetscCall(VecDuplicate(fl%vel(c), fl%forcing(c), ierr))
+      end if
       PetscCall(VecSet(fl%vel(c), 0.0_dp, ierr))
       PetscCall(VecSet(fl%vel_star(c), 0.0_dp, ierr))          ! written to checkpoints before it is set
-      PetscCall(VecSet(fl%vel_star_old(c), 0.0_dp, ierr))
       PetscCall(PetscObjectSetName(fl%vel(c), field_names(c), ierr))
       PetscCall(PetscObjectSetName(fl%vel_star(c), trim(field_names(c))//'_star', ierr))
-      PetscCall(PetscObjectSetName(fl%vel_star_old(c), trim(field_names(c))//'_star_old', ierr))
-    end do
-    do c = 1, 4
-      PetscCall(DMCreateLocalVector(grid%da(c), fl%loc(c), ierr))
     end do
     PetscCall(DMCreateGlobalVector(grid%da(FIELD_P), fl%pressure, ierr))
     PetscCall(VecDuplicate(fl%pressure, fl%phi, ierr))
-    PetscCall(VecDuplicate(fl%pressure, fl%rhs_p, ierr))
+    if (.not. fl%direct) then
+      PetscCall(VecDuplicate(fl%pressure, fl%rhs_p, ierr))
+    end if
     PetscCall(VecDuplicate(fl%pressure, fl%div_star, ierr))
     PetscCall(VecSet(fl%pressure, 0.0_dp, ierr))
     PetscCall(VecSet(fl%phi, 0.0_dp, ierr))
@@ -132,7 +145,7 @@ contains
     PetscScalar, pointer :: f(:,:,:)
     integer :: c, i, j, k
 
-    fl%has_forcing = cfg%verification%manufactured_solution .or. any(cfg%fluid%body_force /= 0.0_dp)
+    if (.not. fl%has_forcing) return   ! no forcing vectors: fluid_step adds zero (fluid_create)
     do c = 1, 3
       PetscCall(VecSet(fl%forcing(c), cfg%fluid%body_force(c), ierr))
       if (.not. cfg%verification%manufactured_solution) cycle
@@ -177,26 +190,28 @@ contains
   ! The wall ghosts are set above and below the owned (i, k) only: the 7-point stencil reads
   ! nothing else there, and the star-stencil exchange leaves the edge ghosts beside them unfilled
   ! (mod_grid, doc/DESIGN.md "Ghost layers").
-  subroutine ghosted(grid, fl, c, global, ierr)
+  ! local: a local vector of grid%da(c) (borrowed by the caller).
+  subroutine ghosted(grid, fl, c, global, local, ierr)
     type(grid_t), intent(in) :: grid
     type(fluid_t), intent(inout) :: fl
     integer, intent(in) :: c
     Vec, intent(in) :: global
+    Vec, intent(inout) :: local
     PetscErrorCode, intent(out) :: ierr
     PetscScalar, pointer :: a(:,:,:)
     integer :: ny, lo(3), hi(3)
-    PetscCall(DMGlobalToLocalBegin(grid%da(c), global, INSERT_VALUES, fl%loc(c), ierr))
-    PetscCall(DMGlobalToLocalEnd(grid%da(c), global, INSERT_VALUES, fl%loc(c), ierr))
+    PetscCall(DMGlobalToLocalBegin(grid%da(c), global, INSERT_VALUES, local, ierr))
+    PetscCall(DMGlobalToLocalEnd(grid%da(c), global, INSERT_VALUES, local, ierr))
     if (.not. grid%walls .or. c == FIELD_V .or. c == FIELD_P) return
     ny = grid%n(2)
     lo = grid%lo
     hi = grid%hi
-    PetscCall(DMDAVecGetArrayF90(grid%da(c), fl%loc(c), a, ierr))
+    PetscCall(DMDAVecGetArrayF90(grid%da(c), local, a, ierr))
     if (grid%lo(2) == 0) a(lo(1):hi(1), -1, lo(3):hi(3)) = 2.0_dp * wall_velocity(fl, c, -1) &
                                                           - a(lo(1):hi(1), 0, lo(3):hi(3))
     if (grid%hi(2) == ny - 1) a(lo(1):hi(1), ny, lo(3):hi(3)) = 2.0_dp * wall_velocity(fl, c, +1) &
                                                                - a(lo(1):hi(1), ny - 1, lo(3):hi(3))
-    PetscCall(DMDAVecRestoreArrayF90(grid%da(c), fl%loc(c), a, ierr))
+    PetscCall(DMDAVecRestoreArrayF90(grid%da(c), local, a, ierr))
   end subroutine ghosted
 
   ! source: an extra force density on the u, v, w faces (the fictitious-domain Lambda^n).
@@ -207,9 +222,10 @@ contains
     Vec, intent(in), optional :: source(3)
     PetscScalar, pointer :: a(:,:,:), p(:,:,:), r(:,:,:), f(:,:,:), ph(:,:,:), ds(:,:,:)
     integer :: c, i, j, k, e(3), ny
-    real(dp) :: h, mass, lap, explicit, implicit, wall_term, rate
+    real(dp) :: h, mass, lap, explicit, implicit, wall_term, rate, force
     PetscReal :: local_max, global_max
     PetscErrorCode :: mpierr
+    Vec :: loc_p, loc_c, rhs, rhs_p
 
     h = grid%h
     ny = grid%n(2)
@@ -217,16 +233,27 @@ contains
     explicit = (1.0_dp - fl%theta) * fl%viscosity
     implicit = fl%theta * fl%viscosity
 
-    ! 1. provisional velocity
-    PetscCall(ghosted(grid, fl, FIELD_P, fl%pressure, ierr))
-    PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_P), fl%loc(FIELD_P), p, ierr))
+    ! 1. provisional velocity; with the direct solves the right-hand side is built in vel_star,
+    ! which the solve then overwrites with u*
+    PetscCall(DMGetLocalVector(grid%da(FIELD_P), loc_p, ierr))
+    PetscCall(ghosted(grid, fl, FIELD_P, fl%pressure, loc_p, ierr))
+    PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_P), loc_p, p, ierr))
+    force = 0.0_dp
     do c = 1, 3
       e = 0
       e(c) = 1
-      PetscCall(ghosted(grid, fl, c, fl%vel(c), ierr))
-      PetscCall(DMDAVecGetArrayReadF90(grid%da(c), fl%loc(c), a, ierr))
-      PetscCall(DMDAVecGetArrayF90(grid%da(c), fl%rhs(c), r, ierr))
-      PetscCall(DMDAVecGetArrayReadF90(grid%da(c), fl%forcing(c), f, ierr))
+      if (fl%direct) then
+        rhs = fl%vel_star(c)
+      else
+        rhs = fl%rhs(c)
+      end if
+      PetscCall(DMGetLocalVector(grid%da(c), loc_c, ierr))
+      PetscCall(ghosted(grid, fl, c, fl%vel(c), loc_c, ierr))
+      PetscCall(DMDAVecGetArrayReadF90(grid%da(c), loc_c, a, ierr))
+      PetscCall(DMDAVecGetArrayF90(grid%da(c), rhs, r, ierr))
+      if (fl%has_forcing) then
+        PetscCall(DMDAVecGetArrayReadF90(grid%da(c), fl%forcing(c), f, ierr))
+      end if
       do k = grid%lo(3), grid%hi(3)
         do j = grid%lo(2), grid%hi(2)
           do i = grid%lo(1), grid%hi(1)
@@ -236,8 +263,10 @@ contains
             end if
             lap = (a(i-1, j, k) + a(i+1, j, k) + a(i, j-1, k) + a(i, j+1, k) + a(i, j, k-1) &
                  + a(i, j, k+1) - 6.0_dp * a(i, j, k)) / h**2
+            ! without forcing vectors the force is +0.0, added all the same (the same bits)
+            if (fl%has_forcing) force = f(i, j, k)
             r(i, j, k) = mass * a(i, j, k) + explicit * lap &
-                 - (p(i, j, k) - p(i - e(1), j - e(2), k - e(3))) / h + f(i, j, k)
+                 - (p(i, j, k) - p(i - e(1), j - e(2), k - e(3))) / h + force
             ! implicit half of the wall ghost 2 U_w - x_0: its U_w part is known
             if (grid%walls .and. c /= FIELD_V) then
               wall_term = 0.0_dp
@@ -248,16 +277,20 @@ contains
           end do
         end do
       end do
-      PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), fl%forcing(c), f, ierr))
-      PetscCall(DMDAVecRestoreArrayF90(grid%da(c), fl%rhs(c), r, ierr))
-      PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), fl%loc(c), a, ierr))
+      if (fl%has_forcing) then
+        PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), fl%forcing(c), f, ierr))
+      end if
+      PetscCall(DMDAVecRestoreArrayF90(grid%da(c), rhs, r, ierr))
+      PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), loc_c, a, ierr))
+      PetscCall(DMRestoreLocalVector(grid%da(c), loc_c, ierr))
       if (present(source)) then
-        PetscCall(VecAXPY(fl%rhs(c), 1.0_dp, source(c), ierr))
+        PetscCall(VecAXPY(rhs, 1.0_dp, source(c), ierr))
         ! the wall row of v stays a fixed row (v = 0): a particle never forces it
       end if
-      if (fl%solver(c)%direct) then
-        ! exact solves need no guess: u*^n is kept only for the Krylov path's extrapolation
-        PetscCall(solver_solve(fl%solver(c), fl%rhs(c), fl%vel_star(c), ierr))
+      if (fl%direct) then
+        ! exact solves need no guess, and may solve in place: u*^n is kept only for the Krylov
+        ! path's extrapolation
+        PetscCall(solver_solve(fl%solver(c), rhs, fl%vel_star(c), ierr))
       else if (fl%star_history == STAR_HISTORY_FULL .and. fl%extrapolate) then
         ! vel_star_old := 2 u*^n - u*^{n-1}, then swapped: the guess in vel_star, u*^n in vel_star_old
         PetscCall(VecAXPBY(fl%vel_star_old(c), 2.0_dp, -1.0_dp, fl%vel_star(c), ierr))
@@ -271,17 +304,25 @@ contains
       end if
     end do
     ! (direct solves keep no history: a Krylov run restarted from their checkpoint starts from u^n)
-    if (.not. fl%solver(FIELD_U)%direct) fl%star_history = min(STAR_HISTORY_FULL, fl%star_history + 1)
-    PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_P), fl%loc(FIELD_P), p, ierr))
+    if (.not. fl%direct) fl%star_history = min(STAR_HISTORY_FULL, fl%star_history + 1)
+    PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_P), loc_p, p, ierr))
+    ! returned before the divergence borrows three: at most three ghosted work vectors at once
+    PetscCall(DMRestoreLocalVector(grid%da(FIELD_P), loc_p, ierr))
 
-    ! 2. pressure increment: -lap phi = -(Re/dt) div u*
-    PetscCall(divergence(grid, fl, fl%vel_star, fl%div_star, ierr))
-    PetscCall(VecAXPBY(fl%rhs_p, -mass, 0.0_dp, fl%div_star, ierr))
-    PetscCall(solver_solve(fl%solver(FIELD_P), fl%rhs_p, fl%phi, ierr))
+    ! 2. pressure increment: -lap phi = -(Re/dt) div u* (the direct solve in place in phi)
+    PetscCall(divergence(grid, fl%vel_star, fl%div_star, ierr))
+    if (fl%direct) then
+      rhs_p = fl%phi
+    else
+      rhs_p = fl%rhs_p
+    end if
+    PetscCall(VecAXPBY(rhs_p, -mass, 0.0_dp, fl%div_star, ierr))
+    PetscCall(solver_solve(fl%solver(FIELD_P), rhs_p, fl%phi, ierr))
 
     ! 3. projection, with the rate of change for steady-state detection
-    PetscCall(ghosted(grid, fl, FIELD_P, fl%phi, ierr))
-    PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_P), fl%loc(FIELD_P), ph, ierr))
+    PetscCall(DMGetLocalVector(grid%da(FIELD_P), loc_p, ierr))
+    PetscCall(ghosted(grid, fl, FIELD_P, fl%phi, loc_p, ierr))
+    PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_P), loc_p, ph, ierr))
     local_max = 0.0_dp
     do c = 1, 3
       e = 0
@@ -301,7 +342,8 @@ contains
       PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), fl%vel_star(c), r, ierr))
       PetscCall(DMDAVecRestoreArrayF90(grid%da(c), fl%vel(c), a, ierr))
     end do
-    PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_P), fl%loc(FIELD_P), ph, ierr))
+    PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_P), loc_p, ph, ierr))
+    PetscCall(DMRestoreLocalVector(grid%da(FIELD_P), loc_p, ierr))
     call MPI_Allreduce(local_max, global_max, 1, MPIU_REAL, MPI_MAX, PETSC_COMM_WORLD, mpierr)
     fl%max_rate = global_max / fl%dt
 
@@ -319,21 +361,22 @@ contains
 
   ! div of a face field at the cell centres: (u(i+1)-u(i) + v(j+1)-v(j) + w(k+1)-w(k))/h.
   ! With walls, v(n) is the periodic image of v(0) = 0: the top wall.
-  subroutine divergence(grid, fl, vel, div, ierr)
+  subroutine divergence(grid, vel, div, ierr)
     type(grid_t), intent(in) :: grid
-    type(fluid_t), intent(inout) :: fl
     Vec, intent(in) :: vel(3)
     Vec, intent(inout) :: div
     PetscErrorCode, intent(out) :: ierr
     PetscScalar, pointer :: u(:,:,:), v(:,:,:), w(:,:,:), d(:,:,:)
+    Vec :: loc(3)
     integer :: i, j, k
     do i = 1, 3
-      PetscCall(DMGlobalToLocalBegin(grid%da(i), vel(i), INSERT_VALUES, fl%loc(i), ierr))
-      PetscCall(DMGlobalToLocalEnd(grid%da(i), vel(i), INSERT_VALUES, fl%loc(i), ierr))
+      PetscCall(DMGetLocalVector(grid%da(i), loc(i), ierr))
+      PetscCall(DMGlobalToLocalBegin(grid%da(i), vel(i), INSERT_VALUES, loc(i), ierr))
+      PetscCall(DMGlobalToLocalEnd(grid%da(i), vel(i), INSERT_VALUES, loc(i), ierr))
     end do
-    PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_U), fl%loc(FIELD_U), u, ierr))
-    PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_V), fl%loc(FIELD_V), v, ierr))
-    PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_W), fl%loc(FIELD_W), w, ierr))
+    PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_U), loc(FIELD_U), u, ierr))
+    PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_V), loc(FIELD_V), v, ierr))
+    PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_W), loc(FIELD_W), w, ierr))
     PetscCall(DMDAVecGetArrayF90(grid%da(FIELD_P), div, d, ierr))
     do k = grid%lo(3), grid%hi(3)
       do j = grid%lo(2), grid%hi(2)
@@ -344,9 +387,12 @@ contains
       end do
     end do
     PetscCall(DMDAVecRestoreArrayF90(grid%da(FIELD_P), div, d, ierr))
-    PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_W), fl%loc(FIELD_W), w, ierr))
-    PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_V), fl%loc(FIELD_V), v, ierr))
-    PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_U), fl%loc(FIELD_U), u, ierr))
+    PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_W), loc(FIELD_W), w, ierr))
+    PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_V), loc(FIELD_V), v, ierr))
+    PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_U), loc(FIELD_U), u, ierr))
+    do i = 3, 1, -1
+      PetscCall(DMRestoreLocalVector(grid%da(i), loc(i), ierr))
+    end do
   end subroutine divergence
 
   ! Divergence of u^{n+1} relative to max|u|/h, and the mean shear stress on each wall,
@@ -360,7 +406,7 @@ contains
     PetscErrorCode :: mpierr
     integer :: c, ny
 
-    PetscCall(divergence(grid, fl, fl%vel, fl%div_star, ierr))
+    PetscCall(divergence(grid, fl%vel, fl%div_star, ierr))
     PetscCall(VecNorm(fl%div_star, NORM_INFINITY, dmax, ierr))
     umax = 0.0_dp
     do c = 1, 3
@@ -417,17 +463,22 @@ contains
     do c = 1, 3
       PetscCall(VecDestroy(fl%vel(c), ierr))
       PetscCall(VecDestroy(fl%vel_star(c), ierr))
-      PetscCall(VecDestroy(fl%vel_star_old(c), ierr))
-      PetscCall(VecDestroy(fl%rhs(c), ierr))
-      PetscCall(VecDestroy(fl%forcing(c), ierr))
+      if (.not. fl%direct) then
+        PetscCall(VecDestroy(fl%vel_star_old(c), ierr))
+        PetscCall(VecDestroy(fl%rhs(c), ierr))
+      end if
+      if (fl%has_forcing) then
+        PetscCall(VecDestroy(fl%forcing(c), ierr))
+      end if
     end do
     do c = 1, 4
-      PetscCall(VecDestroy(fl%loc(c), ierr))
       PetscCall(solver_destroy(fl%solver(c), ierr))
     end do
     PetscCall(VecDestroy(fl%pressure, ierr))
     PetscCall(VecDestroy(fl%phi, ierr))
-    PetscCall(VecDestroy(fl%rhs_p, ierr))
+    if (.not. fl%direct) then
+      PetscCall(VecDestroy(fl%rhs_p, ierr))
+    end if
     PetscCall(VecDestroy(fl%div_star, ierr))
   end subroutine fluid_destroy
 

@@ -27,6 +27,21 @@
 ! whatever the local vector held), so faces within a cell of an edge of a rank's block (where two
 ! of its sides meet, each a rank or a periodic boundary) read stale values, and as the edges move
 ! with the rank layout, so did the answer.
+!
+! Memory (doc/BENCHMARKS.md §14, doc/DESIGN.md "One layout with the direct solves"): with the
+! direct (FFT) solves of the default path no matrix is ever made from the layout, so the star
+! stencil buys nothing there: the four fields and the carry then share ONE box-stencil DMDA
+! (grid%da(1:4) and grid_create_box_layout hand out the same DM, referenced once per handle).
+! One DMDA instead of five holds one local-to-global map and one ghost scatter instead of five
+! (about 25 B per cell each, summed over ranks), and the borrowed work vectors of every field
+! come from one cache. The extra edge and corner ghosts it fills are never read by the fluid's
+! operators, so the fields are bitwise the same. The Krylov path (-fluid_solver krylov) keeps four
+! star DMDAs: each KSP keeps its operator callback and multigrid options on its own DM. fdsusp
+! itself builds no application ordering (AO): the FFT scatter and the Krylov path's cell-centred
+! prolongation number points from the ownership ranges (ownership_index). Should anything else ask
+! (a natural-order viewer), every DMDA's AO is memory-scalable: the default is a copy of the
+! global ordering on every rank (16 B per cell of the whole grid on each rank, 32 GB per rank at
+! 1e9 cells).
 #include <petsc/finclude/petscdmda.h>
 module mod_grid
   use petscdmda
@@ -36,7 +51,7 @@ module mod_grid
   implicit none
   private
   public :: grid_t, grid_create, grid_destroy, grid_position, grid_fixed_row, direct_solves_wanted
-  public :: grid_create_box_layout
+  public :: grid_create_box_layout, grid_create_star_layout, grid_petsc_index, ownership_index
   public :: FIELD_U, FIELD_V, FIELD_W, FIELD_P, field_names
 
   integer, parameter :: FIELD_U = 1, FIELD_V = 2, FIELD_W = 3, FIELD_P = 4
@@ -49,7 +64,8 @@ module mod_grid
     logical :: walls = .true.     ! walls at y = 0 and y = Ly
     integer :: mg_levels = 1      ! levels the decomposition allows for geometric multigrid
     integer :: nprocs(3) = 1      ! process grid
-    DM :: da(4)                   ! u, v, w, p (star stencil, width 1)
+    DM :: da(4)                   ! u, v, w, p (star stencil, width 1; with the direct solves one shared box DMDA)
+    logical :: shared_layout = .false.  ! da(1:4) are one DMDA (box stencil): the direct-solve path
     ! cells owned by each rank of the process grid along x, y, z (the same for every field)
     PetscInt, allocatable :: rank_cells_x(:), rank_cells_y(:), rank_cells_z(:)
     integer :: lo(3) = 0, hi(3) = -1    ! owned index range (inclusive, 0-based)
@@ -102,12 +118,23 @@ contains
     grid%rank_cells_x = lx
     grid%rank_cells_y = ly
     grid%rank_cells_z = lz
-    ! star: the fluid's operators read face neighbours only (see the top of this file)
-    do f = 1, 4
-      PetscCall(DMDACreate3d(PETSC_COMM_WORLD, DM_BOUNDARY_PERIODIC, DM_BOUNDARY_PERIODIC, DM_BOUNDARY_PERIODIC, DMDA_STENCIL_STAR, grid%n(1), grid%n(2), grid%n(3), m(1), m(2), m(3), 1, 1, lx, ly, lz, grid%da(f), ierr))
-      PetscCall(DMSetOptionsPrefix(grid%da(f), field_names(f)//'_', ierr))
-      PetscCall(DMSetUp(grid%da(f), ierr))
-    end do
+    grid%shared_layout = direct_solves_wanted()
+    if (grid%shared_layout) then
+      ! the direct solves make no matrix: one box-stencil DMDA for the four fields and the carry
+      ! (see the top of this file)
+      PetscCall(DMDACreate3d(PETSC_COMM_WORLD, DM_BOUNDARY_PERIODIC, DM_BOUNDARY_PERIODIC, DM_BOUNDARY_PERIODIC, DMDA_STENCIL_BOX, grid%n(1), grid%n(2), grid%n(3), m(1), m(2), m(3), 1, 1, lx, ly, lz, grid%da(1), ierr))
+      PetscCall(DMDASetAOType(grid%da(1), AOMEMORYSCALABLE, ierr))
+      PetscCall(DMSetUp(grid%da(1), ierr))
+      do f = 2, 4
+        grid%da(f) = grid%da(1)
+        PetscCall(PetscObjectReference(grid%da(1), ierr))
+      end do
+    else
+      ! star: the fluid's operators read face neighbours only (see the top of this file)
+      do f = 1, 4
+        PetscCall(grid_create_star_layout(grid, f, grid%da(f), ierr))
+      end do
+    end if
     PetscCall(DMDAGetCorners(grid%da(FIELD_P), xs, ys, zs, xm, ym, zm, ierr))
     grid%lo = [xs, ys, zs]
     grid%hi = grid%lo + [xm, ym, zm] - 1
@@ -131,14 +158,80 @@ contains
   ! every vector of grid%da works with it) whose one layer of ghosts holds the edge and corner
   ! neighbours too (box stencil): for reads that interpolate trilinearly across a cell, the Lambda
   ! carry of mod_fictitious_domain. Width 1 is enough as a sphere moves less than a cell per step.
-  ! The caller destroys it.
+  ! The caller destroys it. With the shared layout of the direct solves it is grid%da(1) itself,
+  ! referenced once more.
   subroutine grid_create_box_layout(grid, da, ierr)
     type(grid_t), intent(in) :: grid
     DM, intent(out) :: da
     PetscErrorCode, intent(out) :: ierr
+    if (grid%shared_layout) then
+      da = grid%da(1)
+      PetscCall(PetscObjectReference(grid%da(1), ierr))
+      return
+    end if
     PetscCall(DMDACreate3d(PETSC_COMM_WORLD, DM_BOUNDARY_PERIODIC, DM_BOUNDARY_PERIODIC, DM_BOUNDARY_PERIODIC, DMDA_STENCIL_BOX, grid%n(1), grid%n(2), grid%n(3), grid%nprocs(1), grid%nprocs(2), grid%nprocs(3), 1, 1, grid%rank_cells_x, grid%rank_cells_y, grid%rank_cells_z, da, ierr))
+    PetscCall(DMDASetAOType(da, AOMEMORYSCALABLE, ierr))
     PetscCall(DMSetUp(da, ierr))
   end subroutine grid_create_box_layout
+
+  ! The star-stencil DMDA of field f (options prefix u_, v_, w_ or p_) with the fields'
+  ! decomposition: each field's own in the Krylov path, and a Krylov solver's own beside the shared
+  ! layout of the direct solves (mod_solvers: a matrix made from the box layout would store 27
+  ! entries per row instead of 7). The caller destroys it. Needs grid%nprocs and grid%rank_cells_*.
+  subroutine grid_create_star_layout(grid, f, da, ierr)
+    type(grid_t), intent(in) :: grid
+    integer, intent(in) :: f
+    DM, intent(out) :: da
+    PetscErrorCode, intent(out) :: ierr
+    PetscCall(DMDACreate3d(PETSC_COMM_WORLD, DM_BOUNDARY_PERIODIC, DM_BOUNDARY_PERIODIC, DM_BOUNDARY_PERIODIC, DMDA_STENCIL_STAR, grid%n(1), grid%n(2), grid%n(3), grid%nprocs(1), grid%nprocs(2), grid%nprocs(3), 1, 1, grid%rank_cells_x, grid%rank_cells_y, grid%rank_cells_z, da, ierr))
+    PetscCall(DMSetOptionsPrefix(da, field_names(f)//'_', ierr))
+    PetscCall(DMDASetAOType(da, AOMEMORYSCALABLE, ierr))
+    PetscCall(DMSetUp(da, ierr))
+  end subroutine grid_create_star_layout
+
+  ! The PETSc (global vector) index of the point (i, j, k), 0-based, of every field: what
+  ! AOApplicationToPetsc of the DMDA's AO gives, without the AO (mod_fft_solver).
+  pure function grid_petsc_index(grid, i, j, k) result(index)
+    type(grid_t), intent(in) :: grid
+    integer, intent(in) :: i, j, k
+    PetscInt :: index
+    index = ownership_index(grid%rank_cells_x, grid%rank_cells_y, grid%rank_cells_z, grid%n, i, j, k)
+  end function grid_petsc_index
+
+  ! The PETSc index of point (i, j, k), 0-based, of a DMDA of n(1) x n(2) x n(3) points whose
+  ! ranks own lx(r) x ly(s) x lz(t) boxes (DMDAGetOwnershipRanges), numbered rank by rank (x
+  ! fastest in the process grid) and x fastest within each: computed from the ownership ranges
+  ! alone, where an application ordering (AO) would hold the global ordering (AOBASIC, on every
+  ! rank) or need every rank in each call (AOMEMORYSCALABLE).
+  pure function ownership_index(lx, ly, lz, n, i, j, k) result(index)
+    PetscInt, intent(in) :: lx(:), ly(:), lz(:)
+    integer, intent(in) :: n(3), i, j, k
+    PetscInt :: index
+    integer :: s(3), w(3)
+    call owner_range(lx, i, s(1), w(1))
+    call owner_range(ly, j, s(2), w(2))
+    call owner_range(lz, k, s(3), w(3))
+    ! the points of the ranks before in rank order: whole z-layers of ranks, then whole y-rows of
+    ! ranks within the layer, then the ranks before in the row; then the place within the box
+    index = int(n(1), kind(index)) * n(2) * s(3) + int(n(1), kind(index)) * s(2) * w(3) &
+          + int(s(1), kind(index)) * w(2) * w(3) &
+          + (i - s(1)) + w(1) * ((j - s(2)) + w(2) * (k - s(3)))
+  end function ownership_index
+
+  ! The first index start and the width of the rank's range (widths l) that holds index p.
+  pure subroutine owner_range(l, p, start, width)
+    PetscInt, intent(in) :: l(:)
+    integer, intent(in) :: p
+    integer, intent(out) :: start, width
+    integer :: r
+    start = 0
+    width = int(l(size(l)))
+    do r = 1, size(l)
+      width = int(l(r))
+      if (p < start + width) return
+      start = start + width
+    end do
+  end subroutine owner_range
 
   ! Split nblocks blocks of size block over nproc ranks as evenly as possible.
   subroutine shares(nblocks, nproc, block, l)

@@ -13,7 +13,8 @@ module mod_solvers
   use petscdmda
   use, intrinsic :: iso_c_binding, only: C_INT
   use mod_kinds, only: dp
-  use mod_grid, only: grid_t, FIELD_V, FIELD_P, field_names, direct_solves_wanted
+  use mod_grid, only: grid_t, FIELD_V, FIELD_P, field_names, direct_solves_wanted, ownership_index, &
+                      grid_create_star_layout
   use mod_errors, only: fatal_error, log_line
   use mod_petsc_options, only: set_default_option
   use mod_fft_solver, only: fft_solver_t, fft_create, fft_solve, fft_destroy
@@ -41,6 +42,9 @@ module mod_solvers
     real(dp) :: cell_volume = 1.0_dp   ! rows are scaled by the cell volume (see compute_operator)
     MatNullSpace :: nullspace
     logical :: direct = .false.     ! solved by fast transforms (mod_fft_solver), no KSP
+    ! a Krylov solver beside the direct solves' shared box layout has its own star DMDA (mod_grid)
+    logical :: owns_dm = .false.
+    DM :: dm
     type(fft_solver_t) :: fft
     ! the callback's context, on the heap: PETSc keeps its address, which must not move when the
     ! solver_t is copied or its holder reallocated
@@ -118,14 +122,23 @@ contains
       PetscCall(set_default_option(prefix//'mg_coarse_redundant_pc_factor_shift_type', 'nonzero', ierr))
     end if
 
+    ! the operators come from the DMDA's preallocation: a star one (7 entries per row), the
+    ! solver's own where the fields share the box layout of the direct solves (doc/DESIGN.md "One
+    ! layout with the direct solves"; e.g. the -bench_cold_poisson yardstick)
+    s%owns_dm = grid%shared_layout
+    if (s%owns_dm) then
+      PetscCall(grid_create_star_layout(grid, field, s%dm, ierr))
+    else
+      s%dm = grid%da(field)
+    end if
     PetscCall(KSPCreate(PETSC_COMM_WORLD, s%ksp, ierr))
     PetscCall(KSPSetOptionsPrefix(s%ksp, field_names(field)//'_', ierr))
-    PetscCall(KSPSetDM(s%ksp, grid%da(field), ierr))
+    PetscCall(KSPSetDM(s%ksp, s%dm, ierr))
     PetscCall(KSPSetComputeOperators(s%ksp, compute_operator, s%context, ierr))
     PetscCall(KSPSetInitialGuessNonzero(s%ksp, PETSC_TRUE, ierr))
     PetscCall(KSPSetFromOptions(s%ksp, ierr))
     if (field == FIELD_P) then
-      PetscCall(set_cell_centred_interpolation(s%ksp, grid%da(FIELD_P), s%context%walls, ierr))
+      PetscCall(set_cell_centred_interpolation(s%ksp, s%dm, s%context%walls, ierr))
     end if
     if (s%singular) then
       PetscCall(MatNullSpaceCreate(PETSC_COMM_WORLD, PETSC_TRUE, 0, PETSC_NULL_VEC, s%nullspace, ierr))
@@ -193,7 +206,7 @@ contains
     PetscScalar :: w(8)
     integer :: idx(2, 3), f(3), d
     real(dp) :: wt(2, 3)
-    AO :: fine_ao, coarse_ao
+    PetscInt, allocatable :: fx(:), fy(:), fz(:), cx(:), cy(:), cz(:)
 
     PetscCall(DMDAGetInfo(fine, dim, mf(1), mf(2), mf(3), procs(1), procs(2), procs(3), dof, sw, bt(1), bt(2), bt(3), st, ierr))
     PetscCall(DMDAGetInfo(coarse, dim, mc(1), mc(2), mc(3), procs(1), procs(2), procs(3), dof, sw, bt(1), bt(2), bt(3), st, ierr))
@@ -204,8 +217,12 @@ contains
       call fatal_error('fdsusp: error: cell-centred multigrid needs every level to halve the pressure grid; use '// &
                        'fewer -p_pc_mg_levels or -p_mg_cell_centred 0', 1)
     end if
-    PetscCall(DMDAGetAO(fine, fine_ao, ierr))
-    PetscCall(DMDAGetAO(coarse, coarse_ao, ierr))
+    ! the PETSc numbering from the ownership ranges (mod_grid's ownership_index): the DMDAs' AOs are
+    ! memory-scalable, and those map only in calls every rank makes together (doc/DESIGN.md "One
+    ! layout with the direct solves")
+    allocate(fx(procs(1)), fy(procs(2)), fz(procs(3)), cx(procs(1)), cy(procs(2)), cz(procs(3)))
+    PetscCall(DMDAGetOwnershipRanges(fine, fx, fy, fz, ierr))
+    PetscCall(DMDAGetOwnershipRanges(coarse, cx, cy, cz, ierr))
     PetscCall(MatCreateAIJ(PETSC_COMM_WORLD, xm * ym * zm, cxm * cym * czm, PETSC_DETERMINE, PETSC_DETERMINE, 8, PETSC_NULL_INTEGER, 8, PETSC_NULL_INTEGER, P, ierr))
     do k = zs, zs + zm - 1
       do j = ys, ys + ym - 1
@@ -229,14 +246,12 @@ contains
             do b = 1, 2
               do a = 1, 2
                 n = n + 1
-                cols(n) = idx(a, 1) + mc(1) * (idx(b, 2) + mc(2) * idx(c, 3))
+                cols(n) = ownership_index(cx, cy, cz, int(mc), idx(a, 1), idx(b, 2), idx(c, 3))
                 w(n) = wt(a, 1) * wt(b, 2) * wt(c, 3)
               end do
             end do
           end do
-          row(1) = i + mf(1) * (j + mf(2) * k)
-          PetscCall(AOApplicationToPetsc(fine_ao, 1, row, ierr))
-          PetscCall(AOApplicationToPetsc(coarse_ao, 8, cols, ierr))
+          row(1) = ownership_index(fx, fy, fz, int(mf), int(i), int(j), int(k))
           ! ADD: at a wall two of the eight columns coincide
           PetscCall(MatSetValues(P, 1, row, 8, cols, w, ADD_VALUES, ierr))
         end do
@@ -402,6 +417,10 @@ contains
       PetscCall(fft_destroy(s%fft, ierr))
     else
       PetscCall(KSPDestroy(s%ksp, ierr))
+      if (s%owns_dm) then
+        PetscCall(DMDestroy(s%dm, ierr))
+      end if
+      s%owns_dm = .false.
       if (s%singular) then
         PetscCall(MatNullSpaceDestroy(s%nullspace, ierr))
       end if

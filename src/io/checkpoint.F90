@@ -41,7 +41,7 @@ module mod_checkpoint
   use, intrinsic :: iso_fortran_env, only: int64
   use mod_kinds, only: dp
   use mod_params, only: config_t
-  use mod_grid, only: grid_t, FIELD_U, FIELD_V, FIELD_W
+  use mod_grid, only: grid_t, FIELD_U, FIELD_V, FIELD_W, field_names
   use mod_fluid, only: fluid_t
   use mod_h5util, only: write_attribute, read_attribute, write_string_attribute, has_object, dataset_dims, &
                         write_dataset, read_dataset, has_attribute
@@ -95,13 +95,14 @@ contains
     PetscInt :: length
     real(dp) :: bytes
     Vec, allocatable :: fields(:)
+    character(len=16), allocatable :: stand_in(:)
     real(dp), allocatable :: statistics(:)
 
     tmp = trim(path)//'.tmp'
     dir = directory_of(path)
     stars = 0
     if (associated(state%fl)) then
-      fields = field_vectors(state, .true.)
+      fields = field_vectors(state, .true., stand_in)
       ! a full disk must stop every rank here, before the parallel write (mod_file_services)
       bytes = 0.0_dp
       do k = 1, size(fields)
@@ -111,6 +112,11 @@ contains
       call require_free_space(dir, bytes, tmp)
       PetscCall(PetscViewerHDF5Open(PETSC_COMM_WORLD, trim(tmp), FILE_MODE_WRITE, viewer, ierr))
       do k = 1, size(fields)
+        if (len_trim(stand_in(k)) > 0) then
+          ! the zeros of u*^{n-1} of the direct solves, which keep none (mod_fluid)
+          PetscCall(VecSet(fields(k), 0.0_dp, ierr))
+          PetscCall(PetscObjectSetName(fields(k), trim(stand_in(k)), ierr))
+        end if
         PetscCall(VecView(fields(k), viewer, ierr))
       end do
       PetscCall(PetscViewerDestroy(viewer, ierr))
@@ -203,19 +209,33 @@ contains
 
   ! The vectors of the fluid in the file's order (the datasets are named by the vectors):
   ! u, v, w, p, phi, with stars the provisional velocities u*^n, u*^{n-1} of each component, and
-  ! with particles Lambda. One list for the write and the read.
-  function field_vectors(state, stars) result(v)
+  ! with particles Lambda. One list for the write and the read. The direct solves keep no u*^{n-1}
+  ! (mod_fluid): its place holds the fluid's work vector div_star, and stand_in(k) names the
+  ! dataset it stands in for (blank for the vectors that are themselves).
+  function field_vectors(state, stars, stand_in) result(v)
     type(checkpoint_state_t), intent(in) :: state
     logical, intent(in) :: stars
+    character(len=16), allocatable, intent(out) :: stand_in(:)
     Vec, allocatable :: v(:)
     integer :: c
     v = [state%fl%vel(FIELD_U:FIELD_W), state%fl%pressure, state%fl%phi]
     if (stars) then
       do c = FIELD_U, FIELD_W
-        v = [v, state%fl%vel_star(c), state%fl%vel_star_old(c)]
+        if (state%fl%direct) then
+          v = [v, state%fl%vel_star(c), state%fl%div_star]
+        else
+          v = [v, state%fl%vel_star(c), state%fl%vel_star_old(c)]
+        end if
       end do
     end if
     if (associated(state%lambda)) v = [v, state%lambda]
+    allocate(stand_in(size(v)))
+    stand_in = ''
+    if (stars .and. state%fl%direct) then
+      do c = FIELD_U, FIELD_W
+        stand_in(5 + 2 * c) = field_names(c)//'_star_old'
+      end do
+    end if
   end function field_vectors
 
   ! Before any work: is PATH a checkpoint of this scene, run with this deck's physics (doc/INPUT.md
@@ -638,6 +658,7 @@ contains
     character(len=40) :: group, variable
     real(dp), allocatable :: buffer(:, :)
     Vec, allocatable :: fields(:)
+    character(len=16), allocatable :: stand_in(:)
     ! the Lees-Edwards offset, and how many provisional velocities the file holds (none in a
     ! checkpoint older than them)
     delta = 0.0_dp
@@ -680,8 +701,10 @@ contains
     end if
     if (associated(state%fl)) then
       call MPI_Bcast(stars, 1, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
+      ! the direct solves use no earlier u* (a Krylov run's history is not read, and not kept)
+      if (state%fl%direct) stars = 0
       state%fl%star_history = stars(1)
-      fields = field_vectors(state, stars(1) > 0)
+      fields = field_vectors(state, stars(1) > 0, stand_in)
       PetscCall(PetscViewerHDF5Open(PETSC_COMM_WORLD, trim(path), FILE_MODE_READ, viewer, ierr))
       do k = 1, size(fields)
         PetscCall(VecLoad(fields(k), viewer, ierr))

@@ -4,19 +4,22 @@
 !
 ! Component c = 1..3 is u, v, w on the x, y, z faces, c = 4 the cell centres (the interior
 ! pressure of §3.7). A sphere's visit (sphere_visit) lists the unknowns it owns in the block with
-! their wrapped index, their offset r from the centre (from the unwrapped index: no image logic),
-! their cover alpha (§3.1, less the runner-up's where rivals reach, §3.4) and the relaxation
+! their wrapped index, their cover alpha (§3.1, less the runner-up's where rivals reach, §3.4) and the relaxation
 ! 1/(1 + gamma) (§3.3), and adds w g g^T dV to M_p (§3.2). The list comes in runs of one sphere
 ! and one component (faces_build visits every sphere once), and the per-run kernels below work
 ! run by run with the block's bounds, so that the compiler sees fixed strides and a run's sums
 ! stay in registers (doc/DESIGN.md "Fictitious domain", Face runs).
+! The offset r of a face from its sphere's centre is not stored (24 B per listed unknown, ~65 B per
+! grid cell at the paper's scene; doc/BENCHMARKS.md §14): each pass forms
+! it run by run (run_offsets) from the unwrapped index, recovered from the wrapped one and the
+! run's box, by the visit's own expression, so it is bitwise the value the visit used.
 module mod_sphere_faces
   use mod_kinds, only: dp
   use mod_solid_fraction, only: cube_fraction
   implicit none
   private
   public :: STAGGER, mac_block_t, face_list_t, field_view_t
-  public :: faces_build, sphere_visit, sphere_box, box_width, face_run, faces_reserve
+  public :: faces_build, sphere_visit, sphere_box, box_width, face_run, faces_reserve, run_offsets, face_offset
   public :: torque_arm, carry_corners, carry_run, moments_run, new_lambda_run, update_run, pressure_run
   public :: faces_carry, faces_moments, faces_new_lambda, faces_update
 
@@ -35,15 +38,18 @@ module mod_sphere_faces
     integer :: lo(3) = 0, hi(3) = 0
   end type mac_block_t
 
-  ! The covered unknowns of a block, in runs of one sphere and one component. The arrays grow by
+  ! The covered unknowns of a block, in runs of one sphere and one component (offsets r: run_offsets). The arrays grow by
   ! doubling and are kept between steps (no allocation per step).
   type :: face_list_t
     integer :: nf = 0
     integer, allocatable :: ijk(:, :)                        ! (3, :) wrapped index
-    real(dp), allocatable :: r(:, :), alpha(:), relax(:)   ! offset r, alpha, 1/(1+gamma)
+    real(dp), allocatable :: alpha(:), relax(:)             ! alpha, 1/(1+gamma)
     integer :: nruns = 0
     integer, allocatable :: run_start(:)   ! run r is run_start(r) .. run_start(r+1)-1
     integer, allocatable :: run_comp(:), run_part(:)   ! its component and its sphere
+    integer, allocatable :: run_lo(:, :), run_hi(:, :) ! (3, :) its sphere's box (unwrapped indices, sphere_box)
+    real(dp), allocatable :: centre(:, :)  ! (3, n) the centres the list was built at
+    type(mac_block_t) :: block             ! the block it was built on
   end type face_list_t
 
   ! One field on the block: the array of a component with the block's bounds (or the ghosted
@@ -67,16 +73,20 @@ contains
     real(dp), intent(in) :: rival_offset(:, :)
     type(face_list_t), intent(inout) :: faces
     real(dp), intent(inout) :: rigid(:, :, :)
-    integer :: n, q, c, f0, m0, m1
+    integer :: n, q, c, f0, m0, m1, box_lo(3), box_hi(3)
     n = size(positions, 2)
     if (.not. allocated(faces%ijk)) call faces_reserve(faces, 1024)
     faces%nf = 0
     faces%nruns = 0
+    faces%block = block
+    faces%centre = positions
     if (allocated(faces%run_start)) then
-      if (size(faces%run_start) < 4 * n + 1) deallocate(faces%run_start, faces%run_comp, faces%run_part)
+      if (size(faces%run_start) < 4 * n + 1) deallocate(faces%run_start, faces%run_comp, faces%run_part, &
+                                                         faces%run_lo, faces%run_hi)
     end if
     if (.not. allocated(faces%run_start)) then
-      allocate(faces%run_start(max(1, 4 * n + 1)), faces%run_comp(4 * n), faces%run_part(4 * n))
+      allocate(faces%run_start(max(1, 4 * n + 1)), faces%run_comp(4 * n), faces%run_part(4 * n), &
+               faces%run_lo(3, 4 * n), faces%run_hi(3, 4 * n))
     end if
     do q = 1, n
       m0 = rival_start(q)
@@ -84,17 +94,88 @@ contains
       do c = 1, 4
         f0 = faces%nf + 1
         call sphere_visit(block, c, q, positions, radii, gamma_unit, rival_part(m0:m1), rival_offset(:, m0:m1), &
-                          faces, rigid(:, :, q))
+                          faces, rigid(:, :, q), box_lo, box_hi)
         if (faces%nf >= f0) then
           faces%nruns = faces%nruns + 1
           faces%run_start(faces%nruns) = f0
           faces%run_comp(faces%nruns) = c
           faces%run_part(faces%nruns) = q
+          faces%run_lo(:, faces%nruns) = box_lo
+          faces%run_hi(:, faces%nruns) = box_hi
         end if
       end do
     end do
     faces%run_start(faces%nruns + 1) = faces%nf + 1
   end subroutine faces_build
+
+  ! The offsets r (3, f1 - f0 + 1) from the centre of the faces of run (f0..f1, component c, sphere
+  ! q; face_run), as sphere_visit formed them: (k + stagger) h - centre with k the unwrapped index,
+  ! the one in the run's box whose wrap is the stored index (within the reach of the sphere,
+  ! should a box be wider than a periodic length: the other candidate lies a period away, beyond it).
+  pure subroutine run_offsets(faces, run, r)
+    type(face_list_t), intent(in) :: faces
+    integer, intent(in) :: run
+    real(dp), intent(out) :: r(:, :)
+    integer :: f0, f1, c, q, d, f, k, lo, hi, n
+    real(dp) :: h, x, other
+    logical :: periodic
+    call face_run(faces, run, f0, f1, c, q)
+    h = faces%block%h
+    do d = 1, 3
+      lo = faces%run_lo(d, run)
+      hi = faces%run_hi(d, run)
+      n = faces%block%n(d)
+      periodic = .not. (d == 2 .and. faces%block%walls)
+      do f = f0, f1
+        k = faces%ijk(d, f)
+        if (periodic) then
+          if (k < lo) then
+            k = k + n
+          else if (k > hi) then
+            k = k - n
+          end if
+        end if
+        x = (k + STAGGER(d, c)) * h - faces%centre(d, q)
+        if (periodic .and. hi - lo + 1 > n) then
+          ! a box wider than the period: the wrap has two unwrapped indices in it
+          if (k + n <= hi) then
+            other = (k + n + STAGGER(d, c)) * h - faces%centre(d, q)
+            if (abs(other) < abs(x)) x = other
+          end if
+          if (k - n >= lo) then
+            other = (k - n + STAGGER(d, c)) * h - faces%centre(d, q)
+            if (abs(other) < abs(x)) x = other
+          end if
+        end if
+        r(d, f - f0 + 1) = x
+      end do
+    end do
+  end subroutine run_offsets
+
+  ! The offset r of listed face f (run_offsets of its run; for tests and diagnostics).
+  function face_offset(faces, f) result(r)
+    type(face_list_t), intent(in) :: faces
+    integer, intent(in) :: f
+    real(dp) :: r(3)
+    real(dp), allocatable :: rr(:, :)
+    integer :: run
+    do run = 1, faces%nruns
+      if (f < faces%run_start(run + 1)) exit
+    end do
+    allocate(rr(3, faces%run_start(run + 1) - faces%run_start(run)))
+    call run_offsets(faces, run, rr)
+    r = rr(:, f - faces%run_start(run) + 1)
+  end function face_offset
+
+  ! The longest run of the list (the size of the work arrays of the passes).
+  pure integer function longest_run(faces)
+    type(face_list_t), intent(in) :: faces
+    integer :: run
+    longest_run = 1
+    do run = 1, faces%nruns
+      longest_run = max(longest_run, faces%run_start(run + 1) - faces%run_start(run))
+    end do
+  end function longest_run
 
   ! The faces f0..f1 of run, their component c and their sphere q.
   pure subroutine face_run(faces, run, f0, f1, c, q)
@@ -153,7 +234,9 @@ contains
   ! grid-sized ownership arrays, no second pass. rival_part, rival_offset (3, :): q's rivals and
   ! their centres minus q's (minimum image); positions (3, :), radii (:): every centre and every
   ! inflated radius (a rival of another size reaches as far as its own radius takes it).
-  subroutine sphere_visit(block, c, q, positions, radii, gamma_unit, rival_part, rival_offset, faces, rigid)
+  ! box_lo, box_hi, optional: the box visited (sphere_box), for run_offsets.
+  subroutine sphere_visit(block, c, q, positions, radii, gamma_unit, rival_part, rival_offset, faces, rigid, &
+                          box_lo, box_hi)
     type(mac_block_t), intent(in) :: block
     integer, intent(in) :: c, q
     real(dp), intent(in) :: positions(:, :), radii(:), gamma_unit
@@ -161,6 +244,7 @@ contains
     real(dp), intent(in) :: rival_offset(:, :)
     type(face_list_t), intent(inout) :: faces
     real(dp), intent(inout) :: rigid(6, 6)
+    integer, intent(out), optional :: box_lo(3), box_hi(3)
     integer :: wrapped(box_width(radii(q), block%h), 3)
     logical :: mine(box_width(radii(q), block%h), 3)
     integer :: lo(3), hi(3), i, j, k, m, ilo, ihi, iw, jw, kw, f, nrow, idx(3), arm(2)
@@ -177,6 +261,8 @@ contains
     radius = radii(q)
     centre = positions(:, q)
     call sphere_box(block, c, centre, radius, lo, hi, wrapped, mine)
+    if (present(box_lo)) box_lo = lo
+    if (present(box_hi)) box_hi = hi
     call reach_of(radius, reach2, inside2)
     do m = 1, size(rival_part)
       call reach_of(radii(rival_part(m)), rival_reach2(m), rival_inside2(m))
@@ -239,7 +325,6 @@ contains
           f = faces%nf + 1
           faces%nf = f
           faces%ijk(:, f) = [iw, jw, kw]
-          faces%r(:, f) = r
           faces%alpha(f) = a
           if (a == 1.0_dp) then
             faces%relax(f) = 1.0_dp       ! a covered face does not relax (gamma = 0)
@@ -310,15 +395,14 @@ contains
     integer, intent(in) :: n
     integer :: m
     integer, allocatable :: t3(:, :)
-    real(dp), allocatable :: tr(:), tr3(:, :)
+    real(dp), allocatable :: tr(:)
     if (.not. allocated(faces%ijk)) then
-      allocate(faces%ijk(3, n), faces%r(3, n), faces%alpha(n), faces%relax(n))
+      allocate(faces%ijk(3, n), faces%alpha(n), faces%relax(n))
       return
     end if
     if (n <= size(faces%alpha)) return
     m = max(n, 2 * size(faces%alpha))
     allocate(t3(3, m)); t3(:, 1:faces%nf) = faces%ijk(:, 1:faces%nf); call move_alloc(t3, faces%ijk)
-    allocate(tr3(3, m)); tr3(:, 1:faces%nf) = faces%r(:, 1:faces%nf); call move_alloc(tr3, faces%r)
     allocate(tr(m)); tr(1:faces%nf) = faces%alpha(1:faces%nf); call move_alloc(tr, faces%alpha)
     allocate(tr(m)); tr(1:faces%nf) = faces%relax(1:faces%nf); call move_alloc(tr, faces%relax)
   end subroutine faces_reserve
@@ -523,10 +607,13 @@ contains
     real(dp), intent(in) :: dv
     real(dp), intent(inout) :: moments(:, :)
     integer :: run, f0, f1, c, q
+    real(dp), allocatable :: r(:, :)
+    allocate(r(3, longest_run(faces)))
     do run = 1, faces%nruns
       call face_run(faces, run, f0, f1, c, q)
       if (c == 4) cycle
-      call moments_run(c, u(c)%v, lam(c)%v, lo, hi, f1 - f0 + 1, faces%ijk(:, f0:f1), faces%r(:, f0:f1), &
+      call run_offsets(faces, run, r)
+      call moments_run(c, u(c)%v, lam(c)%v, lo, hi, f1 - f0 + 1, faces%ijk(:, f0:f1), r, &
                        faces%alpha(f0:f1), faces%relax(f0:f1), dv, moments(:, q))
     end do
   end subroutine faces_moments
@@ -540,10 +627,13 @@ contains
     real(dp), intent(in) :: beta, velocity(:, :), omega(:, :)
     real(dp), intent(inout) :: lambda_new(:)
     integer :: run, f0, f1, c, q
+    real(dp), allocatable :: r(:, :)
+    allocate(r(3, longest_run(faces)))
     do run = 1, faces%nruns
       call face_run(faces, run, f0, f1, c, q)
       if (c == 4) cycle
-      call new_lambda_run(c, u(c)%v, lam(c)%v, lo, hi, f1 - f0 + 1, faces%ijk(:, f0:f1), faces%r(:, f0:f1), &
+      call run_offsets(faces, run, r)
+      call new_lambda_run(c, u(c)%v, lam(c)%v, lo, hi, f1 - f0 + 1, faces%ijk(:, f0:f1), r, &
                           faces%alpha(f0:f1), faces%relax(f0:f1), beta, velocity(:, q), omega(:, q), lambda_new(f0:f1))
     end do
   end subroutine faces_new_lambda
@@ -560,16 +650,19 @@ contains
     real(dp), intent(inout) :: sums(:, :)
     real(dp), intent(in), optional :: lambda_new(:)
     integer :: run, f0, f1, c, q
+    real(dp), allocatable :: r(:, :)
+    allocate(r(3, longest_run(faces)))
     do run = 1, faces%nruns
       call face_run(faces, run, f0, f1, c, q)
+      if (c /= 4) call run_offsets(faces, run, r)
       if (c == 4) then
         call pressure_run(p%v, lo, hi, f1 - f0 + 1, faces%ijk(:, f0:f1), faces%alpha(f0:f1), dv, sums(16, q))
       else if (present(lambda_new)) then
-        call update_run(c, u(c)%v, lam(c)%v, lo, hi, f1 - f0 + 1, faces%ijk(:, f0:f1), faces%r(:, f0:f1), &
+        call update_run(c, u(c)%v, lam(c)%v, lo, hi, f1 - f0 + 1, faces%ijk(:, f0:f1), r, &
                         faces%alpha(f0:f1), faces%relax(f0:f1), beta, dv, velocity(:, q), omega(:, q), sums(:, q), &
                         lambda_new(f0:f1))
       else
-        call update_run(c, u(c)%v, lam(c)%v, lo, hi, f1 - f0 + 1, faces%ijk(:, f0:f1), faces%r(:, f0:f1), &
+        call update_run(c, u(c)%v, lam(c)%v, lo, hi, f1 - f0 + 1, faces%ijk(:, f0:f1), r, &
                         faces%alpha(f0:f1), faces%relax(f0:f1), beta, dv, velocity(:, q), omega(:, q), sums(:, q))
       end if
     end do

@@ -16,7 +16,7 @@ program fdsusp
   use mod_errors, only: log_line, warn_line, input_error, report_limits
   use mod_run_control, only: command_line, prepare_output_directory, continue_from_directory, run_stop_reason, &
                              run_stop_line, RUN_GOES_ON, RUN_DONE
-  use mod_os_services, only: install_signal_handlers, release_directory
+  use mod_os_services, only: install_signal_handlers, release_directory, peak_resident_kb
   use mod_timers, only: timers_register, stage_push, stage_pop, STAGE_SETUP
   use mod_h5util, only: h5util_init
   use mod_grid, only: grid_t, grid_create, grid_destroy
@@ -202,6 +202,7 @@ program fdsusp
   end if
   write(text, '(a,f10.2,a)') 'wall time ', MPI_Wtime() - wall_start, ' s'
   call log_line(text)
+  call memory_line()
 
   if (cfg%resolved) then
     if (has_particles) then
@@ -216,6 +217,26 @@ program fdsusp
   PetscCallA(PetscFinalize(ierr))
 
 contains
+
+  ! The peak resident memory of the run (VmHWM), summed over the ranks and per grid cell: gross,
+  ! the libraries' fixed cost included. scripts/bench_memory.sh takes the difference of two grids
+  ! for the cost of a cell (doc/BENCHMARKS.md §14).
+  subroutine memory_line()
+    real(dp) :: kb(1), total(1), largest(1), cells
+    integer :: nranks, mpierr
+    kb = real(peak_resident_kb(), dp)
+    call MPI_Allreduce(kb, total, 1, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, mpierr)
+    call MPI_Allreduce(kb, largest, 1, MPI_DOUBLE_PRECISION, MPI_MAX, PETSC_COMM_WORLD, mpierr)
+    call MPI_Comm_size(PETSC_COMM_WORLD, nranks, mpierr)
+    if (total(1) < 0.0_dp) return    ! no /proc
+    write(text, '(a,i0,a,f10.1,a,f10.1,a)') 'memory: peak resident (VmHWM) summed over ', nranks, ' ranks ', &
+         total(1) / 1024.0_dp, ' MiB, largest rank ', largest(1) / 1024.0_dp, ' MiB'
+    if (cfg%resolved) then
+      cells = real(cfg%cells(1), dp) * real(cfg%cells(2), dp) * real(cfg%cells(3), dp)
+      write(text, '(a,a,f8.1,a)') trim(text), ';', total(1) * 1024.0_dp / cells, ' B per grid cell (gross)'
+    end if
+    call log_line(text)
+  end subroutine memory_line
 
   ! The spheres: a random packing made now (&particles solid_fraction), or the deck's or the
   ! position file's. Lubrication dynamics moves spheres and nothing else: a file or packing that

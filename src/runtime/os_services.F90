@@ -1,13 +1,17 @@
 ! Operating-system services, the Fortran side of src/runtime/os_services_c.c: signals, atomic file
-! publication, directories, the output directory's lock and the directory of the executable.
+! publication, directories, the output directory's lock, the directory of the executable and the
+! peak resident memory.
 module mod_os_services
-  use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
+  use, intrinsic :: iso_c_binding, only: c_int, c_long, c_char, c_null_char
   implicit none
   private
   public :: install_signal_handlers, stop_signal, publish_file, make_directory, probe_directory, &
-            lock_directory, release_directory, executable_dir
+            lock_directory, release_directory, executable_dir, peak_resident_kb
 
   interface
+    integer(c_long) function fdsusp_peak_resident_kb() bind(C, name='fdsusp_peak_resident_kb')
+      import :: c_long
+    end function fdsusp_peak_resident_kb
     subroutine fdsusp_install_signal_handlers() bind(C, name='fdsusp_install_signal_handlers')
     end subroutine fdsusp_install_signal_handlers
     integer(c_int) function fdsusp_stop_signal() bind(C, name='fdsusp_stop_signal')
@@ -99,5 +103,10 @@ contains
   subroutine release_directory()
     call fdsusp_release_directory()
   end subroutine release_directory
+
+  ! This process's peak resident set size in kB (VmHWM), -1 where the system does not say.
+  integer function peak_resident_kb()
+    peak_resident_kb = int(fdsusp_peak_resident_kb())
+  end function peak_resident_kb
 
 end module mod_os_services

@@ -233,3 +233,22 @@ int fdsusp_executable_dir(char *buf, int len)
   memcpy(buf, dir, m + 1);
   return (int)m;
 }
+
+/* The peak resident set size of this process in kB (VmHWM of /proc/self/status: exact, where
+ * getrusage and PETSc's -memory_view sample), or -1 where there is no /proc (not Linux). The
+ * memory report at the end of a run (doc/BENCHMARKS.md §14). */
+long fdsusp_peak_resident_kb(void)
+{
+  FILE *f = fopen("/proc/self/status", "r");
+  char line[256];
+  long kb = -1;
+  if (!f) return -1;
+  while (fgets(line, sizeof line, f)) {
+    if (strncmp(line, "VmHWM:", 6) == 0) {
+      kb = strtol(line + 6, NULL, 10);
+      break;
+    }
+  }
+  fclose(f);
+  return kb;
+}

@@ -50,7 +50,7 @@ program test_sphere_faces
   use mod_kinds, only: dp, pi
   use mod_solid_fraction, only: cube_fraction
   use mod_sphere_faces, only: STAGGER, mac_block_t, face_list_t, field_view_t, faces_build, face_run, &
-                              faces_moments, faces_new_lambda, faces_update, torque_arm, carry_corners, carry_run
+                              faces_moments, faces_new_lambda, faces_update, torque_arm, carry_corners, carry_run, face_offset
   use mod_vector, only: cross
   use mod_unit_checks, only: check, check_below, finish
   implicit none
@@ -267,7 +267,7 @@ contains
             g = owner(piece%ijk(1, f), piece%ijk(2, f), piece%ijk(3, f), comp_of(piece, f))
             if (g == 0) cycle
             if (piece%alpha(f) == one%alpha(g) .and. piece%relax(f) == one%relax(g) .and. &
-                all(piece%r(:, f) == one%r(:, g))) matched = matched + 1
+                all(face_offset(piece, f) == face_offset(one, g))) matched = matched + 1
           end do
         end do
       end do
@@ -439,7 +439,7 @@ contains
       call face_run(faces, run, f0, f1, c, q)
       if (c == 4) cycle
       do f = f0, f1
-        gu = velocity(:, 1) + cross(omega(:, 1), faces%r(:, f))
+        gu = velocity(:, 1) + cross(omega(:, 1), face_offset(faces, f))
         u(faces%ijk(1, f), faces%ijk(2, f), faces%ijk(3, f), c) = gu(c)
       end do
     end do

@@ -16,6 +16,7 @@
 !      0: the values travel as doubles, no tolerance), and the statistics are not started afresh.
 ! Not checkpointed, so not checked: the per-step particle quantities (hydrodynamic forces,
 ! stresslets, prescribed motion and external loads), which each step recomputes or the deck gives.
+! The fluid runs the Krylov path (-fluid_solver krylov), the one that keeps u*^{n-1}.
 ! Singleton here; on 3 ranks (tests/regression/test_unit_petsc_ranks.sh) the fields go through
 ! PETSc's parallel HDF5 viewer.
 #include <petsc/finclude/petscdmda.h>
@@ -91,6 +92,10 @@ program test_checkpoint_roundtrip
   cfg%rheology%profile_bins = 4
   cfg%rheology%angle_bins = 8
   cfg%rheology%contact_shell = 0.005_dp
+  ! the provisional velocities u*^{n-1} exist in the Krylov path only: the direct solves keep none
+  ! and their checkpoints hold zeros there (mod_fluid; tests/regression/test_restart.py and
+  ! test_checkpoint_checksum.py restart the direct path)
+  PetscCallA(PetscOptionsSetValue(PETSC_NULL_OPTIONS, '-fluid_solver', 'krylov', ierr))
   PetscCallA(grid_create(cfg, grid, ierr))
 
   ! the state written: random values everywhere (the same on every rank where it is not distributed)

@@ -25,7 +25,10 @@
 !   4. the transform kinds match the boundary kinds: with walls, the Helmholtz system of u (ghost
 !      -x_0, DST-II) solved with the transforms of p's boundary (DCT-II), and p's boundary's
 !      Helmholtz system solved with u's transforms (DST-II), miss x* by O(1) (> 0.1 relative),
-!      while each with its own kind meets 1e-12: a transform of the wrong kind cannot pass 2.
+!      while each with its own kind meets 1e-12: a transform of the wrong kind cannot pass 2;
+!   5. structure (issue 45, memory per cell): with the direct solves the four fields share one DMDA,
+!      and its application ordering is AOMEMORYSCALABLE (never a copy of the global ordering on
+!      every rank).
 ! Every check is of a global quantity (reduced over the ranks): the program runs as a singleton
 ! (tests/run_tests.sh) and on 3 ranks (tests/regression/test_unit_petsc_ranks.sh, where 8 x 6 x 4
 ! leaves one rank without a z-slab of the transforms, and 8 x 6 x 6 gives the pressure its
@@ -75,6 +78,7 @@ program test_fluid_solvers
          trim(cfg%domain%y_boundary), ', ', nranks, ' rank(s)'
     if (rank == 0) print '(2a)', '# ', trim(scene)
     PetscCallA(grid_create(cfg, grid, ierr))
+    call test_layout(grid, trim(scene))
     call test_scene(grid, trim(scene))
     PetscCallA(grid_destroy(grid, ierr))
   end do
@@ -83,6 +87,20 @@ program test_fluid_solvers
   PetscCallA(PetscFinalize(ierr))
 
 contains
+
+  ! Structure (doc/DESIGN.md "One layout with the direct solves"): the direct solves put every
+  ! field on one DMDA, and its application ordering, should anything ask for one, is the
+  ! memory-scalable kind, not a copy of the global ordering on every rank.
+  subroutine test_layout(grid, scene)
+    type(grid_t), intent(in) :: grid
+    character(len=*), intent(in) :: scene
+    AO :: ao
+    PetscBool :: scalable
+    call check(grid%shared_layout, scene//': the direct solves share one DMDA among the four fields')
+    PetscCallA(DMDAGetAO(grid%da(FIELD_P), ao, ierr))
+    PetscCallA(PetscObjectTypeCompare(ao, AOMEMORYSCALABLE, scalable, ierr))
+    call check(logical(scalable), scene//': the DMDA''s ordering is memory-scalable (AOMEMORYSCALABLE)')
+  end subroutine test_layout
 
   ! The three checks of every field, and the transform kinds with walls.
   subroutine test_scene(grid, scene)
