@@ -26,12 +26,12 @@ module mod_time_step
   use mod_rheology, only: rheology_t, rheo_sample, rheo_sample_flow
   use mod_lees_edwards, only: lees_edwards_t, le_wrap, le_advance, le_set_strain
   use mod_shear_protocol, only: shear_protocol_t, shear_protocol_begin_step, shear_protocol_end_step, &
-                                shear_protocol_varies, PROTOCOL_OSCILLATORY
+                                shear_protocol_varies, shear_protocol_set_rate, PROTOCOL_OSCILLATORY, CONTROL_STRESS
   use mod_lubrication_dynamics, only: lubrication_dynamics_t
   use mod_fictitious_domain, only: fictitious_domain_t, fictitious_domain_geometry, fictitious_domain_follow, &
                                    fictitious_domain_moments, fictitious_domain_solve_motion, fictitious_domain_update
   use mod_lubrication_links, only: lubrication_links_evaluate
-  use mod_ld_motion, only: ld_motion_solve
+  use mod_ld_motion, only: ld_motion_solve, ld_motion_solve_stress
   use mod_particle_solver, only: particle_solver_t
   implicit none
   private
@@ -145,11 +145,15 @@ contains
     integer, intent(in) :: step
     PetscErrorCode, intent(out) :: ierr
     integer :: info
+    real(dp) :: rate, reached
+    logical :: stress_control
     ierr = 0
     ts%failure = ''
-    ! the imposed rate of this step, gamma_dot(t_n), in every piece that uses it
+    ! the imposed rate of this step, gamma_dot(t_n), in every piece that uses it (stress control:
+    ! the last step's, until the particle solve has found this step's; doc/METHOD.md §7.3)
     call shear_protocol_begin_step(ts%protocol)
     if (shear_protocol_varies(ts%protocol)) call impose_rate(ts)
+    stress_control = ts%protocol%control == CONTROL_STRESS
     if (ts%variant == TIME_STEP_FLUID) then
       PetscCall(stage_push(STAGE_FLUID, ierr))
       PetscCall(fluid_step(ts%grid, ts%fluid, ierr))
@@ -170,7 +174,12 @@ contains
         end if
       end if
       if (associated(ts%lubrication)) then
-        ! the lubrication links at X^n, taken implicitly in the particle problem below
+        ! the lubrication links at X^n, taken implicitly in the particle problem below (stress
+        ! control: their drives per unit rate, which the particle solve scales)
+        if (stress_control) then
+          ts%lubrication%shear_rate = 1.0_dp
+          ts%lubrication%le%shear_rate = 1.0_dp
+        end if
         PetscCall(stage_push(STAGE_LUBRICATION, ierr))
         PetscCall(lubrication_links_evaluate(ts%lubrication, parts%position, ierr, le%offset))
         PetscCall(stage_pop(ierr))
@@ -195,8 +204,21 @@ contains
         PetscCall(stage_push(STAGE_PARTICLES, ierr))
         ! lubrication dynamics: the 6N Stokes balance of the spheres alone (one-body drag in the
         ! imposed flow, the pair and wall links, the contacts), then their hydrodynamic force,
-        ! torque and stresslet (doc/METHOD.md §6)
-        PetscCall(ld_motion_solve(ts%ld, ts%ld_solver, parts, ierr, lubrication=ts%lubrication, contacts=ts%contacts))
+        ! torque and stresslet (doc/METHOD.md §6); under stress control with the rate that sets the
+        ! mean shear stress, which every piece then takes (§7.3)
+        if (stress_control) then
+          rate = ts%protocol%rate
+          PetscCall(ld_motion_solve_stress(ts%ld, ts%ld_solver, parts, ts%protocol%stress, rate, reached, ierr, rheology=ts%rheology, lubrication=ts%lubrication, contacts=ts%contacts))
+          ! the strain and the offset advance with the spheres' Adams-Bashforth step (§7.3)
+          if (parts%have_prev) then
+            call shear_protocol_set_rate(ts%protocol, rate, reached, 1.5_dp * rate - 0.5_dp * ts%protocol%rate)
+          else
+            call shear_protocol_set_rate(ts%protocol, rate, reached, rate)
+          end if
+          call impose_rate(ts)
+        else
+          PetscCall(ld_motion_solve(ts%ld, ts%ld_solver, parts, ierr, lubrication=ts%lubrication, contacts=ts%contacts))
+        end if
       end if
       ! the core statistics of this configuration, before it moves on
       if (associated(ts%rheology)) then
@@ -219,8 +241,8 @@ contains
       call shear_protocol_end_step(ts%protocol)
       if (le%active) then
         ! the boundary slides on (by the strain of the step, exactly: an oscillation's offset is
-        ! gamma(t_{n+1}) Ly); spheres that left through y = 0 or Ly re-enter from the image
-        if (ts%protocol%kind == PROTOCOL_OSCILLATORY) then
+        ! gamma(t_{n+1}) Ly, stress control's the strain its spheres advanced, §7.3); spheres that left through y = 0 or Ly re-enter from the image
+        if (ts%protocol%kind == PROTOCOL_OSCILLATORY .or. stress_control) then
           call le_set_strain(le, ts%protocol%strain)
         else
           call le_advance(le, ts%dt)

@@ -66,6 +66,7 @@ contains
     call real_item('domain', 'shear_rate', BRANCH_MAY_CHANGE, [cfg%domain%shear_rate], legacy='shear_rate')
     call text_item('shear', 'control', BRANCH_MAY_CHANGE, cfg%shear%control)
     call text_item('shear', 'protocol', BRANCH_MAY_CHANGE, cfg%shear%protocol)
+    if (cfg%shear%control == 'stress') call real_item('shear', 'stress', BRANCH_MAY_CHANGE, [cfg%shear%stress])
     if (cfg%shear%protocol == 'reversal') &
       call real_item('shear', 'reversal_strain', BRANCH_MAY_CHANGE, [cfg%shear%reversal_strain])
     if (cfg%shear%protocol == 'oscillatory') then

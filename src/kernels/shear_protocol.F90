@@ -9,6 +9,10 @@
 !                whole steps flips after exactly G/(|rate| dt) steps despite round-off)
 !   oscillatory  gamma(t) = gamma_0 sin(omega t), gamma_dot(t) = gamma_0 omega cos(omega t),
 !                omega = 2 pi/T; the strain is gamma(t) itself, evaluated, not summed
+! Stress control (control = 'stress', doc/INPUT.md "&shear", doc/METHOD.md §7.3; steady only): the
+! rate of a step is not a function of time but the solution of the step's stress balance, which the
+! step solves and sets here (shear_protocol_set_rate) before the strain is integrated with it; until
+! then p%rate holds the last step's rate (the one the previous velocities went with).
 ! The reference rate (the unit of time and of stress, doc/INPUT.md "&shear") is rate (steady,
 ! reversal: signed, as given) or gamma_0 omega (oscillatory): the rate at t = 0 in every protocol.
 ! The state (time, strain, accumulated |strain|, sign, reversals) is what a checkpoint holds
@@ -23,16 +27,20 @@ module mod_shear_protocol
   private
   public :: shear_protocol_t, shear_protocol_create, shear_protocol_begin_step, shear_protocol_end_step, &
             shear_protocol_varies, shear_protocol_state, shear_protocol_restore, shear_protocol_columns, &
-            shear_protocol_kind, shear_protocol_reference_rate, shear_protocol_begin_at
+            shear_protocol_kind, shear_protocol_reference_rate, shear_protocol_begin_at, shear_protocol_set_rate
   public :: PROTOCOL_STEADY, PROTOCOL_REVERSAL, PROTOCOL_OSCILLATORY, PROTOCOL_STATE_SIZE
+  public :: CONTROL_RATE, CONTROL_STRESS
 
   integer, parameter :: PROTOCOL_STEADY = 1, PROTOCOL_REVERSAL = 2, PROTOCOL_OSCILLATORY = 3
   integer, parameter :: PROTOCOL_STATE_SIZE = 7
+  integer, parameter :: CONTROL_RATE = 1, CONTROL_STRESS = 2
   ! a reversal is due when the accumulated |strain| is within this share of one step's strain of it
   real(dp), parameter :: reversal_slack = 1.0e-9_dp
 
   type :: shear_protocol_t
     integer :: kind = PROTOCOL_STEADY
+    integer :: control = CONTROL_RATE
+    real(dp) :: stress = 0.0_dp           ! stress control: the target mean shear stress [eta gamma_dot]
     real(dp) :: reference_rate = 1.0_dp   ! signed; the rate at t = 0 [gamma_dot]
     real(dp) :: reversal_strain = 0.0_dp  ! G [-]
     real(dp) :: strain_amplitude = 0.0_dp ! gamma_0 [-]
@@ -49,17 +57,26 @@ module mod_shear_protocol
     real(dp) :: rate = 0.0_dp             ! gamma_dot(t_n), held over the step
     real(dp) :: step_strain = 0.0_dp      ! gamma(t_n) of the step (the record's configuration)
     logical :: reversed = .false.         ! the direction flipped at the start of this step
+    real(dp) :: step_stress = 0.0_dp      ! stress control: the mean shear stress the step's solve reached
+    real(dp) :: advance = 0.0_dp          ! stress control: the rate the step's strain advances at
   end type shear_protocol_t
 
 contains
 
   !> A protocol of the given kind (PROTOCOL_*): rate is the steady/reversal rate (signed), ignored
-  !> for an oscillation, whose reference rate is gamma_0 2 pi/T; dt: the time step.
-  pure function shear_protocol_create(kind, rate, dt, reversal_strain, strain_amplitude, period) result(p)
+  !> for an oscillation, whose reference rate is gamma_0 2 pi/T; dt: the time step. stress
+  !> (optional): stress control at this mean shear stress (steady; rate is then the reference
+  !> rate, the unit, and the rate of the first step's explicit contacts).
+  pure function shear_protocol_create(kind, rate, dt, reversal_strain, strain_amplitude, period, stress) result(p)
     integer, intent(in) :: kind
     real(dp), intent(in) :: rate, dt, reversal_strain, strain_amplitude, period
+    real(dp), intent(in), optional :: stress
     type(shear_protocol_t) :: p
     p%kind = kind
+    if (present(stress)) then
+      p%control = CONTROL_STRESS
+      p%stress = stress
+    end if
     p%dt = dt
     p%reversal_strain = reversal_strain
     p%strain_amplitude = strain_amplitude
@@ -90,7 +107,7 @@ contains
   !> Does the rate change in time? (A steady protocol leaves every physics object as created.)
   pure logical function shear_protocol_varies(p)
     type(shear_protocol_t), intent(in) :: p
-    shear_protocol_varies = p%kind /= PROTOCOL_STEADY
+    shear_protocol_varies = p%kind /= PROTOCOL_STEADY .or. p%control == CONTROL_STRESS
   end function shear_protocol_varies
 
   !> The rate of the step that starts at p%time (t_n): a reversal that is due flips the direction
@@ -100,6 +117,7 @@ contains
     real(dp) :: due
     p%reversed = .false.
     p%step_strain = p%strain
+    if (p%control == CONTROL_STRESS) return       ! p%rate: the last step's, until the step sets its own
     select case (p%kind)
     case (PROTOCOL_STEADY)
       p%rate = p%reference_rate
@@ -116,6 +134,20 @@ contains
     end select
   end subroutine shear_protocol_begin_step
 
+  !> Stress control: the rate the step solved for, the mean shear stress it reached with it, and
+  !> the rate its strain advances at: the spheres move by Adams-Bashforth, X^{n+1} - X^n =
+  !> dt (3/2 U^n - 1/2 U^{n-1}), so the affine part of their motion, and with it the Lees-Edwards
+  !> offset, advances at 3/2 gamma_dot^n - 1/2 gamma_dot^{n-1} (gamma_dot^n on a step by forward
+  !> Euler); under a rate that jumps from step to step any other offset would shear the pairs
+  !> across the boundary against the bulk (doc/METHOD.md §7.3).
+  pure subroutine shear_protocol_set_rate(p, rate, stress, advance)
+    type(shear_protocol_t), intent(inout) :: p
+    real(dp), intent(in) :: rate, stress, advance
+    p%rate = rate
+    p%step_stress = stress
+    p%advance = advance
+  end subroutine shear_protocol_set_rate
+
   !> The end of the step: time t_{n+1}, the strain integrated exactly over the step (the rate is
   !> constant over a step of a steady or reversal protocol; an oscillation's strain is gamma(t)).
   pure subroutine shear_protocol_end_step(p)
@@ -125,9 +157,17 @@ contains
     case (PROTOCOL_OSCILLATORY)
       p%strain = p%origin + p%strain_amplitude * sin(2.0_dp * pi * p%time / p%period)
     case default
-      p%strain = p%strain + p%rate * p%dt
+      if (p%control == CONTROL_STRESS) then
+        p%strain = p%strain + p%advance * p%dt
+      else
+        p%strain = p%strain + p%rate * p%dt
+      end if
     end select
-    p%travel = p%travel + abs(p%rate) * p%dt
+    if (p%control == CONTROL_STRESS) then
+      p%travel = p%travel + abs(p%advance) * p%dt
+    else
+      p%travel = p%travel + abs(p%rate) * p%dt
+    end if
   end subroutine shear_protocol_end_step
 
   !> The state a checkpoint holds: time, strain, travel, direction, reversals, the last step's rate,
@@ -164,18 +204,22 @@ contains
     p%travel = 0.0_dp
     p%direction = 1.0_dp
     p%reversals = 0
-    p%rate = p%reference_rate
+    ! stress control keeps the rate the configuration was reached with (its explicit contacts')
+    if (p%control == CONTROL_RATE) p%rate = p%reference_rate
   end subroutine shear_protocol_begin_at
 
   !> The protocol's columns of the series (doc/RHEOLOGY.md "Protocols"): the imposed rate of the
-  !> step the record's statistics were sampled in, and the strain gamma(t_n) of that configuration.
+  !> step the record's statistics were sampled in, and the strain gamma(t_n) of that configuration;
+  !> under stress control the rate is the one the step solved for, and shear/stress the mean shear
+  !> stress it reached (the target to round-off).
   function shear_protocol_columns(p) result(c)
     type(shear_protocol_t), intent(in) :: p
     type(column_t), allocatable :: c(:)
     ! element by element: an array constructor of column_t leaks their values (gfortran 12)
-    allocate(c(2))
+    allocate(c(merge(3, 2, p%control == CONTROL_STRESS)))
     c(1) = column('shear/rate', p%rate)
     c(2) = column('shear/strain', p%step_strain)
+    if (p%control == CONTROL_STRESS) c(3) = column('shear/stress', p%step_stress)
   end function shear_protocol_columns
 
 end module mod_shear_protocol

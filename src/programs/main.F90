@@ -102,8 +102,15 @@ program fdsusp
   if (cfg%lees_edwards) le = le_create(cfg%domain%box, cfg%domain%shear_rate, 0.0_dp)
   ! the imposed shear as a function of time (doc/INPUT.md "&shear"); the pieces below are made with
   ! its reference rate, the rate at t = 0, and the step gives them the rate of each step
-  protocol = shear_protocol_create(shear_protocol_kind(cfg%shear%protocol), cfg%shear%rate, cfg%time%dt, &
-                                   cfg%shear%reversal_strain, cfg%shear%strain_amplitude, cfg%shear%period)
+  ! (stress control: the reference rate is the unit, and each step solves for its own rate)
+  if (cfg%shear%control == 'stress') then
+    protocol = shear_protocol_create(shear_protocol_kind(cfg%shear%protocol), cfg%shear%rate, cfg%time%dt, &
+                                     cfg%shear%reversal_strain, cfg%shear%strain_amplitude, cfg%shear%period, &
+                                     cfg%shear%stress)
+  else
+    protocol = shear_protocol_create(shear_protocol_kind(cfg%shear%protocol), cfg%shear%rate, cfg%time%dt, &
+                                     cfg%shear%reversal_strain, cfg%shear%strain_amplitude, cfg%shear%period)
+  end if
   call make_contacts()
   call make_lubrication()
   call make_statistics()

@@ -52,7 +52,8 @@ module mod_params
   ! &shear: the imposed flow (doc/INPUT.md "&shear"; mod_shear_protocol)
   type :: shear_settings_t
     real(dp) :: rate = rate_not_given                   ! the imposed rate (default 1) [gamma_dot]
-    character(len=16) :: control = 'rate'               ! 'rate' ('stress': not yet)
+    character(len=16) :: control = 'rate'               ! 'rate' or 'stress' (lubrication dynamics)
+    real(dp) :: stress = 0.0_dp                         ! control = 'stress': the mean shear stress [eta*gamma_dot]
     character(len=16) :: protocol = 'steady'            ! 'steady', 'reversal' or 'oscillatory'
     real(dp) :: reversal_strain = 0.0_dp                ! 'reversal': the strain between reversals [-]
     real(dp) :: strain_amplitude = 0.0_dp               ! 'oscillatory': gamma_0 [-]
@@ -729,10 +730,11 @@ contains
   subroutine validate_shear(cfg)
     type(config_t), intent(inout) :: cfg
     character(len=200) :: text
-    if (cfg%shear%control == 'stress') call input_error(cfg%deck_file, 'shear', 'control', &
-         '''stress'' (stress control) is not implemented yet: use control = ''rate''')
-    if (cfg%shear%control /= 'rate') call input_error(cfg%deck_file, 'shear', 'control', &
-         'must be ''rate'' (''stress'' is not implemented yet), not '''//trim(cfg%shear%control)//'''')
+    if (cfg%shear%control /= 'rate' .and. cfg%shear%control /= 'stress') call input_error(cfg%deck_file, 'shear', &
+         'control', 'must be ''rate'' or ''stress'', not '''//trim(cfg%shear%control)//'''')
+    if (cfg%shear%control == 'rate' .and. cfg%shear%stress /= 0.0_dp) call input_error(cfg%deck_file, 'shear', &
+         'stress', 'is given only with control = ''stress'' (under control = ''rate'' the rate is imposed)')
+    if (cfg%shear%control == 'stress') call validate_stress_control(cfg)
     if (shear_protocol_kind(cfg%shear%protocol) == 0) call input_error(cfg%deck_file, 'shear', 'protocol', &
          'must be ''steady'', ''reversal'' or ''oscillatory'', not '''//trim(cfg%shear%protocol)//'''')
     if (cfg%shear%protocol /= 'oscillatory') then
@@ -765,6 +767,38 @@ contains
       end if
     end if
   end subroutine validate_shear
+
+  ! Stress control (doc/INPUT.md "&shear", doc/METHOD.md §7.3): a non-zero stress, a steady
+  ! protocol, lubrication dynamics, a stress to measure (spheres or walls) with the statistics'
+  ! weights (&rheology), spheres that move freely; &shear rate stays the unit (positive).
+  subroutine validate_stress_control(cfg)
+    type(config_t), intent(inout) :: cfg
+    logical :: spheres
+    spheres = cfg%particles%number > 0 .or. len_trim(cfg%particles%position_file) > 0 .or. &
+              cfg%particles%solid_fraction > 0.0_dp
+    if (cfg%shear%stress == 0.0_dp) call input_error(cfg%deck_file, 'shear', 'stress', &
+         'must be given (non-zero, in eta*gamma_dot_ref) with control = ''stress''')
+    call check_real(cfg, 'shear', 'stress', cfg%shear%stress, -1.0e6_dp, 1.0e6_dp)
+    if (cfg%shear%protocol /= 'steady') call input_error(cfg%deck_file, 'shear', 'protocol', &
+         'must be ''steady'' with control = ''stress'' (reversals, oscillations and steps of the stress are '// &
+         'not implemented), not '''//trim(cfg%shear%protocol)//'''')
+    if (cfg%resolved) call input_error(cfg%deck_file, 'shear', 'control', &
+         '''stress'' is implemented for lubrication dynamics (&fluid model = ''none'') only: in the resolved '// &
+         'DNS the wall velocity as the unknown is not implemented yet')
+    if (.not. (cfg%walls .or. cfg%lees_edwards)) call input_error(cfg%deck_file, 'shear', 'control', &
+         '''stress'' needs a sheared box (y_boundary = ''walls'' or ''lees-edwards''): a periodic box in y has '// &
+         'no shear stress to control')
+    if (.not. spheres .and. .not. cfg%walls) call input_error(cfg%deck_file, 'shear', 'control', &
+         '''stress'': no stress can be measured without particles and without walls')
+    if (cfg%shear%rate <= 0.0_dp) call input_error(cfg%deck_file, trim(cfg%rate_group), trim(cfg%rate_name), &
+         'is the unit of time and stress under control = ''stress'' (gamma_dot_ref): must be > 0')
+    if (spheres .and. .not. cfg%rheology_group) call input_error(cfg%deck_file, 'shear', 'control', &
+         '''stress'' with particles needs &rheology: the mean shear stress is the one the statistics measure '// &
+         '(doc/RHEOLOGY.md), and so are their weights')
+    if (spheres .and. cfg%particles%motion /= 'free' .and. cfg%particles%motion /= 'frozen') &
+      call input_error(cfg%deck_file, 'particles', 'motion', 'must be ''free'' or ''frozen'' with &shear '// &
+           'control = ''stress'' (imposed particle motion leaves no balance for the rate)')
+  end subroutine validate_stress_control
 
   ! Ranges of &rheology, and the step counts of the averaging window (doc/RHEOLOGY.md).
   subroutine validate_rheology(cfg)
