@@ -67,7 +67,7 @@ contains
   !> the solves come from the checkpointed state alone (0 for U_0, U^{n-1}/gamma_dot^{n-1} for U_1),
   !> so that a restart repeats the iterations bitwise. rate: in, the last step's rate (the one the
   !> velocities U^{n-1} and the explicit contact forces went with); out, this step's. reached: the stress the step's velocities give (stress to round-off).
-  !> rheology: the statistics' weights (absent: no spheres, the stress is eta gamma_dot alone).
+  !> rheology: the statistics' weights (mod_params asks for &rheology under stress control).
   subroutine ld_motion_solve_stress(ld, solver, parts, stress, rate, reached, ierr, rheology, lubrication, contacts)
     type(lubrication_dynamics_t), intent(inout) :: ld
     type(particle_solver_t), intent(inout) :: solver
@@ -90,13 +90,6 @@ contains
     ierr = 0
     n = parts%n
     rate_before = rate
-    if (n == 0) then
-      ! the solvent alone: sigma = eta gamma_dot
-      rate = stress / ld%viscosity
-      reached = ld%viscosity * rate
-      ld%shear_rate = rate
-      return
-    end if
     if (.not. present(rheology)) call fatal_error('fdsusp: fatal: stress control with spheres needs the '// &
                                                   'statistics'' weights (&rheology)', 4)
     if (parts%motion /= MOTION_FREE .and. parts%motion /= MOTION_FROZEN) &

@@ -18,7 +18,7 @@ module mod_time_step
   use mod_errors, only: log_line, report_limits
   use mod_contact, only: overlap_limit, wall_lower, wall_upper
   use mod_grid, only: grid_t
-  use mod_fluid, only: fluid_t, fluid_step, fluid_mean_profile
+  use mod_fluid, only: fluid_t, fluid_step, fluid_mean_profile, fluid_add_response
   use mod_timers, only: stage_push, stage_pop, STAGE_FLUID, STAGE_PARTICLES, STAGE_CONTACTS, STAGE_LUBRICATION
   use mod_particles, only: particles_t, advance_positions, displacements
   use mod_particle_contacts, only: particle_contacts_t, particle_contacts_step
@@ -62,6 +62,7 @@ module mod_time_step
     integer :: largest_overlap_step = 0
     type(grid_t), pointer :: grid => null()
     type(fluid_t), pointer :: fluid => null()
+    type(fluid_t), pointer :: fluid_response => null()   ! stress control: the step per unit wall speed
     type(fictitious_domain_t), pointer :: fd => null()
     type(particles_t), pointer :: parts => null()
     type(particle_contacts_t), pointer :: contacts => null()
@@ -84,7 +85,7 @@ contains
   ! Options: -fd_carry_lambda, -fault_nan_step. Collective (resolved: the geometry of X^n is built
   ! here).
   subroutine time_step_create(ts, dt, box, walls, le, protocol, ierr, grid, fluid, fd, parts, ld, ld_solver, &
-                              contacts, lubrication, rheology)
+                              contacts, lubrication, rheology, fluid_response)
     type(time_step_t), intent(out) :: ts
     real(dp), intent(in) :: dt, box(3)
     logical, intent(in) :: walls
@@ -93,6 +94,7 @@ contains
     PetscErrorCode, intent(out) :: ierr
     type(grid_t), target, intent(in), optional :: grid
     type(fluid_t), target, intent(in), optional :: fluid
+    type(fluid_t), target, intent(in), optional :: fluid_response
     type(fictitious_domain_t), target, intent(in), optional :: fd
     type(particles_t), target, intent(in), optional :: parts
     type(lubrication_dynamics_t), target, intent(in), optional :: ld
@@ -114,6 +116,7 @@ contains
     ts%protocol => protocol
     if (present(grid)) ts%grid => grid
     if (present(fluid)) ts%fluid => fluid
+    if (present(fluid_response)) ts%fluid_response => fluid_response
     if (present(fd)) ts%fd => fd
     if (present(parts)) ts%parts => parts
     if (present(ld)) ts%ld => ld
@@ -157,6 +160,15 @@ contains
     if (ts%variant == TIME_STEP_FLUID) then
       PetscCall(stage_push(STAGE_FLUID, ierr))
       PetscCall(fluid_step(ts%grid, ts%fluid, ierr))
+      if (stress_control) then
+        ! the walls' speed that sets the mean wall stress to the target: the step plus the
+        ! multiple of its unit response that makes up the difference (doc/METHOD.md §7.3)
+        associate(fl => ts%fluid, unit => ts%fluid_response)
+          PetscCall(fluid_add_response(ts%grid, fl, unit, (ts%protocol%stress - 0.5_dp * (fl%tau_bottom + fl%tau_top)) / (0.5_dp * (unit%tau_bottom + unit%tau_top)), ierr))
+          rate = 2.0_dp * fl%wall_speed / ts%box(2)
+          call shear_protocol_set_rate(ts%protocol, rate, 0.5_dp * (fl%tau_bottom + fl%tau_top), rate)
+        end associate
+      end if
       PetscCall(stage_pop(ierr))
       call shear_protocol_end_step(ts%protocol)
       call count_step(ts, step)

@@ -769,7 +769,7 @@ contains
   end subroutine validate_shear
 
   ! Stress control (doc/INPUT.md "&shear", doc/METHOD.md §7.3): a non-zero stress, a steady
-  ! protocol, lubrication dynamics, a stress to measure (spheres or walls) with the statistics'
+  ! protocol, lubrication dynamics or the DNS's fluid alone, a stress to measure (spheres or walls) with the statistics'
   ! weights (&rheology), spheres that move freely; &shear rate stays the unit (positive).
   subroutine validate_stress_control(cfg)
     type(config_t), intent(inout) :: cfg
@@ -782,9 +782,14 @@ contains
     if (cfg%shear%protocol /= 'steady') call input_error(cfg%deck_file, 'shear', 'protocol', &
          'must be ''steady'' with control = ''stress'' (reversals, oscillations and steps of the stress are '// &
          'not implemented), not '''//trim(cfg%shear%protocol)//'''')
-    if (cfg%resolved) call input_error(cfg%deck_file, 'shear', 'control', &
-         '''stress'' is implemented for lubrication dynamics (&fluid model = ''none'') only: in the resolved '// &
-         'DNS the wall velocity as the unknown is not implemented yet')
+    if (cfg%resolved .and. spheres) call input_error(cfg%deck_file, 'shear', 'control', &
+         '''stress'' in the resolved DNS is implemented for the fluid alone: with particles (the wall velocity '// &
+         'as the unknown of the coupled step) it is not implemented yet; lubrication dynamics (&fluid model = '// &
+         '''none'') takes it')
+    if (cfg%resolved .and. cfg%fluid%viscous_theta /= 1.0_dp) call input_error(cfg%deck_file, 'fluid', &
+         'viscous_theta', 'must be 1 (backward Euler) with &shear control = ''stress'': the wall speed jumps each '// &
+         'step, and the Crank-Nicolson response of the wall cells to a jump overshoots (a wall stress that falls as '// &
+         'the wall speeds up), which the stress balance amplifies (doc/METHOD.md §7.3)')
     if (.not. (cfg%walls .or. cfg%lees_edwards)) call input_error(cfg%deck_file, 'shear', 'control', &
          '''stress'' needs a sheared box (y_boundary = ''walls'' or ''lees-edwards''): a periodic box in y has '// &
          'no shear stress to control')

@@ -158,8 +158,8 @@ cases = [
     ('stress under rate control', GOOD + "&shear stress = 2 /\n", [], ['bad.nml', '&shear', 'stress', "control = 'stress'"]),
     ('stress control without a stress', LDS + "&rheology /\n&shear control = 'stress' /\n", [],
      ['bad.nml', '&shear', 'stress', 'must be given']),
-    ('stress control in the DNS', GOOD + "&shear control = 'stress', stress = 2 /\n", [],
-     ['bad.nml', '&shear', 'control', 'not implemented yet']),
+    ('stress control in the DNS with particles', GOOD + "&shear control = 'stress', stress = 2 /\n"
+     "&particles number = 1, position(:,1) = 1.6, 1.6, 1.6 /\n", [], ['bad.nml', '&shear', 'control', 'not implemented yet']),
     ('stress control with a reversal', LDS + "&rheology /\n&shear control = 'stress', stress = 2, protocol = 'reversal', "
      "reversal_strain = 1 /\n", [], ['bad.nml', '&shear', 'protocol', "'steady'"]),
     ('stress control, no particles and no walls', LDS.replace('&particles number = 1, position(:,1) = 1.6, 1.6, 1.6 /\n', '')
