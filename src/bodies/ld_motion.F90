@@ -4,7 +4,7 @@
 ! prefix particles_, the same options as the DNS);
 ! then the contacts' implicit update, the links' corrections and the hydrodynamic force, torque
 ! and stresslet of every sphere. Identical on every rank (replicated data).
-! Under stress control (ld_motion_solve_stress; doc/METHOD.md §7.3) the step's rate is an unknown:
+! Under stress control (ld_motion_solve_stress; doc/METHOD.md §7.4) the step's rate is an unknown:
 ! the step is affine in it, so two solves with the same matrix (the rate-independent part and the
 ! part per unit rate) and one scalar equation give it.
 #include <petsc/finclude/petscksp.h>
@@ -52,7 +52,7 @@ contains
     call lubrication_dynamics_hydrodynamics(ld, parts, lubrication)
   end subroutine ld_motion_solve
 
-  !> Stress control (doc/METHOD.md §7.3): the rate gamma_dot of this step such that the mean shear
+  !> Stress control (doc/METHOD.md §7.4): the rate gamma_dot of this step such that the mean shear
   !> stress of the configuration, eta gamma_dot + Sigma^h_xy + Sigma^c_xy as mod_rheology weighs it
   !> (rheo_particle_shear_stress), equals stress; then the spheres' velocities and hydrodynamics at
   !> that rate, as ld_motion_solve leaves them. Free or frozen spheres. Within a step everything

@@ -153,7 +153,7 @@ contains
     ierr = 0
     ts%failure = ''
     ! the imposed rate of this step, gamma_dot(t_n), in every piece that uses it (stress control:
-    ! the last step's, until the particle solve has found this step's; doc/METHOD.md §7.3)
+    ! the last step's, until the particle solve has found this step's; doc/METHOD.md §7.4)
     call shear_protocol_begin_step(ts%protocol)
     if (shear_protocol_varies(ts%protocol)) call impose_rate(ts)
     stress_control = ts%protocol%control == CONTROL_STRESS
@@ -162,7 +162,7 @@ contains
       PetscCall(fluid_step(ts%grid, ts%fluid, ierr))
       if (stress_control) then
         ! the walls' speed that sets the mean wall stress to the target: the step plus the
-        ! multiple of its unit response that makes up the difference (doc/METHOD.md §7.3)
+        ! multiple of its unit response that makes up the difference (doc/METHOD.md §7.4)
         associate(fl => ts%fluid, unit => ts%fluid_response)
           PetscCall(fluid_add_response(ts%grid, fl, unit, (ts%protocol%stress - 0.5_dp * (fl%tau_bottom + fl%tau_top)) / (0.5_dp * (unit%tau_bottom + unit%tau_top)), ierr))
           rate = 2.0_dp * fl%wall_speed / ts%box(2)
@@ -217,11 +217,11 @@ contains
         ! lubrication dynamics: the 6N Stokes balance of the spheres alone (one-body drag in the
         ! imposed flow, the pair and wall links, the contacts), then their hydrodynamic force,
         ! torque and stresslet (doc/METHOD.md §6); under stress control with the rate that sets the
-        ! mean shear stress, which every piece then takes (§7.3)
+        ! mean shear stress, which every piece then takes (§7.4)
         if (stress_control) then
           rate = ts%protocol%rate
           PetscCall(ld_motion_solve_stress(ts%ld, ts%ld_solver, parts, ts%protocol%stress, rate, reached, ierr, rheology=ts%rheology, lubrication=ts%lubrication, contacts=ts%contacts))
-          ! the strain and the offset advance with the spheres' Adams-Bashforth step (§7.3)
+          ! the strain and the offset advance with the spheres' Adams-Bashforth step (§7.4)
           if (parts%have_prev) then
             call shear_protocol_set_rate(ts%protocol, rate, reached, 1.5_dp * rate - 0.5_dp * ts%protocol%rate)
           else
@@ -253,7 +253,8 @@ contains
       call shear_protocol_end_step(ts%protocol)
       if (le%active) then
         ! the boundary slides on (by the strain of the step, exactly: an oscillation's offset is
-        ! gamma(t_{n+1}) Ly, stress control's the strain its spheres advanced, §7.3); spheres that left through y = 0 or Ly re-enter from the image
+        ! gamma(t_{n+1}) Ly, stress control's the strain its spheres advanced, §7.4); spheres
+        ! that left through y = 0 or Ly re-enter from the image
         if (ts%protocol%kind == PROTOCOL_OSCILLATORY .or. stress_control) then
           call le_set_strain(le, ts%protocol%strain)
         else

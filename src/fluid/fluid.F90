@@ -317,7 +317,7 @@ contains
     PetscCall(diagnostics(grid, fl, ierr))
   end subroutine fluid_step
 
-  ! Stress control of the pure fluid (doc/METHOD.md §7.3): the step is affine in the wall speed U_w
+  ! Stress control of the pure fluid (doc/METHOD.md §7.4): the step is affine in the wall speed U_w
   ! (it enters the right-hand side of step 1 and the wall stresses only, linearly), so what one unit
   ! of U_w adds to any step of the run is one step of the same fluid from rest without forcing, the
   ! walls at -+1. fl: a fluid made by fluid_create for this run; it is set so and takes that step,

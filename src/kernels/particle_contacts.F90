@@ -280,7 +280,7 @@ contains
   !> the step's links); rate_before: the last step's rate, that of the images' velocities U^{n-1}
   !> in the Adams-Bashforth term (X^{n+1} - X^n = c_now U^n + c_before U^{n-1}; an image moves
   !> with the boundary's offset, which advances at c_now rate + c_before rate_before). A
-  !> stress-controlled step (doc/METHOD.md §7.3) calls it between particle_contacts_step, whose
+  !> stress-controlled step (doc/METHOD.md §7.4) calls it between particle_contacts_step, whose
   !> explicit forces keep the rate they were evaluated with (the last step's), and the particle
   !> solve, whose implicit part (particle_contacts_add_stiffness, particle_contacts_implicit_update)
   !> is then affine in the rate.

@@ -444,7 +444,7 @@ contains
 
   !> The particle shear stress Sigma^h_xy + Sigma^c_xy of one configuration, exactly as rheo_sample
   !> weighs it (the core's w_i, 1 across Lees-Edwards boundaries; the same order of summation):
-  !> what a stress-controlled step (doc/METHOD.md §7.3) sets, with the solvent's eta gamma_dot, to
+  !> what a stress-controlled step (doc/METHOD.md §7.4) sets, with the solvent's eta gamma_dot, to
   !> the target stress. stresslet: (3, 3, n) the sum of each sphere's hydrodynamic and contact stresslets.
   pure real(dp) function rheo_particle_shear_stress(r, position, stresslet) result(sxy)
     type(rheology_t), intent(in) :: r

@@ -9,7 +9,7 @@
 !                whole steps flips after exactly G/(|rate| dt) steps despite round-off)
 !   oscillatory  gamma(t) = gamma_0 sin(omega t), gamma_dot(t) = gamma_0 omega cos(omega t),
 !                omega = 2 pi/T; the strain is gamma(t) itself, evaluated, not summed
-! Stress control (control = 'stress', doc/INPUT.md "&shear", doc/METHOD.md §7.3; steady only): the
+! Stress control (control = 'stress', doc/INPUT.md "&shear", doc/METHOD.md §7.4; steady only): the
 ! rate of a step is not a function of time but the solution of the step's stress balance, which the
 ! step solves and sets here (shear_protocol_set_rate) before the strain is integrated with it; until
 ! then p%rate holds the last step's rate (the one the previous velocities went with).
@@ -139,7 +139,7 @@ contains
   !> dt (3/2 U^n - 1/2 U^{n-1}), so the affine part of their motion, and with it the Lees-Edwards
   !> offset, advances at 3/2 gamma_dot^n - 1/2 gamma_dot^{n-1} (gamma_dot^n on a step by forward
   !> Euler); under a rate that jumps from step to step any other offset would shear the pairs
-  !> across the boundary against the bulk (doc/METHOD.md §7.3).
+  !> across the boundary against the bulk (doc/METHOD.md §7.4).
   pure subroutine shear_protocol_set_rate(p, rate, stress, advance)
     type(shear_protocol_t), intent(inout) :: p
     real(dp), intent(in) :: rate, stress, advance

@@ -132,7 +132,7 @@ program fdsusp
     PetscCallA(grid_create(cfg, grid, ierr))
     PetscCallA(fluid_create(cfg, grid, fl, ierr))
     if (cfg%shear%control == 'stress') then
-      ! stress control (doc/METHOD.md §7.3): a second fluid, one step from rest with walls at -+1
+      ! stress control (doc/METHOD.md §7.4): a second fluid, one step from rest with walls at -+1
       allocate(fl_unit)
       PetscCallA(fluid_create(cfg, grid, fl_unit, ierr))
       PetscCallA(fluid_unit_response(grid, fl_unit, ierr))

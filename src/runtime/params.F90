@@ -768,7 +768,7 @@ contains
     end if
   end subroutine validate_shear
 
-  ! Stress control (doc/INPUT.md "&shear", doc/METHOD.md §7.3): a non-zero stress, a steady
+  ! Stress control (doc/INPUT.md "&shear", doc/METHOD.md §7.4): a non-zero stress, a steady
   ! protocol, lubrication dynamics or the DNS's fluid alone, a stress to measure (spheres or walls) with the statistics'
   ! weights (&rheology), spheres that move freely; &shear rate stays the unit (positive).
   subroutine validate_stress_control(cfg)
@@ -789,7 +789,7 @@ contains
     if (cfg%resolved .and. cfg%fluid%viscous_theta /= 1.0_dp) call input_error(cfg%deck_file, 'fluid', &
          'viscous_theta', 'must be 1 (backward Euler) with &shear control = ''stress'': the wall speed jumps each '// &
          'step, and the Crank-Nicolson response of the wall cells to a jump overshoots (a wall stress that falls as '// &
-         'the wall speeds up), which the stress balance amplifies (doc/METHOD.md §7.3)')
+         'the wall speeds up), which the stress balance amplifies (doc/METHOD.md §7.4)')
     if (.not. (cfg%walls .or. cfg%lees_edwards)) call input_error(cfg%deck_file, 'shear', 'control', &
          '''stress'' needs a sheared box (y_boundary = ''walls'' or ''lees-edwards''): a periodic box in y has '// &
          'no shear stress to control')
