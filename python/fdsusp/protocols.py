@@ -29,14 +29,14 @@ class NoProtocol(ValueError):
 
 
 def settings(outdir):
-    """The protocol of a run from its series attributes: {'protocol': 'steady'|'reversal'|'oscillatory',
+    """The protocol of a run from its series attributes: {'protocol': 'steady'|'reversal'|'oscillatory'|'steps',
     'reference_rate', 'reversal_strain', 'strain_amplitude', 'period', 'dt', 'control': 'rate'|'stress',
     'stress'} (a steady protocol records them under stress control only)."""
     _, attributes = series.read(outdir, ['shear/rate'])
     a = series.settings(attributes)
     if 'shear_protocol' not in a:
         raise NoProtocol(f'{outdir}: the series records no varying protocol (&shear protocol steady?)')
-    kind = {1: 'steady', 2: 'reversal', 3: 'oscillatory'}[int(a['shear_protocol'])]
+    kind = {1: 'steady', 2: 'reversal', 3: 'oscillatory', 4: 'steps'}[int(a['shear_protocol'])]
     control = {1: 'rate', 2: 'stress'}[int(a.get('shear_control', 1))]
     return {'protocol': kind, 'reference_rate': a['shear_reference_rate'], 'reversal_strain': a['shear_reversal_strain'],
             'strain_amplitude': a['shear_strain_amplitude'], 'period': a['shear_period'], 'dt': a['shear_dt'],

@@ -175,6 +175,11 @@ contains
       return
     end if
     associate(parts => ts%parts, le => ts%le)
+      ! a reversal (or a change of level of 'steps') is a jump of the rate: the Adams-Bashforth
+      ! extrapolation across it would carry the old rate on, so the step after it starts afresh
+      ! (Euler, as the first step does), and so does the implicit contacts' prediction of the
+      ! motion (particle_contacts_add_stiffness), set from the same flag
+      if (ts%protocol%reversed) parts%have_prev = .false.
       if (associated(ts%contacts)) then
         ! contacts at X^n with the latest velocities (those of the previous step)
         PetscCall(stage_push(STAGE_CONTACTS, ierr))
@@ -246,9 +251,6 @@ contains
         end if
       end if
       ts%position_before = parts%position
-      ! a reversal is a jump of the rate: the Adams-Bashforth extrapolation across it would carry
-      ! the old direction on, so the step after it starts afresh (Euler, as the first step does)
-      if (ts%protocol%reversed) parts%have_prev = .false.
       call advance_positions(parts, ts%dt, ts%box, [.true., .not. (ts%walls .or. le%active), .true.])
       call shear_protocol_end_step(ts%protocol)
       if (le%active) then

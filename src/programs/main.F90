@@ -34,6 +34,7 @@ program fdsusp
   use mod_rheology, only: rheology_t, rheo_create
   use mod_lees_edwards, only: lees_edwards_t, le_create
   use mod_shear_protocol, only: shear_protocol_t, shear_protocol_create, shear_protocol_kind, shear_protocol_varies, &
+                                PROTOCOL_STEPS, &
                                 shear_protocol_begin_at
   use mod_fictitious_domain, only: fictitious_domain_t, fictitious_domain_create, fictitious_domain_destroy, &
                                    fictitious_domain_pair_lag_limit, fictitious_domain_stresslet_lag_limit
@@ -105,7 +106,19 @@ program fdsusp
   ! the imposed shear as a function of time (doc/INPUT.md "&shear"); the pieces below are made with
   ! its reference rate, the rate at t = 0, and the step gives them the rate of each step
   ! (stress control: the reference rate is the unit, and each step solves for its own rate)
-  if (cfg%shear%control == 'stress') then
+  if (cfg%shear%protocol == 'steps') then
+    associate(n => cfg%shear%levels)
+      if (cfg%shear%control == 'stress') then
+        protocol = shear_protocol_create(PROTOCOL_STEPS, cfg%shear%rate, cfg%time%dt, 0.0_dp, 0.0_dp, 0.0_dp, &
+                                         0.0_dp, cfg%shear%step_at(1:n), cfg%shear%step_level(1:n), &
+                                         cfg%shear%step_by == 'strain')
+      else
+        protocol = shear_protocol_create(PROTOCOL_STEPS, cfg%shear%rate, cfg%time%dt, 0.0_dp, 0.0_dp, 0.0_dp, &
+                                         step_at=cfg%shear%step_at(1:n), step_level=cfg%shear%step_level(1:n), &
+                                         by_strain=cfg%shear%step_by == 'strain')
+      end if
+    end associate
+  else if (cfg%shear%control == 'stress') then
     protocol = shear_protocol_create(shear_protocol_kind(cfg%shear%protocol), cfg%shear%rate, cfg%time%dt, &
                                      cfg%shear%reversal_strain, cfg%shear%strain_amplitude, cfg%shear%period, &
                                      cfg%shear%stress)

@@ -168,6 +168,21 @@ cases = [
      ['bad.nml', '&shear', 'control', '&rheology']),
     ('stress control with a zero reference rate', LDS + "&rheology /\n&shear control = 'stress', stress = 2, rate = 0 /\n",
      [], ['bad.nml', '&shear', 'rate', '> 0']),
+    # steps of rate or stress (protocol 'steps')
+    ('steps without levels', GOOD + "&shear protocol = 'steps' /\n", [], ['bad.nml', '&shear', 'levels', '2 ..']),
+    ('step_at without steps', GOOD + "&shear step_at = 0, 1 /\n", [], ['bad.nml', '&shear', 'step_at', "'steps'"]),
+    ('first step not at 0', GOOD + "&shear protocol = 'steps', levels = 2, step_at = 0.5, 1, step_level = 1, 2 /\n", [],
+     ['bad.nml', '&shear', 'step_at(1)', 'must be 0']),
+    ('steps not increasing', GOOD + "&shear protocol = 'steps', levels = 2, step_at = 0, 0, step_level = 1, 2 /\n", [],
+     ['bad.nml', '&shear', 'step_at(2)', 'one step']),
+    ('a level at rest counted in strain', GOOD + "&shear protocol = 'steps', levels = 2, step_at = 0, 1, "
+     "step_level = 0, 2 /\n", [], ['bad.nml', '&shear', 'step_level(1)', 'never reaches']),
+    ('more step values than levels', GOOD + "&shear protocol = 'steps', levels = 2, step_at = 0, 1, 2, "
+     "step_level = 1, 2 /\n", [], ['bad.nml', '&shear', 'step_at', 'more values than levels']),
+    ('unknown step_by', GOOD + "&shear protocol = 'steps', step_by = 'steps', levels = 2, step_at = 0, 1, "
+     "step_level = 1, 2 /\n", [], ['bad.nml', '&shear', 'step_by', "'time'"]),
+    ('a stress with stress steps', LDS + "&rheology /\n&shear control = 'stress', stress = 2, protocol = 'steps', "
+     "levels = 2, step_at = 0, 1, step_level = 1, 2 /\n", [], ['bad.nml', '&shear', 'stress', 'step_level']),
     ('stress control of prescribed spheres', LDS.replace('1.6, 1.6, 1.6 /', "1.6, 1.6, 1.6, motion = 'prescribed' /")
      + "&rheology /\n&shear control = 'stress', stress = 2 /\n", [], ['bad.nml', '&particles', 'motion', "'stress'"]),
     ('unknown protocol', GOOD + "&shear protocol = 'creep' /\n", [], ['bad.nml', '&shear', 'protocol', 'creep']),

@@ -14,7 +14,10 @@ steady runs). Cases, each stopped in the middle of what the protocol does:
   200 against 100 + 100: the rate the restarted step solves for starts its solves from the
   checkpoint's velocities and rate, as the uninterrupted step does; and of the pure fluid in the
   DNS on 2 ranks (stress 2.5 from rest), 60 against 30 + 30: the unit wall-speed response is made
-  again at the restart, the same.
+  again at the restart, the same;
+- steps of the stress by time in lubrication dynamics (8, 12, 6 from t = 0, 0.3, 0.7: steps 61
+  and 141), 200 against 100 + 100: the level of the last step is in the checkpoint (as the
+  reversals are), so the restarted step sees no spurious jump.
 A branch (-branch) starts the deck's protocol afresh from the checkpoint's configuration: after a
 steady pre-shear of 100 steps in lubrication dynamics (Lees-Edwards), a reversal every 0.25 strain
 flips at the steps 50, 100, 150 after the branch, and both it and an oscillation continue the
@@ -61,6 +64,8 @@ STRESS = """&domain box = 8.0, 8.0, 8.0, y_boundary = 'lees-edwards' /
 &contact roughness = 5.0e-3, friction = 0.5 /
 &rheology discard_strain = 0.0, average_strain = 0.95, blocks = 2 /
 """
+STEPS = STRESS.replace("stress = 8.0", "protocol = 'steps', step_by = 'time', levels = 3, step_at = 0.0, 0.3, 0.7, "
+                       "step_level = 8.0, 12.0, 6.0")
 STRESS_FLUID = """&domain box = 4.0, 4.0, 4.0, cells_per_radius = 2 /
 &shear control = 'stress', stress = 2.5 /
 &fluid reynolds = 0.01, viscous_theta = 1.0 /
@@ -101,6 +106,9 @@ s = split('stress', STRESS, 200)
 T.check(np.all(np.abs(s['shear/stress'] - 8.0) < 1e-12) and np.ptp(s['shear/rate']) > 0,
         'stress control: the stress is 8 at every record, the rate varies (%.3f .. %.3f)'
         % (s['shear/rate'].min(), s['shear/rate'].max()))
+s = split('stress_steps', STEPS, 200)
+T.check(list(s['step'][1:][np.abs(np.diff(s['shear/stress'])) > 1]) == [61, 141],
+        'stress steps: the stress changes at steps 61 and 141, on either side of the restart')
 s = split('stress_fluid', STRESS_FLUID, 60, ranks=2)
 T.check(np.all(np.abs(s['shear/stress'] - 2.5) < 1e-12), 'stress control of the fluid alone: the stress is 2.5 at every record')
 
