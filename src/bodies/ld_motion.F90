@@ -133,8 +133,8 @@ contains
       c_stresslet = contacts%stresslet
       c_added = contacts%stiffness_added
     end if
-    sigma0 = trial(0.0_dp, u0, w0)
-    sigma1 = trial(1.0_dp, u0 + u1, w0 + w1)
+    call at_rate(0.0_dp, u0, w0, sigma0)
+    call at_rate(1.0_dp, u0 + u1, w0 + w1, sigma1)
     slope = sigma1 - sigma0
     if (.not. (slope > 0.0_dp)) then
       write(text, '(a,es12.4,a)') 'fdsusp: fatal: stress control: the mean shear stress does not grow with the rate '// &
@@ -142,7 +142,7 @@ contains
       call fatal_error(text, 4)
     end if
     rate = (stress - sigma0) / slope
-    reached = trial(rate, u0 + rate * u1, w0 + rate * w1)
+    call at_rate(rate, u0 + rate * u1, w0 + rate * w1, reached)
 
   contains
 
@@ -160,10 +160,13 @@ contains
       if (present(contacts)) call particle_contacts_set_rate(contacts, r, rate_before)
     end subroutine set_rate
 
-    ! the velocities U, Omega (3, n) at rate r, their contact and hydrodynamic force, torque,
-    ! stresslet (as ld_motion_solve leaves them), and the mean shear stress they give
-    real(dp) function trial(r, u, w) result(sigma)
+    ! the step at rate r with the velocities U, Omega (3, n): every rate-dependent datum, the
+    ! spheres' velocities, their contact and hydrodynamic force, torque, stresslet (as
+    ! ld_motion_solve leaves them; the contacts' step forces restored first), and sigma, the mean
+    ! shear stress they give
+    subroutine at_rate(r, u, w, sigma)
       real(dp), intent(in) :: r, u(:, :), w(:, :)
+      real(dp), intent(out) :: sigma
       call set_rate(r)
       parts%velocity = u
       parts%omega = w
@@ -182,7 +185,7 @@ contains
       else
         sigma = ld%viscosity * r + rheo_particle_shear_stress(rheology, parts%position, parts%stresslet_hydro)
       end if
-    end function trial
+    end subroutine at_rate
   end subroutine ld_motion_solve_stress
 
 end module mod_ld_motion

@@ -813,7 +813,8 @@ contains
         call check_real(cfg, 'shear', trim(name), sh%step_level(k), -bound, bound)
         if (sh%step_by == 'strain' .and. sh%step_level(k) == 0.0_dp) call input_error(cfg%deck_file, 'shear', &
              trim(name), 'is 0, and a level at rest never reaches the next strain: step_by = ''time'' allows it')
-        if (k == 1) cycle
+      end do
+      do k = 2, sh%levels
         write(name, '(a,i0,a)') 'step_at(', k, ')'
         per_step = cfg%time%dt
         if (sh%step_by == 'strain' .and. sh%control == 'rate') per_step = abs(sh%step_level(k - 1)) * cfg%time%dt
