@@ -19,6 +19,9 @@ A. Lubrication dynamics, 49 rough frictional spheres (phi 0.4, eps_r 5e-3, mu_d 
       stress grows nearly in proportion to the rate: eta_r changes little over the few percent
       that S is uncertain). Measured: S = 10.18 +- 0.41, mean rate 1.029 +- 0.047 (0.16 of the
       tolerance 0.19; the rate itself ranges over 0.39 .. 2.39 from step to step).
+C. Lubrication dynamics between walls (phi 0.35, 150 steps), stress 5: the stress is 5 at every
+   record (the walls' terms, wall lubrication and wall contacts, are affine in the rate too, to
+   1e-12), and the run on 2 ranks (lubrication links shared out, gathered) is the run on 1, bitwise.
 B. DNS, the fluid alone between walls (4a cube, a/Delta = 2, Re 0.01, backward Euler, dt 0.01,
    from rest), stress 2.5: the mean wall stress is 2.5 at every record (to 1e-12: the step plus a
    multiple of its unit wall-speed response), both walls alike (the flow is antisymmetric), and
@@ -93,6 +96,23 @@ p = subprocess.run([sys.executable, os.path.join(T.ROOT, 'scripts', 'rheology.py
                    capture_output=True, text=True)
 T.check(p.returncode == 0 and 'agrees to 1e-10' in p.stdout,
         'scripts/rheology.py reproduces summary.json of the stress-controlled run (stresses over gamma_dot_ref)')
+
+# C. lubrication dynamics between walls, on 1 and 2 ranks
+WALLS = LD.replace("y_boundary = 'lees-edwards'", "y_boundary = 'walls'").replace('steps = 3000', 'steps = 150') \
+    .replace('solid_fraction = 0.4, seed = 1', 'solid_fraction = 0.35, seed = 4') \
+    .replace('discard_strain = 1.0, average_strain = 14.0, blocks = 7', 'discard_strain = 0.0, average_strain = 0.7, blocks = 2')
+w = {}
+for ranks in (1, 2):
+    w[ranks] = T.scratch('protocol_stress_walls_%d' % ranks)
+    T.run(T.write_deck(w[ranks], 'walls.nml', WALLS.format(shear="control = 'stress', stress = 5.0", out='walls')),
+          w[ranks], np_ranks=ranks)
+s = T.series(os.path.join(w[1], 'walls'))
+miss = max(np.max(np.abs(s['shear/stress'] - 5.0)),
+           np.max(np.abs(s['shear/rate'] + s['core/stress_hydro'][:, 3] + s['core/stress_contact'][:, 3] - 5.0))) / 5.0
+T.check(miss < 1e-12 and np.any(s['contacts_wall'] > 0) and np.all(s['lubrication_walls'] > 0),
+        'walls: the stress is 5 at every record, wall contacts and wall lubrication in the step (%.1e)' % miss)
+T.compare_h5(os.path.join(w[1], 'walls', 'series.h5'), os.path.join(w[2], 'walls', 'series.h5'),
+             'walls: 2 ranks (the links shared out) against 1', rtol=0, skip=('wall_time',))
 
 # B. the fluid alone between walls
 FLUID = """&domain box = 4.0, 4.0, 4.0, cells_per_radius = 2 /
