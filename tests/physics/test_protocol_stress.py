@@ -12,7 +12,9 @@ A. Lubrication dynamics, 49 rough frictional spheres (phi 0.4, eps_r 5e-3, mu_d 
    3. the strain advances with the spheres' Adams-Bashforth step, dt (3/2 gamma_dot^n -
       1/2 gamma_dot^{n-1}) (forward Euler on the first step), and the Lees-Edwards offset is that
       strain times Ly modulo Lx (to 1e-12 a);
-   4. scripts/rheology.py redoes its summary from series.h5 (stresses over gamma_dot_ref, as for
+   4. fdsusp.protocols.stress_control_rate takes the mean rate over the summary's blocks as the
+      test does (to 1e-12), and the viscosity S/<rate>;
+      scripts/rheology.py redoes its summary from series.h5 (stresses over gamma_dot_ref, as for
       any rate that varies) and agrees with summary.json;
    5. the mean rate over the same window gives back the imposed rate 1 within 3 combined standard
       errors: its own block error, and the error of S carried into the rate, err(S)/S (the
@@ -82,6 +84,11 @@ miss = np.max(np.minimum(gap, LY - gap))
 T.check(miss < 1e-12, 'the Lees-Edwards offset is the strain times Ly (%.1e a)' % miss)
 
 mean, err = block_mean(rate[s['step'] > DISCARD])
+v = protocols.stress_control_rate(os.path.join(d, 'stress'))
+T.check(v['blocks'] == BLOCKS and abs(v['rate'] - mean) < 1e-12 and abs(v['rate_error'] - err) < 1e-12
+        and abs(v['viscosity'] - S / mean) < 1e-12 * S,
+        'fdsusp.protocols.stress_control_rate: the mean rate %.4f +- %.4f over the 7 blocks, eta = S/rate %.3f'
+        % (v['rate'], v['rate_error'], v['viscosity']))
 tolerance = 3.0 * np.hypot(err, S_err / S)
 print('S = %.4f +- %.4f; stress control at S: mean rate %.4f +- %.4f (rate range %.3f .. %.3f)'
       % (S, S_err, mean, err, rate.min(), rate.max()))
