@@ -14,6 +14,7 @@ the hydrodynamic shear stress here. Stresses are returned in units of eta*|refer
     r = protocols.reversal_transient('out/rev')        # strain since reversal, mean and error
     m = protocols.oscillation_moduli('out/osc')        # G', G'' (harmonics 1 and 3), per period
     d = protocols.stroboscopic_msd('out/osc')          # <|dx|^2> between cycles
+    v = protocols.stress_control_rate('out/stress')     # mean rate and S/<rate> under stress control
 """
 import math
 
@@ -29,15 +30,18 @@ class NoProtocol(ValueError):
 
 
 def settings(outdir):
-    """The protocol of a run from its series attributes: {'protocol': 'reversal'|'oscillatory',
-    'reference_rate', 'reversal_strain', 'strain_amplitude', 'period', 'dt'}."""
+    """The protocol of a run from its series attributes: {'protocol': 'steady'|'reversal'|'oscillatory'|'steps',
+    'reference_rate', 'reversal_strain', 'strain_amplitude', 'period', 'dt', 'control': 'rate'|'stress',
+    'stress'} (a steady protocol records them under stress control only)."""
     _, attributes = series.read(outdir, ['shear/rate'])
     a = series.settings(attributes)
     if 'shear_protocol' not in a:
         raise NoProtocol(f'{outdir}: the series records no varying protocol (&shear protocol steady?)')
-    kind = {2: 'reversal', 3: 'oscillatory'}[int(a['shear_protocol'])]
+    kind = {1: 'steady', 2: 'reversal', 3: 'oscillatory', 4: 'steps'}[int(a['shear_protocol'])]
+    control = {1: 'rate', 2: 'stress'}[int(a.get('shear_control', 1))]
     return {'protocol': kind, 'reference_rate': a['shear_reference_rate'], 'reversal_strain': a['shear_reversal_strain'],
-            'strain_amplitude': a['shear_strain_amplitude'], 'period': a['shear_period'], 'dt': a['shear_dt']}
+            'strain_amplitude': a['shear_strain_amplitude'], 'period': a['shear_period'], 'dt': a['shear_dt'],
+            'control': control, 'stress': a.get('shear_stress', 0.0)}
 
 
 def stresses(columns):
@@ -190,3 +194,35 @@ def stroboscopic_msd(outdir, box, lees_edwards=True, threshold=None):
             moved.append(float(np.mean(np.sqrt(r2) > threshold)))
     return {'cycles': np.rint(k[at_phase]).astype(int), 'msd': np.array(msd),
             'moved': np.array(moved) if threshold is not None else None}
+
+
+def stress_control_rate(outdir):
+    """The mean rate of a stress-controlled run (&shear control = 'stress', doc/RHEOLOGY.md "Stress
+    control") over its &rheology window, as the summary takes its blocks (the records on the
+    series_every grid after discard_step, `blocks` blocks of block_steps steps, the complete ones):
+    {'stress': S, 'rate': mean of the block means of shear/rate, 'rate_error': their standard
+    deviation (ddof 1) / sqrt(blocks), 'viscosity': S / rate, 'viscosity_error': S rate_error /
+    rate^2, 'blocks': the complete blocks}, in units of gamma_dot_ref and eta. Stress steps are not
+    averaged here (NoProtocol)."""
+    columns, attributes = series.read(outdir, ['step', 'shear/rate'])
+    a = series.settings(attributes)
+    if int(a.get('shear_control', 1)) != 2 or int(a.get('shear_protocol', 1)) != 1:
+        raise NoProtocol(f'{outdir}: not a steady stress-controlled run (&shear control = \'stress\')')
+    step = np.rint(columns['step']).astype(np.int64)
+    blocks, discard, block_steps = int(a['blocks']), int(a['discard_step']), int(a['block_steps'])
+    every = int(a['series_every'])
+    block = np.where((step > discard) & (step % every == 0), (step - discard - 1) // block_steps, -1)
+    block[block >= blocks] = -1
+    last_step = int(step.max())
+    complete = 0
+    for b in range(1, blocks + 1):
+        if discard + b * block_steps <= last_step and np.any(block == b - 1):
+            complete = b
+    if complete < 2:
+        raise ValueError(f'{outdir}: fewer than 2 complete blocks of the &rheology window')
+    means = np.array([columns['shear/rate'][block == b].mean() for b in range(complete)])
+    rate = means.mean()
+    error = means.std(ddof=1) / math.sqrt(complete)
+    stress = a['shear_stress']
+    return {'stress': stress, 'rate': rate, 'rate_error': error, 'viscosity': stress / rate,
+            'viscosity_error': stress * error / rate ** 2, 'blocks': complete}

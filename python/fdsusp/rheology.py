@@ -95,9 +95,11 @@ def quantities(m, shear_rate, fixed_rate=None):
 
 
 def _fixed_rate(a):
-    """|reference rate| when the run's protocol varies the rate (series attribute shear_protocol),
-    else None: the summary's stresses are then over it (doc/RHEOLOGY.md "Protocols")."""
-    return abs(a['shear_rate']) if a.get('shear_protocol', 1) > 1 else None
+    """|reference rate| when the run's rate varies (series attribute shear_protocol: a reversal or an
+    oscillation; shear_control 2: stress control), else None: the summary's stresses are then over
+    it (doc/RHEOLOGY.md "Protocols")."""
+    varies = a.get('shear_protocol', 1) > 1 or a.get('shear_control', 1) == 2
+    return abs(a['shear_rate']) if varies else None
 
 
 def species_quantities(m, ms):

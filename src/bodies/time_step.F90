@@ -18,7 +18,7 @@ module mod_time_step
   use mod_errors, only: log_line, report_limits
   use mod_contact, only: overlap_limit, wall_lower, wall_upper
   use mod_grid, only: grid_t
-  use mod_fluid, only: fluid_t, fluid_step, fluid_mean_profile
+  use mod_fluid, only: fluid_t, fluid_step, fluid_mean_profile, fluid_add_response
   use mod_timers, only: stage_push, stage_pop, STAGE_FLUID, STAGE_PARTICLES, STAGE_CONTACTS, STAGE_LUBRICATION
   use mod_particles, only: particles_t, advance_positions, displacements
   use mod_particle_contacts, only: particle_contacts_t, particle_contacts_step
@@ -26,12 +26,12 @@ module mod_time_step
   use mod_rheology, only: rheology_t, rheo_sample, rheo_sample_flow
   use mod_lees_edwards, only: lees_edwards_t, le_wrap, le_advance, le_set_strain
   use mod_shear_protocol, only: shear_protocol_t, shear_protocol_begin_step, shear_protocol_end_step, &
-                                shear_protocol_varies, PROTOCOL_OSCILLATORY
+                                shear_protocol_varies, shear_protocol_set_rate, PROTOCOL_OSCILLATORY, CONTROL_STRESS
   use mod_lubrication_dynamics, only: lubrication_dynamics_t
   use mod_fictitious_domain, only: fictitious_domain_t, fictitious_domain_geometry, fictitious_domain_follow, &
                                    fictitious_domain_moments, fictitious_domain_solve_motion, fictitious_domain_update
   use mod_lubrication_links, only: lubrication_links_evaluate
-  use mod_ld_motion, only: ld_motion_solve
+  use mod_ld_motion, only: ld_motion_solve, ld_motion_solve_stress
   use mod_particle_solver, only: particle_solver_t
   implicit none
   private
@@ -62,6 +62,7 @@ module mod_time_step
     integer :: largest_overlap_step = 0
     type(grid_t), pointer :: grid => null()
     type(fluid_t), pointer :: fluid => null()
+    type(fluid_t), pointer :: fluid_response => null()   ! stress control: the step per unit wall speed
     type(fictitious_domain_t), pointer :: fd => null()
     type(particles_t), pointer :: parts => null()
     type(particle_contacts_t), pointer :: contacts => null()
@@ -84,7 +85,7 @@ contains
   ! Options: -fd_carry_lambda, -fault_nan_step. Collective (resolved: the geometry of X^n is built
   ! here).
   subroutine time_step_create(ts, dt, box, walls, le, protocol, ierr, grid, fluid, fd, parts, ld, ld_solver, &
-                              contacts, lubrication, rheology)
+                              contacts, lubrication, rheology, fluid_response)
     type(time_step_t), intent(out) :: ts
     real(dp), intent(in) :: dt, box(3)
     logical, intent(in) :: walls
@@ -93,6 +94,7 @@ contains
     PetscErrorCode, intent(out) :: ierr
     type(grid_t), target, intent(in), optional :: grid
     type(fluid_t), target, intent(in), optional :: fluid
+    type(fluid_t), target, intent(in), optional :: fluid_response
     type(fictitious_domain_t), target, intent(in), optional :: fd
     type(particles_t), target, intent(in), optional :: parts
     type(lubrication_dynamics_t), target, intent(in), optional :: ld
@@ -114,6 +116,7 @@ contains
     ts%protocol => protocol
     if (present(grid)) ts%grid => grid
     if (present(fluid)) ts%fluid => fluid
+    if (present(fluid_response)) ts%fluid_response => fluid_response
     if (present(fd)) ts%fd => fd
     if (present(parts)) ts%parts => parts
     if (present(ld)) ts%ld => ld
@@ -145,20 +148,38 @@ contains
     integer, intent(in) :: step
     PetscErrorCode, intent(out) :: ierr
     integer :: info
+    real(dp) :: rate, reached
+    logical :: stress_control
     ierr = 0
     ts%failure = ''
-    ! the imposed rate of this step, gamma_dot(t_n), in every piece that uses it
+    ! the imposed rate of this step, gamma_dot(t_n), in every piece that uses it (stress control:
+    ! the last step's, until the particle solve has found this step's; doc/METHOD.md §7.4)
     call shear_protocol_begin_step(ts%protocol)
     if (shear_protocol_varies(ts%protocol)) call impose_rate(ts)
+    stress_control = ts%protocol%control == CONTROL_STRESS
     if (ts%variant == TIME_STEP_FLUID) then
       PetscCall(stage_push(STAGE_FLUID, ierr))
       PetscCall(fluid_step(ts%grid, ts%fluid, ierr))
+      if (stress_control) then
+        ! the walls' speed that sets the mean wall stress to the target: the step plus the
+        ! multiple of its unit response that makes up the difference (doc/METHOD.md §7.4)
+        associate(fl => ts%fluid, unit => ts%fluid_response)
+          PetscCall(fluid_add_response(ts%grid, fl, unit, (ts%protocol%stress - 0.5_dp * (fl%tau_bottom + fl%tau_top)) / (0.5_dp * (unit%tau_bottom + unit%tau_top)), ierr))
+          rate = 2.0_dp * fl%wall_speed / ts%box(2)
+          call shear_protocol_set_rate(ts%protocol, rate, 0.5_dp * (fl%tau_bottom + fl%tau_top), rate)
+        end associate
+      end if
       PetscCall(stage_pop(ierr))
       call shear_protocol_end_step(ts%protocol)
       call count_step(ts, step)
       return
     end if
     associate(parts => ts%parts, le => ts%le)
+      ! a reversal (or a change of level of 'steps') is a jump of the rate: the Adams-Bashforth
+      ! extrapolation across it would carry the old rate on, so the step after it starts afresh
+      ! (Euler, as the first step does), and so does the implicit contacts' prediction of the
+      ! motion (particle_contacts_add_stiffness), set from the same flag
+      if (ts%protocol%reversed) parts%have_prev = .false.
       if (associated(ts%contacts)) then
         ! contacts at X^n with the latest velocities (those of the previous step)
         PetscCall(stage_push(STAGE_CONTACTS, ierr))
@@ -170,7 +191,12 @@ contains
         end if
       end if
       if (associated(ts%lubrication)) then
-        ! the lubrication links at X^n, taken implicitly in the particle problem below
+        ! the lubrication links at X^n, taken implicitly in the particle problem below (stress
+        ! control: their drives per unit rate, which the particle solve scales)
+        if (stress_control) then
+          ts%lubrication%shear_rate = 1.0_dp
+          ts%lubrication%le%shear_rate = 1.0_dp
+        end if
         PetscCall(stage_push(STAGE_LUBRICATION, ierr))
         PetscCall(lubrication_links_evaluate(ts%lubrication, parts%position, ierr, le%offset))
         PetscCall(stage_pop(ierr))
@@ -195,8 +221,21 @@ contains
         PetscCall(stage_push(STAGE_PARTICLES, ierr))
         ! lubrication dynamics: the 6N Stokes balance of the spheres alone (one-body drag in the
         ! imposed flow, the pair and wall links, the contacts), then their hydrodynamic force,
-        ! torque and stresslet (doc/METHOD.md §6)
-        PetscCall(ld_motion_solve(ts%ld, ts%ld_solver, parts, ierr, lubrication=ts%lubrication, contacts=ts%contacts))
+        ! torque and stresslet (doc/METHOD.md §6); under stress control with the rate that sets the
+        ! mean shear stress, which every piece then takes (§7.4)
+        if (stress_control) then
+          rate = ts%protocol%rate
+          PetscCall(ld_motion_solve_stress(ts%ld, ts%ld_solver, parts, ts%protocol%stress, rate, reached, ierr, rheology=ts%rheology, lubrication=ts%lubrication, contacts=ts%contacts))
+          ! the strain and the offset advance with the spheres' Adams-Bashforth step (§7.4)
+          if (parts%have_prev) then
+            call shear_protocol_set_rate(ts%protocol, rate, reached, 1.5_dp * rate - 0.5_dp * ts%protocol%rate)
+          else
+            call shear_protocol_set_rate(ts%protocol, rate, reached, rate)
+          end if
+          call impose_rate(ts)
+        else
+          PetscCall(ld_motion_solve(ts%ld, ts%ld_solver, parts, ierr, lubrication=ts%lubrication, contacts=ts%contacts))
+        end if
       end if
       ! the core statistics of this configuration, before it moves on
       if (associated(ts%rheology)) then
@@ -212,15 +251,13 @@ contains
         end if
       end if
       ts%position_before = parts%position
-      ! a reversal is a jump of the rate: the Adams-Bashforth extrapolation across it would carry
-      ! the old direction on, so the step after it starts afresh (Euler, as the first step does)
-      if (ts%protocol%reversed) parts%have_prev = .false.
       call advance_positions(parts, ts%dt, ts%box, [.true., .not. (ts%walls .or. le%active), .true.])
       call shear_protocol_end_step(ts%protocol)
       if (le%active) then
         ! the boundary slides on (by the strain of the step, exactly: an oscillation's offset is
-        ! gamma(t_{n+1}) Ly); spheres that left through y = 0 or Ly re-enter from the image
-        if (ts%protocol%kind == PROTOCOL_OSCILLATORY) then
+        ! gamma(t_{n+1}) Ly, stress control's the strain its spheres advanced, §7.4); spheres
+        ! that left through y = 0 or Ly re-enter from the image
+        if (ts%protocol%kind == PROTOCOL_OSCILLATORY .or. stress_control) then
           call le_set_strain(le, ts%protocol%strain)
         else
           call le_advance(le, ts%dt)

@@ -39,7 +39,7 @@ module mod_fluid
   implicit none
   private
   public :: fluid_t, fluid_create, fluid_step, fluid_destroy, fluid_mean_profile, fluid_columns
-  public :: fluid_options_check, fluid_bench_cold_poisson
+  public :: fluid_options_check, fluid_bench_cold_poisson, fluid_unit_response, fluid_add_response
   integer, parameter :: STAR_HISTORY_FULL = 2   ! u*^n and u*^{n-1} known: extrapolate
 
   type :: fluid_t
@@ -358,6 +358,50 @@ contains
 
     PetscCall(diagnostics(grid, fl, ierr))
   end subroutine fluid_step
+
+  ! Stress control of the pure fluid (doc/METHOD.md §7.4): the step is affine in the wall speed U_w
+  ! (it enters the right-hand side of step 1 and the wall stresses only, linearly), so what one unit
+  ! of U_w adds to any step of the run is one step of the same fluid from rest without forcing, the
+  ! walls at -+1. fl: a fluid made by fluid_create for this run; it is set so and takes that step,
+  ! and then holds the response (u, p^{n+1/2}, phi, u*, the wall stresses). Collective.
+  subroutine fluid_unit_response(grid, fl, ierr)
+    type(grid_t), intent(in) :: grid
+    type(fluid_t), intent(inout) :: fl
+    PetscErrorCode, intent(out) :: ierr
+    integer :: c
+    do c = 1, 3
+      PetscCall(VecSet(fl%vel(c), 0.0_dp, ierr))
+      PetscCall(VecSet(fl%vel_star(c), 0.0_dp, ierr))
+      PetscCall(VecSet(fl%vel_star_old(c), 0.0_dp, ierr))
+      PetscCall(VecSet(fl%forcing(c), 0.0_dp, ierr))
+    end do
+    PetscCall(VecSet(fl%pressure, 0.0_dp, ierr))
+    PetscCall(VecSet(fl%phi, 0.0_dp, ierr))
+    fl%has_forcing = .false.
+    fl%star_history = 0
+    fl%wall_speed = 1.0_dp
+    PetscCall(fluid_step(grid, fl, ierr))
+  end subroutine fluid_unit_response
+
+  ! fl after its step plus factor times the unit response of fluid_unit_response: the step as if
+  ! its walls had moved factor faster (velocity, pressure, increment, provisional velocity, wall
+  ! speed, and the diagnostics, wall stresses included, of the result). Collective.
+  subroutine fluid_add_response(grid, fl, response, factor, ierr)
+    type(grid_t), intent(in) :: grid
+    type(fluid_t), intent(inout) :: fl
+    type(fluid_t), intent(in) :: response
+    real(dp), intent(in) :: factor
+    PetscErrorCode, intent(out) :: ierr
+    integer :: c
+    do c = 1, 3
+      PetscCall(VecAXPY(fl%vel(c), factor, response%vel(c), ierr))
+      PetscCall(VecAXPY(fl%vel_star(c), factor, response%vel_star(c), ierr))
+    end do
+    PetscCall(VecAXPY(fl%pressure, factor, response%pressure, ierr))
+    PetscCall(VecAXPY(fl%phi, factor, response%phi, ierr))
+    fl%wall_speed = fl%wall_speed + factor * response%wall_speed
+    PetscCall(diagnostics(grid, fl, ierr))
+  end subroutine fluid_add_response
 
   ! div of a face field at the cell centres: (u(i+1)-u(i) + v(j+1)-v(j) + w(k+1)-w(k))/h.
   ! With walls, v(n) is the periodic image of v(0) = 0: the top wall.

@@ -66,6 +66,12 @@ contains
     call real_item('domain', 'shear_rate', BRANCH_MAY_CHANGE, [cfg%domain%shear_rate], legacy='shear_rate')
     call text_item('shear', 'control', BRANCH_MAY_CHANGE, cfg%shear%control)
     call text_item('shear', 'protocol', BRANCH_MAY_CHANGE, cfg%shear%protocol)
+    if (cfg%shear%control == 'stress') call real_item('shear', 'stress', BRANCH_MAY_CHANGE, [cfg%shear%stress])
+    if (cfg%shear%protocol == 'steps') then
+      call text_item('shear', 'step_by', BRANCH_MAY_CHANGE, cfg%shear%step_by)
+      call real_item('shear', 'step_at', BRANCH_MAY_CHANGE, cfg%shear%step_at(1:cfg%shear%levels))
+      call real_item('shear', 'step_level', BRANCH_MAY_CHANGE, cfg%shear%step_level(1:cfg%shear%levels))
+    end if
     if (cfg%shear%protocol == 'reversal') &
       call real_item('shear', 'reversal_strain', BRANCH_MAY_CHANGE, [cfg%shear%reversal_strain])
     if (cfg%shear%protocol == 'oscillatory') then

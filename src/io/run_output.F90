@@ -121,10 +121,11 @@ contains
       if (shear_protocol_varies(out%state%protocol)) then
         if (.not. allocated(names)) allocate(names(0), values(0))
         names = [names, [character(len=32) :: 'shear_protocol', 'shear_reference_rate', 'shear_reversal_strain', &
-                         'shear_strain_amplitude', 'shear_period', 'shear_dt']]
+                         'shear_strain_amplitude', 'shear_period', 'shear_dt', 'shear_control', 'shear_stress']]
+        ! shear_control: 1 rate, 2 stress (mod_shear_protocol CONTROL_*); shear_stress: the target
         values = [values, real(out%state%protocol%kind, dp), out%state%protocol%reference_rate, &
                   out%state%protocol%reversal_strain, out%state%protocol%strain_amplitude, out%state%protocol%period, &
-                  cfg%time%dt]
+                  cfg%time%dt, real(out%state%protocol%control, dp), out%state%protocol%stress]
       end if
     end if
     if (allocated(names)) call series_attributes(out%series, names, values)

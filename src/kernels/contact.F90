@@ -107,6 +107,13 @@ module mod_contact
     ! what the partner's velocity gains as seen from i: its Lees-Edwards image's s gamma_dot Ly e_x
     ! (0 without sliding boundaries, and for walls)
     real(dp), allocatable :: image_velocity(:,:)   ! (3, n)
+    ! the s of that image (0 without sliding boundaries, and for walls): a stress-controlled step
+    ! sets image_velocity anew for the rate it solves for (particle_contacts_set_rate)
+    real(dp), allocatable :: image_shift(:)        ! (n)
+    ! the image's velocity shift over the last step, whose velocities U^{n-1} the implicit
+    ! contacts' Adams-Bashforth term takes (image_velocity but under stress control, where the
+    ! rate of the last step differs from this one's)
+    real(dp), allocatable :: image_velocity_before(:,:)   ! (3, n)
   end type contact_links_t
 
   !> Tangential springs of the open contacts, in compressed-row form over the owner particle:
@@ -635,7 +642,7 @@ contains
       torque(:, j) = torque(:, j) + tqj
       stresslet(:, :, i) = stresslet(:, :, i) + s
       stresslet(:, :, j) = stresslet(:, :, j) + sj
-      if (present(links)) call add_link(j, li, lj, [ai, aj], vshift)
+      if (present(links)) call add_link(j, li, lj, [ai, aj], vshift, image_shift_of(r(2) - (x(2, j) - x(2, i))))
       call tally(.false., j)
     end do
 
@@ -663,7 +670,7 @@ contains
       torque(:, i) = torque(:, i) + tq
       li = 0.5_dp * (ai + d) * n               ! (a_i + gap/2) n, gap = d - a_i
       stresslet(:, :, i) = stresslet(:, :, i) + contact_stresslet(f, li)
-      if (present(links)) call add_link(-w, li, [0.0_dp, 0.0_dp, 0.0_dp], [ai, ai], [0.0_dp, 0.0_dp, 0.0_dp])
+      if (present(links)) call add_link(-w, li, [0.0_dp, 0.0_dp, 0.0_dp], [ai, ai], [0.0_dp, 0.0_dp, 0.0_dp], 0.0_dp)
       call tally(.true., -w)
     end do
 
@@ -679,9 +686,9 @@ contains
       new_ups(:, nnew) = ups
     end subroutine append
 
-    subroutine add_link(other, lever, lever_partner, arm, image_velocity)
+    subroutine add_link(other, lever, lever_partner, arm, image_velocity, image_shift)
       integer, intent(in) :: other
-      real(dp), intent(in) :: lever(3), lever_partner(3), arm(2), image_velocity(3)
+      real(dp), intent(in) :: lever(3), lever_partner(3), arm(2), image_velocity(3), image_shift
       links%n = links%n + 1
       links%i(links%n) = i
       links%partner(links%n) = other
@@ -694,7 +701,16 @@ contains
       links%spring(:, links%n) = ups
       links%sliding(links%n) = sliding
       links%image_velocity(:, links%n) = image_velocity
+      links%image_shift(links%n) = image_shift
+      links%image_velocity_before(:, links%n) = image_velocity
     end subroutine add_link
+
+    ! s of the Lees-Edwards image (le_separation shifted the y separation by s Ly: dy, 0 or +-Ly)
+    real(dp) function image_shift_of(dy) result(s)
+      real(dp), intent(in) :: dy
+      s = 0
+      if (sliding_boundaries) s = anint(dy / box(2))
+    end function image_shift_of
 
     subroutine tally(wall, partner)
       logical, intent(in) :: wall
@@ -722,12 +738,14 @@ contains
     if (allocated(links%i)) then
       if (size(links%i) >= m) return
       deallocate(links%i, links%partner, links%normal, links%lever, links%lever_partner, links%arm, links%spring, &
-                 links%overlap, links%stiffness, links%sliding, links%image_velocity)
+                 links%overlap, links%stiffness, links%sliding, links%image_velocity, links%image_shift, &
+                 links%image_velocity_before)
     end if
     allocate(links%i(max(m, 16)), links%partner(max(m, 16)), links%normal(3, max(m, 16)), &
              links%lever(3, max(m, 16)), links%lever_partner(3, max(m, 16)), links%arm(2, max(m, 16)), &
              links%spring(3, max(m, 16)), links%overlap(max(m, 16)), links%stiffness(max(m, 16)), &
-             links%sliding(max(m, 16)), links%image_velocity(3, max(m, 16)))
+             links%sliding(max(m, 16)), links%image_velocity(3, max(m, 16)), links%image_shift(max(m, 16)), &
+             links%image_velocity_before(3, max(m, 16)))
   end subroutine links_reserve
 
   ! ---- the history -------------------------------------------------------------------------

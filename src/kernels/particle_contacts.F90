@@ -32,7 +32,8 @@ module mod_particle_contacts
   private
   public :: particle_contacts_settings_t, particle_contacts_t, particle_contacts_create, particle_contacts_step, &
             particle_contacts_description
-  public :: particle_contacts_add_stiffness, particle_contacts_implicit_update, particle_contacts_columns
+  public :: particle_contacts_add_stiffness, particle_contacts_implicit_update, particle_contacts_columns, &
+            particle_contacts_set_rate
 
   ! The deck's &contact (doc/INPUT.md): its variables, named as in the deck, with their defaults.
   type :: particle_contacts_settings_t
@@ -213,7 +214,7 @@ contains
       if (j > 0) then
         call particle_system_add_diagonal(sys, j, a(7:12, 7:12))
         call particle_system_add_pair(sys, i, j, a(1:6, 7:12))
-        q = [u(:, i), om(:, i), u(:, j) + pc%links%image_velocity(:, m), om(:, j)]
+        q = [u(:, i), om(:, i), u(:, j) + pc%links%image_velocity_before(:, m), om(:, j)]
         g = -pc%c_before * matmul(kn, q)
         if (pc%le%active) then
           ! the partner's Lees-Edwards image moves with U_j + image_velocity: the known part of
@@ -250,7 +251,7 @@ contains
       j = pc%links%partner(m)
       if (j > 0) then
         q = [u(:, i), om(:, i), u(:, j) + pc%links%image_velocity(:, m), om(:, j)]
-        q0 = [pc%u_before(:, i), pc%om_before(:, i), pc%u_before(:, j) + pc%links%image_velocity(:, m), &
+        q0 = [pc%u_before(:, i), pc%om_before(:, i), pc%u_before(:, j) + pc%links%image_velocity_before(:, m), &
               pc%om_before(:, j)]
       else
         q = [u(:, i), om(:, i), pc%wall_velocity(:, -j), 0.0_dp, 0.0_dp, 0.0_dp]
@@ -274,6 +275,30 @@ contains
     pc%stiffness_added = .false.
   end subroutine particle_contacts_implicit_update
 
+  !> The imposed rate of the step in every velocity the contacts take from it: the walls' (-+ rate
+  !> Ly/2 along x), the Lees-Edwards images' (s rate Ly e_x, per boundary and per open contact of
+  !> the step's links); rate_before: the last step's rate, that of the images' velocities U^{n-1}
+  !> in the Adams-Bashforth term (X^{n+1} - X^n = c_now U^n + c_before U^{n-1}; an image moves
+  !> with the boundary's offset, which advances at c_now rate + c_before rate_before). A
+  !> stress-controlled step (doc/METHOD.md §7.4) calls it between particle_contacts_step, whose
+  !> explicit forces keep the rate they were evaluated with (the last step's), and the particle
+  !> solve, whose implicit part (particle_contacts_add_stiffness, particle_contacts_implicit_update)
+  !> is then affine in the rate.
+  pure subroutine particle_contacts_set_rate(pc, rate, rate_before)
+    type(particle_contacts_t), intent(inout) :: pc
+    real(dp), intent(in) :: rate, rate_before
+    integer :: m
+    if (.not. pc%periodic(2)) then
+      pc%wall_velocity(1, 1) = -0.5_dp * rate * pc%box(2)
+      pc%wall_velocity(1, 2) = 0.5_dp * rate * pc%box(2)
+    end if
+    pc%le%shear_rate = rate
+    if (.not. pc%le%active) return
+    do m = 1, pc%links%n
+      pc%links%image_velocity(:, m) = [pc%links%image_shift(m) * rate * pc%box(2), 0.0_dp, 0.0_dp]
+      pc%links%image_velocity_before(:, m) = [pc%links%image_shift(m) * rate_before * pc%box(2), 0.0_dp, 0.0_dp]
+    end do
+  end subroutine particle_contacts_set_rate
 
   !> The contacts' columns of the series: open and sliding contacts, the largest overlap, and the
   !> contact force, torque and stresslet on each sphere (doc/INPUT.md "&contact").

@@ -69,7 +69,8 @@ module mod_rheology
 
   public :: species_summary_t, rheo_summarise_species, rheo_species_quantities, NSPECIES_Q, NQS, species_names
   public :: rheology_settings_t, rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, rheo_quantities, rheo_block_of, &
-            rheo_state, rheo_restore, rheo_summarise, rheo_columns, NQ, NSUMMARY, summary_names, slab_volume
+            rheo_state, rheo_restore, rheo_summarise, rheo_columns, NQ, NSUMMARY, summary_names, slab_volume, &
+            rheo_particle_shear_stress
 
   ! per-record values that are block-averaged: stress_hydro(5), stress_contact(5), phi_core,
   ! particle fit(5), suspension fit(5)
@@ -440,6 +441,30 @@ contains
       if (dist < r_contact) r%angles(k, 2) = r%angles(k, 2) + 1
     end subroutine count_pair
   end subroutine rheo_sample
+
+  !> The particle shear stress Sigma^h_xy + Sigma^c_xy of one configuration, exactly as rheo_sample
+  !> weighs it (the core's w_i, 1 across Lees-Edwards boundaries; the same order of summation):
+  !> what a stress-controlled step (doc/METHOD.md §7.4) sets, with the solvent's eta gamma_dot, to
+  !> the target stress. stresslet: (3, 3, n) the sum of each sphere's hydrodynamic and contact stresslets.
+  pure real(dp) function rheo_particle_shear_stress(r, position, stresslet) result(sxy)
+    type(rheology_t), intent(in) :: r
+    real(dp), intent(in) :: position(:, :), stresslet(:, :, :)
+    real(dp) :: ai, vi, w
+    integer :: i
+    sxy = 0
+    ai = r%radius
+    vi = 4.0_dp / 3.0_dp * pi * ai**3
+    do i = 1, size(position, 2)
+      if (r%sized) then
+        ai = r%radii(i)
+        vi = 4.0_dp / 3.0_dp * pi * ai**3
+      end if
+      w = slab_volume(position(2, i), ai, r%core(1), r%core(2)) / vi
+      if (r%le%active) w = 1.0_dp
+      if (w > 0) sxy = sxy + w * stresslet(1, 2, i)
+    end do
+    sxy = sxy / (r%box(1) * r%box(3) * (r%core(2) - r%core(1)))
+  end function rheo_particle_shear_stress
 
   !> The suspension's mean velocity profile u(y_j) (x-z plane means at the cell rows y_j =
   !> (j + 1/2) h, j = 0..): the five sums of its least-squares line over the rows in the core.

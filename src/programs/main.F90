@@ -13,14 +13,15 @@ program fdsusp
   use petscsys
   use mod_kinds, only: dp, pi
   use mod_params, only: config_t, read_deck, echo_deck, max_line
-  use mod_errors, only: log_line, warn_line, input_error, report_limits
+  use mod_errors, only: log_line, warn_line, input_error, report_limits, fatal_error
   use mod_run_control, only: command_line, prepare_output_directory, continue_from_directory, run_stop_reason, &
                              run_stop_line, RUN_GOES_ON, RUN_DONE
   use mod_os_services, only: install_signal_handlers, release_directory, peak_resident_kb
   use mod_timers, only: timers_register, stage_push, stage_pop, STAGE_SETUP
   use mod_h5util, only: h5util_init
   use mod_grid, only: grid_t, grid_create, grid_destroy
-  use mod_fluid, only: fluid_t, fluid_create, fluid_destroy, fluid_options_check, fluid_bench_cold_poisson
+  use mod_fluid, only: fluid_t, fluid_create, fluid_destroy, fluid_options_check, fluid_bench_cold_poisson, &
+                       fluid_unit_response
   use mod_fluid_verification, only: fluid_errors_vs_manufactured
   use mod_particles, only: particles_t, MOTION_FREE
   use mod_particles_io, only: particles_load
@@ -33,6 +34,7 @@ program fdsusp
   use mod_rheology, only: rheology_t, rheo_create
   use mod_lees_edwards, only: lees_edwards_t, le_create
   use mod_shear_protocol, only: shear_protocol_t, shear_protocol_create, shear_protocol_kind, shear_protocol_varies, &
+                                PROTOCOL_STEPS, &
                                 shear_protocol_begin_at
   use mod_fictitious_domain, only: fictitious_domain_t, fictitious_domain_create, fictitious_domain_destroy, &
                                    fictitious_domain_pair_lag_limit, fictitious_domain_stresslet_lag_limit
@@ -48,6 +50,7 @@ program fdsusp
   type(config_t) :: cfg
   type(grid_t), target :: grid
   type(fluid_t), target :: fl
+  type(fluid_t), allocatable, target :: fl_unit     ! stress control of the pure fluid: the step per unit wall speed
   type(particles_t), target :: parts
   type(fictitious_domain_t), target :: fd
   type(particle_contacts_t), allocatable, target :: pc    ! allocated when the run has contacts
@@ -102,8 +105,27 @@ program fdsusp
   if (cfg%lees_edwards) le = le_create(cfg%domain%box, cfg%domain%shear_rate, 0.0_dp)
   ! the imposed shear as a function of time (doc/INPUT.md "&shear"); the pieces below are made with
   ! its reference rate, the rate at t = 0, and the step gives them the rate of each step
-  protocol = shear_protocol_create(shear_protocol_kind(cfg%shear%protocol), cfg%shear%rate, cfg%time%dt, &
-                                   cfg%shear%reversal_strain, cfg%shear%strain_amplitude, cfg%shear%period)
+  ! (stress control: the reference rate is the unit, and each step solves for its own rate)
+  if (cfg%shear%protocol == 'steps') then
+    associate(n => cfg%shear%levels)
+      if (cfg%shear%control == 'stress') then
+        protocol = shear_protocol_create(PROTOCOL_STEPS, cfg%shear%rate, cfg%time%dt, 0.0_dp, 0.0_dp, 0.0_dp, &
+                                         0.0_dp, cfg%shear%step_at(1:n), cfg%shear%step_level(1:n), &
+                                         cfg%shear%step_by == 'strain')
+      else
+        protocol = shear_protocol_create(PROTOCOL_STEPS, cfg%shear%rate, cfg%time%dt, 0.0_dp, 0.0_dp, 0.0_dp, &
+                                         step_at=cfg%shear%step_at(1:n), step_level=cfg%shear%step_level(1:n), &
+                                         by_strain=cfg%shear%step_by == 'strain')
+      end if
+    end associate
+  else if (cfg%shear%control == 'stress') then
+    protocol = shear_protocol_create(shear_protocol_kind(cfg%shear%protocol), cfg%shear%rate, cfg%time%dt, &
+                                     cfg%shear%reversal_strain, cfg%shear%strain_amplitude, cfg%shear%period, &
+                                     cfg%shear%stress)
+  else
+    protocol = shear_protocol_create(shear_protocol_kind(cfg%shear%protocol), cfg%shear%rate, cfg%time%dt, &
+                                     cfg%shear%reversal_strain, cfg%shear%strain_amplitude, cfg%shear%period)
+  end if
   call make_contacts()
   call make_lubrication()
   call make_statistics()
@@ -122,6 +144,15 @@ program fdsusp
   if (cfg%resolved) then
     PetscCallA(grid_create(cfg, grid, ierr))
     PetscCallA(fluid_create(cfg, grid, fl, ierr))
+    if (cfg%shear%control == 'stress') then
+      ! stress control (doc/METHOD.md §7.4): a second fluid, one step from rest with walls at -+1
+      allocate(fl_unit)
+      PetscCallA(fluid_create(cfg, grid, fl_unit, ierr))
+      PetscCallA(fluid_unit_response(grid, fl_unit, ierr))
+      ! backward Euler keeps the response monotone (a discrete maximum principle): its wall stress is > 0
+      if (.not. (fl_unit%tau_bottom + fl_unit%tau_top > 0.0_dp)) call fatal_error('fdsusp: fatal: stress control: '// &
+           'the wall stress of the unit wall-speed response is not positive: the wall speed cannot set the stress', 4)
+    end if
     if (has_particles) then
       call fictitious_domain_create(grid, cfg%fluid%reynolds, cfg%time%dt, cfg%particles%slip_kappa, &
                                     cfg%particles%radius_offset, fd, ierr); CHKERRA(ierr)
@@ -209,6 +240,9 @@ program fdsusp
       PetscCallA(fictitious_domain_destroy(fd, ierr))
     end if
     PetscCallA(fluid_destroy(fl, ierr))
+    if (allocated(fl_unit)) then
+      PetscCallA(fluid_destroy(fl_unit, ierr))
+    end if
     PetscCallA(grid_destroy(grid, ierr))
   else
     PetscCallA(particle_solver_destroy(ld_solver, ierr))
@@ -322,7 +356,8 @@ contains
     PetscErrorCode, intent(out) :: ierr
     if (cfg%resolved) then
       call time_step_create(ts, cfg%time%dt, cfg%domain%box, cfg%walls, le, protocol, ierr, grid=grid_p, fluid=fluid_p, &
-                            fd=fd, parts=parts_p, contacts=contacts_p, lubrication=lubrication_p, rheology=rheology_p)
+                            fd=fd, parts=parts_p, contacts=contacts_p, lubrication=lubrication_p, rheology=rheology_p, &
+                            fluid_response=fl_unit)
     else
       call time_step_create(ts, cfg%time%dt, cfg%domain%box, cfg%walls, le, protocol, ierr, parts=parts_p, ld=ld, &
                             ld_solver=ld_solver, contacts=contacts_p, lubrication=lubrication_p, rheology=rheology_p)

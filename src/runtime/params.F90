@@ -23,7 +23,7 @@ module mod_params
   use mod_packing_geometry, only: phi_max
   use mod_particle_contacts, only: particle_contacts_settings_t
   use mod_rheology, only: rheology_settings_t
-  use mod_shear_protocol, only: shear_protocol_kind, shear_protocol_reference_rate, PROTOCOL_OSCILLATORY
+  use mod_shear_protocol, only: shear_protocol_kind, shear_protocol_reference_rate, PROTOCOL_OSCILLATORY, MAX_LEVELS
   implicit none
   private
   public :: config_t, read_deck, echo_deck, max_line, max_inline_particles, max_species
@@ -52,11 +52,16 @@ module mod_params
   ! &shear: the imposed flow (doc/INPUT.md "&shear"; mod_shear_protocol)
   type :: shear_settings_t
     real(dp) :: rate = rate_not_given                   ! the imposed rate (default 1) [gamma_dot]
-    character(len=16) :: control = 'rate'               ! 'rate' ('stress': not yet)
+    character(len=16) :: control = 'rate'               ! 'rate' or 'stress' (lubrication dynamics)
+    real(dp) :: stress = 0.0_dp                         ! control = 'stress': the mean shear stress [eta*gamma_dot]
     character(len=16) :: protocol = 'steady'            ! 'steady', 'reversal' or 'oscillatory'
     real(dp) :: reversal_strain = 0.0_dp                ! 'reversal': the strain between reversals [-]
     real(dp) :: strain_amplitude = 0.0_dp               ! 'oscillatory': gamma_0 [-]
     real(dp) :: period = 0.0_dp                         ! 'oscillatory': T [1/gamma_dot]
+    integer :: levels = 0                               ! 'steps': how many levels (2..MAX_LEVELS)
+    character(len=16) :: step_by = 'strain'             ! 'steps': step_at counts 'strain' (accumulated |strain|) or 'time'
+    real(dp) :: step_at(MAX_LEVELS) = 0.0_dp            ! 'steps': where each level starts [-] or [1/gamma_dot]
+    real(dp) :: step_level(MAX_LEVELS) = 0.0_dp         ! 'steps': each level's rate [gamma_dot] (stress control: stress [eta*gamma_dot])
   end type shear_settings_t
 
   ! &fluid
@@ -729,12 +734,15 @@ contains
   subroutine validate_shear(cfg)
     type(config_t), intent(inout) :: cfg
     character(len=200) :: text
-    if (cfg%shear%control == 'stress') call input_error(cfg%deck_file, 'shear', 'control', &
-         '''stress'' (stress control) is not implemented yet: use control = ''rate''')
-    if (cfg%shear%control /= 'rate') call input_error(cfg%deck_file, 'shear', 'control', &
-         'must be ''rate'' (''stress'' is not implemented yet), not '''//trim(cfg%shear%control)//'''')
+    if (cfg%shear%control /= 'rate' .and. cfg%shear%control /= 'stress') call input_error(cfg%deck_file, 'shear', &
+         'control', 'must be ''rate'' or ''stress'', not '''//trim(cfg%shear%control)//'''')
+    if (cfg%shear%control == 'rate' .and. cfg%shear%stress /= 0.0_dp) call input_error(cfg%deck_file, 'shear', &
+         'stress', 'is given only with control = ''stress'' (under control = ''rate'' the rate is imposed)')
+    cfg%shear%step_by = to_lower(cfg%shear%step_by)
+    if (cfg%shear%control == 'stress') call validate_stress_control(cfg)
     if (shear_protocol_kind(cfg%shear%protocol) == 0) call input_error(cfg%deck_file, 'shear', 'protocol', &
-         'must be ''steady'', ''reversal'' or ''oscillatory'', not '''//trim(cfg%shear%protocol)//'''')
+         'must be ''steady'', ''reversal'', ''oscillatory'' or ''steps'', not '''//trim(cfg%shear%protocol)//'''')
+    call validate_steps(cfg)
     if (cfg%shear%protocol /= 'oscillatory') then
       if (cfg%shear%strain_amplitude /= 0.0_dp) call input_error(cfg%deck_file, 'shear', 'strain_amplitude', &
            'is given only with protocol = ''oscillatory''')
@@ -758,13 +766,107 @@ contains
              abs(cfg%shear%rate) * cfg%time%dt, '): the rate would reverse every step'
         call input_error(cfg%deck_file, 'shear', 'reversal_strain', trim(text))
       end if
-    else
+    else if (cfg%shear%protocol == 'oscillatory') then
       if (cfg%shear%period < 4.0_dp * cfg%time%dt) then
         write(text, '(a,es10.3,a)') 'is shorter than 4 steps (dt = ', cfg%time%dt, '): the step cannot follow the oscillation'
         call input_error(cfg%deck_file, 'shear', 'period', trim(text))
       end if
     end if
   end subroutine validate_shear
+
+  ! Steps (doc/INPUT.md "&shear", protocol 'steps'): its variables with it only; 2..MAX_LEVELS
+  ! levels, the first from 0, each later one after the one before, at least a step long; levels
+  ! within the range of a rate (or of a stress), non-zero when counted in strain (a level at rest
+  ! would never reach the next); &shear rate, the unit, positive.
+  subroutine validate_steps(cfg)
+    type(config_t), intent(inout) :: cfg
+    character(len=200) :: text
+    character(len=16) :: name
+    real(dp) :: bound, per_step
+    integer :: k
+    associate(sh => cfg%shear)
+      if (sh%protocol /= 'steps') then
+        if (sh%levels /= 0) call input_error(cfg%deck_file, 'shear', 'levels', 'is given only with protocol = ''steps''')
+        if (any(sh%step_at /= 0.0_dp)) call input_error(cfg%deck_file, 'shear', 'step_at', &
+             'is given only with protocol = ''steps''')
+        if (any(sh%step_level /= 0.0_dp)) call input_error(cfg%deck_file, 'shear', 'step_level', &
+             'is given only with protocol = ''steps''')
+        if (sh%step_by /= 'strain') call input_error(cfg%deck_file, 'shear', 'step_by', &
+             'is given only with protocol = ''steps''')
+        return
+      end if
+      write(text, '(a,i0,a)') 'must be 2 .. ', MAX_LEVELS, ' (the number of step_at and step_level given)'
+      if (sh%levels < 2 .or. sh%levels > MAX_LEVELS) call input_error(cfg%deck_file, 'shear', 'levels', trim(text))
+      if (sh%step_by /= 'strain' .and. sh%step_by /= 'time') call input_error(cfg%deck_file, 'shear', 'step_by', &
+           'must be ''strain'' or ''time'', not '''//trim(sh%step_by)//'''')
+      if (any(sh%step_at(sh%levels + 1:) /= 0.0_dp)) call input_error(cfg%deck_file, 'shear', 'step_at', &
+           'has more values than levels')
+      if (any(sh%step_level(sh%levels + 1:) /= 0.0_dp)) call input_error(cfg%deck_file, 'shear', 'step_level', &
+           'has more values than levels')
+      if (sh%step_at(1) /= 0.0_dp) call input_error(cfg%deck_file, 'shear', 'step_at(1)', &
+           'must be 0: the first level starts the run')
+      if (sh%rate <= 0.0_dp) call input_error(cfg%deck_file, trim(cfg%rate_group), trim(cfg%rate_name), &
+           'is the unit of time and stress with protocol = ''steps'' (the levels give the rates): must be > 0')
+      bound = merge(1.0e6_dp, 1.0e3_dp, sh%control == 'stress')
+      do k = 1, sh%levels
+        write(name, '(a,i0,a)') 'step_level(', k, ')'
+        call check_real(cfg, 'shear', trim(name), sh%step_level(k), -bound, bound)
+        if (sh%step_by == 'strain' .and. sh%step_level(k) == 0.0_dp) call input_error(cfg%deck_file, 'shear', &
+             trim(name), 'is 0, and a level at rest never reaches the next strain: step_by = ''time'' allows it')
+      end do
+      do k = 2, sh%levels
+        write(name, '(a,i0,a)') 'step_at(', k, ')'
+        per_step = cfg%time%dt
+        if (sh%step_by == 'strain' .and. sh%control == 'rate') per_step = abs(sh%step_level(k - 1)) * cfg%time%dt
+        if (sh%step_at(k) - sh%step_at(k - 1) < per_step) then
+          write(text, '(a,es10.3,a)') 'must follow step_at(k-1) by at least one step (', per_step, ')'
+          call input_error(cfg%deck_file, 'shear', trim(name), trim(text))
+        end if
+      end do
+    end associate
+  end subroutine validate_steps
+
+  ! Stress control (doc/INPUT.md "&shear", doc/METHOD.md §7.4): a non-zero stress, a steady
+  ! protocol, lubrication dynamics or the DNS's fluid alone, a stress to measure (spheres or walls) with the statistics'
+  ! weights (&rheology), spheres that move freely; &shear rate stays the unit (positive).
+  subroutine validate_stress_control(cfg)
+    type(config_t), intent(inout) :: cfg
+    logical :: spheres
+    spheres = cfg%particles%number > 0 .or. len_trim(cfg%particles%position_file) > 0 .or. &
+              cfg%particles%solid_fraction > 0.0_dp
+    if (cfg%shear%protocol == 'steps') then
+      if (cfg%shear%stress /= 0.0_dp) call input_error(cfg%deck_file, 'shear', 'stress', &
+           'is not given with protocol = ''steps'': the stresses are its step_level')
+    else
+      if (cfg%shear%stress == 0.0_dp) call input_error(cfg%deck_file, 'shear', 'stress', &
+           'must be given (non-zero, in eta*gamma_dot_ref) with control = ''stress''')
+      call check_real(cfg, 'shear', 'stress', cfg%shear%stress, -1.0e6_dp, 1.0e6_dp)
+    end if
+    if (cfg%shear%protocol /= 'steady' .and. cfg%shear%protocol /= 'steps') call input_error(cfg%deck_file, &
+         'shear', 'protocol', 'must be ''steady'' or ''steps'' with control = ''stress'' (reversals and '// &
+         'oscillations of the stress are not implemented), not '''//trim(cfg%shear%protocol)//'''')
+    if (cfg%resolved .and. spheres) call input_error(cfg%deck_file, 'shear', 'control', &
+         '''stress'' in the resolved DNS is implemented for the fluid alone: with particles (the wall velocity '// &
+         'as the unknown of the coupled step) it is not implemented yet; lubrication dynamics (&fluid model = '// &
+         '''none'') takes it')
+    if (cfg%resolved .and. cfg%fluid%viscous_theta /= 1.0_dp) call input_error(cfg%deck_file, 'fluid', &
+         'viscous_theta', 'must be 1 (backward Euler) with &shear control = ''stress'': the wall speed jumps each '// &
+         'step, and the Crank-Nicolson response of the wall cells to a jump overshoots (a wall stress that falls as '// &
+         'the wall speeds up), which the stress balance amplifies (doc/METHOD.md §7.4)')
+    if (.not. (cfg%walls .or. cfg%lees_edwards)) call input_error(cfg%deck_file, 'shear', 'control', &
+         '''stress'' needs a sheared box (y_boundary = ''walls'' or ''lees-edwards''): a periodic box in y has '// &
+         'no shear stress to control')
+    if (.not. spheres .and. .not. cfg%walls) call input_error(cfg%deck_file, 'shear', 'control', &
+         '''stress'': no stress can be measured without particles and without walls')
+    if (cfg%shear%rate <= 0.0_dp) call input_error(cfg%deck_file, trim(cfg%rate_group), trim(cfg%rate_name), &
+         'is the unit of time and stress under control = ''stress'' (gamma_dot_ref): must be > 0')
+    if (spheres .and. .not. cfg%rheology_group) call input_error(cfg%deck_file, 'shear', 'control', &
+         '''stress'' with particles needs &rheology: the mean shear stress is the one the statistics measure '// &
+         '(doc/RHEOLOGY.md), and so are their weights')
+    if (spheres .and. cfg%particles%motion /= 'free' .and. cfg%particles%motion /= 'frozen') &
+      call input_error(cfg%deck_file, 'particles', 'motion', 'must be ''free'' or ''frozen'' with &shear '// &
+           'control = ''stress'' (imposed particle motion leaves no balance for the rate)')
+  end subroutine validate_stress_control
 
   ! Ranges of &rheology, and the step counts of the averaging window (doc/RHEOLOGY.md).
   subroutine validate_rheology(cfg)

@@ -10,10 +10,10 @@ rate 1 reversed every strain G = 1 (200 steps of dt 5e-3), 600 steps:
    while the hydrodynamic stress stays (Gadala-Maria & Acrivos 1980; Peters et al. 2016).
    fdsusp.protocols.reversal_transient averages both reversals: the signed contact shear stress
    at strains 0.02-0.1 after a reversal is below 10 % of its mean over the last 0.1 strain before
-   the first reversal ("near zero": measured 0.19 %), and the hydrodynamic shear stress (with the
+   the first reversal ("near zero": measured 0.15 %), and the hydrodynamic shear stress (with the
    solvent) keeps at least half its value;
 3. it builds up again: over the last 0.1 strain before the next reversal the contact stress is at
-   least 5 times what it was right after (measured 85 times).
+   least 5 times what it was right after (measured 118 times).
 About 6 s on one core."""
 import numpy as np
 import fdsusp_testlib as T

@@ -34,6 +34,9 @@ os.rename(os.path.join(d, 'out'), os.path.join(d, 'ld_run'))
 with T.h5py.File(os.path.join(d, 'empty_positions.h5'), 'w') as f:
     f.create_dataset('particles/position', data=T.np.zeros((0, 3)))
 
+LDS = GOOD.replace('cells_per_radius = 5', "cells_per_radius = 5, y_boundary = 'lees-edwards'") \
+    .replace('reynolds = 0.01', "model = 'none'") + '&particles number = 1, position(:,1) = 1.6, 1.6, 1.6 /\n'
+
 cases = [
     # name, deck text (None: do not write), extra args, words the message must contain
     ('unknown variable', GOOD.replace('reynolds', 'reynold'), [], ['bad.nml', '&fluid', 'reynold', 'unknown variable']),
@@ -150,7 +153,38 @@ cases = [
     # &shear (doc/INPUT.md): the protocols of rate control
     ('rate under both names', GOOD.replace('cells_per_radius = 5', 'cells_per_radius = 5, shear_rate = 1') +
      '&shear rate = 1 /\n', [], ['bad.nml', '&shear', 'rate', 'shear_rate']),
-    ('stress control', GOOD + "&shear control = 'stress' /\n", [], ['bad.nml', '&shear', 'control', 'not implemented yet']),
+    # stress control (doc/INPUT.md "&shear"): LDS, a lubrication-dynamics deck with one sphere
+    ('unknown control', GOOD + "&shear control = 'strain' /\n", [], ['bad.nml', '&shear', 'control', 'strain']),
+    ('stress under rate control', GOOD + "&shear stress = 2 /\n", [], ['bad.nml', '&shear', 'stress', "control = 'stress'"]),
+    ('stress control without a stress', LDS + "&rheology /\n&shear control = 'stress' /\n", [],
+     ['bad.nml', '&shear', 'stress', 'must be given']),
+    ('stress control in the DNS with particles', GOOD + "&shear control = 'stress', stress = 2 /\n"
+     "&particles number = 1, position(:,1) = 1.6, 1.6, 1.6 /\n", [], ['bad.nml', '&shear', 'control', 'not implemented yet']),
+    ('stress control with a reversal', LDS + "&rheology /\n&shear control = 'stress', stress = 2, protocol = 'reversal', "
+     "reversal_strain = 1 /\n", [], ['bad.nml', '&shear', 'protocol', "'steady'"]),
+    ('stress control, no particles and no walls', LDS.replace('&particles number = 1, position(:,1) = 1.6, 1.6, 1.6 /\n', '')
+     + "&shear control = 'stress', stress = 2 /\n", [], ['bad.nml', '&shear', 'control', 'no stress can be measured']),
+    ('stress control without statistics', LDS + "&shear control = 'stress', stress = 2 /\n", [],
+     ['bad.nml', '&shear', 'control', '&rheology']),
+    ('stress control with a zero reference rate', LDS + "&rheology /\n&shear control = 'stress', stress = 2, rate = 0 /\n",
+     [], ['bad.nml', '&shear', 'rate', '> 0']),
+    # steps of rate or stress (protocol 'steps')
+    ('steps without levels', GOOD + "&shear protocol = 'steps' /\n", [], ['bad.nml', '&shear', 'levels', '2 ..']),
+    ('step_at without steps', GOOD + "&shear step_at = 0, 1 /\n", [], ['bad.nml', '&shear', 'step_at', "'steps'"]),
+    ('first step not at 0', GOOD + "&shear protocol = 'steps', levels = 2, step_at = 0.5, 1, step_level = 1, 2 /\n", [],
+     ['bad.nml', '&shear', 'step_at(1)', 'must be 0']),
+    ('steps not increasing', GOOD + "&shear protocol = 'steps', levels = 2, step_at = 0, 0, step_level = 1, 2 /\n", [],
+     ['bad.nml', '&shear', 'step_at(2)', 'one step']),
+    ('a level at rest counted in strain', GOOD + "&shear protocol = 'steps', levels = 2, step_at = 0, 1, "
+     "step_level = 0, 2 /\n", [], ['bad.nml', '&shear', 'step_level(1)', 'never reaches']),
+    ('more step values than levels', GOOD + "&shear protocol = 'steps', levels = 2, step_at = 0, 1, 2, "
+     "step_level = 1, 2 /\n", [], ['bad.nml', '&shear', 'step_at', 'more values than levels']),
+    ('unknown step_by', GOOD + "&shear protocol = 'steps', step_by = 'steps', levels = 2, step_at = 0, 1, "
+     "step_level = 1, 2 /\n", [], ['bad.nml', '&shear', 'step_by', "'time'"]),
+    ('a stress with stress steps', LDS + "&rheology /\n&shear control = 'stress', stress = 2, protocol = 'steps', "
+     "levels = 2, step_at = 0, 1, step_level = 1, 2 /\n", [], ['bad.nml', '&shear', 'stress', 'step_level']),
+    ('stress control of prescribed spheres', LDS.replace('1.6, 1.6, 1.6 /', "1.6, 1.6, 1.6, motion = 'prescribed' /")
+     + "&rheology /\n&shear control = 'stress', stress = 2 /\n", [], ['bad.nml', '&particles', 'motion', "'stress'"]),
     ('unknown protocol', GOOD + "&shear protocol = 'creep' /\n", [], ['bad.nml', '&shear', 'protocol', 'creep']),
     ('amplitude without oscillation', GOOD + '&shear strain_amplitude = 0.1 /\n', [],
      ['bad.nml', '&shear', 'strain_amplitude', 'oscillatory']),

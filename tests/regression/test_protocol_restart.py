@@ -9,7 +9,15 @@ steady runs). Cases, each stopped in the middle of what the protocol does:
   falls at 0.4 period, with contacts under load;
 - a reversal in lubrication dynamics between walls (G = 60 steps' strain), 150 against 75 + 75:
   the reversals at steps 60 and 120 lie on either side of the restart;
-- an oscillation of the pure fluid in the DNS on 2 ranks (T = 40 steps), 60 against 30 + 30.
+- an oscillation of the pure fluid in the DNS on 2 ranks (T = 40 steps), 60 against 30 + 30;
+- stress control (control = 'stress') in lubrication dynamics (the oscillation's scene at stress 8),
+  200 against 100 + 100: the rate the restarted step solves for starts its solves from the
+  checkpoint's velocities and rate, as the uninterrupted step does; and of the pure fluid in the
+  DNS on 2 ranks (stress 2.5 from rest), 60 against 30 + 30: the unit wall-speed response is made
+  again at the restart, the same;
+- steps of the stress by time in lubrication dynamics (8, 12, 6 from t = 0, 0.3, 0.7: steps 61
+  and 141), 200 against 100 + 100: the level of the last step is in the checkpoint (as the
+  reversals are), so the restarted step sees no spurious jump.
 A branch (-branch) starts the deck's protocol afresh from the checkpoint's configuration: after a
 steady pre-shear of 100 steps in lubrication dynamics (Lees-Edwards), a reversal every 0.25 strain
 flips at the steps 50, 100, 150 after the branch, and both it and an oscillation continue the
@@ -47,6 +55,23 @@ STEADY = """&domain box = 8.0, 8.0, 8.0, y_boundary = 'lees-edwards' /
 &particles solid_fraction = 0.35, seed = 5 /
 &contact roughness = 5.0e-3, friction = 0.5 /
 """
+STRESS = """&domain box = 8.0, 8.0, 8.0, y_boundary = 'lees-edwards' /
+&shear control = 'stress', stress = 8.0 /
+&fluid model = 'none' /
+&time dt = 5.0e-3, steps = {steps} /
+&output directory = 'out', progress_every = 1000 /
+&particles solid_fraction = 0.4, seed = 1 /
+&contact roughness = 5.0e-3, friction = 0.5 /
+&rheology discard_strain = 0.0, average_strain = 0.95, blocks = 2 /
+"""
+STEPS = STRESS.replace("stress = 8.0", "protocol = 'steps', step_by = 'time', levels = 3, step_at = 0.0, 0.3, 0.7, "
+                       "step_level = 8.0, 12.0, 6.0")
+STRESS_FLUID = """&domain box = 4.0, 4.0, 4.0, cells_per_radius = 2 /
+&shear control = 'stress', stress = 2.5 /
+&fluid reynolds = 0.01, viscous_theta = 1.0 /
+&time dt = 1.0e-2, steps = {steps} /
+&output directory = 'out', progress_every = 1000 /
+"""
 FLUID = """&domain box = 4.0, 4.0, 4.0, cells_per_radius = 2 /
 &shear protocol = 'oscillatory', strain_amplitude = 0.5, period = 0.4 /
 &fluid reynolds = 0.01, initial_flow = 'shear' /
@@ -77,6 +102,15 @@ s = split('reversal', REV, 150)
 flips = s['step'][1:][np.sign(s['shear/rate'][1:]) != np.sign(s['shear/rate'][:-1])]
 T.check(list(flips) == [61, 121], 'reversal: the rate flips at steps 61 and 121, across the restart: %s' % list(flips))
 split('fluid', FLUID, 60, ranks=2)
+s = split('stress', STRESS, 200)
+T.check(np.all(np.abs(s['shear/stress'] - 8.0) < 1e-12) and np.ptp(s['shear/rate']) > 0,
+        'stress control: the stress is 8 at every record, the rate varies (%.3f .. %.3f)'
+        % (s['shear/rate'].min(), s['shear/rate'].max()))
+s = split('stress_steps', STEPS, 200)
+T.check(list(s['step'][1:][np.abs(np.diff(s['shear/stress'])) > 1]) == [61, 141],
+        'stress steps: the stress changes at steps 61 and 141, on either side of the restart')
+s = split('stress_fluid', STRESS_FLUID, 60, ranks=2)
+T.check(np.all(np.abs(s['shear/stress'] - 2.5) < 1e-12), 'stress control of the fluid alone: the stress is 2.5 at every record')
 
 # a branch starts the deck's protocol afresh from the configuration reached: a steady pre-shear of
 # 100 steps (Lees-Edwards), then a reversal every 50 steps' strain, and an oscillation

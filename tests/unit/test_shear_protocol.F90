@@ -11,20 +11,27 @@
 !     period (the rate is held at its t_n value over a step: the sum of rate dt differs from
 !     gamma(t) by at most gamma_0 omega^2 dt^2 / 2 per step, bound checked at T/4);
 !  4. the state of shear_protocol_state restores exactly: a protocol restored half way continues
-!     bitwise as the uninterrupted one (the restart of a run).
+!     bitwise as the uninterrupted one (the restart of a run);
+!  5. steps by strain (rates 1, -2, 0.5 from accumulated |strain| 0, 0.01, 0.05; dt 1e-3): the level
+!     changes at the start of steps 10 and 30 (0.01 = 10 x 1e-3, 0.04 more = 20 x 2e-3) and at no
+!     other, p%reversed marks exactly those, the rate is the level; by time (levels from t = 0 and
+!     0.0125): the change at the first step boundary past it, step 13; a state restored after a
+!     change continues without a spurious jump;
+!  6. stress control: the step begins with the last step's rate, the target is the stress (or the
+!     level of stress steps), and the strain advances with the rate set_rate gives to advance.
 program test_shear_protocol
   use mod_kinds, only: dp, pi
   use mod_shear_protocol, only: shear_protocol_t, shear_protocol_create, shear_protocol_begin_step, &
                                 shear_protocol_end_step, shear_protocol_state, shear_protocol_restore, &
                                 shear_protocol_kind, shear_protocol_varies, PROTOCOL_STEADY, PROTOCOL_REVERSAL, &
-                                PROTOCOL_OSCILLATORY
+                                PROTOCOL_OSCILLATORY, PROTOCOL_STEPS, shear_protocol_set_rate
   use mod_unit_checks, only: check, check_below, finish
   implicit none
   type(shear_protocol_t) :: p, q
   integer :: n, flips
   logical :: all_rates, all_flips, restored_same
   real(dp) :: worst, summed, omega, gamma_0, period, dt, triangle
-  integer, allocatable :: flip_steps(:)
+  integer, allocatable :: flip_steps(:), changes(:)
 
   ! 1. steady
   p = shear_protocol_create(PROTOCOL_STEADY, 0.7_dp, 1.0e-3_dp, 0.0_dp, 0.0_dp, 0.0_dp)
@@ -100,6 +107,67 @@ program test_shear_protocol
     end if
   end do
   call check(restored_same .and. flips == 4, 'restore: a protocol restored at step 70 continues bitwise (4 flips)')
+
+  ! 5. steps
+  p = shear_protocol_create(PROTOCOL_STEPS, 1.0_dp, 1.0e-3_dp, 0.0_dp, 0.0_dp, 0.0_dp, step_at=[0.0_dp, 0.01_dp, 0.05_dp], &
+                            step_level=[1.0_dp, -2.0_dp, 0.5_dp], by_strain=.true.)
+  q = shear_protocol_create(PROTOCOL_STEPS, 1.0_dp, 1.0e-3_dp, 0.0_dp, 0.0_dp, 0.0_dp, step_at=[0.0_dp, 0.01_dp, 0.05_dp], &
+                            step_level=[1.0_dp, -2.0_dp, 0.5_dp], by_strain=.true.)
+  allocate(changes(0))
+  all_rates = .true.
+  restored_same = .true.
+  do n = 0, 59
+    if (n == 40) call shear_protocol_restore(q, shear_protocol_state(p))
+    call shear_protocol_begin_step(p)
+    if (p%reversed) changes = [changes, n]
+    all_rates = all_rates .and. p%rate == merge(1.0_dp, merge(-2.0_dp, 0.5_dp, n < 30), n < 10)
+    call shear_protocol_end_step(p)
+    if (n >= 40) then
+      call shear_protocol_begin_step(q)
+      restored_same = restored_same .and. .not. q%reversed
+      call shear_protocol_end_step(q)
+      restored_same = restored_same .and. all(shear_protocol_state(p) == shear_protocol_state(q))
+    end if
+  end do
+  call check(size(changes) == 2 .and. shear_protocol_varies(p) .and. shear_protocol_kind('steps') == PROTOCOL_STEPS, &
+             'steps by strain: two changes of level')
+  if (size(changes) == 2) call check(all(changes == [10, 30]), 'steps by strain: at the steps 10 and 30')
+  call check(all_rates, 'steps by strain: the rate is the level of each step')
+  call check(restored_same, 'steps: a state restored after a change continues bitwise, no spurious jump')
+  p = shear_protocol_create(PROTOCOL_STEPS, 1.0_dp, 1.0e-3_dp, 0.0_dp, 0.0_dp, 0.0_dp, step_at=[0.0_dp, 0.0125_dp], &
+                            step_level=[1.0_dp, 3.0_dp], by_strain=.false.)
+  changes = [integer ::]
+  do n = 0, 29
+    call shear_protocol_begin_step(p)
+    if (p%reversed) changes = [changes, n]
+    call shear_protocol_end_step(p)
+  end do
+  call check(size(changes) == 1 .and. p%rate == 3.0_dp, 'steps by time: one change, to the second level')
+  if (size(changes) == 1) call check(changes(1) == 13, 'steps by time: at the first step from t = 0.0125 on, 13')
+
+  ! 6. stress control
+  p = shear_protocol_create(PROTOCOL_STEADY, 1.0_dp, 1.0e-3_dp, 0.0_dp, 0.0_dp, 0.0_dp, stress=4.0_dp)
+  call shear_protocol_begin_step(p)
+  call check(p%rate == 1.0_dp .and. p%stress == 4.0_dp .and. shear_protocol_varies(p), &
+             'stress control: the first step begins at the reference rate, the target the stress')
+  call shear_protocol_set_rate(p, 1.5_dp, 4.0_dp, 1.5_dp)
+  call shear_protocol_end_step(p)
+  call shear_protocol_begin_step(p)
+  call check(p%rate == 1.5_dp, 'stress control: a step begins with the last step''s rate')
+  call shear_protocol_set_rate(p, 2.0_dp, 4.0_dp, 1.5_dp * 2.0_dp - 0.5_dp * 1.5_dp)
+  call shear_protocol_end_step(p)
+  call check_below('stress control: the strain advances with the advance rates', abs(p%strain - 1.0e-3_dp * (1.5_dp + 2.25_dp)), &
+                   1.0e-15_dp)
+  p = shear_protocol_create(PROTOCOL_STEPS, 1.0_dp, 1.0e-3_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, [0.0_dp, 0.002_dp], &
+                            [5.0_dp, 7.0_dp], .false.)
+  all_rates = .true.
+  do n = 0, 3
+    call shear_protocol_begin_step(p)
+    all_rates = all_rates .and. p%stress == merge(5.0_dp, 7.0_dp, n < 2) .and. (p%reversed .eqv. n == 2)
+    call shear_protocol_set_rate(p, 1.0_dp, p%stress, 1.0_dp)
+    call shear_protocol_end_step(p)
+  end do
+  call check(all_rates, 'stress steps: the target is the level of each step, the change marked')
   call finish('test_shear_protocol')
 
 contains
