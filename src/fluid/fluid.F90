@@ -369,15 +369,20 @@ contains
     type(fluid_t), intent(inout) :: fl
     PetscErrorCode, intent(out) :: ierr
     integer :: c
+    ! vel_star_old exists only on the Krylov path and forcing only with a forcing (fluid_create):
+    ! what exists is zeroed, so the response step runs from rest without forcing
     do c = 1, 3
       PetscCall(VecSet(fl%vel(c), 0.0_dp, ierr))
       PetscCall(VecSet(fl%vel_star(c), 0.0_dp, ierr))
-      PetscCall(VecSet(fl%vel_star_old(c), 0.0_dp, ierr))
-      PetscCall(VecSet(fl%forcing(c), 0.0_dp, ierr))
+      if (.not. fl%direct) then
+        PetscCall(VecSet(fl%vel_star_old(c), 0.0_dp, ierr))
+      end if
+      if (fl%has_forcing) then
+        PetscCall(VecSet(fl%forcing(c), 0.0_dp, ierr))
+      end if
     end do
     PetscCall(VecSet(fl%pressure, 0.0_dp, ierr))
     PetscCall(VecSet(fl%phi, 0.0_dp, ierr))
-    fl%has_forcing = .false.
     fl%star_history = 0
     fl%wall_speed = 1.0_dp
     PetscCall(fluid_step(grid, fl, ierr))

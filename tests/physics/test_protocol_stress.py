@@ -23,7 +23,11 @@ A. Lubrication dynamics, 49 rough frictional spheres (phi 0.4, eps_r 5e-3, mu_d 
       tolerance 0.19; the rate itself ranges over 0.39 .. 2.39 from step to step).
 C. Lubrication dynamics between walls (phi 0.35, 150 steps), stress 5: the stress is 5 at every
    record (the walls' terms, wall lubrication and wall contacts, are affine in the rate too, to
-   1e-12), and the run on 2 ranks (lubrication links shared out, gathered) is the run on 1, bitwise.
+   1e-12), and the run on 2 ranks is the run on 1 to 1e-10 of each column's largest magnitude (the
+   6N system is solved in parallel, doc/DESIGN.md "Parallelism": CG's inner products sum in
+   another order, and the two solves of a step agree to the solver's tolerance 1e-12; measured
+   2026-11-28 at most 7.4e-13 of the largest, the contact stresslets; a share lost or doubled in
+   the parallel solve, or in the gather of the links, changes them at O(1)).
 B. DNS, the fluid alone between walls (4a cube, a/Delta = 2, Re 0.01, backward Euler, dt 0.01,
    from rest), stress 2.5: the mean wall stress is 2.5 at every record (to 1e-12: the step plus a
    multiple of its unit wall-speed response), both walls alike (the flow is antisymmetric), and
@@ -119,7 +123,7 @@ miss = max(np.max(np.abs(s['shear/stress'] - 5.0)),
 T.check(miss < 1e-12 and np.any(s['contacts_wall'] > 0) and np.all(s['lubrication_walls'] > 0),
         'walls: the stress is 5 at every record, wall contacts and wall lubrication in the step (%.1e)' % miss)
 T.compare_h5(os.path.join(w[1], 'walls', 'series.h5'), os.path.join(w[2], 'walls', 'series.h5'),
-             'walls: 2 ranks (the links shared out) against 1', rtol=0, skip=('wall_time',))
+             'walls: 2 ranks (the links shared out, the solve in parallel) against 1', rtol=1e-10, skip=('wall_time',))
 
 # B. the fluid alone between walls
 FLUID = """&domain box = 4.0, 4.0, 4.0, cells_per_radius = 2 /
