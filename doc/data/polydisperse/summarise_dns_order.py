@@ -110,7 +110,7 @@ def main(out_equal, out_mixture, json_path, png_path):
         q6_core = np.array([q6_of_bonds(bonds(x, radius, box, (x[:, 1] >= lo) & (x[:, 1] <= hi)))
                             for x in s['particles/position']])
         rows = {}
-        for w0, w1 in ((0, 1), (4, 6), (9, 11), (14, 16), (18, 20)):
+        for w0, w1 in [(0, 1)] + [(k, k + 2) for k in range(1, 20, 2)]:
             m = (strain >= w0) & (strain < w1)
             if m.any():
                 rows['%d-%d' % (w0, w1)] = {'q6_core': float(q6_core[m].mean()),
