@@ -18,11 +18,13 @@ Two phases are attacked:
 Exact comparison (rtol 0): one rank, and a continuation repeats the arithmetic of the steps it
 redoes bitwise (tests/regression/test_restart.py).
 Scene: lubrication dynamics, 18 rough frictional spheres in an 8a Lees-Edwards cube with the
-rheology on (every column kind: scalars, vectors, 3 x N, 3 x 3 x N). ~70 runs of ~0.5 s.
+rheology on (every column kind: scalars, vectors, 3 x N, 3 x 3 x N). ~70 runs of ~0.5 s, two at a
+time (each trial in its own directory).
 Needs strace (scripts/install-deps installs it)."""
 import os
 import shutil
 import subprocess
+from concurrent.futures import ThreadPoolExecutor
 import h5py
 import numpy as np
 import fdsusp_testlib as T
@@ -112,11 +114,33 @@ deck = T.write_deck(work, 'k.nml', DECK.format(steps=STEPS, checkpoint_every=20)
 out = os.path.join(work, 'out')
 
 
-def prepare(phase):
-    shutil.rmtree(out, ignore_errors=True)
+def prepare(phase, where=work):
+    """A fresh output directory under where: empty (A), or the state phase B starts from."""
+    target = os.path.join(where, 'out')
+    shutil.rmtree(target, ignore_errors=True)
     if phase == 'B':
-        shutil.copytree(os.path.join(ref, 'out'), out)
-        shutil.copy(os.path.join(c40, 'out', 'checkpoint.h5'), os.path.join(out, 'checkpoint.h5'))
+        shutil.copytree(os.path.join(ref, 'out'), target)
+        shutil.copy(os.path.join(c40, 'out', 'checkpoint.h5'), os.path.join(target, 'checkpoint.h5'))
+
+
+def trial(phase, syscall, when):
+    """One kill and its continuation, in a directory of its own (the trials are independent, so
+    two run at a time on the 2-core machine): '' when the series comes out whole, else the
+    problem; None when the run ended before that call (nothing was killed)."""
+    where = os.path.join(work, 'trial_%s_%s_%d' % (phase, syscall, when))
+    shutil.rmtree(where, ignore_errors=True)
+    os.makedirs(where)
+    shutil.copy(deck, where)
+    prepare(phase, where)
+    mine = os.path.join(where, os.path.basename(deck))
+    if strace_run(mine, where, syscall, when) == 0:
+        return None
+    rc, so, se = T.run(mine, where, args=['-continue'] + FLUSH, expect_ok=False)
+    problem = 'continuation failed (%d): %s' % (rc, se.strip()[-300:]) if rc != 0 else \
+        series_problem(os.path.join(where, 'out'), want)
+    if not problem:
+        shutil.rmtree(where, ignore_errors=True)
+    return problem
 
 
 SYSCALLS = ('pwrite64', 'write', 'rename', 'unlink')
@@ -127,22 +151,12 @@ opening = T.write_deck(work, 'o.nml', DECK.format(steps=40, checkpoint_every=20)
 for phase in ('A', 'B'):
     prepare(phase)
     counts = count_calls(deck if phase == 'A' else opening, work, SYSCALLS)
-    bad = []
-    trials = 0
-    for syscall in SYSCALLS:
-        for when in spread(counts[syscall], PLAN[syscall]):
-            prepare(phase)
-            status = strace_run(deck, work, syscall, when)
-            trials += 1
-            if status == 0:
-                continue      # the run ended before that call: nothing was killed
-            rc, so, se = T.run(deck, work, args=['-continue'] + FLUSH, expect_ok=False)
-            problem = 'continuation failed (%d): %s' % (rc, se.strip()[-300:]) if rc != 0 else \
-                series_problem(out, want)
-            if problem:
-                bad.append('%s #%d: %s' % (syscall, when, problem))
+    plan = [(syscall, when) for syscall in SYSCALLS for when in spread(counts[syscall], PLAN[syscall])]
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        problems = list(pool.map(lambda sw: trial(phase, *sw), plan))
+    bad = ['%s #%d: %s' % (sw[0], sw[1], pr) for sw, pr in zip(plan, problems) if pr]
     T.check(not bad, 'phase %s: %d kills (of %s calls %s) each followed by -continue give the '
-            'uninterrupted series%s' % (phase, trials, '/'.join(SYSCALLS),
+            'uninterrupted series%s' % (phase, len(plan), '/'.join(SYSCALLS),
                                         '/'.join(str(counts[s]) for s in SYSCALLS),
                                         '' if not bad else ': ' + '; '.join(bad[:6])))
 
