@@ -12,12 +12,19 @@
 !   steps        piecewise constant: level k (rate, or stress under stress control) from the time or
 !                the accumulated |strain| step_at(k) on (step_at(1) = 0); a level starts at the first
 !                step boundary at which it is due (within 1e-9 of a step, as a reversal)
-! Stress control (control = 'stress', doc/INPUT.md "&shear", doc/METHOD.md §7.4; steady only): the
-! rate of a step is not a function of time but the solution of the step's stress balance, which the
-! step solves and sets here (shear_protocol_set_rate) before the strain is integrated with it; until
-! then p%rate holds the last step's rate (the one the previous velocities went with).
+! Stress control (control = 'stress', doc/INPUT.md "&shear", doc/METHOD.md §7.4): the rate of a
+! step is not a function of time but the solution of the step's stress balance, which the step
+! solves and sets here (shear_protocol_set_rate) before the strain is integrated with it; until
+! then p%rate holds the last step's rate (the one the previous velocities went with). The target
+! stress of a step is the protocol's function of time, evaluated at t_n as the rate is:
+!   steady       S
+!   reversal     +-|S|, the sign (that of S at the start) flipping each time the accumulated
+!                |strain| reaches a multiple of G, as under rate control
+!   oscillatory  S sin(omega t_n), omega = 2 pi/T (S the amplitude); the strain is integrated
+!   steps        the level of the step
 ! The reference rate (the unit of time and of stress, doc/INPUT.md "&shear") is rate (steady,
-! reversal: signed, as given) or gamma_0 omega (oscillatory): the rate at t = 0 in every protocol.
+! reversal: signed, as given; any protocol under stress control) or gamma_0 omega (oscillatory
+! under rate control): the rate at t = 0 in every rate-controlled protocol.
 ! The state (time, strain, accumulated |strain|, sign, reversals) is what a checkpoint holds
 ! (shear_protocol_state / shear_protocol_restore): a restart continues it exactly. A branch starts
 ! the protocol afresh from the checkpoint's configuration (shear_protocol_begin_at): its time,
@@ -44,7 +51,8 @@ module mod_shear_protocol
   type :: shear_protocol_t
     integer :: kind = PROTOCOL_STEADY
     integer :: control = CONTROL_RATE
-    real(dp) :: stress = 0.0_dp           ! stress control: the target mean shear stress [eta gamma_dot]
+    real(dp) :: stress = 0.0_dp           ! stress control: the target mean shear stress of the step [eta gamma_dot]
+    real(dp) :: stress_given = 0.0_dp     ! stress control: &shear stress (steady, reversal: signed; oscillatory: the amplitude)
     real(dp) :: reference_rate = 1.0_dp   ! signed; the rate at t = 0 [gamma_dot]
     real(dp) :: reversal_strain = 0.0_dp  ! G [-]
     real(dp) :: strain_amplitude = 0.0_dp ! gamma_0 [-]
@@ -74,8 +82,9 @@ contains
 
   !> A protocol of the given kind (PROTOCOL_*): rate is the steady/reversal rate (signed), ignored
   !> for an oscillation, whose reference rate is gamma_0 2 pi/T; dt: the time step. stress
-  !> (optional): stress control at this mean shear stress (steady; rate is then the reference
-  !> rate, the unit, and the rate of the first step's explicit contacts).
+  !> (optional): stress control at this mean shear stress (steady, reversal: signed; oscillatory:
+  !> the amplitude; rate is then the reference rate, the unit, and the rate of the first step's
+  !> explicit contacts).
   !> step_at, step_level, by_strain (optional): the levels of 'steps' (size: their number).
   pure function shear_protocol_create(kind, rate, dt, reversal_strain, strain_amplitude, period, stress, &
                                       step_at, step_level, by_strain) result(p)
@@ -87,7 +96,9 @@ contains
     p%kind = kind
     if (present(stress)) then
       p%control = CONTROL_STRESS
+      p%stress_given = stress
       p%stress = stress
+      if (kind == PROTOCOL_OSCILLATORY) p%stress = 0.0_dp
     end if
     if (present(step_at)) then
       p%levels = size(step_at)
@@ -100,7 +111,11 @@ contains
     p%reversal_strain = reversal_strain
     p%strain_amplitude = strain_amplitude
     p%period = period
-    p%reference_rate = shear_protocol_reference_rate(kind, rate, strain_amplitude, period)
+    if (p%control == CONTROL_STRESS) then
+      p%reference_rate = rate
+    else
+      p%reference_rate = shear_protocol_reference_rate(kind, rate, strain_amplitude, period)
+    end if
     p%rate = p%reference_rate
   end function shear_protocol_create
 
@@ -138,17 +153,29 @@ contains
     p%reversed = .false.
     p%step_strain = p%strain
     if (p%kind == PROTOCOL_STEPS) call begin_level(p)
-    if (p%control == CONTROL_STRESS) return       ! p%rate: the last step's, until the step sets its own
-    select case (p%kind)
-    case (PROTOCOL_STEADY)
-      p%rate = p%reference_rate
-    case (PROTOCOL_REVERSAL)
-      due = (p%reversals + 1) * p%reversal_strain - reversal_slack * abs(p%reference_rate) * p%dt
+    if (p%kind == PROTOCOL_REVERSAL) then
+      due = (p%reversals + 1) * p%reversal_strain - reversal_slack * max(abs(p%rate), abs(p%reference_rate)) * p%dt
       if (p%travel >= due) then
         p%direction = -p%direction
         p%reversals = p%reversals + 1
         p%reversed = .true.
       end if
+    end if
+    if (p%control == CONTROL_STRESS) then         ! p%rate: the last step's, until the step sets its own
+      select case (p%kind)
+      case (PROTOCOL_STEADY)
+        p%stress = p%stress_given
+      case (PROTOCOL_REVERSAL)
+        p%stress = p%direction * p%stress_given
+      case (PROTOCOL_OSCILLATORY)
+        p%stress = p%stress_given * sin(2.0_dp * pi * p%time / p%period)
+      end select
+      return
+    end if
+    select case (p%kind)
+    case (PROTOCOL_STEADY)
+      p%rate = p%reference_rate
+    case (PROTOCOL_REVERSAL)
       p%rate = p%direction * p%reference_rate
     case (PROTOCOL_OSCILLATORY)
       p%rate = p%reference_rate * cos(2.0_dp * pi * p%time / p%period)
@@ -196,20 +223,18 @@ contains
   end subroutine shear_protocol_set_rate
 
   !> The end of the step: time t_{n+1}, the strain integrated exactly over the step (the rate is
-  !> constant over a step of a steady or reversal protocol; an oscillation's strain is gamma(t)).
+  !> constant over a step of a steady or reversal protocol; an oscillation of the rate has its
+  !> strain gamma(t); under stress control the strain advances with the spheres, p%advance).
   pure subroutine shear_protocol_end_step(p)
     type(shear_protocol_t), intent(inout) :: p
     p%time = p%time + p%dt
-    select case (p%kind)
-    case (PROTOCOL_OSCILLATORY)
+    if (p%control == CONTROL_STRESS) then
+      p%strain = p%strain + p%advance * p%dt
+    else if (p%kind == PROTOCOL_OSCILLATORY) then
       p%strain = p%origin + p%strain_amplitude * sin(2.0_dp * pi * p%time / p%period)
-    case default
-      if (p%control == CONTROL_STRESS) then
-        p%strain = p%strain + p%advance * p%dt
-      else
-        p%strain = p%strain + p%rate * p%dt
-      end if
-    end select
+    else
+      p%strain = p%strain + p%rate * p%dt
+    end if
     if (p%control == CONTROL_STRESS) then
       p%travel = p%travel + abs(p%advance) * p%dt
     else

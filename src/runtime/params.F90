@@ -712,7 +712,7 @@ contains
       cfg%rate_name = 'shear_rate'
       cfg%shear%rate = cfg%domain%shear_rate
     end if
-    if (cfg%shear%protocol == 'oscillatory') then
+    if (cfg%shear%protocol == 'oscillatory' .and. cfg%shear%control /= 'stress') then
       if (new_name .or. old_name) call input_error(cfg%deck_file, trim(cfg%rate_group), trim(cfg%rate_name), &
            'is not given with protocol = ''oscillatory'': its rate follows from strain_amplitude and period '// &
            '(reference rate strain_amplitude*2*pi/period)')
@@ -826,8 +826,8 @@ contains
     end associate
   end subroutine validate_steps
 
-  ! Stress control (doc/INPUT.md "&shear", doc/METHOD.md §7.4): a non-zero stress, a steady
-  ! protocol, lubrication dynamics or the DNS's fluid alone, a stress to measure (spheres or walls) with the statistics'
+  ! Stress control (doc/INPUT.md "&shear", doc/METHOD.md §7.4): a non-zero stress (an
+  ! oscillation's amplitude, with a period), lubrication dynamics or the DNS's fluid alone, a stress to measure (spheres or walls) with the statistics'
   ! weights (&rheology), spheres that move freely; &shear rate stays the unit (positive).
   subroutine validate_stress_control(cfg)
     type(config_t), intent(inout) :: cfg
@@ -842,9 +842,11 @@ contains
            'must be given (non-zero, in eta*gamma_dot_ref) with control = ''stress''')
       call check_real(cfg, 'shear', 'stress', cfg%shear%stress, -1.0e6_dp, 1.0e6_dp)
     end if
-    if (cfg%shear%protocol /= 'steady' .and. cfg%shear%protocol /= 'steps') call input_error(cfg%deck_file, &
-         'shear', 'protocol', 'must be ''steady'' or ''steps'' with control = ''stress'' (reversals and '// &
-         'oscillations of the stress are not implemented), not '''//trim(cfg%shear%protocol)//'''')
+    if (cfg%shear%protocol == 'oscillatory' .and. cfg%shear%strain_amplitude /= 0.0_dp) call input_error( &
+         cfg%deck_file, 'shear', 'strain_amplitude', 'is not given with control = ''stress'': an oscillation '// &
+         'of the stress has the amplitude &shear stress (stress(t) = stress sin(2 pi t/period))')
+    if (cfg%shear%protocol == 'oscillatory') &
+      call check_real(cfg, 'shear', 'period', cfg%shear%period, 0.0_dp, 1.0e9_dp, .true.)
     if (cfg%resolved .and. spheres) call input_error(cfg%deck_file, 'shear', 'control', &
          '''stress'' in the resolved DNS is implemented for the fluid alone: with particles (the wall velocity '// &
          'as the unknown of the coupled step) it is not implemented yet; lubrication dynamics (&fluid model = '// &

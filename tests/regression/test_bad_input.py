@@ -160,8 +160,13 @@ cases = [
      ['bad.nml', '&shear', 'stress', 'must be given']),
     ('stress control in the DNS with particles', GOOD + "&shear control = 'stress', stress = 2 /\n"
      "&particles number = 1, position(:,1) = 1.6, 1.6, 1.6 /\n", [], ['bad.nml', '&shear', 'control', 'not implemented yet']),
-    ('stress control with a reversal', LDS + "&rheology /\n&shear control = 'stress', stress = 2, protocol = 'reversal', "
-     "reversal_strain = 1 /\n", [], ['bad.nml', '&shear', 'protocol', "'steady'"]),
+    ('a strain amplitude in a stress oscillation', LDS + "&rheology /\n&shear control = 'stress', stress = 2, "
+     "protocol = 'oscillatory', strain_amplitude = 0.1, period = 1 /\n", [],
+     ['bad.nml', '&shear', 'strain_amplitude', 'amplitude &shear stress']),
+    ('a stress oscillation without a period', LDS + "&rheology /\n&shear control = 'stress', stress = 2, "
+     "protocol = 'oscillatory' /\n", [], ['bad.nml', '&shear', 'period']),
+    ('a stress reversal shorter than a step', LDS + "&rheology /\n&shear control = 'stress', stress = 2, "
+     "protocol = 'reversal', reversal_strain = 1e-6 /\n", [], ['bad.nml', '&shear', 'reversal_strain', 'one step']),
     ('stress control, no particles and no walls', LDS.replace('&particles number = 1, position(:,1) = 1.6, 1.6, 1.6 /\n', '')
      + "&shear control = 'stress', stress = 2 /\n", [], ['bad.nml', '&shear', 'control', 'no stress can be measured']),
     ('stress control without statistics', LDS + "&shear control = 'stress', stress = 2 /\n", [],

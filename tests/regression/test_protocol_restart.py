@@ -15,6 +15,9 @@ steady runs). Cases, each stopped in the middle of what the protocol does:
   checkpoint's velocities and rate, as the uninterrupted step does; and of the pure fluid in the
   DNS on 2 ranks (stress 2.5 from rest), 60 against 30 + 30: the unit wall-speed response is made
   again at the restart, the same;
+- a reversal of the stress (8, G = 0.3) and an oscillation of the stress (amplitude 8, T = 150
+  steps) in lubrication dynamics, 200 against 100 + 100: the restart between two flips of the
+  stress, and at 2/3 of a period;
 - steps of the stress by time in lubrication dynamics (8, 12, 6 from t = 0, 0.3, 0.7: steps 61
   and 141), 200 against 100 + 100: the level of the last step is in the checkpoint (as the
   reversals are), so the restarted step sees no spurious jump.
@@ -66,6 +69,8 @@ STRESS = """&domain box = 8.0, 8.0, 8.0, y_boundary = 'lees-edwards' /
 """
 STEPS = STRESS.replace("stress = 8.0", "protocol = 'steps', step_by = 'time', levels = 3, step_at = 0.0, 0.3, 0.7, "
                        "step_level = 8.0, 12.0, 6.0")
+STRESS_REVERSAL = STRESS.replace("stress = 8.0", "stress = 8.0, protocol = 'reversal', reversal_strain = 0.3")
+STRESS_OSCILLATION = STRESS.replace("stress = 8.0", "stress = 8.0, protocol = 'oscillatory', period = 0.75")
 STRESS_FLUID = """&domain box = 4.0, 4.0, 4.0, cells_per_radius = 2 /
 &shear control = 'stress', stress = 2.5 /
 &fluid reynolds = 0.01, viscous_theta = 1.0 /
@@ -109,6 +114,13 @@ T.check(np.all(np.abs(s['shear/stress'] - 8.0) < 1e-12) and np.ptp(s['shear/rate
 s = split('stress_steps', STEPS, 200)
 T.check(list(s['step'][1:][np.abs(np.diff(s['shear/stress'])) > 1]) == [61, 141],
         'stress steps: the stress changes at steps 61 and 141, on either side of the restart')
+s = split('stress_reversal', STRESS_REVERSAL, 200)
+flips = s['step'][1:][np.sign(s['shear/stress'][1:]) != np.sign(s['shear/stress'][:-1])]
+T.check(len(flips) >= 2 and flips[0] < 101 < flips[-1] and np.all(np.abs(np.abs(s['shear/stress']) - 8.0) < 1e-12),
+        'stress reversal: the stress is +-8 and flips at steps %s, on either side of the restart' % list(flips))
+s = split('stress_oscillation', STRESS_OSCILLATION, 200)
+T.check(np.all(np.abs(s['shear/stress'] - 8.0 * np.sin(2 * np.pi * (s['step'] - 1) * 5.0e-3 / 0.75)) < 1e-11),
+        'stress oscillation: the stress is 8 sin(2 pi t_n/T) at every record (the restart at 2/3 of a period)')
 s = split('stress_fluid', STRESS_FLUID, 60, ranks=2)
 T.check(np.all(np.abs(s['shear/stress'] - 2.5) < 1e-12), 'stress control of the fluid alone: the stress is 2.5 at every record')
 

@@ -18,7 +18,17 @@
 !     0.0125): the change at the first step boundary past it, step 13; a state restored after a
 !     change continues without a spurious jump;
 !  6. stress control: the step begins with the last step's rate, the target is the stress (or the
-!     level of stress steps), and the strain advances with the rate set_rate gives to advance.
+!     level of stress steps), and the strain advances with the rate set_rate gives to advance;
+!  7. stress reversal (S = -3, G = 0.05, the solved rate 0.5 in magnitude, dt 1e-3: 100 steps per
+!     segment): the target is -3 until the accumulated |strain| reaches G, then +3, -3, ...,
+!     flipping at the start of steps 100, 200, 300 and no other (as the rate under rate control,
+!     the same 1e-9 slack), p%reversed marks them; the reference rate (the unit) is the deck's
+!     rate, not derived from the stress;
+!  8. stress oscillation (amplitude 2, T = 0.8, dt 1e-3): the target of the step from t_n is
+!     2 sin(2 pi t_n/T) with t_n = n dt (to 1e-12: the protocol sums its time step by step, n
+!     round-offs of t ~ 1e-16 each, times the slope 2 x 2 pi/T), the reference rate is the deck's rate, and the
+!     strain is the sum of the advance rates (not gamma_0 sin: to 1e-15 against the sum); a state
+!     restored half way continues bitwise.
 program test_shear_protocol
   use mod_kinds, only: dp, pi
   use mod_shear_protocol, only: shear_protocol_t, shear_protocol_create, shear_protocol_begin_step, &
@@ -168,6 +178,54 @@ program test_shear_protocol
     call shear_protocol_end_step(p)
   end do
   call check(all_rates, 'stress steps: the target is the level of each step, the change marked')
+
+  ! 7. stress reversal: the solver's rate is +-0.5 with the sign of the target (a Newtonian
+  ! response), so each segment of G = 0.05 is 100 steps of 5e-4
+  p = shear_protocol_create(PROTOCOL_REVERSAL, 1.0_dp, 1.0e-3_dp, 0.05_dp, 0.0_dp, 0.0_dp, stress=-3.0_dp)
+  call check(p%reference_rate == 1.0_dp, 'stress reversal: the reference rate is the deck''s rate (the unit)')
+  flip_steps = [integer ::]
+  all_rates = .true.
+  do n = 0, 399
+    call shear_protocol_begin_step(p)
+    if (p%reversed) flip_steps = [flip_steps, n]
+    all_rates = all_rates .and. p%stress == merge(-3.0_dp, 3.0_dp, mod(n / 100, 2) == 0)
+    call shear_protocol_set_rate(p, sign(0.5_dp, p%stress), p%stress, sign(0.5_dp, p%stress))
+    call shear_protocol_end_step(p)
+  end do
+  call check(size(flip_steps) == 3, 'stress reversal: three flips in 400 steps')
+  if (size(flip_steps) == 3) call check(all(flip_steps == [100, 200, 300]), &
+                                        'stress reversal: the target flips at the start of steps 100, 200, 300')
+  call check(all_rates, 'stress reversal: the target is -3 on the first segment, then +-3 alternately')
+  call check_below('stress reversal: the strain comes back to 0 after four segments', abs(p%strain), 1.0e-12_dp)
+
+  ! 8. stress oscillation
+  period = 0.8_dp
+  p = shear_protocol_create(PROTOCOL_OSCILLATORY, 1.0_dp, 1.0e-3_dp, 0.0_dp, 0.0_dp, period, stress=2.0_dp)
+  call check(p%reference_rate == 1.0_dp .and. p%stress == 0.0_dp, &
+             'stress oscillation: the reference rate is the deck''s rate, the target at t = 0 is 0')
+  worst = 0.0_dp
+  summed = 0.0_dp
+  restored_same = .true.
+  do n = 0, 999
+    if (n == 500) then
+      q = p
+      call shear_protocol_restore(q, shear_protocol_state(p))
+    end if
+    call shear_protocol_begin_step(p)
+    worst = max(worst, abs(p%stress - 2.0_dp * sin(2.0_dp * pi * n * 1.0e-3_dp / period)))
+    call shear_protocol_set_rate(p, 0.3_dp * p%stress, p%stress, 0.3_dp * p%stress)
+    summed = summed + 0.3_dp * p%stress * 1.0e-3_dp
+    call shear_protocol_end_step(p)
+    if (n >= 500) then
+      call shear_protocol_begin_step(q)
+      call shear_protocol_set_rate(q, 0.3_dp * q%stress, q%stress, 0.3_dp * q%stress)
+      call shear_protocol_end_step(q)
+      restored_same = restored_same .and. q%stress == p%stress .and. q%strain == p%strain
+    end if
+  end do
+  call check_below('stress oscillation: the target is 2 sin(2 pi n dt/T)', worst, 1.0e-12_dp)
+  call check_below('stress oscillation: the strain is the sum of the advance rates', abs(p%strain - summed), 1.0e-15_dp)
+  call check(restored_same, 'stress oscillation: a state restored at step 500 continues bitwise')
   call finish('test_shear_protocol')
 
 contains
