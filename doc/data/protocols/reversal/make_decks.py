@@ -12,8 +12,8 @@ WINDOW = 6                        # &rheology over segments 2-6 (strains 3-18; t
 here = os.path.dirname(os.path.abspath(__file__))
 CASES = [(phi, eps_bar, mu, G, SEGMENTS, WINDOW, '') for phi, eps_bar in ((0.30, 0.05), (0.40, 0.025), (0.45, 0.025))
          for mu in (0.0, 0.5)]
-# is strain 3 the steady state? phi 0.45 reversed every strain 6 (4 segments, 3 reversals, 24 strains)
-CASES += [(0.45, 0.025, mu, 6.0, 4, 4, '_g6') for mu in (0.0, 0.5)]
+# is strain 3 the steady state? phi 0.30 and 0.40 reversed every strain 6 (4 segments, 3 reversals, 24 strains)
+CASES += [(phi, eps_bar, mu, 6.0, 4, 4, '_g6') for phi, eps_bar in ((0.30, 0.05), (0.40, 0.025)) for mu in (0.0, 0.5)]
 for phi, eps_bar, mu, G, SEGMENTS, WINDOW, suffix in CASES:
     if True:
         dt = 2.0e-3 if (mu == 0 or eps_bar == 0.05) else 1.0e-3

@@ -9,11 +9,13 @@ Definitions (stresses in eta*|rate|, the solvent included in eta and eta_h; fdsu
   eta_c (contact), N1, N2; value +- standard error over the segments (one value per segment).
 - transient: fdsusp.protocols.reversal_transient over every reversal: the mean at equal strain
   since reversal, +- standard error over the reversals.
-- eta_min: the smallest mean eta over strain since reversal <= 1, with its strain, and eta_h,
+- eta_min: the smallest mean eta over strain since reversal <= 2, with its strain, and eta_h,
   eta_c there; eta(0.02): the record nearest strain 0.02 after reversal.
 - gamma_90: the strain since reversal at which the mean eta, smoothed over 0.1 strain, first
   regains 90 % of the drop, eta_min + 0.9 (eta_ss - eta_min); gamma_90c the same for eta_c (from
   its value at 0.02 to its steady value).
+- eta_23, eta_c_23: the mean transient over strain 2-3 after reversal (the G = 3 runs' steady
+  window), to set against the steady values of the G = 6 runs.
 - gamma_50: the same for half the drop (the recovery is sigmoidal in strain, not exponential: an
   exponential fit from the minimum runs to its bound).
 - steady shear: eta_r, eta_h, eta_c of the steady runs of doc/data/polydisperse/curves (equal
@@ -34,7 +36,7 @@ from fdsusp import protocols, series
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, '..', '..', '..', '..'))
 NAMES = ['rev_mu0_p30', 'rev_mu0_p40', 'rev_mu0_p45', 'rev_mu05_p30', 'rev_mu05_p40', 'rev_mu05_p45',
-         'rev_mu0_p45_g6', 'rev_mu05_p45_g6']
+         'rev_mu0_p30_g6', 'rev_mu05_p30_g6', 'rev_mu0_p40_g6', 'rev_mu05_p40_g6']
 QUANTITIES = ('shear', 'shear_h', 'shear_c', 'N1', 'N2', 'N1_c', 'N2_c')
 
 
@@ -81,7 +83,7 @@ def recovery(x, eta, eta_ss, start_value, start_index, per_01, fraction=0.9):
 def measures(x, tables, eta_ss, G, per_01):
     """The transient's numbers from per-reversal tables (reversals x strain bins)."""
     mean = {q: np.nanmean(tables[q], axis=0) for q in tables}
-    early = x <= 1.0 + 1e-9
+    early = x <= 2.0 + 1e-9
     imin = int(np.nanargmin(np.where(early, mean['shear'], np.inf)))
     i02 = int(np.argmin(np.abs(x - 0.02)))
     out = {'strain_min': float(x[imin]), 'eta_min': float(mean['shear'][imin]),
@@ -94,6 +96,9 @@ def measures(x, tables, eta_ss, G, per_01):
     out['gamma_50'] = recovery(x, mean['shear'], eta_ss['shear'], out['eta_min'], imin, per_01, 0.5)
     out['eta_h_max_early'] = float(np.nanmax(np.where(x <= 0.1 + 1e-9, mean['shear_h'], -np.inf)))
     out['ratio_c_002'] = out['shear_c_002'] / eta_ss['shear_c']
+    w = (x >= 2.0 - 1e-9) & (x <= 3.0 + 1e-9)         # where the G = 3 runs take their steady values
+    out['eta_23'] = float(np.nanmean(mean['shear'][w]))
+    out['eta_c_23'] = float(np.nanmean(mean['shear_c'][w]))
     out['ratio_min'] = out['eta_min'] / eta_ss['shear']
     out['ratio_002'] = out['shear_002'] / eta_ss['shear']
     out['ratio_min_to_h'] = out['eta_min'] / eta_ss['shear_h']
@@ -139,6 +144,9 @@ def analyse(outdir, name):
             tables[q].append(row)
     tables = {q: np.array(v) for q, v in tables.items()}
     n = len(tables['shear'])
+    if n == 0 or len(steady['shear']) == 0:
+        print(f'{name}: no complete reversal yet', file=sys.stderr)
+        return None
     result = measures(x, tables, ss, G, per_01)
     # jackknife over the reversals (and their preceding steady segment)
     if n > 2:
@@ -226,7 +234,7 @@ def figure(runs, path):
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt
     byname = {r['name']: r for r in runs}
-    fig, axes = plt.subplots(2, 3, figsize=(13, 7.5), sharex=True)
+    fig, axes = plt.subplots(2, 3, figsize=(13, 7.5))
     for i, mu in enumerate(('0', '05')):
         for j, p in enumerate(('30', '40', '45')):
             ax = axes[i, j]
@@ -234,7 +242,8 @@ def figure(runs, path):
             r6 = byname.get(f'rev_mu{mu}_p{p}_g6')
             if r6:
                 t6 = r6['transient']
-                ax.plot(t6['strain'], t6['shear'], color='0.55', lw=0.8, ls='--', label='eta, G = 6')
+                ax.plot(t6['strain'], t6['shear'], color='0.45', lw=0.9, ls='--', label='eta, G = 6')
+                ax.plot(t6['strain'], t6['shear_c'], color='salmon', lw=0.9, ls='--', label='eta_c, G = 6')
             ax.set_title(f'phi 0.{p}, mu_d {"0" if mu == "0" else "0.5"}' + ('' if r else ' (not run)'), fontsize=10)
             if not r:
                 continue
@@ -261,7 +270,7 @@ def figure(runs, path):
             if (i == 0 and j == 0) or r6:
                 ax.legend(fontsize=7, loc='center left')
     fig.suptitle('Shear reversal, lubrication dynamics (10a Lees-Edwards cube, eps_r 5e-3): mean over reversals +- s.e.; '
-                 'dotted: steady values', fontsize=10)
+                 'dotted: steady values (G = 3); dashed: G = 6 runs', fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
 
@@ -275,7 +284,12 @@ def main():
     for name in NAMES:
         d = os.path.join(args.out, name)
         if os.path.exists(os.path.join(d, 'series.h5')):
-            r = analyse(d, name)
+            try:
+                r = analyse(d, name)
+            except protocols.NoProtocol:
+                r = None
+            if r is None:
+                continue
             with open(os.path.join(HERE, name + '.summary.json'), 'w') as f:
                 json.dump(r, f, indent=1)
             runs.append(r)
