@@ -61,33 +61,51 @@ def stresses(columns):
 def reversal_transient(outdir, skip_reversals=0):
     """The stress against the strain since the last reversal, averaged over the reversals.
 
-    A reversal starts at each record whose rate has the opposite sign of the record before; the
-    strain since it is |gamma(t_n) - gamma at the reversal|, on the grid of one step's strain (the
-    records of every reversal share it when reversal_strain is a whole number of steps). The shear
-    stresses are signed with the current direction (positive when they resist the flow); N1, N2 as
-    they are. Each is averaged over the reversals after the first skip_reversals, with its standard
-    error (standard deviation over the reversals, ddof 1, / sqrt(count); NaN from one reversal).
-    Returns {'strain': (k,), 'count': (k,), 'reversal_steps': steps of the reversal records,
-    name: {'mean': (k,), 'error': (k,)}} with the names of stresses(), in eta*|reference rate|."""
+    A reversal starts at each record whose rate has the opposite sign of the record before. The
+    strain since it is measured from the turning point gamma_r, the strain of the configuration at
+    which the rate changed sign, whether or not a record holds it (series_every > 1): with |rate|
+    constant the records either side of the turn, at configurations n1 < n2, give
+    gamma_r = (gamma(n1) + gamma(n2) - rate(n2) dt (n2 - n1))/2; with series_every 1 gamma_r is the
+    strain of the reversal record itself. The strain since it, |gamma(t_n) - gamma_r|, is binned on
+    the grid of the records (series_every steps) starting at the first reversal's offset (the
+    records of every reversal share it when reversal_strain is a whole number of series_every
+    steps). The shear stresses are signed with the current direction (positive when they resist
+    the flow); N1, N2 as they are. Each is averaged over the reversals after the first
+    skip_reversals, with its standard error (standard deviation over the reversals, ddof 1, /
+    sqrt(count); NaN from one reversal). Returns {'strain': (k,), 'count': (k,), 'reversal_steps':
+    steps of the first records after each reversal, 'turning_strain': gamma_r of each, name:
+    {'mean': (k,), 'error': (k,)}} with the names of stresses(), in eta*|reference rate|."""
     p = settings(outdir)
     columns, _ = series.read(outdir, STRESS_COLUMNS + ['step'])
-    rate, strain = columns['shear/rate'], columns['shear/strain']
+    return reversal_transient_columns(columns, p, skip_reversals)
+
+
+def reversal_transient_columns(columns, p, skip_reversals=0):
+    """reversal_transient from the series columns (STRESS_COLUMNS and 'step') and the protocol
+    settings p (settings(): 'reference_rate', 'dt')."""
+    rate, strain, step = columns['shear/rate'], columns['shear/strain'], columns['step']
     sign = np.sign(rate)
     starts = np.flatnonzero(sign[1:] != sign[:-1]) + 1
     starts = starts[skip_reversals:]
     if len(starts) == 0:
-        raise NoProtocol(f'{outdir}: no reversal in the series')
+        raise NoProtocol('no reversal in the series')
     ends = list(starts[1:]) + [len(rate)]
     s = stresses(columns)
     unit = abs(p['reference_rate'])
-    step_strain = unit * p['dt'] * max(1, int(np.median(np.diff(columns['step']))))
+    dt = p['dt']
+    step_strain = unit * dt * max(1, int(np.median(np.diff(step))))
+    turns = [(strain[a - 1] + strain[a] - rate[a] * dt * (step[a] - step[a - 1])) / 2 for a in starts]
+    offset = None
     segments = []
-    for a, b in zip(starts, ends):
-        since = np.abs(strain[a:b] - strain[a])
-        bins = np.rint(since / step_strain).astype(int)
+    for a, b, turn in zip(starts, ends, turns):
+        since = np.abs(strain[a:b] - turn)
+        if offset is None:
+            offset = since[0] - step_strain * np.floor(since[0] / step_strain + 1e-9)
+        bins = np.rint((since - offset) / step_strain).astype(int)
         segments.append((bins, a, b))
     nbins = max(seg[0].max() for seg in segments) + 1
-    result = {'strain': np.arange(nbins) * step_strain, 'reversal_steps': columns['step'][starts]}
+    result = {'strain': offset + np.arange(nbins) * step_strain, 'reversal_steps': step[starts],
+              'turning_strain': np.array(turns)}
     counts = np.zeros(nbins, int)
     for bins, _, _ in segments:
         counts[bins] += 1

@@ -59,7 +59,7 @@ def test_stroboscopic(tmp_path):
     assert list(d['moved']) == [0.5, 0.5]
 
 
-def test_reversal(tmp_path):
+def reversal_columns():
     """Rate +1 for 50 steps, then -1, +1, -1 (G = 0.5): the contact shear stress relaxes to 0 after
     each reversal and rises as c = strain since reversal (signed with the direction); N1 = 2 c."""
     n = 200
@@ -75,6 +75,11 @@ def test_reversal(tmp_path):
             'core/stress_hydro': np.zeros((n, 5)), 'core/stress_contact': sc}
     attrs = dict(shear_protocol=2.0, shear_reference_rate=1.0, shear_reversal_strain=0.5,
                  shear_strain_amplitude=0.0, shear_period=0.0, shear_dt=DT)
+    return cols, attrs
+
+
+def test_reversal(tmp_path):
+    cols, attrs = reversal_columns()
     write_series(os.path.join(str(tmp_path), 'series.h5'), cols, attrs)
     r = protocols.reversal_transient(str(tmp_path))
     assert list(r['reversal_steps']) == [51, 101, 151] and list(r['count']) == [3] * 50
@@ -83,6 +88,22 @@ def test_reversal(tmp_path):
     assert r['N1_c']['mean'] == pytest.approx(2 * np.arange(50) * DT)
     assert r['shear_c']['error'] == pytest.approx(np.zeros(50), abs=1e-12)
     assert r['shear_h']['mean'] == pytest.approx(np.ones(50))        # the solvent: |rate| = 1
+
+
+def test_reversal_sparse_records(tmp_path):
+    """Every 5th record from the 4th (series_every 5, no record on a reversal step): the strain
+    since reversal counts from the turning point (3 steps before the first record after it), not
+    from that record."""
+    cols, attrs = reversal_columns()
+    sparse = {k: v[3::5] for k, v in cols.items()}
+    write_series(os.path.join(str(tmp_path), 'series.h5'), sparse, attrs)
+    r = protocols.reversal_transient(str(tmp_path))
+    assert list(r['reversal_steps']) == [54, 104, 154] and list(r['count']) == [3] * 10
+    assert r['turning_strain'] == pytest.approx([0.5, 0.0, 0.5], abs=1e-12)
+    expected = 0.03 + 0.05 * np.arange(10)
+    assert r['strain'] == pytest.approx(expected)
+    assert r['shear_c']['mean'] == pytest.approx(expected)
+    assert r['N1_c']['mean'] == pytest.approx(2 * expected)
 
 
 def test_steady_has_no_protocol(tmp_path):
