@@ -63,11 +63,13 @@ module mod_contact
   ! stiffer contacts.
   ! With mu_d >= SHEAR_JAM_WARN_MU the overlap guard stopped runs from SHEAR_JAM_WARN_PHI on,
   ! between walls. In Lees-Edwards cubes (12a) with mu_d 0.5 equal spheres and the 1:1.4 mixture
-  ! flow at 0.57 (eta_r ~130) and jam at 0.589 (JAMMED_PHI on): the contact stress doubles every
-  ! 0.02 strain, the same at two stiffnesses, until the overlap guard at strain 0.12-0.14
-  ! (doc/VALIDATION.md §11.2).
+  ! flow at 0.57 (eta_r ~130); at 0.589 (STARTUP_JAM_PHI on) the start-up from the isotropic
+  ! packing under rate control jams (the contact stress doubles every 0.02 strain, the same at two
+  ! stiffnesses, until the overlap guard at strain 0.12-0.14), while stress control creeps through
+  ! it and flows, and rate control branched from that flowing state flows (eta_r ~265;
+  ! doc/VALIDATION.md §11.2, §12.11).
   real(dp), parameter :: SHEAR_JAM_MU = 0.2_dp, SHEAR_JAM_PHI = 0.545_dp, DENSE_EPS_BAR = 0.005_dp
-  real(dp), parameter :: SHEAR_JAM_WARN_MU = 0.5_dp, SHEAR_JAM_WARN_PHI = 0.52_dp, JAMMED_PHI = 0.585_dp
+  real(dp), parameter :: SHEAR_JAM_WARN_MU = 0.5_dp, SHEAR_JAM_WARN_PHI = 0.52_dp, STARTUP_JAM_PHI = 0.585_dp
   ! smooth spheres (h_r = 0) stop when an overlap exceeds this fraction of their radius
   ! (mod_particle_contacts overlap_limit; doc/CONTACT.md "Overlap guard")
   real(dp), parameter, public :: SMOOTH_OVERLAP_BOUND = 0.05_dp
@@ -261,15 +263,15 @@ contains
                          trim(merge('normal_stiffness', 'eps_bar         ', stiffness_prescribed)))
         return
       end if
-      if (p%mu_d >= SHEAR_JAM_WARN_MU .and. phi >= JAMMED_PHI) then
-        write(text, '(a,f6.4,a,f5.2,a)') 'phi = ', phi, ' with mu_d = ', p%mu_d, ' is past shear jamming: at phi '// &
-             '0.589 with mu_d 0.5 equal spheres and the 1:1.4 mixture jammed in Lees-Edwards cubes, their contact '// &
-             'stress doubling every 0.02 strain whatever the stiffness, until the overlap guard stopped them at '// &
-             'strain 0.12-0.14 (doc/VALIDATION.md §11.2): under rate control this run will stop there too; '// &
-             '&shear control = ''stress'' lets it creep'
+      if (p%mu_d >= SHEAR_JAM_WARN_MU .and. phi >= STARTUP_JAM_PHI) then
+        write(text, '(a,f6.4,a,f5.2,a)') 'phi = ', phi, ' with mu_d = ', p%mu_d, ' jams on start-up under rate '// &
+             'control: at phi 0.589 with mu_d 0.5 the isotropic packing''s contact stress doubled every 0.02 strain '// &
+             'whatever the stiffness until the overlap guard stopped it at strain 0.12-0.14, while the same packing '// &
+             'under &shear control = ''stress'' crept through the start-up and flowed, and rate control branched '// &
+             '(-branch) from that sheared state flowed (doc/VALIDATION.md §11.2, §12.11): start from a sheared state'
       else
         write(text, '(a,f6.4,a,f5.2,a)') 'phi = ', phi, ' with mu_d = ', p%mu_d, ' flows with contacts this stiff '// &
-             'in Lees-Edwards cubes up to phi 0.57 (doc/VALIDATION.md §6, §11.2; jammed at 0.589); between walls '// &
+             'in Lees-Edwards cubes up to phi 0.589 (doc/VALIDATION.md §6, §11.2, §12.11); between walls '// &
              'the core packs denser (0.570-0.576 in a 15.6a cell, where the shear localised at the walls and the '// &
              'core sheared at a fifth of the rate; cells 12a high jammed at any stiffness): the overlap guard stops '// &
              'a run that jams'

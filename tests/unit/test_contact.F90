@@ -36,8 +36,8 @@
 !      cell, naming &contact eps_bar, the budget and the stiffness that flowed (eps_bar <= 0.005,
 !      normal_stiffness >= 2^1.5 k_n); a prescribed k_n as soft is refused naming normal_stiffness;
 !      eps_bar 0.005 passes with a warning; a 1:1.4 mixture at eps_bar 0.005 is refused (its
-!      largest pair's overlaps are 1.4 times); at phi 0.589 (measured to jam at any stiffness,
-!      doc/VALIDATION.md §11.2) eps_bar 0.002 passes with the warning that the run jams; warns at
+!      largest pair's overlaps are 1.4 times); at phi 0.589 (a rate-controlled start-up measured
+!      to jam at any stiffness, doc/VALIDATION.md §11.2) eps_bar 0.002 passes with that warning; warns at
 !      phi 0.53 with mu_d 0.5, and lets phi 0.5485 pass frictionless, with mu_d 0.1, or without
 !      shear (no sliding boundary, or walls at rest).
 !  15. A mixture's overlap estimate is its largest pair's (doc/CONTACT.md "Spheres of several
@@ -278,14 +278,14 @@ program test_contact
   call contact_setup(pb, 1.0_dp, 5.0e-3_dp, 0.5_dp, 0.005_dp, 0.0_dp, 1.0_dp, 1.0_dp, info, msg)
   found = contact_limits(pb, 2.0e-4_dp, .true., .true., 0.5485_dp, 0.005_dp, .false.)
   call check(count(found%level == LIMIT_REFUSE) == 0 .and. any(found%level == LIMIT_WARN .and. &
-             index(found%text, 'Lees-Edwards cubes up to phi 0.57') > 0), 'eps_bar 0.005: no refusal, a warning')
+             index(found%text, 'Lees-Edwards cubes up to phi 0.589') > 0), 'eps_bar 0.005: no refusal, a warning')
   found = contact_limits(pb, 2.0e-4_dp, .true., .true., 0.5485_dp, 0.005_dp, .false., 1.4_dp)
   call check(count(found%level == LIMIT_REFUSE) == 1, 'eps_bar 0.005 with a 1:1.4 mixture: refused')
   call contact_setup(pb, 1.0_dp, 5.0e-3_dp, 0.5_dp, 0.002_dp, 0.0_dp, 1.0_dp, 1.0_dp, info, msg)
   found = contact_limits(pb, 8.0e-5_dp, .true., .true., 0.589_dp, 0.002_dp, .false.)
   call check(count(found%level == LIMIT_REFUSE) == 0 .and. any(found%level == LIMIT_WARN .and. &
-             index(found%text, 'past shear jamming') > 0 .and. index(found%text, 'control = ''stress''') > 0), &
-             'phi 0.589, mu_d 0.5, eps_bar 0.002: no refusal, the warning that it jams (stress control creeps)')
+             index(found%text, 'jams on start-up') > 0 .and. index(found%text, 'control = ''stress''') > 0), &
+             'phi 0.589, mu_d 0.5, eps_bar 0.002: no refusal, the warning that a rate-controlled start-up jams')
   found = contact_limits(p0, 1.0e-3_dp, .true., .false., 0.5485_dp, 0.01_dp, .false.)
   call check(count(found%level == LIMIT_REFUSE) == 0, 'not sheared: no refusal')
   call contact_setup(pb, 1.0_dp, 5.0e-3_dp, 0.5_dp, 0.01_dp, 1.0e8_dp, 1.0_dp, 0.0_dp, info, msg)
