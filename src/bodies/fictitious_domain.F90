@@ -358,10 +358,10 @@ contains
   ! the right-hand side next to external_force/external_torque (free and frozen motion).
   ! lubrication, optional: the links of this configuration (those of this rank's spheres,
   ! mod_lubrication_links); their resistance enters the 6N system implicitly. contacts, optional:
-  ! the contacts of this step (particle_contacts_step at X^n): their forces and torques join the right-hand side (free and frozen
-  ! motion) and, for free motion with implicit contacts, their linearised stiffness the 6N system;
-  ! after the solve their force, torque and stresslet are those the balance used
-  ! (mod_particle_contacts). Identical on every rank (replicated data).
+  ! the contacts of this step (particle_contacts_step at X^n): their forces and torques join the
+  ! right-hand side (free and frozen motion) and, for free motion with implicit contacts, their
+  ! linearised stiffness the 6N system; after the solve their force, torque and stresslet are
+  ! those the balance used (mod_particle_contacts). Identical on every rank (replicated data).
   subroutine fictitious_domain_solve_motion(fd, parts, ierr, extra_force, extra_torque, lubrication, contacts)
     type(fictitious_domain_t), intent(inout) :: fd
     type(particles_t), intent(inout) :: parts

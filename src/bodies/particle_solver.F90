@@ -25,8 +25,8 @@
 ! in parallel, and the shares of the solution are gathered (doc/DESIGN.md "Parallelism"). Each
 ! rank's system holds every block of its own rows: the one-body and contact blocks are replicated,
 ! and a rank holds the lubrication links of its own spheres (mod_lubrication_links); the blocks of
-! other rows it may hold are ignored. One rank gives the same numbers as before, bitwise; more ranks agree
-! to the solver's tolerance (test_ld_rank_independence). The sparse Cholesky by CHOLMOD runs on one
+! other rows it may hold are ignored. One rank gives the same numbers as before, bitwise; more
+! ranks agree to the solver's tolerance (test_ld_rank_independence). The sparse Cholesky by CHOLMOD runs on one
 ! rank only; -particles_pc_factor_mat_solver_type mumps factors the distributed aij matrix.
 #include <petsc/finclude/petscksp.h>
 module mod_particle_solver
