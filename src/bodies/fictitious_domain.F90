@@ -35,9 +35,9 @@ module mod_fictitious_domain
   use mod_grid, only: grid_t, grid_create_box_layout, FIELD_P
   use mod_particles, only: particles_t, MOTION_FREE, MOTION_FROZEN, impose_motion
   use mod_particle_system, only: particle_system_reset, particle_system_add_diagonal
-  use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_corrections, &
-                                      particle_lubrication_add_to_system, &
+  use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_add_to_system, &
                                       particle_lubrication_add_corrections
+  use mod_lubrication_links, only: lubrication_links_corrections
   use mod_particle_contacts, only: particle_contacts_t, particle_contacts_add_stiffness, &
                                    particle_contacts_implicit_update
   use mod_particle_solver, only: particle_solver_t, particle_solver_create, particle_solver_solve, &
@@ -356,12 +356,12 @@ contains
   ! with the weights), for free motion; prescribed, resistance and fixed motions set them.
   ! extra_force, extra_torque (3, n), optional: further given forces on the particles, added to
   ! the right-hand side next to external_force/external_torque (free and frozen motion).
-  ! lubrication, optional: the links of this configuration (mod_particle_lubrication); their
-  ! resistance enters the 6N system implicitly. contacts, optional: the contacts of this step
-  ! (particle_contacts_step at X^n): their forces and torques join the right-hand side (free and frozen
-  ! motion) and, for free motion with implicit contacts, their linearised stiffness the 6N system;
-  ! after the solve their force, torque and stresslet are those the balance used
-  ! (mod_particle_contacts). Identical on every rank (replicated data).
+  ! lubrication, optional: the links of this configuration (those of this rank's spheres,
+  ! mod_lubrication_links); their resistance enters the 6N system implicitly. contacts, optional:
+  ! the contacts of this step (particle_contacts_step at X^n): their forces and torques join the
+  ! right-hand side (free and frozen motion) and, for free motion with implicit contacts, their
+  ! linearised stiffness the 6N system; after the solve their force, torque and stresslet are
+  ! those the balance used (mod_particle_contacts). Identical on every rank (replicated data).
   subroutine fictitious_domain_solve_motion(fd, parts, ierr, extra_force, extra_torque, lubrication, contacts)
     type(fictitious_domain_t), intent(inout) :: fd
     type(particles_t), intent(inout) :: parts
@@ -462,7 +462,9 @@ contains
       PetscCall(DMDAVecRestoreArrayF90(grid%da(c), vel(c), u(c)%v, ierr))
     end do
     call MPI_Allreduce(MPI_IN_PLACE, sums, 16 * n, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
-    if (present(lubrication)) call particle_lubrication_corrections(lubrication, parts%velocity, parts%omega)
+    if (present(lubrication)) then
+      PetscCall(lubrication_links_corrections(lubrication, parts%velocity, parts%omega, ierr))
+    end if
     do q = 1, n
       parts%force_hydro(:, q) = sums(1:3, q)
       parts%torque_hydro(:, q) = sums(4:6, q)

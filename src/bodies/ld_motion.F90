@@ -3,7 +3,8 @@
 ! mod_particle_solver (directly, block by block, when no pair couples it, else by the KSP with the
 ! prefix particles_, the same options as the DNS);
 ! then the contacts' implicit update, the links' corrections and the hydrodynamic force, torque
-! and stresslet of every sphere. Identical on every rank (replicated data).
+! and stresslet of every sphere. Identical on every rank (replicated data; each rank holds the
+! lubrication links of its own spheres, whose corrections mod_lubrication_links gathers).
 ! Under stress control (ld_motion_solve_stress; doc/METHOD.md §7.4) the step's rate is an unknown:
 ! the step is affine in it, so two solves with the same matrix (the rate-independent part and the
 ! part per unit rate) and one scalar equation give it.
@@ -14,7 +15,8 @@ module mod_ld_motion
   use mod_errors, only: fatal_error
   use mod_particles, only: particles_t, MOTION_FREE, MOTION_FROZEN, impose_motion
   use mod_particle_solver, only: particle_solver_t, particle_solver_solve
-  use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_corrections
+  use mod_particle_lubrication, only: particle_lubrication_t
+  use mod_lubrication_links, only: lubrication_links_corrections
   use mod_particle_contacts, only: particle_contacts_t, particle_contacts_implicit_update, particle_contacts_set_rate
   use mod_lubrication_dynamics, only: lubrication_dynamics_t, lubrication_dynamics_assemble, &
                                       lubrication_dynamics_hydrodynamics
@@ -48,7 +50,9 @@ contains
     case default                    ! prescribed, resistance, fixed
       call impose_motion(parts)
     end select
-    if (present(lubrication)) call particle_lubrication_corrections(lubrication, parts%velocity, parts%omega)
+    if (present(lubrication)) then
+      PetscCall(lubrication_links_corrections(lubrication, parts%velocity, parts%omega, ierr))
+    end if
     call lubrication_dynamics_hydrodynamics(ld, parts, lubrication)
   end subroutine ld_motion_solve
 
@@ -133,8 +137,8 @@ contains
       c_stresslet = contacts%stresslet
       c_added = contacts%stiffness_added
     end if
-    call at_rate(0.0_dp, u0, w0, sigma0)
-    call at_rate(1.0_dp, u0 + u1, w0 + w1, sigma1)
+    PetscCall(at_rate(0.0_dp, u0, w0, sigma0))
+    PetscCall(at_rate(1.0_dp, u0 + u1, w0 + w1, sigma1))
     slope = sigma1 - sigma0
     if (.not. (slope > 0.0_dp)) then
       write(text, '(a,es12.4,a)') 'fdsusp: fatal: stress control: the mean shear stress does not grow with the rate '// &
@@ -142,7 +146,7 @@ contains
       call fatal_error(text, 4)
     end if
     rate = (stress - sigma0) / slope
-    call at_rate(rate, u0 + rate * u1, w0 + rate * w1, reached)
+    PetscCall(at_rate(rate, u0 + rate * u1, w0 + rate * w1, reached))
 
   contains
 
@@ -163,7 +167,7 @@ contains
     ! the step at rate r with the velocities U, Omega (3, n): every rate-dependent datum, the
     ! spheres' velocities, their contact and hydrodynamic force, torque, stresslet (as
     ! ld_motion_solve leaves them; the contacts' step forces restored first), and sigma, the mean
-    ! shear stress they give
+    ! shear stress they give. Collective (the links' corrections; the host's ierr).
     subroutine at_rate(r, u, w, sigma)
       real(dp), intent(in) :: r, u(:, :), w(:, :)
       real(dp), intent(out) :: sigma
@@ -177,7 +181,9 @@ contains
         contacts%stiffness_added = c_added
         call particle_contacts_implicit_update(contacts, u, w)
       end if
-      if (present(lubrication)) call particle_lubrication_corrections(lubrication, u, w)
+      if (present(lubrication)) then
+        PetscCall(lubrication_links_corrections(lubrication, u, w, ierr))
+      end if
       call lubrication_dynamics_hydrodynamics(ld, parts, lubrication)
       if (present(contacts)) then
         sigma = ld%viscosity * r + rheo_particle_shear_stress(rheology, parts%position, &

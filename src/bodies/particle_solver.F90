@@ -19,12 +19,14 @@
 ! At 1000 spheres (phi = 0.4, ~2900 lubricating pairs) CG takes ~46 iterations and is ~20 times
 ! faster than the factorisation (doc/BENCHMARKS.md, scripts/bench_particle_solver.sh); in
 ! lubrication dynamics (no fluid mass on the diagonal) CG takes 64-97 iterations at 1000 spheres and
-! is still the faster, ~7x at 500 spheres (doc/BENCHMARKS.md §11). Particle data is replicated, so every
-! rank assembles the same system; the sparse solve is shared out (since 2026-11-28, issue 45): the
-! matrix and vectors live on PETSC_COMM_WORLD, each rank owns the block rows of a contiguous range of
-! spheres and sets only those, CG runs in parallel, and the shares of the solution are gathered
-! (doc/DESIGN.md "Parallelism"). One rank gives the same numbers as before, bitwise; more ranks agree
-! to the solver's tolerance (test_ld_rank_independence). The sparse Cholesky by CHOLMOD runs on one
+! is still the faster, ~7x at 500 spheres (doc/BENCHMARKS.md §11). The sparse solve is shared out
+! (since 2026-11-28, issue 45): the matrix and vectors live on PETSC_COMM_WORLD, each rank owns the
+! block rows of a contiguous range of spheres (particle_solver_split) and sets only those, CG runs
+! in parallel, and the shares of the solution are gathered (doc/DESIGN.md "Parallelism"). Each
+! rank's system holds every block of its own rows: the one-body and contact blocks are replicated,
+! and a rank holds the lubrication links of its own spheres (mod_lubrication_links); the blocks of
+! other rows it may hold are ignored. One rank gives the same numbers as before, bitwise; more
+! ranks agree to the solver's tolerance (test_ld_rank_independence). The sparse Cholesky by CHOLMOD runs on one
 ! rank only; -particles_pc_factor_mat_solver_type mumps factors the distributed aij matrix.
 #include <petsc/finclude/petscksp.h>
 module mod_particle_solver
@@ -36,7 +38,8 @@ module mod_particle_solver
   use mod_errors, only: fatal_error
   implicit none
   private
-  public :: particle_solver_t, particle_solver_create, particle_solver_solve, particle_solver_destroy
+  public :: particle_solver_t, particle_solver_create, particle_solver_solve, particle_solver_destroy, &
+            particle_solver_split
 
   type :: particle_solver_t
     type(particle_system_t) :: system   ! the 6N system of the step, assembled by the caller
@@ -76,14 +79,18 @@ contains
     character(len=*), intent(in) :: hint
     real(dp), allocatable :: x(:, :)
     KSPConvergedReason :: reason
-    logical :: ok
+    logical :: ok, coupled
     character(len=300) :: text
     real(dp) :: t0
     ierr = 0
     allocate(x(6, parts%n))
     x(1:3, :) = parts%velocity
     x(4:6, :) = parts%omega
-    if (ps%system%npairs == 0) then
+    ! a rank holds only the lubrication links of its spheres (mod_lubrication_links): the system is
+    ! coupled when any rank's is, and every rank must take the same (collective) branch
+    coupled = ps%system%npairs > 0
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, coupled, 1, MPI_LOGICAL, MPI_LOR, PETSC_COMM_WORLD, ierr))
+    if (.not. coupled) then
       call particle_system_solve(ps%system, rhs, x, 1.0e-12_dp, ps%iterations, ok)
       if (.not. ok) then
         write(text, '(a,i0,2a)') 'fdsusp: fatal: the particle system is not positive definite or did not '// &
@@ -136,18 +143,11 @@ contains
 
     n6 = 6 * sys%n
     ! The spheres' block rows are shared out in contiguous ranges (PETSc's split): this rank owns
-    ! spheres lo..hi. The system is replicated (every rank assembled it), so each rank sets its own
-    ! rows and nothing crosses ranks in the assembly; the solve then runs on every rank's share.
+    ! spheres lo..hi. Its system holds every block of those rows (the header), so each rank sets its
+    ! own rows and nothing crosses ranks in the assembly; the solve then runs on every rank's share.
     PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, ranks, ierr))
     PetscCallMPI(MPI_Comm_rank(PETSC_COMM_WORLD, rank, ierr))
-    allocate(counts(ranks), displs(ranks))
-    do i = 1, ranks
-      counts(i) = sys%n / ranks + merge(1, 0, i - 1 < mod(sys%n, ranks))
-    end do
-    displs(1) = 0
-    do i = 2, ranks
-      displs(i) = displs(i - 1) + counts(i - 1)
-    end do
+    call particle_solver_split(sys%n, ranks, counts, displs)
     lo = displs(rank + 1) + 1
     hi = displs(rank + 1) + counts(rank + 1)
     owned = counts(rank + 1)
@@ -244,6 +244,23 @@ contains
     PetscCall(VecDestroy(vb, ierr))
     PetscCall(MatDestroy(a, ierr))
   end subroutine ksp_solve
+
+  !> The contiguous ranges of spheres whose block rows the ranks own (PETSc's split of n over
+  !> ranks): rank r (0-based) owns spheres displs(r + 1) + 1 .. displs(r + 1) + counts(r + 1).
+  !> mod_lubrication_links shares the links out by the same ranges.
+  pure subroutine particle_solver_split(n, ranks, counts, displs)
+    integer, intent(in) :: n, ranks
+    integer, allocatable, intent(out) :: counts(:), displs(:)
+    integer :: i
+    allocate(counts(ranks), displs(ranks))
+    do i = 1, ranks
+      counts(i) = n / ranks + merge(1, 0, i - 1 < mod(n, ranks))
+    end do
+    displs(1) = 0
+    do i = 2, ranks
+      displs(i) = displs(i - 1) + counts(i - 1)
+    end do
+  end subroutine particle_solver_split
 
   ! PETSc takes a block row by row
   pure function row_major(b) result(v)

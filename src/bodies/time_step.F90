@@ -441,6 +441,12 @@ contains
         call log_line(text)
       end if
     end if
+    if (associated(ts%lubrication)) then
+      ! each rank holds the pair links of its own spheres (mod_lubrication_links)
+      write(text, '(a,i0,a,i0,a)') 'lubrication: ', ts%lubrication%npairs_total, &
+           ' pair links in the last step, at most ', ts%lubrication%npairs_most, ' held on one rank'
+      call log_line(text)
+    end if
     if (ts%variant == TIME_STEP_RESOLVED) then
       solves = ts%fd%solver%solves
       seconds = ts%fd%solver%seconds

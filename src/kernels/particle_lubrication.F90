@@ -1,8 +1,9 @@
 ! Lubrication in the particle time step (doc/LUBRICATION.md): the model, the neighbour list of
 ! lubricating pairs and sphere-wall links, and per step the 6x6 / 12x12 blocks that the implicit
 ! particle system takes (doc/METHOD.md §3.2 equation (1)) and the corrections once the velocities are
-! known. Pure: no PETSc, MPI or files; particle data is replicated, so every rank computes the
-! same blocks in the same order.
+! known. Pure: no PETSc, MPI or files. Particle data is replicated; on several ranks each evaluates
+! the links of a range of spheres (particle_lubrication_links' owned) and mod_lubrication_links
+! combines what the ranks need of them.
 !
 ! The undisturbed flow is the imposed shear of the Couette cell: U_inf = shear_rate (y - Ly/2) e_x,
 ! Om_inf = -shear_rate/2 e_z, E_inf = shear_rate/2 (e_x e_y + e_y e_x); at rest in a periodic box.
@@ -29,7 +30,7 @@
 ! semi-definite, wall blocks floored at lub_wall_floor with the sphere's own radius, as for equal
 ! spheres.
 module mod_particle_lubrication
-  use mod_kinds, only: dp, i8, pi
+  use mod_kinds, only: dp, pi
   use mod_pair_resistance, only: n_pair_scalars, resistance_scalars
   use mod_pair_resistance_unequal, only: unequal_pair_t, unequal_pair_setup, unequal_pair_scalars, &
        exchange_sign, twin_multipole_order, sphere_wall_gap
@@ -43,8 +44,7 @@ module mod_particle_lubrication
   implicit none
   private
   public :: particle_lubrication_t, particle_lubrication_create, particle_lubrication_links, &
-            particle_lubrication_corrections, particle_lubrication_reserve_pairs, &
-            particle_lubrication_add_to_system, particle_lubrication_add_corrections, particle_lubrication_columns
+            particle_lubrication_corrections, particle_lubrication_add_to_system, particle_lubrication_add_corrections, particle_lubrication_columns
 
   type :: particle_lubrication_t
     type(lubrication_t) :: lub
@@ -56,8 +56,10 @@ module mod_particle_lubrication
     integer, allocatable :: links_of(:)                        ! (np) links per sphere (model 'exact')
     integer :: ncand = 0, ncand_walls = 0
     integer, allocatable :: cand(:, :), cand_walls(:, :)        ! canonical candidate lists
-    ! links of the current configuration
-    integer :: npairs = 0, nwalls = 0
+    ! links of the current configuration (pairs: those evaluated here, all of them or those with a
+    ! sphere in the owned range; npairs_total, npairs_most: the pair links of the whole system and
+    ! the most one rank holds, npairs on one rank, set by mod_lubrication_links on several)
+    integer :: npairs = 0, nwalls = 0, npairs_total = 0, npairs_most = 0
     integer, allocatable :: pair(:, :)                         ! (2, npairs)
     real(dp), allocatable :: pair_d(:, :), pair_f(:, :)        ! (3, :), (22, :)
     real(dp), allocatable :: pair_f2(:, :)                     ! (22, :) 22 and 21 scalars (sized)
@@ -228,19 +230,22 @@ contains
   !> The lubrication links at positions x (3, np): which pairs and walls are within the outer
   !> cut-off, and their blocks. Call once per step before the particle problem. A block that
   !> cannot be decomposed is named in pl%failed_link for the caller to report.
-  !> part, parts (optional): only the part-th of parts contiguous shares of the pair candidates
-  !> (0-based; mod_lubrication_links gathers the shares of all ranks in order); walls always all.
+  !> owned (optional): the spheres owned(1)..owned(2); only the pair candidates with a sphere among
+  !> them, in the order of all candidates, so that each owned sphere has all its pair links, in the
+  !> order all links would have them (mod_lubrication_links); walls always all.
   !> offset (optional): the Lees-Edwards offset delta of this configuration (runs created with le).
-  subroutine particle_lubrication_links(pl, x, part, parts, offset)
+  subroutine particle_lubrication_links(pl, x, owned, offset)
     type(particle_lubrication_t), intent(inout) :: pl
     real(dp), intent(in) :: x(:, :)
-    integer, intent(in), optional :: part, parts
+    integer, intent(in), optional :: owned(2)
     real(dp), intent(in), optional :: offset
-    integer :: c, i, j, side, first, last, status
+    integer :: c, i, j, side, status
     real(dp) :: r(3), dist, gap, d(3), om_inf(3), e_inf(3, 3), u_inf(3, 2), normal(3), u_wall(3), w(n_wall_scalars)
     real(dp) :: vshift(3), floor_scale, scale(12)
     pl%npairs = 0
     pl%nwalls = 0
+    pl%npairs_total = 0
+    pl%npairs_most = 0
     pl%min_gap = huge(1.0_dp)
     pl%failed_link = 0
     if (pl%lub%model == LUB_NONE) return
@@ -253,15 +258,12 @@ contains
       floor_scale = -0.5_dp * min(6.0_dp * pi * pl%lub%viscosity * pl%lub%radius, &
                                   8.0_dp * pi * pl%lub%viscosity * pl%lub%radius**3)
     end if
-    first = 1
-    last = pl%ncand
-    if (present(part) .and. present(parts)) then
-      first = int(int(part, i8) * pl%ncand / parts) + 1
-      last = int(int(part + 1, i8) * pl%ncand / parts)
-    end if
-    do c = first, last
+    do c = 1, pl%ncand
       i = pl%cand(1, c)
       j = pl%cand(2, c)
+      if (present(owned)) then
+        if ((i < owned(1) .or. i > owned(2)) .and. (j < owned(1) .or. j > owned(2))) cycle
+      end if
       r = separation(i, j)
       dist = norm2(r)
       gap = pair_gap(i, j, dist)
@@ -344,6 +346,8 @@ contains
       end if
       if (status /= 0 .and. pl%failed_link(1) == 0) pl%failed_link = [i, 0]
     end do
+    pl%npairs_total = pl%npairs
+    pl%npairs_most = pl%npairs
 
   contains
 
@@ -435,8 +439,18 @@ contains
     end subroutine count_links
 
     subroutine grow_pairs()
+      integer :: m
+      integer, allocatable :: ip(:, :)
+      real(dp), allocatable :: t2(:, :), t3(:, :, :)
       if (pl%npairs < size(pl%pair, 2)) return
-      call particle_lubrication_reserve_pairs(pl, 2 * size(pl%pair, 2))
+      m = 2 * size(pl%pair, 2)
+      allocate(ip(2, m)); ip(:, 1:pl%npairs) = pl%pair(:, 1:pl%npairs); call move_alloc(ip, pl%pair)
+      allocate(t2(3, m)); t2(:, 1:pl%npairs) = pl%pair_d(:, 1:pl%npairs); call move_alloc(t2, pl%pair_d)
+      allocate(t2(n_pair_scalars, m)); t2(:, 1:pl%npairs) = pl%pair_f(:, 1:pl%npairs); call move_alloc(t2, pl%pair_f)
+      allocate(t2(n_pair_scalars, m)); t2(:, 1:pl%npairs) = pl%pair_f2(:, 1:pl%npairs); call move_alloc(t2, pl%pair_f2)
+      allocate(t2(6, m)); t2(:, 1:pl%npairs) = pl%pair_uinf(:, 1:pl%npairs); call move_alloc(t2, pl%pair_uinf)
+      allocate(t3(12, 12, m)); t3(:, :, 1:pl%npairs) = pl%pair_r(:, :, 1:pl%npairs); call move_alloc(t3, pl%pair_r)
+      allocate(t2(12, m)); t2(:, 1:pl%npairs) = pl%pair_drive(:, 1:pl%npairs); call move_alloc(t2, pl%pair_drive)
     end subroutine grow_pairs
 
     subroutine grow_walls()
@@ -452,24 +466,6 @@ contains
     end subroutine grow_walls
 
   end subroutine particle_lubrication_links
-
-  !> Room for n pair links (the first npairs kept).
-  subroutine particle_lubrication_reserve_pairs(pl, n)
-    type(particle_lubrication_t), intent(inout) :: pl
-    integer, intent(in) :: n
-    integer :: m
-    integer, allocatable :: ip(:, :)
-    real(dp), allocatable :: t2(:, :), t3(:, :, :)
-    if (n <= size(pl%pair, 2)) return
-    m = n
-    allocate(ip(2, m)); ip(:, 1:pl%npairs) = pl%pair(:, 1:pl%npairs); call move_alloc(ip, pl%pair)
-    allocate(t2(3, m)); t2(:, 1:pl%npairs) = pl%pair_d(:, 1:pl%npairs); call move_alloc(t2, pl%pair_d)
-    allocate(t2(n_pair_scalars, m)); t2(:, 1:pl%npairs) = pl%pair_f(:, 1:pl%npairs); call move_alloc(t2, pl%pair_f)
-    allocate(t2(n_pair_scalars, m)); t2(:, 1:pl%npairs) = pl%pair_f2(:, 1:pl%npairs); call move_alloc(t2, pl%pair_f2)
-    allocate(t2(6, m)); t2(:, 1:pl%npairs) = pl%pair_uinf(:, 1:pl%npairs); call move_alloc(t2, pl%pair_uinf)
-    allocate(t3(12, 12, m)); t3(:, :, 1:pl%npairs) = pl%pair_r(:, :, 1:pl%npairs); call move_alloc(t3, pl%pair_r)
-    allocate(t2(12, m)); t2(:, 1:pl%npairs) = pl%pair_drive(:, 1:pl%npairs); call move_alloc(t2, pl%pair_drive)
-  end subroutine particle_lubrication_reserve_pairs
 
   !> The links into a 6N system (doc/METHOD.md §3.2 eq. (1)): each pair's 12x12 block as two diagonal
   !> blocks and one coupling block, each wall link's 6x6 on its particle's diagonal; their
@@ -496,7 +492,9 @@ contains
   end subroutine particle_lubrication_add_to_system
 
   !> The corrections with the velocities of this step, u and om (3, np): force, torque and
-  !> stresslet on each particle (pl%force, pl%torque, pl%stresslet).
+  !> stresslet on each particle (pl%force, pl%torque, pl%stresslet) from the links evaluated here:
+  !> complete for the spheres whose links all are (every sphere, or the owned range of
+  !> particle_lubrication_links, whose sums mod_lubrication_links gathers).
   subroutine particle_lubrication_corrections(pl, u, om)
     type(particle_lubrication_t), intent(inout) :: pl
     real(dp), intent(in) :: u(:, :), om(:, :)
@@ -556,7 +554,7 @@ contains
     type(column_t), allocatable :: c(:)
     ! element by element: an array constructor of column_t leaks their values (gfortran 12)
     allocate(c(5))
-    c(1) = column('lubrication_pairs', pl%npairs)
+    c(1) = column('lubrication_pairs', pl%npairs_total)
     c(2) = column('lubrication_walls', pl%nwalls)
     c(3) = column('min_gap', pl%min_gap)
     c(4) = column('particles/force_lubrication', pl%force)

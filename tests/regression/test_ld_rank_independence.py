@@ -8,7 +8,11 @@ the sparse solve runs at every step.
     (mpibaij), as -particles_ksp_view reports;
  2. 2 and 3 ranks (unequal shares on 3) agree with 1 rank at every step: positions, velocities
     and angular velocities within 1e-10 of each quantity's largest magnitude;
- 3. 20 steps on 2 ranks, a checkpoint, 20 more on 3 agree with the 40 on 1 rank, likewise.
+ 3. 20 steps on 2 ranks, a checkpoint, 20 more on 3 agree with the 40 on 1 rank, likewise;
+ 4. the lubrication links stay on the ranks that evaluated them (mod_lubrication_links, issue 45):
+    one rank holds all the pair links of the last step (the run log's count), on 2 and 3 ranks
+    none does, each holding at least its share; the series' count of pair links (the whole
+    system's) is 1 rank's at every step.
 Tolerance: the CG iterations run to a relative residual of 1e-12; on more ranks their inner
 products sum in another order, which changes the iterates at round-off and the converged solution
 within the solver's tolerance. Measured (2026-11-28): at most 4.2e-13 (omega, the smallest
@@ -54,6 +58,11 @@ def compare(ref, other, what):
         T.check(diff <= TOL, '%s: %s max difference %.1e of its largest (%.3g) <= %.0e' % (what, k, diff, scale, TOL))
 
 
+def links(out):
+    m = re.search(r'lubrication: (\d+) pair links in the last step, at most (\d+) held on one rank', out)
+    return (int(m.group(1)), int(m.group(2))) if m else (0, 0)
+
+
 def matrix_type(out):
     m = re.search(r'type: (\w*baij)', out)
     return m.group(1) if m else None
@@ -65,10 +74,19 @@ T.check(solves is not None and int(solves.group(1)) == 40,
         'the sparse solve runs at every step (%s of 40)' % (solves.group(1) if solves else 'none'))
 T.check(matrix_type(out1) == 'seqbaij', '1 rank: sequential matrix (%s)' % matrix_type(out1))
 ref = results(d1)
+total1, most1 = links(out1)
+T.check(total1 > 0 and most1 == total1, '1 rank holds all %d pair links (%d)' % (total1, most1))
+pairs1 = T.series(os.path.join(d1, 'out'))['lubrication_pairs']
 for n in (2, 3):
     d, out = run('ld_ranks_%d' % n, n)
     T.check(matrix_type(out) == 'mpibaij', '%d ranks: distributed matrix (%s)' % (n, matrix_type(out)))
     compare(ref, results(d), '%d ranks vs 1' % n)
+    total, most = links(out)
+    T.check(total == total1 and total / n <= most < total,
+            '%d ranks: no rank holds all %d pair links (at most %d on one)' % (n, total, most))
+    pairs = T.series(os.path.join(d, 'out'))['lubrication_pairs']
+    T.check(np.array_equal(pairs, pairs1), '%d ranks: the series counts the pair links of the whole system '
+            '(%d-%d, as 1 rank)' % (n, pairs.min(), pairs.max()))
 
 # restart on another rank count: 20 steps on 2 ranks, then 20 on 3
 d, _ = run('ld_ranks_restart', 2, steps=20)
