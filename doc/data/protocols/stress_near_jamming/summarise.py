@@ -1,5 +1,6 @@
 """Stress control near shear jamming (README.md here): the flow curve at phi 0.50 and the creep at
-phi 0.57 and 0.589, from the runs' series.h5, into summary.json and doc/figures/stress_near_jamming.png.
+phi 0.57 and 0.589, and the rate-controlled branch from the sheared state at 0.589, from the runs'
+output, into summary.json and doc/figures/stress_near_jamming.png.
     PYTHONPATH=python python3 doc/data/protocols/stress_near_jamming/summarise.py [OUT]
 OUT: out/protocols/stress_near_jamming (each run's output directory there, by deck name)."""
 import json
@@ -67,7 +68,7 @@ def figure(result):
     left.legend(fontsize=7)
     left.grid(alpha=0.3)
     for name, label, c in (('creep_p57_S130', 'phi 0.570 (flows under rate control)', 'C0'),
-                           ('creep_p59_S130', 'phi 0.589 (jams under rate control)', 'C3')):
+                           ('creep_p59_S130', 'phi 0.589 (its start-up jams under rate control)', 'C3')):
         if name not in result['creep']:
             continue
         cols, _ = load(name)
@@ -89,6 +90,11 @@ if __name__ == '__main__':
     for n in CREEP:
         if os.path.exists(os.path.join(OUT, n, 'series.h5')):
             result['creep'][n] = creep(n)
+    # rate control branched from creep_p59_S130 at step 12500: its own summary (fdsusp's)
+    branch = os.path.join(OUT, 'branch_p59_rate', 'summary.json')
+    if os.path.exists(branch):
+        q = json.load(open(branch))['quantities']
+        result['branch_p59_rate'] = {k: q[k] for k in ('eta_r', 'eta_h', 'eta_c', 'N1/tau', 'N2/tau', 'Pi/tau', 'mu')}
     json.dump(result, open(os.path.join(HERE, 'summary.json'), 'w'), indent=1)
     print(json.dumps(result, indent=1))
     figure(result)
