@@ -18,7 +18,7 @@ module mod_time_step
   use mod_errors, only: log_line, report_limits
   use mod_contact, only: overlap_limit, wall_lower, wall_upper
   use mod_grid, only: grid_t
-  use mod_fluid, only: fluid_t, fluid_step, fluid_mean_profile, fluid_add_response
+  use mod_fluid, only: fluid_t, fluid_step, fluid_mean_profile, fluid_add_response, fluid_set_sliding
   use mod_timers, only: stage_push, stage_pop, STAGE_FLUID, STAGE_PARTICLES, STAGE_CONTACTS, STAGE_LUBRICATION
   use mod_particles, only: particles_t, advance_positions, displacements
   use mod_particle_contacts, only: particle_contacts_t, particle_contacts_step
@@ -157,6 +157,7 @@ contains
     call shear_protocol_begin_step(ts%protocol)
     if (shear_protocol_varies(ts%protocol)) call impose_rate(ts)
     stress_control = ts%protocol%control == CONTROL_STRESS
+    if (associated(ts%fluid) .and. ts%le%active) call slide_fluid(ts)
     if (ts%variant == TIME_STEP_FLUID) then
       PetscCall(stage_push(STAGE_FLUID, ierr))
       PetscCall(fluid_step(ts%grid, ts%fluid, ierr))
@@ -171,6 +172,7 @@ contains
       end if
       PetscCall(stage_pop(ierr))
       call shear_protocol_end_step(ts%protocol)
+      if (ts%le%active) call slide(ts%le, ts%protocol, ts%dt)
       call count_step(ts, step)
       return
     end if
@@ -254,14 +256,8 @@ contains
       call advance_positions(parts, ts%dt, ts%box, [.true., .not. (ts%walls .or. le%active), .true.])
       call shear_protocol_end_step(ts%protocol)
       if (le%active) then
-        ! the boundary slides on (by the strain of the step, exactly: an oscillation's offset is
-        ! gamma(t_{n+1}) Ly, stress control's the strain its spheres advanced, §7.4); spheres
-        ! that left through y = 0 or Ly re-enter from the image
-        if (ts%protocol%kind == PROTOCOL_OSCILLATORY .or. stress_control) then
-          call le_set_strain(le, ts%protocol%strain)
-        else
-          call le_advance(le, ts%dt)
-        end if
+        ! the boundary slides on; spheres that left through y = 0 or Ly re-enter from the image
+        call slide(le, ts%protocol, ts%dt)
         call le_wrap(le, parts%position, parts%velocity, parts%velocity_prev)
       end if
       if (ts%variant == TIME_STEP_RESOLVED) then
@@ -302,6 +298,36 @@ contains
     end if
     ts%le%shear_rate = rate
   end subroutine impose_rate
+
+  ! The Lees-Edwards boundary after the step (protocol: at its end), by the strain of the step
+  ! exactly: an oscillation's offset is gamma(t_{n+1}) Ly, stress control's the strain its spheres
+  ! advanced (doc/METHOD.md §7.4), otherwise the rate times dt.
+  pure subroutine slide(le, protocol, dt)
+    type(lees_edwards_t), intent(inout) :: le
+    type(shear_protocol_t), intent(in) :: protocol
+    real(dp), intent(in) :: dt
+    if (protocol%kind == PROTOCOL_OSCILLATORY .or. protocol%control == CONTROL_STRESS) then
+      call le_set_strain(le, protocol%strain)
+    else
+      call le_advance(le, dt)
+    end if
+  end subroutine slide
+
+  ! The resolved fluid's Lees-Edwards boundary for the step to come (doc/METHOD.md §2.4): the
+  ! offset now and after the step (the same rule as slide, on copies), and the images' velocity
+  ! gamma_dot Ly at the step's rate.
+  subroutine slide_fluid(ts)
+    type(time_step_t), intent(inout) :: ts
+    type(lees_edwards_t) :: after
+    type(shear_protocol_t) :: protocol_after
+    real(dp) :: jump
+    after = ts%le
+    protocol_after = ts%protocol
+    call shear_protocol_end_step(protocol_after)
+    call slide(after, protocol_after, ts%dt)
+    jump = ts%protocol%rate * ts%box(2)
+    call fluid_set_sliding(ts%fluid, ts%le%offset, after%offset, jump, jump)
+  end subroutine slide_fluid
 
   ! The account of a step taken: the fluid solvers' iterations, and a new largest contact overlap
   ! of the run, warned once past h_r/2 (mod_contact::overlap_limit).

@@ -33,6 +33,15 @@
 ! the global ordering. The operator's inverse eigenvalues are formed during the solve from the
 ! three 1D eigenvalue lists (the same expression as before, so the same bits) instead of a stored
 ! grid-sized array: four buffers, four scatters and four such arrays were about 130 B per cell.
+!
+! Lees-Edwards (doc/METHOD.md §2.4): y is periodic up to a twist of each x-mode, f(x, y + Ly) =
+! f(x - delta, y), i.e. exp(i theta_m) per mode m (mod_sliding_boundary, which shifts the rows of
+! the explicit stencils the same way). The twisted second difference in y is not diagonalised by a
+! real transform, but the phase ramp d(j) = exp(-i theta_m j/ny) c(j) makes it periodic, with
+! eigenvalues 4 sin^2((2 pi l + theta_m)/(2 ny))/h^2: so an r2c transform in x, the ramp, a
+! complex 2D DFT in (z, y) for every x-mode at once (FFTW's MPI "many" transform, left transposed),
+! the division, and back. All four fields share it (there are no wall rows), exact to round-off at
+! any offset, in a complex buffer of about the size of the real one.
 #include <petsc/finclude/petscdmda.h>
 module mod_fft_solver
   use petscdmda
@@ -41,10 +50,11 @@ module mod_fft_solver
   use mod_grid, only: grid_t, grid_petsc_index, FIELD_V, FIELD_P
   use mod_errors, only: fatal_error
   use mod_timers, only: event_begin, event_end, EVENT_FFT
+  use mod_sliding_boundary, only: sliding_twist
   implicit none
   private
   include 'fftw3-mpi.f03'
-  public :: fft_solver_t, fft_create, fft_solve, fft_destroy
+  public :: fft_solver_t, fft_create, fft_solve, fft_destroy, fft_set_sliding_shift
 
   type :: fft_solver_t
     integer :: field = 0
@@ -59,6 +69,7 @@ module mod_fft_solver
     ! the operator mass I - diffusion lap: its eigenvalues are mass + diffusion (eig_x(i) + eig_y(j)
     ! + eig_z(k)), formed during the solve; norm: the normalisation of the transform pair
     real(dp) :: mass = 0.0_dp, diffusion = 0.0_dp, norm = 1.0_dp
+    real(dp) :: h_squared = 1.0_dp   ! Lees-Edwards: the y eigenvalues are formed per solve
     real(dp), allocatable :: eig_x(:), eig_y(:), eig_z(:)
   end type fft_solver_t
 
@@ -82,6 +93,16 @@ module mod_fft_solver
   ! cell). Otherwise the VecScatter above.
   logical, save :: shared_planes = .false.
   integer, allocatable, save :: vec_counts(:), vec_offsets(:), slab_counts(:), slab_offsets(:)
+  ! Lees-Edwards (see the top): the complex buffer of the x-modes [z][y][mode], its y-slab once
+  ! transposed, the plans shared by the four fields, and the offset delta in cells
+  logical, save :: shared_sliding = .false.
+  integer, save :: sliding_modes = 0          ! n(1)/2 + 1
+  integer(C_INTPTR_T), save :: sliding_local_ny = 0, sliding_y_start = 0, sliding_local_nz = 0
+  type(C_PTR), save :: sliding_buffer = C_NULL_PTR
+  complex(C_DOUBLE_COMPLEX), pointer, contiguous, save :: sliding_data(:) => null()
+  type(C_PTR), save :: plan_x_forward = C_NULL_PTR, plan_x_backward = C_NULL_PTR
+  type(C_PTR), save :: plan_yz_forward = C_NULL_PTR, plan_yz_backward = C_NULL_PTR
+  real(dp), save :: sliding_shift = 0.0_dp
 
 contains
 
@@ -102,12 +123,28 @@ contains
       call fftw_mpi_init()
       fftw_ready = .true.
     end if
-    PetscCall(shared_acquire(grid, ierr))
+    PetscCall(shared_acquire(grid, flags, ierr))
     s%field = field
     s%nx = grid%n(1)
     s%nz = grid%n(3)
     s%ny = grid%n(2)
     s%first_row = 0
+    if (shared_sliding) then
+      ! one transform for every field (see the top): only the operator is the solver's own
+      s%mass = mass
+      s%diffusion = diffusion
+      allocate(s%eig_x(sliding_modes))
+      do m = 0, sliding_modes - 1
+        s%eig_x(m + 1) = 4.0_dp * sin(pi * m / real(s%nx, dp))**2 / grid%h**2
+      end do
+      s%eig_z = periodic_eigenvalues(s%nz, grid%h)
+      allocate(s%eig_y(0))
+      s%h_squared = grid%h**2
+      s%norm = real(s%nx, dp) * real(s%ny, dp) * real(s%nz, dp)
+      s%local_nz = sliding_local_nz
+      s%made = .true.
+      return
+    end if
     if (grid%walls) then
       select case (field)
       case (FIELD_P)
@@ -179,8 +216,9 @@ contains
   ! that they solve on the same grid. The buffer holds this rank's z-slab of the whole block and
   ! whatever FFTW asks for the transforms of every field (v between walls has n(2) - 1 rows).
   ! The scatter: slab entry (x, y, z) is natural point (x, y, z_start + z) of the DMDA.
-  subroutine shared_acquire(grid, ierr)
+  subroutine shared_acquire(grid, flags, ierr)
     type(grid_t), intent(in) :: grid
+    integer(C_INT), intent(in) :: flags
     PetscErrorCode, intent(out) :: ierr
     integer(C_INTPTR_T) :: local_nz, z_start, local_ny, y_start, need
     integer :: i, j, k, m, ny
@@ -208,6 +246,7 @@ contains
     shared_n = grid%n
     shared_users = 1
 
+    if (grid%lees_edwards) call sliding_acquire(grid, int(local_nz), flags)
     shared_planes = grid%nprocs(1) == 1 .and. grid%nprocs(2) == 1
     if (shared_planes) then
       call plane_exchange(grid, int(z_start), int(local_nz))
@@ -231,6 +270,108 @@ contains
     PetscCall(DMRestoreGlobalVector(grid%da(FIELD_P), template, ierr))
     PetscCall(ISDestroy(from, ierr))
   end subroutine shared_acquire
+
+  ! The Lees-Edwards transforms (see the top), on the shared buffer's z-slab of local_nz planes:
+  ! r2c in x of every row of the slab into the complex buffer [z][y][mode], and the distributed
+  ! complex DFT in (z, y) of every mode, left transposed ([y][z][mode], y in slabs).
+  subroutine sliding_acquire(grid, local_nz, flags)
+    type(grid_t), intent(in) :: grid
+    integer, intent(in) :: local_nz
+    integer(C_INT), intent(in) :: flags
+    integer(C_INTPTR_T) :: dims(2), need, local_n0, start0
+    integer(C_INT) :: length(1)
+    complex(C_DOUBLE_COMPLEX), pointer :: transformed(:)
+    shared_sliding = .true.
+    sliding_modes = grid%n(1) / 2 + 1
+    dims = [int(grid%n(3), C_INTPTR_T), int(grid%n(2), C_INTPTR_T)]
+    need = fftw_mpi_local_size_many_transposed(2, dims, int(sliding_modes, C_INTPTR_T), FFTW_MPI_DEFAULT_BLOCK, &
+               FFTW_MPI_DEFAULT_BLOCK, PETSC_COMM_WORLD, local_n0, start0, sliding_local_ny, sliding_y_start)
+    if (local_n0 /= local_nz) call fatal_error('fdsusp: internal error: the Lees-Edwards transform splits z '// &
+                                               'unlike the fluid''s slabs', 4)
+    sliding_local_nz = local_n0
+    sliding_buffer = fftw_alloc_complex(max(need, 1_C_INTPTR_T))
+    call c_f_pointer(sliding_buffer, sliding_data, [max(need, 1_C_INTPTR_T)])
+    transformed => sliding_data   ! in place: the same buffer
+    length = grid%n(1)
+    if (local_nz > 0) then
+      plan_x_forward = fftw_plan_many_dft_r2c(1, length, local_nz * grid%n(2), shared_data, length, 1, grid%n(1), &
+                                              sliding_data, [sliding_modes], 1, sliding_modes, flags)
+      plan_x_backward = fftw_plan_many_dft_c2r(1, length, local_nz * grid%n(2), sliding_data, [sliding_modes], 1, &
+                                               sliding_modes, shared_data, length, 1, grid%n(1), flags)
+    end if
+    plan_yz_forward = fftw_mpi_plan_many_dft(2, dims, int(sliding_modes, C_INTPTR_T), FFTW_MPI_DEFAULT_BLOCK, &
+                          FFTW_MPI_DEFAULT_BLOCK, sliding_data, transformed, PETSC_COMM_WORLD, FFTW_FORWARD, &
+                          ior(flags, FFTW_MPI_TRANSPOSED_OUT))
+    plan_yz_backward = fftw_mpi_plan_many_dft(2, dims, int(sliding_modes, C_INTPTR_T), FFTW_MPI_DEFAULT_BLOCK, &
+                           FFTW_MPI_DEFAULT_BLOCK, sliding_data, transformed, PETSC_COMM_WORLD, FFTW_BACKWARD, &
+                           ior(flags, FFTW_MPI_TRANSPOSED_IN))
+    if (.not. (c_associated(plan_yz_forward) .and. c_associated(plan_yz_backward)) .or. (local_nz > 0 .and. &
+        .not. (c_associated(plan_x_forward) .and. c_associated(plan_x_backward)))) &
+      call fatal_error('fdsusp: error: FFTW could not plan the Lees-Edwards transforms of the fluid', 4)
+  end subroutine sliding_acquire
+
+  ! The offset delta of the Lees-Edwards boundary, in cells, that the next solves take (every
+  ! field's: the fluid sets it before each solve, doc/METHOD.md §2.4).
+  subroutine fft_set_sliding_shift(shift)
+    real(dp), intent(in) :: shift
+    sliding_shift = shift
+  end subroutine fft_set_sliding_shift
+
+  ! The solve of fft_solve on the shared buffer, Lees-Edwards (see the top). The ramp and the y
+  ! eigenvalues depend on the offset, so they are tabulated per solve (modes x rows, small).
+  subroutine sliding_solve(s)
+    type(fft_solver_t), intent(in) :: s
+    complex(dp), allocatable :: ramp(:, :)
+    real(dp), allocatable :: eig_y(:, :)
+    real(dp) :: theta, eigenvalue
+    integer :: i, j, k, m, l, nk
+    nk = sliding_modes
+    allocate(ramp(nk, 0:s%ny - 1), eig_y(nk, max(1, int(sliding_local_ny))))
+    do i = 1, nk
+      theta = sliding_twist(i - 1, s%nx, sliding_shift)
+      do j = 0, s%ny - 1
+        ramp(i, j) = cmplx(cos(theta * j / s%ny), -sin(theta * j / s%ny), dp)
+      end do
+      do j = 1, int(sliding_local_ny)
+        l = j - 1 + int(sliding_y_start)
+        eig_y(i, j) = 4.0_dp * sin((2.0_dp * pi * l + theta) / (2.0_dp * s%ny))**2 / s%h_squared
+      end do
+    end do
+    if (sliding_local_nz > 0) call fftw_execute_dft_r2c(plan_x_forward, shared_data, sliding_data)
+    ! d(j) = exp(-i theta j/ny) c(j): periodic in y
+    m = 0
+    do k = 1, int(sliding_local_nz)
+      do j = 0, s%ny - 1
+        sliding_data(m + 1:m + nk) = sliding_data(m + 1:m + nk) * ramp(:, j)
+        m = m + nk
+      end do
+    end do
+    call fftw_mpi_execute_dft(plan_yz_forward, sliding_data, sliding_data)
+    ! transposed: [y][z][mode]
+    m = 0
+    do j = 1, int(sliding_local_ny)
+      do k = 1, s%nz
+        do i = 1, nk
+          m = m + 1
+          eigenvalue = s%mass + s%diffusion * (s%eig_x(i) + eig_y(i, j) + s%eig_z(k))
+          if (eigenvalue > 0.0_dp) then
+            sliding_data(m) = sliding_data(m) * (1.0_dp / (eigenvalue * s%norm))
+          else
+            sliding_data(m) = (0.0_dp, 0.0_dp)
+          end if
+        end do
+      end do
+    end do
+    call fftw_mpi_execute_dft(plan_yz_backward, sliding_data, sliding_data)
+    m = 0
+    do k = 1, int(sliding_local_nz)
+      do j = 0, s%ny - 1
+        sliding_data(m + 1:m + nk) = sliding_data(m + 1:m + nk) * conjg(ramp(:, j))
+        m = m + nk
+      end do
+    end do
+    if (sliding_local_nz > 0) call fftw_execute_dft_c2r(plan_x_backward, sliding_data, shared_data)
+  end subroutine sliding_solve
 
   ! The counts and offsets of the plane exchange (shared_planes): this rank's DMDA planes
   ! [a, a + lz) go to each rank's FFTW slab [c, c + nz), the overlap, and come back the same way.
@@ -342,6 +483,9 @@ contains
         end do
       end do
     end if
+    if (shared_sliding) then
+      call sliding_solve(s)
+    else
     call fftw_mpi_execute_r2r(s%forward, data, result)
     ! divide by the eigenvalues: the expression and the order of the stored inverse of before
     m = 0
@@ -359,6 +503,7 @@ contains
       end do
     end do
     call fftw_mpi_execute_r2r(s%backward, data, result)
+    end if
     if (s%first_row > 0) then
       ! expand (backward: each row moves to a higher address), the wall row zero
       m = s%local_n
@@ -388,8 +533,8 @@ contains
     PetscErrorCode, intent(out) :: ierr
     ierr = 0
     if (.not. s%made) return
-    call fftw_destroy_plan(s%forward)
-    call fftw_destroy_plan(s%backward)
+    if (c_associated(s%forward)) call fftw_destroy_plan(s%forward)
+    if (c_associated(s%backward)) call fftw_destroy_plan(s%backward)
     deallocate(s%eig_x, s%eig_y, s%eig_z)    ! all fft_create made: the solver can be created again
     s%made = .false.
     shared_users = shared_users - 1
@@ -401,6 +546,18 @@ contains
       PetscCall(VecDestroy(shared_slab, ierr))
     end if
     shared_planes = .false.
+    if (shared_sliding) then
+      if (c_associated(plan_x_forward)) call fftw_destroy_plan(plan_x_forward)
+      if (c_associated(plan_x_backward)) call fftw_destroy_plan(plan_x_backward)
+      call fftw_destroy_plan(plan_yz_forward)
+      call fftw_destroy_plan(plan_yz_backward)
+      call fftw_free(sliding_buffer)
+      plan_x_forward = C_NULL_PTR
+      plan_x_backward = C_NULL_PTR
+      sliding_buffer = C_NULL_PTR
+      sliding_data => null()
+      shared_sliding = .false.
+    end if
     call fftw_free(shared_buffer)
     shared_buffer = C_NULL_PTR
     shared_data => null()

@@ -33,13 +33,17 @@ module mod_fluid
                       direct_solves_wanted
   use mod_solvers, only: solver_t, solver_create, solver_solve, solver_destroy, solver_cold_solve, &
                          fft_planner_flags
-  use mod_errors, only: log_line
+  use mod_errors, only: log_line, input_error
   use mod_manufactured, only: mms_forcing
   use mod_columns, only: column_t, column
+  use mod_sliding_boundary, only: sliding_shift_rows
+  use mod_fft_solver, only: fft_set_sliding_shift
   implicit none
   private
   public :: fluid_t, fluid_create, fluid_step, fluid_destroy, fluid_mean_profile, fluid_columns
   public :: fluid_options_check, fluid_bench_cold_poisson, fluid_unit_response, fluid_add_response
+  public :: fluid_set_sliding, fluid_ghosted, fluid_deck_check
+  integer, parameter :: AT_START = 1, AT_END = 2  ! the step's two instants t_n, t_{n+1} (Lees-Edwards)
   integer, parameter :: STAR_HISTORY_FULL = 2   ! u*^n and u*^{n-1} known: extrapolate
 
   type :: fluid_t
@@ -58,6 +62,10 @@ module mod_fluid
     type(solver_t) :: solver(4)
     real(dp) :: reynolds = 0.0_dp, dt = 0.0_dp, theta = 0.5_dp, viscosity = 1.0_dp
     real(dp) :: wall_speed = 0.0_dp
+    ! Lees-Edwards (grid%lees_edwards, doc/METHOD.md §2.4): the boundary's offset delta [a] and the
+    ! velocity of the image above, gamma_dot Ly, at t_n (AT_START: the explicit half of the step)
+    ! and t_{n+1} (AT_END: the implicit half, the projection, the diagnostics); fluid_set_sliding
+    real(dp) :: sliding_offset(2) = 0.0_dp, sliding_jump(2) = 0.0_dp
     ! diagnostics of the last step
     real(dp) :: divergence = 0.0_dp   ! max|div u| h / max|u| after projection
     real(dp) :: tau_bottom = 0.0_dp   ! mean eta du/dy on the wall y = 0
@@ -113,8 +121,11 @@ contains
     ! -fluid_extrapolate 0: the warm start from u^n (for the comparison of doc/BENCHMARKS.md §10)
     PetscCall(PetscOptionsGetBool(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-fluid_extrapolate', fl%extrapolate, found, ierr))
     PetscCall(set_forcing(cfg, grid, fl, ierr))
+    if (grid%lees_edwards) fl%sliding_jump = cfg%domain%shear_rate * cfg%domain%box(2)
     if (cfg%fluid%initial_flow == 'shear' .and. grid%walls) then
-      PetscCall(set_linear_shear(grid, fl, ierr))
+      PetscCall(set_linear_shear(grid, fl, fl%wall_speed, ierr))
+    else if (cfg%fluid%initial_flow == 'shear' .and. grid%lees_edwards) then
+      PetscCall(set_linear_shear(grid, fl, 0.5_dp * fl%sliding_jump(AT_END), ierr))
     end if
 
     ! Round-off floor of each solve: 100 machine epsilons of the right-hand side that a field of
@@ -161,10 +172,12 @@ contains
     end do
   end subroutine set_forcing
 
-  ! u = U (2y/Ly - 1): the steady Couette profile, exact on the grid (the wall ghosts reproduce it).
-  subroutine set_linear_shear(grid, fl, ierr)
+  ! u = U (2y/Ly - 1): the steady Couette profile, exact on the grid (the wall ghosts reproduce it,
+  ! and so do the Lees-Edwards ghosts, U = gamma_dot Ly/2).
+  subroutine set_linear_shear(grid, fl, speed, ierr)
     type(grid_t), intent(in) :: grid
     type(fluid_t), intent(inout) :: fl
+    real(dp), intent(in) :: speed
     PetscErrorCode, intent(out) :: ierr
     PetscScalar, pointer :: a(:,:,:)
     integer :: j
@@ -172,7 +185,7 @@ contains
     PetscCall(DMDAVecGetArrayF90(grid%da(FIELD_U), fl%vel(FIELD_U), a, ierr))
     do j = grid%lo(2), grid%hi(2)
       y = (j + 0.5_dp) * grid%h
-      a(:, j, :) = fl%wall_speed * (2.0_dp * y / grid%box(2) - 1.0_dp)
+      a(:, j, :) = speed * (2.0_dp * y / grid%box(2) - 1.0_dp)
     end do
     PetscCall(DMDAVecRestoreArrayF90(grid%da(FIELD_U), fl%vel(FIELD_U), a, ierr))
   end subroutine set_linear_shear
@@ -190,18 +203,29 @@ contains
   ! The wall ghosts are set above and below the owned (i, k) only: the 7-point stencil reads
   ! nothing else there, and the star-stencil exchange leaves the edge ghosts beside them unfilled
   ! (mod_grid, doc/DESIGN.md "Ghost layers").
+  ! With Lees-Edwards the rows across y = 0 and y = Ly are the boundary's images at the instant
+  ! `at` (AT_START or AT_END, default AT_END: the state after the step; sliding_ghosts).
   ! local: a local vector of grid%da(c) (borrowed by the caller).
-  subroutine ghosted(grid, fl, c, global, local, ierr)
+  subroutine ghosted(grid, fl, c, global, local, ierr, at)
     type(grid_t), intent(in) :: grid
-    type(fluid_t), intent(inout) :: fl
+    type(fluid_t), intent(in) :: fl
     integer, intent(in) :: c
     Vec, intent(in) :: global
     Vec, intent(inout) :: local
     PetscErrorCode, intent(out) :: ierr
+    integer, intent(in), optional :: at
     PetscScalar, pointer :: a(:,:,:)
-    integer :: ny, lo(3), hi(3)
+    integer :: ny, lo(3), hi(3), instant
     PetscCall(DMGlobalToLocalBegin(grid%da(c), global, INSERT_VALUES, local, ierr))
     PetscCall(DMGlobalToLocalEnd(grid%da(c), global, INSERT_VALUES, local, ierr))
+    if (grid%lees_edwards) then
+      instant = AT_END
+      if (present(at)) instant = at
+      PetscCall(DMDAVecGetArrayF90(grid%da(c), local, a, ierr))
+      call sliding_ghosts(grid, c, a, fl%sliding_offset(instant), fl%sliding_jump(instant))
+      PetscCall(DMDAVecRestoreArrayF90(grid%da(c), local, a, ierr))
+      return
+    end if
     if (.not. grid%walls .or. c == FIELD_V .or. c == FIELD_P) return
     ny = grid%n(2)
     lo = grid%lo
@@ -213,6 +237,69 @@ contains
                                                                - a(lo(1):hi(1), ny - 1, lo(3):hi(3))
     PetscCall(DMDAVecRestoreArrayF90(grid%da(c), local, a, ierr))
   end subroutine ghosted
+
+  ! The ghosted copy of a face field (fluid_step's, at the end of the last step): for readers
+  ! outside the fluid step (the output's cell-centred averages). Collective.
+  subroutine fluid_ghosted(grid, fl, c, global, local, ierr)
+    type(grid_t), intent(in) :: grid
+    type(fluid_t), intent(in) :: fl
+    integer, intent(in) :: c
+    Vec, intent(in) :: global
+    Vec, intent(inout) :: local
+    PetscErrorCode, intent(out) :: ierr
+    PetscCall(ghosted(grid, fl, c, global, local, ierr))
+  end subroutine fluid_ghosted
+
+  ! The Lees-Edwards ghost rows of component c in its ghosted array a (doc/METHOD.md §2.4): below
+  ! the box (j = -1) the top row read at x + delta, above it (j = n(2)) the bottom row read at
+  ! x - delta (mod_sliding_boundary), and for u the image's velocity -+ gamma_dot Ly (jump) added:
+  ! u(x, y -+ Ly) = u(x +- delta, y) -+ gamma_dot Ly. The grid is split in z only (mod_grid), so
+  ! the rows are this rank's; their x ghosts are the periodic ones. The star stencil's reads are
+  ! these rows above and below the owned (i, k); edge ghosts beside them (k outside the slab) are
+  ! not set.
+  subroutine sliding_ghosts(grid, c, a, offset, jump)
+    type(grid_t), intent(in) :: grid
+    integer, intent(in) :: c
+    PetscScalar, intent(inout) :: a(grid%glo(1):, grid%glo(2):, grid%glo(3):)
+    real(dp), intent(in) :: offset, jump
+    real(dp), allocatable :: rows(:, :)
+    real(dp) :: image_velocity
+    integer :: nx, ny, k, lo, hi
+    nx = grid%n(1)
+    ny = grid%n(2)
+    lo = grid%lo(3)
+    hi = grid%hi(3)
+    image_velocity = 0.0_dp
+    if (c == FIELD_U) image_velocity = jump
+    allocate(rows(0:nx - 1, lo:hi))
+    do k = lo, hi
+      rows(:, k) = a(0:nx - 1, ny - 1, k)
+    end do
+    call sliding_shift_rows(rows, offset / grid%h)
+    do k = lo, hi
+      a(0:nx - 1, -1, k) = rows(:, k) - image_velocity
+    end do
+    do k = lo, hi
+      rows(:, k) = a(0:nx - 1, 0, k)
+    end do
+    call sliding_shift_rows(rows, -offset / grid%h)
+    do k = lo, hi
+      a(0:nx - 1, ny, k) = rows(:, k) + image_velocity
+    end do
+    a(-1, -1, lo:hi) = a(nx - 1, -1, lo:hi)
+    a(nx, -1, lo:hi) = a(0, -1, lo:hi)
+    a(-1, ny, lo:hi) = a(nx - 1, ny, lo:hi)
+    a(nx, ny, lo:hi) = a(0, ny, lo:hi)
+  end subroutine sliding_ghosts
+
+  ! The Lees-Edwards boundary of the step to come (doc/METHOD.md §2.4): its offset delta [a] and
+  ! image velocity gamma_dot Ly at t_n and at t_{n+1}.
+  subroutine fluid_set_sliding(fl, offset_start, offset_end, jump_start, jump_end)
+    type(fluid_t), intent(inout) :: fl
+    real(dp), intent(in) :: offset_start, offset_end, jump_start, jump_end
+    fl%sliding_offset = [offset_start, offset_end]
+    fl%sliding_jump = [jump_start, jump_end]
+  end subroutine fluid_set_sliding
 
   ! source: an extra force density on the u, v, w faces (the fictitious-domain Lambda^n).
   subroutine fluid_step(grid, fl, ierr, source)
@@ -236,8 +323,10 @@ contains
     ! 1. provisional velocity; with the direct solves the right-hand side is built in vel_star,
     ! which the solve then overwrites with u*
     PetscCall(DMGetLocalVector(grid%da(FIELD_P), loc_p, ierr))
-    PetscCall(ghosted(grid, fl, FIELD_P, fl%pressure, loc_p, ierr))
+    PetscCall(ghosted(grid, fl, FIELD_P, fl%pressure, loc_p, ierr, AT_START))
     PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_P), loc_p, p, ierr))
+    ! the implicit solves and the projection see the boundary at t_{n+1}
+    if (grid%lees_edwards) call fft_set_sliding_shift(fl%sliding_offset(AT_END) / h)
     force = 0.0_dp
     do c = 1, 3
       e = 0
@@ -248,7 +337,7 @@ contains
         rhs = fl%rhs(c)
       end if
       PetscCall(DMGetLocalVector(grid%da(c), loc_c, ierr))
-      PetscCall(ghosted(grid, fl, c, fl%vel(c), loc_c, ierr))
+      PetscCall(ghosted(grid, fl, c, fl%vel(c), loc_c, ierr, AT_START))
       PetscCall(DMDAVecGetArrayReadF90(grid%da(c), loc_c, a, ierr))
       PetscCall(DMDAVecGetArrayF90(grid%da(c), rhs, r, ierr))
       if (fl%has_forcing) then
@@ -273,6 +362,12 @@ contains
               if (j == 0) wall_term = 2.0_dp * wall_velocity(fl, c, -1)
               if (j == ny - 1) wall_term = 2.0_dp * wall_velocity(fl, c, +1)
               r(i, j, k) = r(i, j, k) + implicit * wall_term / h**2
+            end if
+            ! Lees-Edwards: the known part of u's image across the boundary at t_{n+1},
+            ! -+ gamma_dot Ly below and above (sliding_ghosts)
+            if (grid%lees_edwards .and. c == FIELD_U) then
+              if (j == 0) r(i, j, k) = r(i, j, k) - implicit * fl%sliding_jump(AT_END) / h**2
+              if (j == ny - 1) r(i, j, k) = r(i, j, k) + implicit * fl%sliding_jump(AT_END) / h**2
             end if
           end do
         end do
@@ -310,7 +405,7 @@ contains
     PetscCall(DMRestoreLocalVector(grid%da(FIELD_P), loc_p, ierr))
 
     ! 2. pressure increment: -lap phi = -(Re/dt) div u* (the direct solve in place in phi)
-    PetscCall(divergence(grid, fl%vel_star, fl%div_star, ierr))
+    PetscCall(divergence(grid, fl, fl%vel_star, fl%div_star, ierr))
     if (fl%direct) then
       rhs_p = fl%phi
     else
@@ -409,9 +504,11 @@ contains
   end subroutine fluid_add_response
 
   ! div of a face field at the cell centres: (u(i+1)-u(i) + v(j+1)-v(j) + w(k+1)-w(k))/h.
-  ! With walls, v(n) is the periodic image of v(0) = 0: the top wall.
-  subroutine divergence(grid, vel, div, ierr)
+  ! With walls, v(n) is the periodic image of v(0) = 0: the top wall; with Lees-Edwards the image
+  ! of v(0) across the sliding boundary (sliding_ghosts).
+  subroutine divergence(grid, fl, vel, div, ierr)
     type(grid_t), intent(in) :: grid
+    type(fluid_t), intent(in) :: fl
     Vec, intent(in) :: vel(3)
     Vec, intent(inout) :: div
     PetscErrorCode, intent(out) :: ierr
@@ -420,8 +517,12 @@ contains
     integer :: i, j, k
     do i = 1, 3
       PetscCall(DMGetLocalVector(grid%da(i), loc(i), ierr))
-      PetscCall(DMGlobalToLocalBegin(grid%da(i), vel(i), INSERT_VALUES, loc(i), ierr))
-      PetscCall(DMGlobalToLocalEnd(grid%da(i), vel(i), INSERT_VALUES, loc(i), ierr))
+      if (i == FIELD_V .and. grid%lees_edwards) then
+        PetscCall(ghosted(grid, fl, i, vel(i), loc(i), ierr))
+      else
+        PetscCall(DMGlobalToLocalBegin(grid%da(i), vel(i), INSERT_VALUES, loc(i), ierr))
+        PetscCall(DMGlobalToLocalEnd(grid%da(i), vel(i), INSERT_VALUES, loc(i), ierr))
+      end if
     end do
     PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_U), loc(FIELD_U), u, ierr))
     PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_V), loc(FIELD_V), v, ierr))
@@ -455,7 +556,7 @@ contains
     PetscErrorCode :: mpierr
     integer :: c, ny
 
-    PetscCall(divergence(grid, fl%vel, fl%div_star, ierr))
+    PetscCall(divergence(grid, fl, fl%vel, fl%div_star, ierr))
     PetscCall(VecNorm(fl%div_star, NORM_INFINITY, dmax, ierr))
     umax = 0.0_dp
     do c = 1, 3
@@ -467,6 +568,10 @@ contains
 
     fl%tau_bottom = 0.0_dp
     fl%tau_top = 0.0_dp
+    if (grid%lees_edwards) then
+      PetscCall(sliding_shear_stress(grid, fl, ierr))
+      return
+    end if
     if (.not. grid%walls) return
     ny = grid%n(2)
     sums = 0.0_dp
@@ -479,6 +584,29 @@ contains
     fl%tau_bottom = tot(1)
     fl%tau_top = tot(2)
   end subroutine diagnostics
+
+  ! Lees-Edwards: the mean viscous shear stress eta du/dy across the sliding boundary (between the
+  ! first row and its image below), reported as both wall stresses. Its mean over the box is
+  ! eta gamma_dot exactly (u - gamma_dot y is periodic in y up to a shift in x, which leaves
+  ! x-means alone), so this is the fluid's part of the shear stress at y = 0 alone. Collective.
+  subroutine sliding_shear_stress(grid, fl, ierr)
+    type(grid_t), intent(in) :: grid
+    type(fluid_t), intent(inout) :: fl
+    PetscErrorCode, intent(out) :: ierr
+    PetscScalar, pointer :: u(:,:,:)
+    Vec :: loc
+    PetscReal :: local_sum, total
+    PetscErrorCode :: mpierr
+    PetscCall(DMGetLocalVector(grid%da(FIELD_U), loc, ierr))
+    PetscCall(ghosted(grid, fl, FIELD_U, fl%vel(FIELD_U), loc, ierr))
+    PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_U), loc, u, ierr))
+    local_sum = sum(u(grid%lo(1):grid%hi(1), 0, grid%lo(3):grid%hi(3)) - u(grid%lo(1):grid%hi(1), -1, grid%lo(3):grid%hi(3)))
+    PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_U), loc, u, ierr))
+    PetscCall(DMRestoreLocalVector(grid%da(FIELD_U), loc, ierr))
+    call MPI_Allreduce(local_sum, total, 1, MPIU_REAL, MPI_SUM, PETSC_COMM_WORLD, mpierr)
+    fl%tau_bottom = total * fl%viscosity / grid%h / real(grid%n(1) * grid%n(3), dp)
+    fl%tau_top = fl%tau_bottom
+  end subroutine sliding_shear_stress
 
   ! Errors against the manufactured solution (plus the Couette shear, which needs no forcing):
   ! max over all velocity unknowns, and max and rms of the pressure with both means removed.
@@ -554,6 +682,16 @@ contains
     integer :: plan
     if (direct_solves_wanted()) plan = fft_planner_flags()
   end subroutine fluid_options_check
+
+  ! What the deck asks of the fluid that the command line's solver choice cannot give, refused
+  ! before any work: the Lees-Edwards boundary exists on the direct solves only (doc/METHOD.md §2.4).
+  subroutine fluid_deck_check(cfg)
+    type(config_t), intent(in) :: cfg
+    if (.not. (cfg%resolved .and. cfg%lees_edwards)) return
+    if (.not. direct_solves_wanted()) &
+      call input_error(cfg%deck_file, 'domain', 'y_boundary', '''lees-edwards'' with the resolved fluid needs '// &
+           'the direct solves (-fluid_solver fft, the default): the Krylov path has no sliding boundary')
+  end subroutine fluid_deck_check
 
   ! -bench_cold_poisson: time one pressure solve from a zero guess to 1e-8 (doc/BENCHMARKS.md),
   ! logged. The yardstick is the multigrid solve whatever solves the steps (-fluid_solver fft

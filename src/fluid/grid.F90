@@ -62,6 +62,7 @@ module mod_grid
     real(dp) :: h = 0.0_dp        ! cell size [a]
     real(dp) :: box(3) = 0.0_dp   ! box lengths [a]
     logical :: walls = .true.     ! walls at y = 0 and y = Ly
+    logical :: lees_edwards = .false.   ! sliding periodic in y (doc/METHOD.md §2.4): x and y never split
     integer :: mg_levels = 1      ! levels the decomposition allows for geometric multigrid
     integer :: nprocs(3) = 1      ! process grid
     DM :: da(4)                   ! u, v, w, p (star stencil, width 1; with the direct solves one shared box DMDA)
@@ -89,6 +90,7 @@ contains
     grid%h = cfg%h
     grid%box = cfg%domain%box
     grid%walls = cfg%walls
+    grid%lees_edwards = cfg%lees_edwards
 
     ! Let PETSc choose the process grid, then align each rank's share to the coarsest
     ! multigrid block so that every level coarsens with the same decomposition.
@@ -100,6 +102,16 @@ contains
     ! the grid the same way, so that the move is a copy on each rank instead of an exchange between
     ! all of them (PETSc picked 1 x 2 x 1 for 100^3 on 2 ranks; doc/BENCHMARKS.md §8).
     if (direct_solves_wanted() .and. product(m) <= grid%n(3) / 2) m = [1, 1, product(m)]
+    if (grid%lees_edwards) then
+      ! the sliding boundary shifts whole rows in x across y = 0, Ly on the rank that holds them
+      ! (mod_sliding_boundary): z-slabs only, and only the direct solves diagonalise the twist
+      if (.not. direct_solves_wanted()) call fatal_error('fdsusp: error: y_boundary = ''lees-edwards'' with the '// &
+           'resolved fluid needs the direct solves (-fluid_solver fft, the default): the Krylov path has no '// &
+           'sliding boundary (doc/DESIGN.md "Lees-Edwards")', 2)
+      if (product(m) > grid%n(3)) call fatal_error('fdsusp: error: y_boundary = ''lees-edwards'' splits the grid in '// &
+           'z-slabs only: at most one rank per cell in z', 2)
+      m = [1, 1, product(m)]
+    end if
     grid%nprocs = m
 
     nlev = 1

@@ -7,7 +7,7 @@ module mod_output
   use petscdmda
   use mod_kinds, only: dp
   use mod_grid, only: grid_t, field_names, FIELD_U, FIELD_V, FIELD_W, FIELD_P
-  use mod_fluid, only: fluid_t
+  use mod_fluid, only: fluid_t, fluid_ghosted
   use mod_errors, only: is_root, abort_run, abort_if_any
   use mod_os_services, only: publish_file
   use mod_file_services, only: errno_text, write_failure_cause, require_free_space, directory_of
@@ -51,8 +51,8 @@ contains
       e = 0
       e(f) = 1
       PetscCall(DMGetLocalVector(grid%da(f), loc, ierr))
-      PetscCall(DMGlobalToLocalBegin(grid%da(f), fl%vel(f), INSERT_VALUES, loc, ierr))
-      PetscCall(DMGlobalToLocalEnd(grid%da(f), fl%vel(f), INSERT_VALUES, loc, ierr))
+      ! (the ghosts across a Lees-Edwards boundary are its images: mod_fluid)
+      PetscCall(fluid_ghosted(grid, fl, f, fl%vel(f), loc, ierr))
       PetscCall(DMDAVecGetArrayReadF90(grid%da(f), loc, a, ierr))
       PetscCall(DMDAVecGetArrayF90(grid%da(FIELD_P), centre, c, ierr))
       ! mean of the two faces of each cell (with walls, v(n) is the wall face v(0) = 0)

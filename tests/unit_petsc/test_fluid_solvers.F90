@@ -26,6 +26,17 @@
 !      -x_0, DST-II) solved with the transforms of p's boundary (DCT-II), and p's boundary's
 !      Helmholtz system solved with u's transforms (DST-II), miss x* by O(1) (> 0.1 relative),
 !      while each with its own kind meets 1e-12: a transform of the wrong kind cannot pass 2;
+!   6. Lees-Edwards (doc/METHOD.md §2.4): y periodic up to the offset delta, the row across the
+!      boundary read at x + delta (below) or x - delta (above) by trigonometric interpolation with
+!      the Nyquist mode of an even row unshifted; the hand stencil computes each shifted neighbour by
+!      its own direct Fourier sum (not FFTW, not mod_sliding_boundary). At delta = 0, 1.3 h,
+!      2.71 h and Lx - 0.2 h (s = delta/h cells) the direct solve (the phase-ramped complex
+!      transforms) returns x* of every field to 1e-12 relative (cond <= 10.6 and <= 12/(4 sin^2(pi/
+!      n)) as for the periodic box: the twist only raises the y eigenvalues of the x-modes); and
+!      mod_sliding_boundary's shift of a row equals the direct sum to 1e-13 of its largest value and
+!      is undone by the shift by -delta to 1e-13 (the operator is unitary, which div(grad) across
+!      the boundary needs). Told delta = 0, the solve misses the x* of 1.3 h by > 0.01 (the offset
+!      is used). The Krylov path has no sliding boundary (refused by mod_grid).
 !   5. structure (issue 45, memory per cell): with the direct solves the four fields share one DMDA,
 !      and its application ordering is AOMEMORYSCALABLE (never a copy of the global ordering on
 !      every rank).
@@ -42,7 +53,8 @@ program test_fluid_solvers
   use mod_params, only: config_t
   use mod_grid, only: grid_t, grid_create, grid_destroy, FIELD_U, FIELD_V, FIELD_P, field_names
   use mod_solvers, only: solver_t, solver_create, solver_solve, solver_destroy, fft_planner_flags
-  use mod_fft_solver, only: fft_solver_t, fft_create, fft_solve, fft_destroy
+  use mod_fft_solver, only: fft_solver_t, fft_create, fft_solve, fft_destroy, fft_set_sliding_shift
+  use mod_sliding_boundary, only: sliding_shift_rows
   use mod_unit_checks, only: check, check_below, finish
   implicit none
 
@@ -58,6 +70,7 @@ program test_fluid_solvers
   integer :: pass
   character(len=64) :: scene
   real(dp) :: t0
+  real(dp) :: shift = 0.0_dp    ! Lees-Edwards: the offset in cells the hand stencil uses
 
   PetscCallA(PetscInitialize(ierr))
   call MPI_Comm_rank(PETSC_COMM_WORLD, rank, ierr)
@@ -68,18 +81,24 @@ program test_fluid_solvers
   ncells = 3
   PetscCallA(PetscOptionsGetIntArray(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-test_cells', cells, ncells, found, ierr))
 
-  do pass = 1, 2
+  do pass = 1, 3
     cfg%cells = cells
     cfg%h = h
     cfg%domain%box = cells * h
     cfg%walls = pass == 1
+    cfg%lees_edwards = pass == 3
     cfg%domain%y_boundary = merge('walls   ', 'periodic', cfg%walls)
+    if (cfg%lees_edwards) cfg%domain%y_boundary = 'lees-edwards'
     write(scene, '(i0,a,i0,a,i0,a,a,a,i0,a)') cells(1), ' x ', cells(2), ' x ', cells(3), ', ', &
          trim(cfg%domain%y_boundary), ', ', nranks, ' rank(s)'
     if (rank == 0) print '(2a)', '# ', trim(scene)
     PetscCallA(grid_create(cfg, grid, ierr))
     call test_layout(grid, trim(scene))
-    call test_scene(grid, trim(scene))
+    if (grid%lees_edwards) then
+      call test_sliding(grid, trim(scene))
+    else
+      call test_scene(grid, trim(scene))
+    end if
     PetscCallA(grid_destroy(grid, ierr))
   end do
   if (rank == 0) print '(a,f0.2,a)', '# wall time ', MPI_Wtime() - t0, ' s'
@@ -237,6 +256,104 @@ contains
     name = 'CG + '//trim(pc_type)
   end function krylov_name
 
+  ! 6. Lees-Edwards: the direct solves at several offsets, and the row shift itself.
+  subroutine test_sliding(grid, scene)
+    type(grid_t), intent(in) :: grid
+    character(len=*), intent(in) :: scene
+    real(dp), parameter :: shifts(4) = [0.0_dp, 1.3_dp, 2.71_dp, -0.2_dp]
+    type(solver_t) :: direct
+    Vec :: exact, rhs, x
+    integer :: f, n, i, r
+    real(dp) :: m, d, mean, err, worst_shift, worst_inverse
+    real(dp), allocatable :: rows(:, :), hand(:, :)
+    character(len=200) :: what
+
+    do n = 1, size(shifts)
+      shift = shifts(n)
+      if (shift < 0.0_dp) shift = shift + grid%n(1)
+      call fft_set_sliding_shift(shift)
+      do f = FIELD_U, FIELD_P
+        m = merge(0.0_dp, mass, f == FIELD_P)
+        d = merge(1.0_dp, diffusion, f == FIELD_P)
+        mean = field_mean(grid, f)
+        PetscCallA(DMCreateGlobalVector(grid%da(f), exact, ierr))
+        PetscCallA(VecDuplicate(exact, rhs, ierr))
+        PetscCallA(VecDuplicate(exact, x, ierr))
+        call fill(grid, f, f, exact, .false., m, d, mean)
+        call fill(grid, f, f, rhs, .true., m, d, mean)
+        PetscCallA(solver_create(grid, f, krylov_rtol, 0.0_dp, mass, diffusion, direct, ierr))
+        PetscCallA(VecSet(x, 0.0_dp, ierr))
+        PetscCallA(solver_solve(direct, rhs, x, ierr))
+        err = relative_difference(x, exact)
+        write(what, '(3a,f0.2,3a)') scene, ', offset ', '', shift, ' h, ', field_names(f), &
+             ': FFT solve of the twisted system |x - x*|/|x*|'
+        call check_below(trim(what), err, tol_solve)
+        if (n == 2) then
+          ! the solve must see the offset: told delta = 0 it misses the twisted x* at O(1)
+          call fft_set_sliding_shift(0.0_dp)
+          PetscCallA(VecSet(x, 0.0_dp, ierr))
+          PetscCallA(solver_solve(direct, rhs, x, ierr))
+          call fft_set_sliding_shift(shift)
+          err = relative_difference(x, exact)
+          write(what, '(3a)') scene, ', ', field_names(f)//': the solve told offset 0 misses the x* of 1.30 h '// &
+               '(> 0.01 relative)'
+          call check(err > 0.01_dp, trim(what))
+        end if
+        PetscCallA(solver_destroy(direct, ierr))
+        PetscCallA(VecDestroy(exact, ierr))
+        PetscCallA(VecDestroy(rhs, ierr))
+        PetscCallA(VecDestroy(x, ierr))
+      end do
+    end do
+
+    ! the shift of rows (every rank the same rows: a pure kernel)
+    allocate(rows(grid%n(1), 3), hand(grid%n(1), 3))
+    worst_shift = 0.0_dp
+    worst_inverse = 0.0_dp
+    do n = 1, size(shifts)
+      do r = 1, 3
+        do i = 1, grid%n(1)
+          rows(i, r) = exact_value(grid, FIELD_U, i - 1, r, 0, 0.0_dp)
+          hand(i, r) = shifted_value(grid, FIELD_U, i - 1, r, 0, shifts(n), 0.0_dp)
+        end do
+      end do
+      call sliding_shift_rows(rows, shifts(n))
+      worst_shift = max(worst_shift, maxval(abs(rows - hand)) / maxval(abs(hand)))
+      call sliding_shift_rows(rows, -shifts(n))
+      do r = 1, 3
+        do i = 1, grid%n(1)
+          hand(i, r) = exact_value(grid, FIELD_U, i - 1, r, 0, 0.0_dp)
+        end do
+      end do
+      worst_inverse = max(worst_inverse, maxval(abs(rows - hand)) / maxval(abs(hand)))
+    end do
+    call check_below(scene//': mod_sliding_boundary''s row shift = the direct Fourier sum (max relative)', &
+                     worst_shift, 1.0e-13_dp)
+    call check_below(scene//': the shift by -delta undoes the shift by delta (max relative)', worst_inverse, 1.0e-13_dp)
+  end subroutine test_sliding
+
+  ! The exact field of f in row (j, k) read at x_i + s h by trigonometric interpolation: the direct
+  ! Fourier sum (1/n) sum_a x_a [1 + 2 sum_{m=1}^{(n-1)/2} cos(2 pi m (i + s - a)/n) + N], the
+  ! Nyquist term N = cos(pi (i - a)) for even n (unshifted: doc/METHOD.md §2.4).
+  real(dp) function shifted_value(grid, f, i, j, k, s, mean)
+    type(grid_t), intent(in) :: grid
+    integer, intent(in) :: f, i, j, k
+    real(dp), intent(in) :: s, mean
+    integer :: a, m, n
+    real(dp) :: kernel
+    n = grid%n(1)
+    shifted_value = 0.0_dp
+    do a = 0, n - 1
+      kernel = 1.0_dp
+      do m = 1, (n - 1) / 2
+        kernel = kernel + 2.0_dp * cos(2.0_dp * pi * m * (i + s - a) / n)
+      end do
+      if (mod(n, 2) == 0) kernel = kernel + cos(pi * (i - a))
+      shifted_value = shifted_value + exact_value(grid, f, a, j, k, mean) * kernel
+    end do
+    shifted_value = shifted_value / n
+  end function shifted_value
+
   ! The exact field of f at global (i, j, k), wrapped periodically: pseudo-random in [-1, 1) minus
   ! mean; v is 0 on the wall face j = 0 (= n_y).
   real(dp) function exact_value(grid, f, i, j, k, mean)
@@ -284,6 +401,11 @@ contains
           exact_value(grid, f, i, j, k + 1, mean) + exact_value(grid, f, i, j, k - 1, mean) - 2.0_dp * x0
     below = exact_value(grid, f, i, j - 1, k, mean)
     above = exact_value(grid, f, i, j + 1, k, mean)
+    if (grid%lees_edwards) then
+      ! across the sliding boundary: the row read at x + delta below, x - delta above
+      if (j == 0) below = shifted_value(grid, f, i, grid%n(2) - 1, k, shift, mean)
+      if (j == grid%n(2) - 1) above = shifted_value(grid, f, i, 0, k, -shift, mean)
+    end if
     if (grid%walls) then
       select case (f)
       case (FIELD_V)
