@@ -26,6 +26,12 @@
 ! Particle data is replicated; each rank works on the faces it owns and the moments are summed
 ! over ranks, so spheres cross processor boundaries freely and the result does not depend on the
 ! decomposition beyond round-off.
+! Lees-Edwards (doc/METHOD.md §3.9): the grid is not wrapped in y; a sphere that reaches across
+! y = 0 or Ly is visited once more as its image in the box, at x -+ delta, y -+ Ly, moving faster
+! by -+ gamma_dot Ly in x. Each entry of the geometry is a sphere or an image of one (owner, copy);
+! an image's M_p, moments, force, torque and stresslet (about its own centre) are its owner's, its
+! faces' rigid velocity is the owner's plus its copy times gamma_dot Ly e_x, which the moments
+! take off ũ (b - copy gamma_dot Ly M_p e_1).
 #include <petsc/finclude/petscdmda.h>
 #include <petsc/finclude/petscksp.h>
 module mod_fictitious_domain
@@ -45,6 +51,8 @@ module mod_fictitious_domain
   use mod_sphere_faces, only: mac_block_t, face_list_t, field_view_t, faces_build, faces_carry, faces_moments, &
                               faces_new_lambda, faces_update
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates, min_image
+  use mod_lees_edwards, only: lees_edwards_t, le_separation
+  use mod_sliding_boundary, only: sliding_shift_rows
   use mod_errors, only: fatal_error
   use mod_limits, only: limit_finding_t, add_finding, LIMIT_WARN
   use mod_timers, only: event_begin, event_end, EVENT_GEOMETRY, EVENT_CARRY, EVENT_MOMENTS, EVENT_MOTION, &
@@ -54,7 +62,7 @@ module mod_fictitious_domain
   public :: fictitious_domain_t, fictitious_domain_create, fictitious_domain_geometry, &
             fictitious_domain_follow, fictitious_domain_moments, fictitious_domain_solve_motion, &
             fictitious_domain_update, fictitious_domain_destroy, &
-            fictitious_domain_pair_lag_limit, fictitious_domain_stresslet_lag_limit
+            fictitious_domain_pair_lag_limit, fictitious_domain_stresslet_lag_limit, fictitious_domain_set_image_speed
 
   type :: fictitious_domain_t
     real(dp) :: beta = 0.0_dp           ! rho/dt = Re/dt
@@ -84,6 +92,18 @@ module mod_fictitious_domain
     logical :: lambda_listed = .false.       ! Lambda^n is zero off the listed faces (fictitious_domain_follow put it there)
     real(dp), allocatable :: moments(:, :)   ! (12, n): b(u~) and m(Lambda^n) of the step (fictitious_domain_moments)
     type(particle_solver_t) :: solver     ! the 6N system of the particle step and its solution
+    ! Lees-Edwards (see the top): the boundary at the last geometry, the images' extra speed
+    ! gamma_dot Ly of the step, and the entries: sphere owner(e) itself (copy 0, entries 1..n in
+    ! order) or its image above (copy +1) or below (copy -1), at entry_position with entry_radius
+    logical :: sliding = .false.
+    type(lees_edwards_t) :: le
+    real(dp) :: image_speed = 0.0_dp
+    integer :: entries = 0
+    integer, allocatable :: owner(:), copy(:)
+    real(dp), allocatable :: entry_position(:, :), entry_radius(:)
+    real(dp), allocatable :: rigid_entries(:, :, :)   ! (6, 6, entries): M_p of each entry, summed over ranks
+    real(dp), allocatable :: previous_position(:, :)  ! (3, n) the spheres at the last geometry...
+    real(dp) :: previous_offset = 0.0_dp              ! ... and the boundary's offset then
   end type fictitious_domain_t
 
 contains
@@ -150,11 +170,13 @@ contains
   ! the paper scene), the sphere computes their alphas there itself, so every sphere takes the same
   ! decision without grid-sized ownership arrays or a second pass (before 2026-11-26 the geometry
   ! was half of the paper scene's step).
-  subroutine fictitious_domain_geometry(grid, fd, parts)
+  ! le, optional: a Lees-Edwards boundary (le%active), its offset now.
+  subroutine fictitious_domain_geometry(grid, fd, parts, le)
     type(grid_t), intent(in) :: grid
     type(fictitious_domain_t), intent(inout) :: fd
     type(particles_t), intent(in) :: parts
-    integer :: ierr
+    type(lees_edwards_t), intent(in), optional :: le
+    integer :: ierr, e
     real(dp) :: h
     type(mac_block_t) :: block
 
@@ -166,53 +188,141 @@ contains
     if (.not. allocated(fd%inflated_radius)) allocate(fd%inflated_radius(parts%n))
     fd%inflated_radius = parts%radii + fd%radius_offset * grid%h
     fd%lambda_listed = .false.      ! Lambda^n may sit on faces of another geometry (fictitious_domain_follow carries it)
-    call find_rivals(grid, fd, parts, fd%inflated_radius)
     if (allocated(fd%rigid_matrix)) then
       if (size(fd%rigid_matrix, 3) /= parts%n) deallocate(fd%rigid_matrix)
     end if
     if (.not. allocated(fd%rigid_matrix)) allocate(fd%rigid_matrix(6, 6, parts%n))
     fd%rigid_matrix = 0.0_dp
     h = grid%h
-    block = mac_block_t(h=h, box=grid%box, n=grid%n, walls=grid%walls, lo=grid%lo, hi=grid%hi)
     ! the unit of gamma = kappa (1 - alpha) beta h^2 / eta (doc/METHOD.md §3.3)
-    call faces_build(block, parts%position, fd%inflated_radius, fd%kappa * fd%beta * h**2 / fd%eta, fd%rival_start, &
-                     fd%rival_part, fd%rival_offset, fd%faces, fd%rigid_matrix)
-    call MPI_Allreduce(MPI_IN_PLACE, fd%rigid_matrix, 36 * parts%n, MPI_DOUBLE_PRECISION, MPI_SUM, &
-                       PETSC_COMM_WORLD, ierr)
+    if (present(le)) fd%sliding = le%active
+    if (fd%sliding) then
+      ! the spheres and their images in the box (see the top)
+      fd%le = le
+      call make_entries(grid, fd, parts)
+      call find_rivals(grid, fd, fd%entry_position, fd%entry_radius)
+      if (allocated(fd%rigid_entries)) deallocate(fd%rigid_entries)
+      allocate(fd%rigid_entries(6, 6, fd%entries))
+      fd%rigid_entries = 0.0_dp
+      block = mac_block_t(h=h, box=grid%box, n=grid%n, walls=.false., sliding=.true., lo=grid%lo, hi=grid%hi)
+      call faces_build(block, fd%entry_position, fd%entry_radius, fd%kappa * fd%beta * h**2 / fd%eta, &
+                       fd%rival_start, fd%rival_part, fd%rival_offset, fd%faces, fd%rigid_entries)
+      call MPI_Allreduce(MPI_IN_PLACE, fd%rigid_entries, 36 * fd%entries, MPI_DOUBLE_PRECISION, MPI_SUM, &
+                         PETSC_COMM_WORLD, ierr)
+      do e = 1, fd%entries
+        fd%rigid_matrix(:, :, fd%owner(e)) = fd%rigid_matrix(:, :, fd%owner(e)) + fd%rigid_entries(:, :, e)
+      end do
+      fd%previous_position = parts%position
+      fd%previous_offset = le%offset
+    else
+      call find_rivals(grid, fd, parts%position, fd%inflated_radius)
+      block = mac_block_t(h=h, box=grid%box, n=grid%n, walls=grid%walls, lo=grid%lo, hi=grid%hi)
+      call faces_build(block, parts%position, fd%inflated_radius, fd%kappa * fd%beta * h**2 / fd%eta, fd%rival_start, &
+                       fd%rival_part, fd%rival_offset, fd%faces, fd%rigid_matrix)
+      call MPI_Allreduce(MPI_IN_PLACE, fd%rigid_matrix, 36 * parts%n, MPI_DOUBLE_PRECISION, MPI_SUM, &
+                         PETSC_COMM_WORLD, ierr)
+    end if
     PetscCallA(event_end(EVENT_GEOMETRY, ierr))
   end subroutine fictitious_domain_geometry
+
+  ! The entries of a Lees-Edwards geometry (see the top): every sphere (entries 1..n), then the
+  ! image above of each sphere whose visit may reach below y = 0 (its centre within its inflated
+  ! radius and a cell and a half of it: a visit spans R + h/2 beyond a face's stagger) and the image
+  ! below of each that may reach beyond y = Ly. x is wrapped into [0, Lx).
+  subroutine make_entries(grid, fd, parts)
+    type(grid_t), intent(in) :: grid
+    type(fictitious_domain_t), intent(inout) :: fd
+    type(particles_t), intent(in) :: parts
+    integer :: q, e, pass, n
+    real(dp) :: reach, ly
+    character(len=200) :: text
+    n = parts%n
+    ly = grid%box(2)
+    if (ly < 2.0_dp * (maxval(fd%inflated_radius) + 1.5_dp * grid%h)) then
+      write(text, '(a,f8.4,a)') 'fdsusp: error: &domain box(y): a Lees-Edwards box must be at least ', &
+           2.0_dp * (maxval(fd%inflated_radius) + 1.5_dp * grid%h), ' a high (a sphere would meet its own image)'
+      call fatal_error(text, 2)
+    end if
+    do pass = 1, 2
+      e = n
+      do q = 1, n
+        reach = fd%inflated_radius(q) + 1.5_dp * grid%h
+        if (parts%position(2, q) < reach) then
+          e = e + 1
+          if (pass == 2) call set_entry(e, q, +1)
+        end if
+        if (parts%position(2, q) > ly - reach) then
+          e = e + 1
+          if (pass == 2) call set_entry(e, q, -1)
+        end if
+      end do
+      if (pass == 1) then
+        fd%entries = e
+        if (allocated(fd%owner)) deallocate(fd%owner, fd%copy, fd%entry_position, fd%entry_radius)
+        allocate(fd%owner(e), fd%copy(e), fd%entry_position(3, e), fd%entry_radius(e))
+        do q = 1, n
+          call set_entry(q, q, 0)
+        end do
+      end if
+    end do
+  contains
+    subroutine set_entry(e, q, copy)
+      integer, intent(in) :: e, q, copy
+      fd%owner(e) = q
+      fd%copy(e) = copy
+      fd%entry_radius(e) = fd%inflated_radius(q)
+      fd%entry_position(:, e) = parts%position(:, q) + copy * [fd%le%offset, ly, 0.0_dp]
+      fd%entry_position(1, e) = modulo(fd%entry_position(1, e), grid%box(1))
+    end subroutine set_entry
+  end subroutine make_entries
+
+  ! The images' extra speed gamma_dot Ly of the step to come (Lees-Edwards; the rate of the step).
+  subroutine fictitious_domain_set_image_speed(fd, image_speed)
+    type(fictitious_domain_t), intent(inout) :: fd
+    real(dp), intent(in) :: image_speed
+    fd%image_speed = image_speed
+  end subroutine fictitious_domain_set_image_speed
 
   ! The rivals of each sphere: the spheres whose centres are closer than the sum of the two
   ! reaches R_i + sqrt(3) h/2 (R the inflated radius), so that some control volume may meet both
   ! (mod_neighbours' cell lists over the largest reach, with a skin of one cell; every pair when a
   ! periodic length is below twice the list's cut-off). A periodic length below twice the largest
   ! reach would let a sphere reach its own image: refused.
-  subroutine find_rivals(grid, fd, parts, radii)
+  ! Lees-Edwards: among the entries (spheres and images, positions (3, :)), with y not wrapped; the
+  ! entries change with every geometry, so the list is made afresh each time.
+  subroutine find_rivals(grid, fd, positions, radii)
     type(grid_t), intent(in) :: grid
     type(fictitious_domain_t), intent(inout) :: fd
-    type(particles_t), intent(in) :: parts
-    real(dp), intent(in) :: radii(:)
+    real(dp), intent(in) :: positions(:, :), radii(:)
     real(dp) :: reach
     integer :: info, l, i, j, n, pass
     logical :: periodic(3)
     integer, allocatable :: count(:)
     character(len=200) :: text
 
-    n = parts%n
+    n = size(positions, 2)
     reach = maxval(radii) + 0.5_dp * sqrt(3.0_dp) * grid%h
-    periodic = [.true., .not. grid%walls, .true.]
+    periodic = [.true., .not. (grid%walls .or. fd%sliding), .true.]
+    if (fd%sliding .and. allocated(fd%rival_start)) then
+      if (size(fd%rival_start) /= n + 1) deallocate(fd%rival_start)
+      if (allocated(fd%reach_pairs)) deallocate(fd%reach_pairs)
+    end if
     if (.not. allocated(fd%rival_start)) then
       if (any(periodic .and. grid%box < 2.0_dp * reach)) then
         write(text, '(a,f8.4,a)') 'fdsusp: error: &domain box: every periodic length must be at least ', &
              2.0_dp * reach, ' a (twice a sphere''s reach on the grid), or a sphere meets its own image'
         call fatal_error(text, 2)
       end if
+      allocate(fd%rival_start(n + 1))
+      if (.not. allocated(fd%rival_part)) allocate(fd%rival_part(64), fd%rival_offset(3, 64))
+    end if
+    if (fd%sliding .or. fd%reach_list%np == 0) then
       call nlist_init(fd%reach_list, n, grid%box, periodic, 2.0_dp * reach + grid%h, reach + grid%h, grid%h, info)
+      fd%reach_list%built = .false.
       fd%use_reach_list = (info == 0)
-      allocate(fd%rival_start(n + 1), fd%rival_part(64), fd%rival_offset(3, 64))
     end if
     if (fd%use_reach_list .and. n > 1) then
-      call nlist_candidates(fd%reach_list, parts%position, fd%reach_pairs, fd%nreach_pairs, fd%reach_walls, &
+      call nlist_candidates(fd%reach_list, positions, fd%reach_pairs, fd%nreach_pairs, fd%reach_walls, &
                             fd%nreach_walls)
     else if (.not. allocated(fd%reach_pairs)) then
       ! every pair, in the same canonical order (the list never changes: made once)
@@ -250,7 +360,7 @@ contains
     subroutine add_pair(i, j, pass)
       integer, intent(in) :: i, j, pass
       real(dp) :: d(3)
-      d = min_image(parts%position(:, j) - parts%position(:, i), grid%box, periodic)
+      d = min_image(positions(:, j) - positions(:, i), grid%box, periodic)
       if (sum(d**2) >= (radii(i) + radii(j) + sqrt(3.0_dp) * grid%h)**2) return
       if (pass == 2) then
         fd%rival_part(fd%rival_start(i) + count(i)) = j
@@ -274,21 +384,43 @@ contains
   ! unwrapped; each component must stay below one cell (the ghost width). The eight corners of a
   ! face next to an edge or corner of this rank's block lie in edge or corner ghosts: Lambda^n is
   ! exchanged on fd%carry_layout (box stencil), which fills them (doc/DESIGN.md "Ghost layers").
-  ! Collective.
-  subroutine fictitious_domain_follow(grid, fd, parts, displacement, ierr)
+  ! le, optional: a Lees-Edwards boundary (le%active), its offset now. Each entry of its geometry
+  ! (a sphere or an image) is then displaced from the copy of its sphere's last position nearest
+  ! to it at the last offset (an image moves by -+ the offset's change besides its sphere), which
+  ! the carry works out itself (displacement unused), and the old Lambda across y = 0, Ly is read
+  ! at the last offset (the ghost rows of the carry layout, mod_sliding_boundary). Collective.
+  subroutine fictitious_domain_follow(grid, fd, parts, displacement, ierr, le)
     type(grid_t), intent(in) :: grid
     type(fictitious_domain_t), intent(inout) :: fd
     type(particles_t), intent(in) :: parts
     real(dp), intent(in) :: displacement(:, :)
     PetscErrorCode, intent(out) :: ierr
+    type(lees_edwards_t), intent(in), optional :: le
     Vec :: old(3)
     type(field_view_t) :: lam_old(3), lam(3)
-    integer :: c
+    type(lees_edwards_t) :: before
+    real(dp), allocatable :: entry_displacement(:, :), last_position(:, :)
+    real(dp) :: r(3), shift(3)
+    integer :: c, e
     character(len=200) :: text
 
-    call fictitious_domain_geometry(grid, fd, parts)
-    if (maxval(abs(displacement)) >= grid%h) then
-      write(text, '(a,f8.3,a)') 'fdsusp: fatal: a sphere moved ', maxval(abs(displacement)) / grid%h, &
+    if (fd%sliding) then
+      before = fd%le
+      before%offset = fd%previous_offset
+      last_position = fd%previous_position
+    end if
+    call fictitious_domain_geometry(grid, fd, parts, le)
+    if (fd%sliding) then
+      allocate(entry_displacement(3, fd%entries))
+      do e = 1, fd%entries
+        call le_separation(before, last_position(:, fd%owner(e)) - fd%entry_position(:, e), r, shift)
+        entry_displacement(:, e) = -r
+      end do
+    else
+      entry_displacement = displacement
+    end if
+    if (maxval(abs(entry_displacement)) >= grid%h) then
+      write(text, '(a,f8.3,a)') 'fdsusp: fatal: a sphere moved ', maxval(abs(entry_displacement)) / grid%h, &
            ' cells in one step (its force density can follow at most one): reduce &time dt'
       call fatal_error(text, 3)
     end if
@@ -298,20 +430,62 @@ contains
       PetscCall(DMGlobalToLocalBegin(fd%carry_layout, fd%lambda(c), INSERT_VALUES, old(c), ierr))
       PetscCall(DMGlobalToLocalEnd(fd%carry_layout, fd%lambda(c), INSERT_VALUES, old(c), ierr))
       PetscCall(VecSet(fd%lambda(c), 0.0_dp, ierr))
-      PetscCall(DMDAVecGetArrayReadF90(fd%carry_layout, old(c), lam_old(c)%v, ierr))
+      if (fd%sliding) then
+        PetscCall(DMDAVecGetArrayF90(fd%carry_layout, old(c), lam_old(c)%v, ierr))
+        call slide_ghost_rows(grid, lam_old(c)%v, before%offset)
+      else
+        PetscCall(DMDAVecGetArrayReadF90(fd%carry_layout, old(c), lam_old(c)%v, ierr))
+      end if
       PetscCall(DMDAVecGetArrayF90(grid%da(c), fd%lambda(c), lam(c)%v, ierr))
     end do
     ! run by run: the eight corner offsets and weights set once per run (mod_sphere_faces)
-    call faces_carry(fd%faces, lam_old, lam, grid%glo, grid%ghi, grid%lo, grid%hi, displacement, grid%h, &
+    call faces_carry(fd%faces, lam_old, lam, grid%glo, grid%ghi, grid%lo, grid%hi, entry_displacement, grid%h, &
                      grid%walls, grid%n(2))
     fd%lambda_listed = .true.
     do c = 1, 3
       PetscCall(DMDAVecRestoreArrayF90(grid%da(c), fd%lambda(c), lam(c)%v, ierr))
-      PetscCall(DMDAVecRestoreArrayReadF90(fd%carry_layout, old(c), lam_old(c)%v, ierr))
+      if (fd%sliding) then
+        PetscCall(DMDAVecRestoreArrayF90(fd%carry_layout, old(c), lam_old(c)%v, ierr))
+      else
+        PetscCall(DMDAVecRestoreArrayReadF90(fd%carry_layout, old(c), lam_old(c)%v, ierr))
+      end if
       PetscCall(DMRestoreLocalVector(fd%carry_layout, old(c), ierr))
     end do
     PetscCall(event_end(EVENT_CARRY, ierr))
   end subroutine fictitious_domain_follow
+
+  ! The ghost rows j = -1 and n(2) of a ghosted face field (the carry layout's, every plane it
+  ! holds, its ghost planes too) as the Lees-Edwards boundary at offset delta sees them: the top row
+  ! read at x + delta below, the bottom row at x - delta above (mod_sliding_boundary; Lambda, a
+  ! force density, has no jump). The grid is split in z only, so the rows are this rank's.
+  subroutine slide_ghost_rows(grid, a, offset)
+    type(grid_t), intent(in) :: grid
+    real(dp), intent(inout) :: a(grid%glo(1):, grid%glo(2):, grid%glo(3):)
+    real(dp), intent(in) :: offset
+    real(dp), allocatable :: rows(:, :)
+    integer :: nx, ny, k, k0, k1
+    nx = grid%n(1)
+    ny = grid%n(2)
+    k0 = grid%glo(3)
+    k1 = grid%ghi(3)
+    allocate(rows(0:nx - 1, k0:k1))
+    do k = k0, k1
+      rows(:, k) = a(0:nx - 1, ny - 1, k)
+    end do
+    call sliding_shift_rows(rows, offset / grid%h)
+    do k = k0, k1
+      a(0:nx - 1, -1, k) = rows(:, k)
+      rows(:, k) = a(0:nx - 1, 0, k)
+    end do
+    call sliding_shift_rows(rows, -offset / grid%h)
+    do k = k0, k1
+      a(0:nx - 1, ny, k) = rows(:, k)
+    end do
+    a(-1, -1, k0:k1) = a(nx - 1, -1, k0:k1)
+    a(nx, -1, k0:k1) = a(0, -1, k0:k1)
+    a(-1, ny, k0:k1) = a(nx - 1, ny, k0:k1)
+    a(nx, ny, k0:k1) = a(0, ny, k0:k1)
+  end subroutine slide_ghost_rows
 
   ! The particle sub-problem after the fluid step, in three named parts that main.F90 calls in
   ! turn (doc/METHOD.md §3.2 eq. (1), §3.3, §3.5):
@@ -330,7 +504,8 @@ contains
     PetscErrorCode, intent(out) :: ierr
     type(field_view_t) :: u(3), lam(3)
     real(dp) :: dv
-    integer :: c
+    real(dp), allocatable :: entry_moments(:, :)
+    integer :: c, e, q
 
     PetscCall(event_begin(EVENT_MOMENTS, ierr))
     dv = grid%h**3
@@ -343,12 +518,30 @@ contains
       PetscCall(DMDAVecGetArrayReadF90(grid%da(c), vel(c), u(c)%v, ierr))
       PetscCall(DMDAVecGetArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%v, ierr))
     end do
-    call faces_moments(fd%faces, u, lam, grid%lo, grid%hi, dv, fd%moments)
+    if (fd%sliding) then
+      allocate(entry_moments(12, fd%entries))
+      entry_moments = 0.0_dp
+      call faces_moments(fd%faces, u, lam, grid%lo, grid%hi, dv, entry_moments)
+    else
+      call faces_moments(fd%faces, u, lam, grid%lo, grid%hi, dv, fd%moments)
+    end if
     do c = 1, 3
       PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%v, ierr))
       PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), vel(c), u(c)%v, ierr))
     end do
-    call MPI_Allreduce(MPI_IN_PLACE, fd%moments, 12 * n, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
+    if (fd%sliding) then
+      call MPI_Allreduce(MPI_IN_PLACE, entry_moments, 12 * fd%entries, MPI_DOUBLE_PRECISION, MPI_SUM, &
+                         PETSC_COMM_WORLD, ierr)
+      ! an image's faces move faster by copy gamma_dot Ly e_x: b - copy gamma_dot Ly M_p e_1 (see the top)
+      do e = 1, fd%entries
+        q = fd%owner(e)
+        fd%moments(:, q) = fd%moments(:, q) + entry_moments(:, e)
+        if (fd%copy(e) /= 0) fd%moments(1:6, q) = fd%moments(1:6, q) &
+                                                  - fd%copy(e) * fd%image_speed * fd%rigid_entries(1:6, 1, e)
+      end do
+    else
+      call MPI_Allreduce(MPI_IN_PLACE, fd%moments, 12 * n, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
+    end if
     PetscCall(event_end(EVENT_MOMENTS, ierr))
   end subroutine fictitious_domain_moments
 
@@ -411,10 +604,10 @@ contains
     type(particles_t), intent(inout) :: parts
     PetscErrorCode, intent(out) :: ierr
     type(particle_lubrication_t), intent(inout), optional :: lubrication
-    real(dp), allocatable :: sums(:, :)
+    real(dp), allocatable :: sums(:, :), velocity(:, :), omega(:, :), entry_sums(:, :)
     type(field_view_t) :: u(3), lam(3), p
     real(dp) :: dv, integral
-    integer :: c, q, n
+    integer :: c, q, n, e
     logical :: removed
 
     PetscCall(event_begin(EVENT_UPDATE, ierr))
@@ -422,6 +615,19 @@ contains
     dv = grid%h**3
     allocate(sums(16, n))
     sums = 0.0_dp
+    ! the rigid motion of each entry of the geometry: an image's is its sphere's plus copy
+    ! gamma_dot Ly e_x (Lees-Edwards, see the top); otherwise the spheres'
+    if (fd%sliding) then
+      allocate(velocity(3, fd%entries), omega(3, fd%entries), entry_sums(16, fd%entries))
+      entry_sums = 0.0_dp
+      do e = 1, fd%entries
+        velocity(:, e) = parts%velocity(:, fd%owner(e)) + [fd%copy(e) * fd%image_speed, 0.0_dp, 0.0_dp]
+        omega(:, e) = parts%omega(:, fd%owner(e))
+      end do
+    else
+      velocity = parts%velocity
+      omega = parts%omega
+    end if
     ! Lambda^n is non-zero only on the listed faces once fictitious_domain_follow has carried it there; then
     ! removing it and adding Lambda^{n+1} is one pass over the list. Otherwise (the first step
     ! of a run, -fd_carry_lambda 0) Lambda^{n+1} is computed first and Lambda^n removed from the
@@ -436,7 +642,7 @@ contains
         PetscCall(DMDAVecGetArrayReadF90(grid%da(c), vel(c), u(c)%v, ierr))
         PetscCall(DMDAVecGetArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%v, ierr))
       end do
-      call faces_new_lambda(fd%faces, u, lam, grid%lo, grid%hi, fd%beta, parts%velocity, parts%omega, fd%lambda_new)
+      call faces_new_lambda(fd%faces, u, lam, grid%lo, grid%hi, fd%beta, velocity, omega, fd%lambda_new)
       do c = 1, 3
         PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%v, ierr))
         PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), vel(c), u(c)%v, ierr))
@@ -450,18 +656,32 @@ contains
     end do
     PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_P), pressure, p%v, ierr))
     ! with the interior pressure of doc/METHOD.md §3.7 from the runs of cell centres
-    if (removed) then
-      call faces_update(fd%faces, u, lam, p, grid%lo, grid%hi, fd%beta, dv, parts%velocity, parts%omega, sums, &
-                        fd%lambda_new)
+    if (fd%sliding) then
+      if (removed) then
+        call faces_update(fd%faces, u, lam, p, grid%lo, grid%hi, fd%beta, dv, velocity, omega, entry_sums, &
+                          fd%lambda_new)
+      else
+        call faces_update(fd%faces, u, lam, p, grid%lo, grid%hi, fd%beta, dv, velocity, omega, entry_sums)
+      end if
+    else if (removed) then
+      call faces_update(fd%faces, u, lam, p, grid%lo, grid%hi, fd%beta, dv, velocity, omega, sums, fd%lambda_new)
     else
-      call faces_update(fd%faces, u, lam, p, grid%lo, grid%hi, fd%beta, dv, parts%velocity, parts%omega, sums)
+      call faces_update(fd%faces, u, lam, p, grid%lo, grid%hi, fd%beta, dv, velocity, omega, sums)
     end if
     PetscCall(DMDAVecRestoreArrayReadF90(grid%da(FIELD_P), pressure, p%v, ierr))
     do c = 1, 3
       PetscCall(DMDAVecRestoreArrayF90(grid%da(c), fd%lambda(c), lam(c)%v, ierr))
       PetscCall(DMDAVecRestoreArrayF90(grid%da(c), vel(c), u(c)%v, ierr))
     end do
-    call MPI_Allreduce(MPI_IN_PLACE, sums, 16 * n, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
+    if (fd%sliding) then
+      ! an image's force, torque and stresslet (about its own centre) are its sphere's
+      call MPI_Allreduce(MPI_IN_PLACE, entry_sums, 16 * fd%entries, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
+      do e = 1, fd%entries
+        sums(:, fd%owner(e)) = sums(:, fd%owner(e)) + entry_sums(:, e)
+      end do
+    else
+      call MPI_Allreduce(MPI_IN_PLACE, sums, 16 * n, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
+    end if
     if (present(lubrication)) then
       PetscCall(lubrication_links_corrections(lubrication, parts%velocity, parts%omega, ierr))
     end if

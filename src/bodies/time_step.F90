@@ -29,7 +29,8 @@ module mod_time_step
                                 shear_protocol_varies, shear_protocol_set_rate, PROTOCOL_OSCILLATORY, CONTROL_STRESS
   use mod_lubrication_dynamics, only: lubrication_dynamics_t
   use mod_fictitious_domain, only: fictitious_domain_t, fictitious_domain_geometry, fictitious_domain_follow, &
-                                   fictitious_domain_moments, fictitious_domain_solve_motion, fictitious_domain_update
+                                   fictitious_domain_moments, fictitious_domain_solve_motion, fictitious_domain_update, &
+                                   fictitious_domain_set_image_speed
   use mod_lubrication_links, only: lubrication_links_evaluate
   use mod_ld_motion, only: ld_motion_solve, ld_motion_solve_stress
   use mod_particle_solver, only: particle_solver_t
@@ -135,7 +136,7 @@ contains
     if (ts%variant == TIME_STEP_RESOLVED) then
       ! the geometry at X^n; each step then moves it, and Lambda with it, to X^{n+1}
       PetscCall(stage_push(STAGE_PARTICLES, ierr))
-      call fictitious_domain_geometry(ts%grid, ts%fd, ts%parts)
+      call fictitious_domain_geometry(ts%grid, ts%fd, ts%parts, ts%le)
       PetscCall(stage_pop(ierr))
     end if
   end subroutine time_step_create
@@ -216,6 +217,7 @@ contains
         ! the particle sub-problem (doc/METHOD.md §3.2 eq. (1)): moments of u~ and Lambda^n, the
         ! 6N system for U, Omega, then Lambda^{n+1}, u^{n+1} and the hydrodynamic force, torque,
         ! stresslet
+        if (le%active) call fictitious_domain_set_image_speed(ts%fd, ts%protocol%rate * ts%box(2))
         PetscCall(fictitious_domain_moments(ts%grid, ts%fd, ts%fluid%vel, parts%n, ierr))
         PetscCall(fictitious_domain_solve_motion(ts%fd, parts, ierr, lubrication=ts%lubrication, contacts=ts%contacts))
         PetscCall(fictitious_domain_update(ts%grid, ts%fd, ts%fluid%vel, ts%fluid%pressure, parts, ierr, ts%lubrication))
@@ -262,10 +264,11 @@ contains
       end if
       if (ts%variant == TIME_STEP_RESOLVED) then
         if (ts%carry_lambda) then
+          ! (with Lees-Edwards the carry finds the displacement of each sphere and image itself)
           ts%position_before = displacements(parts%position, ts%position_before, ts%box, [.true., .not. ts%walls, .true.])
-          PetscCall(fictitious_domain_follow(ts%grid, ts%fd, parts, ts%position_before, ierr))
+          PetscCall(fictitious_domain_follow(ts%grid, ts%fd, parts, ts%position_before, ierr, le))
         else
-          call fictitious_domain_geometry(ts%grid, ts%fd, parts)
+          call fictitious_domain_geometry(ts%grid, ts%fd, parts, le)
         end if
       end if
       PetscCall(stage_pop(ierr))

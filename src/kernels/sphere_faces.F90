@@ -29,12 +29,16 @@ module mod_sphere_faces
 
   ! The grid as a visit sees it: cells of side h, n per axis over the box, walls at y = 0 and
   ! y = box(2) or periodic, and the block of indices [lo, hi] this rank owns (the same for every
-  ! component on the MAC layout of mod_grid).
+  ! component on the MAC layout of mod_grid). sliding: a Lees-Edwards box (doc/METHOD.md §2.4),
+  ! where y is not wrapped either: what a sphere covers beyond y = 0 or Ly is covered by its image
+  ! in the box (mod_fictitious_domain visits the images as spheres of their own), and v on j = 0
+  ! is an unknown like any other.
   type :: mac_block_t
     real(dp) :: h = 1.0_dp
     real(dp) :: box(3) = 1.0_dp
     integer :: n(3) = 1
     logical :: walls = .false.
+    logical :: sliding = .false.
     integer :: lo(3) = 0, hi(3) = 0
   end type mac_block_t
 
@@ -125,7 +129,7 @@ contains
       lo = faces%run_lo(d, run)
       hi = faces%run_hi(d, run)
       n = faces%block%n(d)
-      periodic = .not. (d == 2 .and. faces%block%walls)
+      periodic = .not. (d == 2 .and. (faces%block%walls .or. faces%block%sliding))
       do f = f0, f1
         k = faces%ijk(d, f)
         if (periodic) then
@@ -213,7 +217,10 @@ contains
       hi(d) = min(ceiling((centre(d) + radius) / block%h - STAGGER(d, c) + 0.5_dp), lo(d) + size(mine, 1) - 1)
       do m = 1, hi(d) - lo(d) + 1
         i = lo(d) + m - 1
-        if (d == 2 .and. block%walls) then
+        if (d == 2 .and. block%sliding) then
+          wrapped(m, d) = i
+          mine(m, d) = i >= 0 .and. i < block%n(2)
+        else if (d == 2 .and. block%walls) then
           wrapped(m, d) = i
           mine(m, d) = i >= 0 .and. i < block%n(2) .and. .not. (c == 2 .and. i == 0)
         else
@@ -381,7 +388,7 @@ contains
       p = rival_part(m)
       do d = 1, 3
         unwrapped = ijk(d)
-        if (.not. (d == 2 .and. block%walls)) unwrapped = ijk(d) + block%n(d) * &
+        if (.not. (d == 2 .and. (block%walls .or. block%sliding))) unwrapped = ijk(d) + block%n(d) * &
              nint((positions(d, p) - (ijk(d) + STAGGER(d, c)) * h) / block%box(d))
         x(d) = (unwrapped + STAGGER(d, c)) * h - positions(d, p)
       end do

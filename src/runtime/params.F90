@@ -481,12 +481,6 @@ contains
       call input_error(cfg%deck_file, 'domain', 'y_boundary', 'must be ''walls'', ''periodic'' or ''lees-edwards'', not '''// &
            trim(cfg%domain%y_boundary)//'''')
     cfg%lees_edwards = (cfg%domain%y_boundary == 'lees-edwards')
-    if (cfg%lees_edwards .and. cfg%resolved .and. (cfg%particles%number > 0 .or. &
-        len_trim(cfg%particles%position_file) > 0 .or. cfg%particles%solid_fraction > 0.0_dp)) &
-      call input_error(cfg%deck_file, 'domain', 'y_boundary', &
-           '''lees-edwards'' with the resolved fluid is implemented for the fluid alone: spheres across the sliding '// &
-           'boundary (the fictitious domain''s images) are not yet; lubrication dynamics (&fluid model = ''none'') '// &
-           'or walls take spheres')
     call resolve_shear_rate(cfg)
     cfg%walls = (cfg%domain%y_boundary == 'walls')
     if (.not. cfg%walls .and. .not. cfg%lees_edwards .and. cfg%domain%shear_rate /= 0.0_dp) &
