@@ -452,9 +452,11 @@ contains
   ! r = r0 + (stress - sigma(r0))/(sigma(r0 + 1) - sigma(r0)); then the velocities, the contacts'
   ! implicit forces and the links' corrections are those of r. rate: in, r0 (the last step's, the
   ! one the explicit contacts and U^{n-1} went with); out, r. particle_stress: the walls' share of
-  ! sigma(r), (F_top,x - F_bottom,x)/(2 Lx Lz). The guesses of the two solves are U^{n-1}/r0 and
-  ! U^{n-1}, from the checkpointed state, so that a restart repeats them. Free or frozen spheres.
-  ! Collective.
+  ! sigma(r), (F_top,x - F_bottom,x)/(2 Lx Lz). The guesses of the two solves are 0 and U^{n-1},
+  ! from the checkpointed state, so that a restart repeats them: one fluid step's response to the
+  ! walls reaches only ~sqrt(dt/Re) into the fluid, so U_1 moves the spheres near the walls and
+  ! U^{n-1}/r0 is a worse guess than 0 (88 against 83 CG iterations a step, doc/BENCHMARKS.md §16).
+  ! Free or frozen spheres. Collective.
   subroutine fictitious_domain_solve_stress(fd, parts, stress, fluid_stress, fluid_slope, response_scale, area, &
                                             rate, particle_stress, ierr, lubrication, contacts)
     type(fictitious_domain_t), intent(inout) :: fd
@@ -491,7 +493,7 @@ contains
     u_before = parts%velocity
     w_before = parts%omega
     allocate(rhs(6, n))
-    ! the homogeneous step per unit rate: U_1, from U^{n-1}/r0
+    ! the homogeneous step per unit rate: U_1, from 0
     call particle_system_reset(fd%solver%system, n)
     do q = 1, n
       call particle_system_add_diagonal(fd%solver%system, q, fd%beta * fd%rigid_matrix(:, :, q))
@@ -501,13 +503,8 @@ contains
     if (present(lubrication)) call particle_lubrication_add_to_system(lubrication, fd%solver%system, rhs)
     if (stiffness) call particle_contacts_add_stiffness(contacts, fd%solver%system, rhs, 0.0_dp * u_before, &
                                                         0.0_dp * w_before, parts%have_prev)
-    if (rate_before /= 0.0_dp) then
-      parts%velocity = u_before / rate_before
-      parts%omega = w_before / rate_before
-    else
-      parts%velocity = 0.0_dp
-      parts%omega = 0.0_dp
-    end if
+    parts%velocity = 0.0_dp
+    parts%omega = 0.0_dp
     call particle_solver_solve(fd%solver, rhs, parts, ierr, ': a particle covers no grid face? (stress control: '// &
                                'the part per unit rate)')
     CHKERRQ(ierr)
