@@ -24,7 +24,8 @@ A. rate control (rate 1): the wall columns hold the walls' share as the spheres'
 B. stress control at S:
    1. at every record the stress the step solved for is S (shear/stress, to 1e-12 relative: the
       coupled step is affine in the rate, so the one scalar equation is solved exactly), and so is
-      sigma_w summed here from the wall columns (to 1e-12);
+      sigma_w summed here from the wall columns (to 1e-12), and by
+      fdsusp.protocols.wall_shear_stress (to 1e-12);
    2. the strain advances with the walls, dt gamma_dot^n each step (to 1e-12);
    3. wall contacts and wall lubrication are in the steps (their share is not zero);
    4. the mean rate over the same window gives back the imposed rate 1 within 3 combined standard
@@ -39,6 +40,7 @@ import json
 import os
 import numpy as np
 import fdsusp_testlib as T
+from fdsusp import protocols
 
 DT, BOX = 2.0e-3, 8.0
 AREA = BOX * BOX
@@ -94,6 +96,10 @@ miss = np.max(np.abs(s['shear/stress'] - S)) / S
 T.check(miss < 1e-12, 'the stress each step solved for is S = %.4f (largest relative miss %.1e)' % (S, miss))
 miss = np.max(np.abs(wall_stress(s) - S)) / S
 T.check(miss < 1e-12, 'the mean wall stress summed from the wall columns is S at every record (%.1e)' % miss)
+w = protocols.wall_shear_stress(os.path.join(d, 'stress'))
+miss = np.max(np.abs(w['sigma'] - wall_stress(s))) / S
+T.check(miss < 1e-12 and np.array_equal(w['step'], s['step']),
+        'fdsusp.protocols.wall_shear_stress sums the same (%.1e)' % miss)
 miss = np.max(np.abs(np.diff(s['shear/strain']) - DT * rate[:-1]))
 T.check(s['shear/strain'][0] == 0.0 and miss < 1e-12, 'the strain advances with the walls, dt rate_n (%.1e)' % miss)
 f = s['wall_force_lubrication'][:, :, 0]
