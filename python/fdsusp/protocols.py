@@ -15,6 +15,7 @@ the hydrodynamic shear stress here. Stresses are returned in units of eta*|refer
     m = protocols.oscillation_moduli('out/osc')        # G', G'' (harmonics 1 and 3), per period
     d = protocols.stroboscopic_msd('out/osc')          # <|dx|^2> between cycles
     v = protocols.stress_control_rate('out/stress')     # mean rate and S/<rate> under stress control
+    w = protocols.wall_shear_stress('out/dns')          # the DNS's mean wall shear stress and its parts
 """
 import math
 
@@ -244,3 +245,24 @@ def stress_control_rate(outdir):
     stress = a['shear_stress']
     return {'stress': stress, 'rate': rate, 'rate_error': error, 'viscosity': stress / rate,
             'viscosity_error': stress * error / rate ** 2, 'blocks': complete}
+
+
+def wall_shear_stress(outdir):
+    """The mean wall shear stress of every record of a DNS between walls (doc/METHOD.md §7.4, the
+    stress that stress control sets): the force on the walls per area, sigma_w = fluid +
+    lubrication + contact, with fluid = (tau_wall_bottom + tau_wall_top)/2 (the grid's viscous
+    stress) and the walls' force on the spheres through the wall lubrication links and the wall
+    contacts, (F_top,x - F_bottom,x)/(2 Lx Lz) (columns wall_force_lubrication, wall_force_contact:
+    record x wall (lower, upper) x component; absent: zero). {'step', 'sigma', 'fluid',
+    'lubrication', 'contact'}, in eta*gamma_dot_ref."""
+    columns, attributes = series.read(outdir)
+    if 'tau_wall_bottom' not in columns:
+        raise KeyError(f'{outdir}: no wall stresses (not a DNS between walls)')
+    area = float(np.ravel(attributes['box_x'])[0]) * float(np.ravel(attributes['box_z'])[0])
+    fluid = 0.5 * (columns['tau_wall_bottom'] + columns['tau_wall_top'])
+    share = {}
+    for part in ('lubrication', 'contact'):
+        f = columns.get('wall_force_' + part)
+        share[part] = np.zeros_like(fluid) if f is None else (f[:, 1, 0] - f[:, 0, 0]) / (2.0 * area)
+    return {'step': columns['step'], 'sigma': fluid + share['lubrication'] + share['contact'], 'fluid': fluid,
+            'lubrication': share['lubrication'], 'contact': share['contact']}

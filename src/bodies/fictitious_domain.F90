@@ -45,7 +45,7 @@ module mod_fictitious_domain
                                       particle_lubrication_add_corrections
   use mod_lubrication_links, only: lubrication_links_corrections
   use mod_particle_contacts, only: particle_contacts_t, particle_contacts_add_stiffness, &
-                                   particle_contacts_implicit_update
+                                   particle_contacts_implicit_update, particle_contacts_set_rate
   use mod_particle_solver, only: particle_solver_t, particle_solver_create, particle_solver_solve, &
                                  particle_solver_destroy
   use mod_sphere_faces, only: mac_block_t, face_list_t, field_view_t, faces_build, faces_carry, faces_moments, &
@@ -61,8 +61,9 @@ module mod_fictitious_domain
   private
   public :: fictitious_domain_t, fictitious_domain_create, fictitious_domain_geometry, &
             fictitious_domain_follow, fictitious_domain_moments, fictitious_domain_solve_motion, &
-            fictitious_domain_update, fictitious_domain_destroy, &
-            fictitious_domain_pair_lag_limit, fictitious_domain_stresslet_lag_limit, fictitious_domain_set_image_speed
+            fictitious_domain_update, fictitious_domain_destroy, fictitious_domain_response_moments, &
+            fictitious_domain_solve_stress, fictitious_domain_set_image_speed, &
+            fictitious_domain_pair_lag_limit, fictitious_domain_stresslet_lag_limit
 
   type :: fictitious_domain_t
     real(dp) :: beta = 0.0_dp           ! rho/dt = Re/dt
@@ -91,6 +92,9 @@ module mod_fictitious_domain
     real(dp), allocatable :: lambda_new(:)   ! Lambda^{n+1} per listed face (kept: no allocation per step)
     logical :: lambda_listed = .false.       ! Lambda^n is zero off the listed faces (fictitious_domain_follow put it there)
     real(dp), allocatable :: moments(:, :)   ! (12, n): b(u~) and m(Lambda^n) of the step (fictitious_domain_moments)
+    ! stress control (doc/METHOD.md §7.4): (6, n) b of the fluid step's response to a unit wall
+    ! speed (fictitious_domain_response_moments)
+    real(dp), allocatable :: response_moments(:, :)
     type(particle_solver_t) :: solver     ! the 6N system of the particle step and its solution
     ! Lees-Edwards (see the top): the boundary at the last geometry, the images' extra speed
     ! gamma_dot Ly of the step, and the entries: sphere owner(e) itself (copy 0, entries 1..n in
@@ -590,6 +594,198 @@ contains
     end select
     PetscCall(event_end(EVENT_MOTION, ierr))
   end subroutine fictitious_domain_solve_motion
+
+  ! Stress control (doc/METHOD.md §7.4): b = sum_f w u_c g dV of vel, the fluid step's response to a
+  ! unit wall speed (the same field every step; the geometry of X^n weighs it), into
+  ! fd%response_moments (6, n), summed over ranks. Collective.
+  subroutine fictitious_domain_response_moments(grid, fd, vel, n, ierr)
+    type(grid_t), intent(in) :: grid
+    type(fictitious_domain_t), intent(inout) :: fd
+    Vec, intent(in) :: vel(3)
+    integer, intent(in) :: n
+    PetscErrorCode, intent(out) :: ierr
+    type(field_view_t) :: u(3), lam(3)
+    real(dp), allocatable :: both(:, :)
+    integer :: c
+
+    PetscCall(event_begin(EVENT_MOMENTS, ierr))
+    allocate(both(12, n))
+    both = 0.0_dp
+    do c = 1, 3
+      PetscCall(DMDAVecGetArrayReadF90(grid%da(c), vel(c), u(c)%v, ierr))
+      PetscCall(DMDAVecGetArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%v, ierr))
+    end do
+    ! (the m of Lambda^n comes along in rows 7-12 and is not wanted: the response has no Lambda^n)
+    call faces_moments(fd%faces, u, lam, grid%lo, grid%hi, grid%h**3, both)
+    do c = 1, 3
+      PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%v, ierr))
+      PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), vel(c), u(c)%v, ierr))
+    end do
+    call MPI_Allreduce(MPI_IN_PLACE, both, 12 * n, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
+    fd%response_moments = both(1:6, :)
+    PetscCall(event_end(EVENT_MOMENTS, ierr))
+  end subroutine fictitious_domain_response_moments
+
+  ! Stress control of the DNS between walls (doc/METHOD.md §7.4): the spheres' velocities of a step
+  ! whose rate gamma_dot (the walls at -+ gamma_dot Ly/2) is the unknown, set so that the mean wall
+  ! shear stress is stress. Given X^n, the contacts' explicit forces (particle_contacts_step, at
+  ! the last step's rate) and the lubrication links evaluated per unit rate, the step is affine
+  ! in the rate: the fluid step (the wall speed enters its right-hand side linearly), the moments,
+  ! the 6N right-hand side (the links' drives, the walls' velocity in the implicit contacts), its
+  ! solution and the wall forces; the matrix does not depend on it. With the fluid stepped at the
+  ! last step's rate r0 (moments in fd%moments) and the response of the fluid step to a unit wall
+  ! speed (fd%response_moments; response_scale = Ly/2 wall speed per unit rate):
+  !   A U_0 = rhs(r0),  A U_1 = beta response_scale b(response) + drives(1) + contact walls(1)
+  ! (the second with neither Lambda^n, contact forces nor U^{n-1}: the homogeneous step), and
+  ! U(r) = U_0 + (r - r0) U_1. The mean wall shear stress is
+  !   sigma(r) = fluid_stress + (r - r0) fluid_slope + (F_top,x - F_bottom,x)/(2 Lx Lz),
+  ! fluid_stress, fluid_slope: the grid's (tau_bottom + tau_top)/2 of the step at r0 and per unit
+  ! rate; F: the force of each wall on the spheres through the wall links and the wall contacts
+  ! (explicit and implicit), affine in r. It is evaluated at r0 and r0 + 1, and
+  ! r = r0 + (stress - sigma(r0))/(sigma(r0 + 1) - sigma(r0)); then the velocities, the contacts'
+  ! implicit forces and the links' corrections are those of r. rate: in, r0 (the last step's, the
+  ! one the explicit contacts and U^{n-1} went with); out, r. particle_stress: the walls' share of
+  ! sigma(r), (F_top,x - F_bottom,x)/(2 Lx Lz). The guesses of the two solves are 0 and U^{n-1},
+  ! from the checkpointed state, so that a restart repeats them: one fluid step's response to the
+  ! walls reaches only ~sqrt(dt/Re) into the fluid, so U_1 moves the spheres near the walls and
+  ! U^{n-1}/r0 is a worse guess than 0 (88 against 83 CG iterations a step, doc/BENCHMARKS.md §16).
+  ! Free or frozen spheres. Collective.
+  subroutine fictitious_domain_solve_stress(fd, parts, stress, fluid_stress, fluid_slope, response_scale, area, &
+                                            rate, particle_stress, ierr, lubrication, contacts)
+    type(fictitious_domain_t), intent(inout) :: fd
+    type(particles_t), intent(inout) :: parts
+    real(dp), intent(in) :: stress, fluid_stress, fluid_slope, response_scale, area
+    real(dp), intent(inout) :: rate
+    real(dp), intent(out) :: particle_stress
+    PetscErrorCode, intent(out) :: ierr
+    type(particle_lubrication_t), intent(inout), optional :: lubrication
+    type(particle_contacts_t), intent(inout), optional :: contacts
+    real(dp), allocatable :: rhs(:, :), u_before(:, :), w_before(:, :), u0(:, :), w0(:, :), u1(:, :), w1(:, :)
+    real(dp), allocatable :: drive(:, :), uinf(:, :), wall_drive(:, :)
+    real(dp), allocatable :: c_force(:, :), c_torque(:, :), c_stresslet(:, :, :)
+    real(dp) :: c_wall_force(3, 2), rate_before, sigma0, sigma1, slope
+    logical :: c_added, stiffness
+    character(len=300) :: text
+    integer :: q, n, np, nw
+
+    PetscCall(event_begin(EVENT_MOTION, ierr))
+    n = parts%n
+    rate_before = rate
+    if (parts%motion /= MOTION_FREE .and. parts%motion /= MOTION_FROZEN) &
+      call fatal_error('fdsusp: fatal: stress control needs free or frozen spheres', 4)
+    stiffness = .false.
+    if (present(contacts)) stiffness = parts%motion == MOTION_FREE
+    ! the links' rate-proportional data, made per unit rate
+    if (present(lubrication)) then
+      np = lubrication%npairs
+      nw = lubrication%nwalls
+      drive = lubrication%pair_drive(:, 1:np)
+      uinf = lubrication%pair_uinf(:, 1:np)
+      wall_drive = lubrication%wall_drive(:, 1:nw)
+    end if
+    u_before = parts%velocity
+    w_before = parts%omega
+    allocate(rhs(6, n))
+    ! the homogeneous step per unit rate: U_1, from 0
+    call particle_system_reset(fd%solver%system, n)
+    do q = 1, n
+      call particle_system_add_diagonal(fd%solver%system, q, fd%beta * fd%rigid_matrix(:, :, q))
+      rhs(:, q) = (fd%beta * response_scale) * fd%response_moments(:, q)
+    end do
+    call set_rate(1.0_dp)
+    if (present(lubrication)) call particle_lubrication_add_to_system(lubrication, fd%solver%system, rhs)
+    if (stiffness) call particle_contacts_add_stiffness(contacts, fd%solver%system, rhs, 0.0_dp * u_before, &
+                                                        0.0_dp * w_before, parts%have_prev)
+    parts%velocity = 0.0_dp
+    parts%omega = 0.0_dp
+    call particle_solver_solve(fd%solver, rhs, parts, ierr, ': a particle covers no grid face? (stress control: '// &
+                               'the part per unit rate)')
+    CHKERRQ(ierr)
+    u1 = parts%velocity
+    w1 = parts%omega
+    ! the step at r0 (assembled last: the contacts keep its U^{n-1} for their implicit update), from U^{n-1}
+    call particle_system_reset(fd%solver%system, n)
+    do q = 1, n
+      call particle_system_add_diagonal(fd%solver%system, q, fd%beta * fd%rigid_matrix(:, :, q))
+      rhs(:, q) = fd%beta * fd%moments(1:6, q) - fd%moments(7:12, q) &
+           + [parts%external_force(:, q), parts%external_torque(:, q)]
+      if (present(contacts)) rhs(:, q) = rhs(:, q) + [contacts%force(:, q), contacts%torque(:, q)]
+    end do
+    call set_rate(rate_before)
+    if (present(lubrication)) call particle_lubrication_add_to_system(lubrication, fd%solver%system, rhs)
+    if (stiffness) call particle_contacts_add_stiffness(contacts, fd%solver%system, rhs, u_before, w_before, &
+                                                        parts%have_prev)
+    parts%velocity = u_before
+    parts%omega = w_before
+    call particle_solver_solve(fd%solver, rhs, parts, ierr, ': a particle covers no grid face?')
+    CHKERRQ(ierr)
+    u0 = parts%velocity
+    w0 = parts%omega
+    ! the contacts' explicit forces of the step, kept for each evaluation
+    if (present(contacts)) then
+      c_force = contacts%force
+      c_torque = contacts%torque
+      c_stresslet = contacts%stresslet
+      c_wall_force = contacts%wall_force
+      c_added = contacts%stiffness_added
+    end if
+    PetscCall(at_rate(rate_before, u0, w0, sigma0))
+    PetscCall(at_rate(rate_before + 1.0_dp, u0 + u1, w0 + w1, sigma1))
+    sigma0 = sigma0 + fluid_stress
+    sigma1 = sigma1 + fluid_stress + fluid_slope
+    slope = sigma1 - sigma0
+    if (.not. (slope > 0.0_dp)) then
+      write(text, '(a,es12.4,a)') 'fdsusp: fatal: stress control: the mean wall stress does not grow with the rate '// &
+           '(d sigma/d gamma_dot = ', slope, '): the step cannot set the stress'
+      call fatal_error(text, 4)
+    end if
+    rate = rate_before + (stress - sigma0) / slope
+    PetscCall(at_rate(rate, u0 + (rate - rate_before) * u1, w0 + (rate - rate_before) * w1, particle_stress))
+    PetscCall(event_end(EVENT_MOTION, ierr))
+
+  contains
+
+    ! every rate-dependent datum of the particle problem at rate r: the links' drives, undisturbed
+    ! velocities and E_inf, the walls' velocity in the contacts
+    subroutine set_rate(r)
+      real(dp), intent(in) :: r
+      if (present(lubrication)) then
+        lubrication%pair_drive(:, 1:np) = r * drive
+        lubrication%pair_uinf(:, 1:np) = r * uinf
+        lubrication%wall_drive(:, 1:nw) = r * wall_drive
+        lubrication%shear_rate = r
+      end if
+      if (present(contacts)) call particle_contacts_set_rate(contacts, r, rate_before)
+    end subroutine set_rate
+
+    ! the particle problem at rate r with the velocities u, w (3, n): the spheres' velocities, the
+    ! contacts' force (explicit forces restored, then the implicit part), the links' corrections,
+    ! and the walls' share of the mean wall shear stress, (F_top,x - F_bottom,x)/(2 area).
+    ! Collective (the links' corrections; the host's ierr).
+    subroutine at_rate(r, u, w, walls_share)
+      real(dp), intent(in) :: r, u(:, :), w(:, :)
+      real(dp), intent(out) :: walls_share
+      real(dp) :: force(3, 2)
+      call set_rate(r)
+      parts%velocity = u
+      parts%omega = w
+      force = 0.0_dp
+      if (present(contacts)) then
+        contacts%force = c_force
+        contacts%torque = c_torque
+        contacts%stresslet = c_stresslet
+        contacts%wall_force = c_wall_force
+        contacts%stiffness_added = c_added
+        call particle_contacts_implicit_update(contacts, u, w)
+        force = force + contacts%wall_force
+      end if
+      if (present(lubrication)) then
+        PetscCall(lubrication_links_corrections(lubrication, u, w, ierr))
+        force = force + lubrication%wall_force
+      end if
+      walls_share = (force(1, 2) - force(1, 1)) / (2.0_dp * area)
+    end subroutine at_rate
+  end subroutine fictitious_domain_solve_stress
 
   ! Lambda^{n+1} = [Lambda^n + beta alpha (g.U - u~)]/(1 + gamma) on owned faces, 0 elsewhere;
   ! u^{n+1} = u~ + (Lambda^{n+1} - Lambda^n)/beta; the moments F = -sum Lambda e_c dV,

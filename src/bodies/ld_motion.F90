@@ -86,7 +86,7 @@ contains
     real(dp), allocatable :: rhs0(:, :), rhs1(:, :), u0(:, :), w0(:, :), u1(:, :), w1(:, :)
     real(dp), allocatable :: drive(:, :), wall_drive(:, :), uinf(:, :)
     real(dp), allocatable :: c_force(:, :), c_torque(:, :), c_stresslet(:, :, :)
-    real(dp) :: sigma0, sigma1, slope, rate_before
+    real(dp) :: sigma0, sigma1, slope, rate_before, c_wall_force(3, 2)
     logical :: c_added
     character(len=300) :: text
     integer :: n, np, nw
@@ -135,6 +135,7 @@ contains
       c_force = contacts%force
       c_torque = contacts%torque
       c_stresslet = contacts%stresslet
+      c_wall_force = contacts%wall_force
       c_added = contacts%stiffness_added
     end if
     PetscCall(at_rate(0.0_dp, u0, w0, sigma0))
@@ -178,6 +179,7 @@ contains
         contacts%force = c_force
         contacts%torque = c_torque
         contacts%stresslet = c_stresslet
+        contacts%wall_force = c_wall_force
         contacts%stiffness_added = c_added
         call particle_contacts_implicit_update(contacts, u, w)
       end if

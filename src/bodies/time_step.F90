@@ -30,7 +30,8 @@ module mod_time_step
   use mod_lubrication_dynamics, only: lubrication_dynamics_t
   use mod_fictitious_domain, only: fictitious_domain_t, fictitious_domain_geometry, fictitious_domain_follow, &
                                    fictitious_domain_moments, fictitious_domain_solve_motion, fictitious_domain_update, &
-                                   fictitious_domain_set_image_speed
+                                   fictitious_domain_set_image_speed, fictitious_domain_response_moments, &
+                                   fictitious_domain_solve_stress
   use mod_lubrication_links, only: lubrication_links_evaluate
   use mod_ld_motion, only: ld_motion_solve, ld_motion_solve_stress
   use mod_particle_solver, only: particle_solver_t
@@ -210,6 +211,7 @@ contains
       end if
       ! (a disassociated pointer passed to an optional argument is absent: contacts, lubrication)
       if (ts%variant == TIME_STEP_RESOLVED) then
+        ! (stress control: the fluid at the last step's wall speed, impose_rate)
         PetscCall(stage_push(STAGE_FLUID, ierr))
         PetscCall(fluid_step(ts%grid, ts%fluid, ierr, ts%fd%lambda))
         PetscCall(stage_pop(ierr))
@@ -219,7 +221,11 @@ contains
         ! stresslet
         if (le%active) call fictitious_domain_set_image_speed(ts%fd, ts%protocol%rate * ts%box(2))
         PetscCall(fictitious_domain_moments(ts%grid, ts%fd, ts%fluid%vel, parts%n, ierr))
-        PetscCall(fictitious_domain_solve_motion(ts%fd, parts, ierr, lubrication=ts%lubrication, contacts=ts%contacts))
+        if (stress_control) then
+          PetscCall(resolved_stress_control(ts, ierr))
+        else
+          PetscCall(fictitious_domain_solve_motion(ts%fd, parts, ierr, lubrication=ts%lubrication, contacts=ts%contacts))
+        end if
         PetscCall(fictitious_domain_update(ts%grid, ts%fd, ts%fluid%vel, ts%fluid%pressure, parts, ierr, ts%lubrication))
       else
         PetscCall(stage_push(STAGE_PARTICLES, ierr))
@@ -275,6 +281,37 @@ contains
     end associate
     call count_step(ts, step)
   end subroutine time_step_advance
+
+  ! Stress control of the DNS with spheres between walls (doc/METHOD.md §7.4): after the fluid step
+  ! at the last step's wall speed and its moments, the rate gamma_dot^n whose mean wall shear stress
+  ! is the target (fictitious_domain_solve_stress: the coupled step is affine in the rate, and the
+  ! fluid step's part of it is the run's unit wall-speed response, ts%fluid_response), then the
+  ! fluid step made that of gamma_dot^n by adding the multiple of the response (u~, p, phi, u*,
+  ! the wall speed and stresses), every piece given gamma_dot^n, and the protocol told the rate,
+  ! the stress reached and the walls' strain rate (the walls move at gamma_dot^n over the step).
+  ! The update that follows (Lambda^{n+1}, u^{n+1}) is affine in u~ and U and is made once, with
+  ! both at gamma_dot^n. Collective.
+  subroutine resolved_stress_control(ts, ierr)
+    type(time_step_t), intent(inout) :: ts
+    PetscErrorCode, intent(out) :: ierr
+    real(dp) :: rate, rate_before, per_rate, walls_share, fluid_stress, fluid_slope
+    associate(fl => ts%fluid, unit => ts%fluid_response)
+      PetscCall(fictitious_domain_response_moments(ts%grid, ts%fd, unit%vel, ts%parts%n, ierr))
+      rate_before = ts%protocol%rate
+      rate = rate_before
+      ! the wall speed per unit rate, Ly/2
+      per_rate = 0.5_dp * ts%box(2)
+      fluid_stress = 0.5_dp * (fl%tau_bottom + fl%tau_top)
+      fluid_slope = per_rate * 0.5_dp * (unit%tau_bottom + unit%tau_top)
+      PetscCall(fictitious_domain_solve_stress(ts%fd, ts%parts, ts%protocol%stress, fluid_stress, fluid_slope, per_rate, ts%box(1) * ts%box(3), rate, walls_share, ierr, lubrication=ts%lubrication, contacts=ts%contacts))
+      PetscCall(stage_push(STAGE_FLUID, ierr))
+      PetscCall(fluid_add_response(ts%grid, fl, unit, (rate - rate_before) * per_rate, ierr))
+      PetscCall(stage_pop(ierr))
+      ! the stress reached: the fluid's wall stress of the step as it now is, and the walls' share
+      call shear_protocol_set_rate(ts%protocol, rate, 0.5_dp * (fl%tau_bottom + fl%tau_top) + walls_share, rate)
+    end associate
+    call impose_rate(ts)
+  end subroutine resolved_stress_control
 
   ! The rate of the step, gamma_dot(t_n) = ts%protocol%rate, given to every piece that uses the
   ! imposed shear (doc/RHEOLOGY.md "Protocols"): the walls of the fluid, of the lubrication and of

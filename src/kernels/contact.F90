@@ -91,6 +91,9 @@ module mod_contact
     real(dp) :: max_overlap = 0         ! max |delta'| / h_r (/ a when h_r = 0)
     integer :: max_overlap_pair(2) = 0  ! its particles (partner wall_lower/wall_upper for a wall)
     real(dp) :: max_normal_force = 0
+    ! the force of the lower and the upper wall on the spheres (the shear stress the walls take
+    ! through their contacts, doc/METHOD.md §7.4)
+    real(dp) :: wall_force(3, 2) = 0
   end type contact_stats_t
 
   !> The open contacts of one step, for their implicit stiffness (contact_stiffness): one entry per
@@ -680,6 +683,7 @@ contains
       call contact_pair_sized(p, kh, n, dlt, u(:, i) - vw(:, w), om(:, i), ai, dt, ups, f, tq, fn, sliding)
       if (tangential) call append(i, -w)
       force(:, i) = force(:, i) + f
+      stats%wall_force(:, w) = stats%wall_force(:, w) + f
       torque(:, i) = torque(:, i) + tq
       li = 0.5_dp * (ai + d) * n               ! (a_i + gap/2) n, gap = d - a_i
       stresslet(:, :, i) = stresslet(:, :, i) + contact_stresslet(f, li)

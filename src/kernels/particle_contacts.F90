@@ -59,6 +59,9 @@ module mod_particle_contacts
     type(contact_stats_t) :: stats           ! of the last step
     real(dp) :: max_overlap = 0              ! max |delta'| of the last step [a]
     real(dp), allocatable :: force(:,:), torque(:,:), stresslet(:,:,:)   ! of the last step
+    ! the force of the lower and the upper wall on the spheres in the last step, explicit and
+    ! implicit parts (the walls' share of the wall shear stress, doc/METHOD.md §7.4)
+    real(dp) :: wall_force(3, 2) = 0
     ! implicit contacts: the switch, the open contacts of the step, and what
     ! particle_contacts_add_stiffness keeps for particle_contacts_implicit_update
     logical :: implicit = .true.
@@ -168,6 +171,7 @@ contains
                           pc%stresslet, pc%stats, info, le=pc%le, radii=pc%radii)
     end if
     if (info /= 0) return
+    pc%wall_force = pc%stats%wall_force
     pc%max_overlap = pc%stats%max_overlap * pc%params%h_r
     if (pc%params%h_r <= 0) pc%max_overlap = pc%stats%max_overlap * pc%params%a
     if (pc%max_overlap > pc%overlap_limit) info = 2
@@ -266,6 +270,7 @@ contains
       pc%torque(:, i) = pc%torque(:, i) + g(4:6)
       s = contact_stresslet(g(1:3), pc%links%lever(:, m))
       pc%stresslet(:, :, i) = pc%stresslet(:, :, i) + s
+      if (j < 0) pc%wall_force(:, -j) = pc%wall_force(:, -j) + g(1:3)
       if (j > 0) then
         pc%force(:, j) = pc%force(:, j) - g(1:3)
         pc%torque(:, j) = pc%torque(:, j) + (pc%links%arm(2, m) / pc%links%arm(1, m)) * g(4:6)
@@ -306,7 +311,7 @@ contains
     type(particle_contacts_t), intent(in) :: pc
     type(column_t), allocatable :: c(:)
     ! element by element: an array constructor of column_t leaks their values (gfortran 12)
-    allocate(c(7))
+    allocate(c(merge(8, 7, .not. pc%periodic(2))))
     c(1) = column('contacts_pair', pc%stats%pair_contacts)
     c(2) = column('contacts_wall', pc%stats%wall_contacts)
     c(3) = column('contacts_sliding', pc%stats%sliding)
@@ -314,6 +319,8 @@ contains
     c(5) = column('particles/force_contact', pc%force)
     c(6) = column('particles/torque_contact', pc%torque)
     c(7) = column('particles/stresslet_contact', pc%stresslet)
+    ! between walls: the force of the lower and the upper wall on the spheres (3 x 2)
+    if (.not. pc%periodic(2)) c(8) = column('wall_force_contact', pc%wall_force)
   end function particle_contacts_columns
 
 end module mod_particle_contacts

@@ -81,6 +81,10 @@ module mod_particle_lubrication
     type(unequal_pair_t), allocatable :: setup(:, :)
     ! corrections of the last step, on each particle
     real(dp), allocatable :: force(:, :), torque(:, :), stresslet(:, :, :)
+    ! the force of the lower and the upper wall on the spheres through the wall links of the last
+    ! step (every rank holds every wall link: the same on every rank; the walls' share of the
+    ! wall shear stress, doc/METHOD.md §7.4)
+    real(dp) :: wall_force(3, 2) = 0
   end type particle_lubrication_t
 
 contains
@@ -498,11 +502,12 @@ contains
   subroutine particle_lubrication_corrections(pl, u, om)
     type(particle_lubrication_t), intent(inout) :: pl
     real(dp), intent(in) :: u(:, :), om(:, :)
-    integer :: l, i, j
+    integer :: l, i, j, side
     real(dp) :: ft(12), ft6(6), v(12), w(12), om_inf(3), e_inf(3, 3), s(3, 3, 2)
     pl%force = 0
     pl%torque = 0
     pl%stresslet = 0
+    pl%wall_force = 0
     if (pl%npairs + pl%nwalls == 0) return
     call ambient_gradients(pl, om_inf, e_inf)
     do l = 1, pl%npairs
@@ -529,6 +534,9 @@ contains
       ft6 = pl%wall_drive(:, l) - matmul(pl%wall_r(:, :, l), [u(:, i), om(:, i)])
       pl%force(:, i) = pl%force(:, i) + ft6(1:3)
       pl%torque(:, i) = pl%torque(:, i) + ft6(4:6)
+      ! the normal points from the wall into the box: +y at the lower wall (1), -y at the upper (2)
+      side = merge(1, 2, pl%wall_n(2, l) > 0)
+      pl%wall_force(:, side) = pl%wall_force(:, side) + ft6(1:3)
       if (pl%sized) then
         pl%stresslet(:, :, i) = pl%stresslet(:, :, i) + lub_wall_stresslet(pl%lub, pl%wall_n(:, l), ft6(1:3), pl%radii(i))
       else
@@ -553,12 +561,14 @@ contains
     type(particle_lubrication_t), intent(in) :: pl
     type(column_t), allocatable :: c(:)
     ! element by element: an array constructor of column_t leaks their values (gfortran 12)
-    allocate(c(5))
+    allocate(c(merge(6, 5, pl%walls)))
     c(1) = column('lubrication_pairs', pl%npairs_total)
     c(2) = column('lubrication_walls', pl%nwalls)
     c(3) = column('min_gap', pl%min_gap)
     c(4) = column('particles/force_lubrication', pl%force)
     c(5) = column('particles/torque_lubrication', pl%torque)
+    ! between walls: the force of the lower and the upper wall on the spheres (3 x 2)
+    if (pl%walls) c(6) = column('wall_force_lubrication', pl%wall_force)
   end function particle_lubrication_columns
 
 end module mod_particle_lubrication

@@ -824,8 +824,9 @@ contains
   end subroutine validate_steps
 
   ! Stress control (doc/INPUT.md "&shear", doc/METHOD.md §7.4): a non-zero stress (an
-  ! oscillation's amplitude, with a period), lubrication dynamics or the DNS's fluid alone, a stress to measure (spheres or walls) with the statistics'
-  ! weights (&rheology), spheres that move freely; &shear rate stays the unit (positive).
+  ! oscillation's amplitude, with a period), a stress to measure (spheres or walls; in lubrication
+  ! dynamics with the statistics' weights, &rheology; in the DNS the mean wall stress, walls and
+  ! backward Euler), spheres that move freely; &shear rate stays the unit (positive).
   subroutine validate_stress_control(cfg)
     type(config_t), intent(inout) :: cfg
     logical :: spheres
@@ -844,10 +845,9 @@ contains
          'of the stress has the amplitude &shear stress (stress(t) = stress sin(2 pi t/period))')
     if (cfg%shear%protocol == 'oscillatory') &
       call check_real(cfg, 'shear', 'period', cfg%shear%period, 0.0_dp, 1.0e9_dp, .true.)
-    if (cfg%resolved .and. spheres) call input_error(cfg%deck_file, 'shear', 'control', &
-         '''stress'' in the resolved DNS is implemented for the fluid alone: with particles (the wall velocity '// &
-         'as the unknown of the coupled step) it is not implemented yet; lubrication dynamics (&fluid model = '// &
-         '''none'') takes it')
+    if (cfg%resolved .and. cfg%lees_edwards) call input_error(cfg%deck_file, 'shear', 'control', &
+         '''stress'' in the resolved DNS sets the walls'' speed from the mean wall stress: with y_boundary = '// &
+         '''lees-edwards'' it is not implemented yet; walls, or lubrication dynamics (&fluid model = ''none''), take it')
     if (cfg%resolved .and. cfg%fluid%viscous_theta /= 1.0_dp) call input_error(cfg%deck_file, 'fluid', &
          'viscous_theta', 'must be 1 (backward Euler) with &shear control = ''stress'': the wall speed jumps each '// &
          'step, and the Crank-Nicolson response of the wall cells to a jump overshoots (a wall stress that falls as '// &
@@ -859,9 +859,10 @@ contains
          '''stress'': no stress can be measured without particles and without walls')
     if (cfg%shear%rate <= 0.0_dp) call input_error(cfg%deck_file, trim(cfg%rate_group), trim(cfg%rate_name), &
          'is the unit of time and stress under control = ''stress'' (gamma_dot_ref): must be > 0')
-    if (spheres .and. .not. cfg%rheology_group) call input_error(cfg%deck_file, 'shear', 'control', &
-         '''stress'' with particles needs &rheology: the mean shear stress is the one the statistics measure '// &
-         '(doc/RHEOLOGY.md), and so are their weights')
+    ! (the DNS controls the mean wall stress, which needs no statistics)
+    if (spheres .and. .not. cfg%resolved .and. .not. cfg%rheology_group) call input_error(cfg%deck_file, 'shear', &
+         'control', '''stress'' with particles in lubrication dynamics needs &rheology: the mean shear stress is the '// &
+         'one the statistics measure (doc/RHEOLOGY.md), and so are their weights')
     if (spheres .and. cfg%particles%motion /= 'free' .and. cfg%particles%motion /= 'frozen') &
       call input_error(cfg%deck_file, 'particles', 'motion', 'must be ''free'' or ''frozen'' with &shear '// &
            'control = ''stress'' (imposed particle motion leaves no balance for the rate)')

@@ -126,6 +126,10 @@ cases = [
     # lubrication dynamics (issue 30)
     ('unknown fluid model', GOOD.replace('reynolds = 0.01', "reynolds = 0.01, model = 'stokes'"), [],
      ['bad.nml', '&fluid', 'model', 'stokes']),
+    ('stress control of the resolved DNS in a Lees-Edwards box', GOOD.replace('cells_per_radius = 5',
+     "cells_per_radius = 5, y_boundary = 'lees-edwards'").replace('reynolds = 0.01', 'reynolds = 0.01, viscous_theta = 1') +
+     "&shear rate = 1, control = 'stress', stress = 2 /\n&particles number = 1, position(:,1) = 1.6, 1.6, 1.6 /\n", [],
+     ['bad.nml', '&shear', 'control', 'lees-edwards']),
     ('sliding boundaries of the resolved fluid on the Krylov path', GOOD.replace('cells_per_radius = 5',
      "cells_per_radius = 5, y_boundary = 'lees-edwards', shear_rate = 1"), ['-fluid_solver', 'krylov'],
      ['bad.nml', '&domain', 'y_boundary', 'lees-edwards', 'direct solves']),
@@ -158,8 +162,13 @@ cases = [
     ('stress under rate control', GOOD + "&shear stress = 2 /\n", [], ['bad.nml', '&shear', 'stress', "control = 'stress'"]),
     ('stress control without a stress', LDS + "&rheology /\n&shear control = 'stress' /\n", [],
      ['bad.nml', '&shear', 'stress', 'must be given']),
-    ('stress control in the DNS with particles', GOOD + "&shear control = 'stress', stress = 2 /\n"
-     "&particles number = 1, position(:,1) = 1.6, 1.6, 1.6 /\n", [], ['bad.nml', '&shear', 'control', 'not implemented yet']),
+    # the DNS with particles takes stress control (the wall speed set by the walls' force balance,
+    # doc/METHOD.md §7.4), with backward Euler as the fluid alone, and free or frozen spheres
+    ('stress control in the DNS with Crank-Nicolson', GOOD + "&shear control = 'stress', stress = 2 /\n"
+     "&particles number = 1, position(:,1) = 1.6, 1.6, 1.6 /\n", [], ['bad.nml', '&fluid', 'viscous_theta', 'must be 1']),
+    ('stress control of prescribed spheres in the DNS', GOOD.replace('reynolds = 0.01', 'reynolds = 0.01, viscous_theta = 1')
+     + "&shear control = 'stress', stress = 2 /\n&particles number = 1, position(:,1) = 1.6, 1.6, 1.6, "
+     "motion = 'prescribed' /\n", [], ['bad.nml', '&particles', 'motion', "'stress'"]),
     ('a strain amplitude in a stress oscillation', LDS + "&rheology /\n&shear control = 'stress', stress = 2, "
      "protocol = 'oscillatory', strain_amplitude = 0.1, period = 1 /\n", [],
      ['bad.nml', '&shear', 'strain_amplitude', 'amplitude &shear stress']),

@@ -14,7 +14,11 @@ steady runs). Cases, each stopped in the middle of what the protocol does:
   200 against 100 + 100: the rate the restarted step solves for starts its solves from the
   checkpoint's velocities and rate, as the uninterrupted step does; and of the pure fluid in the
   DNS on 2 ranks (stress 2.5 from rest), 60 against 30 + 30: the unit wall-speed response is made
-  again at the restart, the same;
+  again at the restart, the same; and of the DNS with 31 rough frictional spheres between walls
+  (phi 0.25, a/Delta = 2, eps_r 0.05, contacts under load) on 2 ranks, stress 3, 60 against 30 + 30, and
+  its stress reversed every 0.05 strain (~17 steps) on 1 rank, 100 against 50 + 50: the step's two
+  particle solves start from the checkpoint's velocities and rate, Lambda and the fluid are the
+  checkpoint's (doc/METHOD.md §7.4);
 - a reversal of the stress (8, G = 0.3) and an oscillation of the stress (amplitude 8, T = 150
   steps) in lubrication dynamics, 200 against 100 + 100: the restart between two flips of the
   stress, and at 2/3 of a period;
@@ -71,6 +75,16 @@ STEPS = STRESS.replace("stress = 8.0", "protocol = 'steps', step_by = 'time', le
                        "step_level = 8.0, 12.0, 6.0")
 STRESS_REVERSAL = STRESS.replace("stress = 8.0", "stress = 8.0, protocol = 'reversal', reversal_strain = 0.3")
 STRESS_OSCILLATION = STRESS.replace("stress = 8.0", "stress = 8.0, protocol = 'oscillatory', period = 0.75")
+STRESS_DNS = """&domain box = 8.0, 8.0, 8.0, cells_per_radius = 2 /
+&shear control = 'stress', stress = 3.0 /
+&fluid reynolds = 0.01, viscous_theta = 1.0, initial_flow = 'shear' /
+&time dt = 2.0e-3, steps = {steps} /
+&output directory = 'out', progress_every = 1000 /
+&particles solid_fraction = 0.25, seed = 1 /
+&contact roughness = 0.05, friction = 0.5 /
+&lubrication model = 'simple' /
+"""
+STRESS_DNS_REVERSAL = STRESS_DNS.replace("stress = 3.0", "stress = 3.0, protocol = 'reversal', reversal_strain = 0.05")
 STRESS_FLUID = """&domain box = 4.0, 4.0, 4.0, cells_per_radius = 2 /
 &shear control = 'stress', stress = 2.5 /
 &fluid reynolds = 0.01, viscous_theta = 1.0 /
@@ -123,6 +137,14 @@ T.check(np.all(np.abs(s['shear/stress'] - 8.0 * np.sin(2 * np.pi * (s['step'] - 
         'stress oscillation: the stress is 8 sin(2 pi t_n/T) at every record (the restart at 2/3 of a period)')
 s = split('stress_fluid', STRESS_FLUID, 60, ranks=2)
 T.check(np.all(np.abs(s['shear/stress'] - 2.5) < 1e-12), 'stress control of the fluid alone: the stress is 2.5 at every record')
+s = split('stress_dns', STRESS_DNS, 60, ranks=2)
+T.check(np.all(np.abs(s['shear/stress'] - 3.0) < 1e-12) and np.any(s['contacts_pair'] > 0),
+        'stress control of the DNS with spheres: the wall stress is 3 at every record, contacts in the steps')
+s = split('stress_dns_reversal', STRESS_DNS_REVERSAL, 100)
+flips = s['step'][1:][np.sign(s['shear/stress'][1:]) != np.sign(s['shear/stress'][:-1])]
+T.check(len(flips) >= 2 and flips[0] < 51 < flips[-1] and np.all(np.abs(np.abs(s['shear/stress']) - 3.0) < 1e-12),
+        'stress reversal in the DNS with spheres: the wall stress is +-3 and flips at steps %s, on either side of '
+        'the restart' % list(flips))
 
 # a branch starts the deck's protocol afresh from the configuration reached: a steady pre-shear of
 # 100 steps (Lees-Edwards), then a reversal every 50 steps' strain, and an oscillation
