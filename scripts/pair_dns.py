@@ -31,6 +31,8 @@ with the lubrication correction, plus contact), S_inf = (20/3) pi eta a^3 gamma_
 Also printed: the DNS pair's relative velocity against the exact free-pair one along its trajectory
 (mobility(): radial / tangential errors at four gaps in the approach and the separation), which
 tells a steady resistance error from a lag (doc/VALIDATION.md §4.4).
+--lees-edwards: the same pair in a Lees-Edwards box, centred on the sliding boundary, so that one
+sphere always sees the other through it (doc/VALIDATION.md §13).
 Needs Debian's python3 with numpy, h5py and matplotlib (the shebang is /usr/bin/python3).
 """
 import argparse
@@ -121,6 +123,9 @@ def main():
     ap.add_argument('--figures', default=os.path.join(ROOT, 'doc', 'figures'))
     ap.add_argument('--tag', default='paper', help='figure names: pair_dns_<tag>_*.png')
     ap.add_argument('--plot-only', action='store_true')
+    ap.add_argument('--lees-edwards', action='store_true',
+                    help='a Lees-Edwards box instead of walls, the pair centred on the sliding boundary y = 0 '
+                         '(doc/METHOD.md §3.9)')
     args = ap.parse_args()
     if args.start >= -2:
         ap.error('--start must be below -2 (the spheres would overlap)')
@@ -131,7 +136,7 @@ def main():
 
         def prepare_case(c, d, steps=None, branched=args.branch):
             return prepare(c, d, args.box, args.cells, args.dt, args.start, args.eps_bar, args.reynolds,
-                           args.theta, args.hours, steps=steps, branched=branched)
+                           args.theta, args.hours, steps=steps, branched=branched, lees_edwards=args.lees_edwards)
 
         commands = {c: prepare_case(c, dirs[c]) for c in args.cases}
         if args.branch:

@@ -33,11 +33,11 @@ EXTEND = 0.1      # a DNS that has not crossed by its last step goes on by this 
 
 # Smooth spheres (eps_r = 0) get no &contact group: lubrication alone keeps them apart, as in
 # pairtraj, whose smooth pair never touches (its closest gap from y = 0.5a is 8.7e-5 a).
-def dns_deck(case, box, cells, reynolds, theta, dt, steps, hours, x1, y1, x2, y2, c, contact):
+def dns_deck(case, box, cells, reynolds, theta, dt, steps, hours, x1, y1, x2, y2, c, contact, boundary='walls'):
     """The DNS deck of a case (fdsusp.deck; numbers to 12 digits, as this study always wrote them);
-    contact: the &contact settings, None for smooth spheres."""
+    contact: the &contact settings, None for smooth spheres; boundary: the deck's y_boundary."""
     every = record_every(dt)
-    groups = [('domain', {'box': (box, box, box), 'cells_per_radius': cells, 'y_boundary': 'walls', 'shear_rate': 1}),
+    groups = [('domain', {'box': (box, box, box), 'cells_per_radius': cells, 'y_boundary': boundary, 'shear_rate': 1}),
               ('fluid', {'reynolds': reynolds, 'viscous_theta': theta, 'initial_flow': 'shear'}),
               ('time', {'dt': dt, 'steps': steps}),
               ('output', {'directory': 'out', 'progress_every': max(1, steps // 20), 'series_every': every,
@@ -83,13 +83,15 @@ def record_every(dt):
 
 
 def prepare(case, d, box, cells, dt, start, eps_bar=0.05, reynolds=0.01, theta=0.5, hours=0.0, steps_factor=1.05,
-            steps=None, branched=False):
+            steps=None, branched=False, lees_edwards=False):
     """Write the case's decks, run pairtraj; return the DNS command (continuing from a checkpoint
     when there is one). The DNS runs for steps_factor times pairtraj's transit time, or to step
     `steps` when given. branched: the case was branched from the trunk (branch()), so its
     checkpoint may be the trunk's, of other contact physics: fdsusp continues it with -branch,
     which takes this deck's contact model (doc/INPUT.md "Restart"); with the case's own
-    checkpoint -branch checks what -restart does."""
+    checkpoint -branch checks what -restart does. lees_edwards: a Lees-Edwards box instead of the
+    Couette cell, the pair centred on the sliding boundary y = 0 (sphere 1 below it, in the top of
+    the box; doc/METHOD.md §3.9), so that it crosses the boundary throughout."""
     os.makedirs(d, exist_ok=True)
     ref = pairtraj(case, d, start, eps_bar)
     _, eps_r, mu_d = CASES[case]
@@ -100,9 +102,11 @@ def prepare(case, d, box, cells, dt, start, eps_bar=0.05, reynolds=0.01, theta=0
     c = box / 2.0
     # smooth spheres (eps_r = 0) get no &contact group (above)
     contact = None if eps_r == 0 else {'roughness': eps_r, 'eps_bar': eps_bar, 'friction': mu_d}
+    y1, y2 = (box - Y0 / 2, Y0 / 2) if lees_edwards else (c - Y0 / 2, c + Y0 / 2)
     fdeck.write(os.path.join(d, 'deck.nml'),
-                dns_deck(case, box, cells, reynolds, theta, dt, steps, hours, x1=c - start / 2, y1=c - Y0 / 2,
-                         x2=c + start / 2, y2=c + Y0 / 2, c=c, contact=contact))
+                dns_deck(case, box, cells, reynolds, theta, dt, steps, hours, x1=c - start / 2, y1=y1,
+                         x2=c + start / 2, y2=y2, c=c, contact=contact,
+                         boundary='lees-edwards' if lees_edwards else 'walls'))
     binary = os.path.join(d, 'fdsusp')          # a copy: a rebuild cannot change a study half-way
     if not os.path.exists(binary):
         copy_program(binary)
@@ -172,17 +176,25 @@ def branch(trunk, d, case):
 
 
 def load_dns(d, box):
-    """The DNS pair: time, relative position r = x2 - x1 (minimum image in x and z), theta, and N1*,
-    N2* of one sphere (the mean of the two, equal by symmetry), with their contact parts."""
+    """The DNS pair: time, relative position r = x2 - x1 (minimum image in x and z; in a
+    Lees-Edwards box first the image in y nearest, shifted in x by the offset of its record), theta,
+    and N1*, N2* of one sphere (the mean of the two, equal by symmetry), with their contact parts."""
     out = os.path.join(d, 'out')
-    contact = 'particles/stresslet_contact' in series.names(out)
+    names = series.names(out)
+    contact = 'particles/stresslet_contact' in names
+    sliding = 'lees_edwards_offset' in names
     f = series.read(out, ['time', 'particles/position', 'particles/stresslet_hydro']
-                    + (['particles/stresslet_contact'] if contact else []))[0]
+                    + (['particles/stresslet_contact'] if contact else [])
+                    + (['lees_edwards_offset'] if sliding else []))[0]
     t = f['time']
     x = f['particles/position']
     s = f['particles/stresslet_hydro']
     sc = f['particles/stresslet_contact'] if contact else np.zeros_like(s)
     r = x[:, 1] - x[:, 0]
+    if sliding:
+        images = -np.round(r[:, 1] / box)
+        r[:, 1] += images * box
+        r[:, 0] += images * f['lees_edwards_offset']
     for k in (0, 2):
         r[:, k] -= box * np.round(r[:, k] / box)
 
