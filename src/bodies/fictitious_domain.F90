@@ -49,7 +49,7 @@ module mod_fictitious_domain
   use mod_particle_solver, only: particle_solver_t, particle_solver_create, particle_solver_solve, &
                                  particle_solver_destroy
   use mod_sphere_faces, only: mac_block_t, face_list_t, field_view_t, faces_build, faces_carry, faces_moments, &
-                              faces_new_lambda, faces_update
+                              faces_new_lambda, faces_update, face_run, run_offsets, new_lambda_run
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates, min_image
   use mod_lees_edwards, only: lees_edwards_t, le_separation
   use mod_sliding_boundary, only: sliding_shift_rows
@@ -606,10 +606,10 @@ contains
     PetscErrorCode, intent(out) :: ierr
     type(field_view_t) :: u(3), lam(3)
     real(dp), allocatable :: both(:, :)
-    integer :: c
+    integer :: c, e, q
 
     PetscCall(event_begin(EVENT_MOMENTS, ierr))
-    allocate(both(12, n))
+    allocate(both(12, max(n, fd%entries)))
     both = 0.0_dp
     do c = 1, 3
       PetscCall(DMDAVecGetArrayReadF90(grid%da(c), vel(c), u(c)%v, ierr))
@@ -621,8 +621,22 @@ contains
       PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%v, ierr))
       PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), vel(c), u(c)%v, ierr))
     end do
-    call MPI_Allreduce(MPI_IN_PLACE, both, 12 * n, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
-    fd%response_moments = both(1:6, :)
+    if (fd%sliding) then
+      ! per entry, then each image's to its sphere, less what its extra speed (gamma_dot Ly per
+      ! unit rate: Ly) takes off (Lees-Edwards, see the top)
+      call MPI_Allreduce(MPI_IN_PLACE, both, 12 * fd%entries, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
+      if (allocated(fd%response_moments)) deallocate(fd%response_moments)
+      allocate(fd%response_moments(6, n))
+      fd%response_moments = 0.0_dp
+      do e = 1, fd%entries
+        q = fd%owner(e)
+        fd%response_moments(:, q) = fd%response_moments(:, q) + both(1:6, e) &
+                                    - fd%copy(e) * fd%le%box(2) * fd%rigid_entries(1:6, 1, e)
+      end do
+    else
+      call MPI_Allreduce(MPI_IN_PLACE, both, 12 * n, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
+      fd%response_moments = both(1:6, 1:n)
+    end if
     PetscCall(event_end(EVENT_MOMENTS, ierr))
   end subroutine fictitious_domain_response_moments
 
@@ -650,8 +664,16 @@ contains
   ! walls reaches only ~sqrt(dt/Re) into the fluid, so U_1 moves the spheres near the walls and
   ! U^{n-1}/r0 is a worse guess than 0 (88 against 83 CG iterations a step, doc/BENCHMARKS.md §16).
   ! Free or frozen spheres. Collective.
+  ! Lees-Edwards (fd%sliding; doc/METHOD.md §7.4): no walls; the mean shear stress of the box is
+  ! eta gamma_dot (the fluid's, exactly: fluid_stress = r0, fluid_slope = 1 from the caller) plus
+  ! the spheres' stresslets over the box's volume, sum_p (S_FD + S_lubrication + S_contact)_xy / V,
+  ! which particle_stress returns instead. S_FD is the fictitious domain's -1/2 sum Lambda^{n+1}
+  ! (r e_c + e_c r) dV of §3.7, affine in the rate through u~ and U: at r0 from u~ (grid, vel)
+  ! with Lambda^n, per unit rate from the fluid's unit response (response_vel) without it
+  ! (shear_stresslet); the links' and contacts' from their corrections at each rate. volume: the box's.
   subroutine fictitious_domain_solve_stress(fd, parts, stress, fluid_stress, fluid_slope, response_scale, area, &
-                                            rate, particle_stress, ierr, lubrication, contacts)
+                                            rate, particle_stress, ierr, lubrication, contacts, grid, vel, &
+                                            response_vel, volume)
     type(fictitious_domain_t), intent(inout) :: fd
     type(particles_t), intent(inout) :: parts
     real(dp), intent(in) :: stress, fluid_stress, fluid_slope, response_scale, area
@@ -660,10 +682,13 @@ contains
     PetscErrorCode, intent(out) :: ierr
     type(particle_lubrication_t), intent(inout), optional :: lubrication
     type(particle_contacts_t), intent(inout), optional :: contacts
+    type(grid_t), intent(in), optional :: grid
+    Vec, intent(in), optional :: vel(3), response_vel(3)
+    real(dp), intent(in), optional :: volume
     real(dp), allocatable :: rhs(:, :), u_before(:, :), w_before(:, :), u0(:, :), w0(:, :), u1(:, :), w1(:, :)
     real(dp), allocatable :: drive(:, :), uinf(:, :), wall_drive(:, :)
     real(dp), allocatable :: c_force(:, :), c_torque(:, :), c_stresslet(:, :, :)
-    real(dp) :: c_wall_force(3, 2), rate_before, sigma0, sigma1, slope
+    real(dp) :: c_wall_force(3, 2), rate_before, sigma0, sigma1, slope, fd_stress0, fd_stress1
     logical :: c_added, stiffness
     character(len=300) :: text
     integer :: q, n, np, nw
@@ -721,6 +746,11 @@ contains
     CHKERRQ(ierr)
     u0 = parts%velocity
     w0 = parts%omega
+    ! Lees-Edwards: the fictitious domain's stresslet at r0 and per unit rate (affine; see above)
+    if (fd%sliding) then
+      PetscCall(shear_stresslet(grid, fd, vel, .true., u0, w0, rate_before * grid%box(2), fd_stress0, ierr))
+      PetscCall(shear_stresslet(grid, fd, response_vel, .false., u1, w1, grid%box(2), fd_stress1, ierr))
+    end if
     ! the contacts' explicit forces of the step, kept for each evaluation
     if (present(contacts)) then
       c_force = contacts%force
@@ -754,13 +784,15 @@ contains
         lubrication%pair_uinf(:, 1:np) = r * uinf
         lubrication%wall_drive(:, 1:nw) = r * wall_drive
         lubrication%shear_rate = r
+        lubrication%le%shear_rate = r
       end if
       if (present(contacts)) call particle_contacts_set_rate(contacts, r, rate_before)
     end subroutine set_rate
 
     ! the particle problem at rate r with the velocities u, w (3, n): the spheres' velocities, the
     ! contacts' force (explicit forces restored, then the implicit part), the links' corrections,
-    ! and the walls' share of the mean wall shear stress, (F_top,x - F_bottom,x)/(2 area).
+    ! and the walls' share of the mean wall shear stress, (F_top,x - F_bottom,x)/(2 area) (with
+    ! Lees-Edwards the spheres' share of the box's, sum_p S_xy/V, see above).
     ! Collective (the links' corrections; the host's ierr).
     subroutine at_rate(r, u, w, walls_share)
       real(dp), intent(in) :: r, u(:, :), w(:, :)
@@ -784,8 +816,63 @@ contains
         force = force + lubrication%wall_force
       end if
       walls_share = (force(1, 2) - force(1, 1)) / (2.0_dp * area)
+      if (fd%sliding) then
+        walls_share = fd_stress0 + (r - rate_before) * fd_stress1
+        if (present(contacts)) walls_share = walls_share + sum(contacts%stresslet(1, 2, :))
+        if (present(lubrication)) walls_share = walls_share + sum(lubrication%stresslet(1, 2, :))
+        walls_share = walls_share / volume
+      end if
     end subroutine at_rate
   end subroutine fictitious_domain_solve_stress
+
+  ! Lees-Edwards stress control: the xy stresslet the fictitious domain would give all spheres,
+  ! sum over the faces of -1/2 Lambda (r_y on u-faces, r_x on v-faces) dV (§3.7), with Lambda =
+  ! [Lambda^n (with_lambda) + beta alpha (rigid - u)]/(1 + gamma) of §3.5 for the field vel and the
+  ! spheres' velocity, omega (3, n), an image's rigid velocity faster by its copy times image_speed;
+  ! nothing is written. Summed over ranks. Collective.
+  subroutine shear_stresslet(grid, fd, vel, with_lambda, velocity, omega, image_speed, sxy, ierr)
+    type(grid_t), intent(in) :: grid
+    type(fictitious_domain_t), intent(inout) :: fd
+    Vec, intent(in) :: vel(3)
+    logical, intent(in) :: with_lambda
+    real(dp), intent(in) :: velocity(:, :), omega(:, :), image_speed
+    real(dp), intent(out) :: sxy
+    PetscErrorCode, intent(out) :: ierr
+    type(field_view_t) :: u(3), lam(3)
+    real(dp), allocatable :: r(:, :), lambda(:)
+    real(dp) :: ve(3), we(3), dv
+    integer :: c, run, f0, f1, e, f, arm
+    dv = grid%h**3
+    do c = 1, 2
+      PetscCall(DMDAVecGetArrayReadF90(grid%da(c), vel(c), u(c)%v, ierr))
+      PetscCall(DMDAVecGetArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%v, ierr))
+    end do
+    allocate(r(3, max(1, fd%faces%nf)), lambda(max(1, fd%faces%nf)))
+    sxy = 0.0_dp
+    do run = 1, fd%faces%nruns
+      call face_run(fd%faces, run, f0, f1, c, e)
+      if (c > 2) cycle
+      call run_offsets(fd%faces, run, r)
+      ve = velocity(:, fd%owner(e)) + [fd%copy(e) * image_speed, 0.0_dp, 0.0_dp]
+      we = omega(:, fd%owner(e))
+      call new_lambda_run(c, u(c)%v, lam(c)%v, grid%lo, grid%hi, f1 - f0 + 1, fd%faces%ijk(:, f0:f1), r, &
+                          fd%faces%alpha(f0:f1), fd%faces%relax(f0:f1), fd%beta, ve, we, lambda)
+      if (.not. with_lambda) then
+        ! the same update without Lambda^n: take its share (Lambda^n relax) off again
+        do f = f0, f1
+          lambda(f - f0 + 1) = lambda(f - f0 + 1) &
+               - lam(c)%v(fd%faces%ijk(1, f), fd%faces%ijk(2, f), fd%faces%ijk(3, f)) * fd%faces%relax(f)
+        end do
+      end if
+      arm = 3 - c          ! u-faces carry r_y, v-faces r_x
+      sxy = sxy - 0.5_dp * dv * sum(lambda(1:f1 - f0 + 1) * r(arm, 1:f1 - f0 + 1))
+    end do
+    do c = 1, 2
+      PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), fd%lambda(c), lam(c)%v, ierr))
+      PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), vel(c), u(c)%v, ierr))
+    end do
+    call MPI_Allreduce(MPI_IN_PLACE, sxy, 1, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
+  end subroutine shear_stresslet
 
   ! Lambda^{n+1} = [Lambda^n + beta alpha (g.U - u~)]/(1 + gamma) on owned faces, 0 elsewhere;
   ! u^{n+1} = u~ + (Lambda^{n+1} - Lambda^n)/beta; the moments F = -sum Lambda e_c dV,

@@ -299,16 +299,31 @@ contains
       PetscCall(fictitious_domain_response_moments(ts%grid, ts%fd, unit%vel, ts%parts%n, ierr))
       rate_before = ts%protocol%rate
       rate = rate_before
-      ! the wall speed per unit rate, Ly/2
-      per_rate = 0.5_dp * ts%box(2)
-      fluid_stress = 0.5_dp * (fl%tau_bottom + fl%tau_top)
-      fluid_slope = per_rate * 0.5_dp * (unit%tau_bottom + unit%tau_top)
-      PetscCall(fictitious_domain_solve_stress(ts%fd, ts%parts, ts%protocol%stress, fluid_stress, fluid_slope, per_rate, ts%box(1) * ts%box(3), rate, walls_share, ierr, lubrication=ts%lubrication, contacts=ts%contacts))
-      PetscCall(stage_push(STAGE_FLUID, ierr))
-      PetscCall(fluid_add_response(ts%grid, fl, unit, (rate - rate_before) * per_rate, ierr))
-      PetscCall(stage_pop(ierr))
-      ! the stress reached: the fluid's wall stress of the step as it now is, and the walls' share
-      call shear_protocol_set_rate(ts%protocol, rate, 0.5_dp * (fl%tau_bottom + fl%tau_top) + walls_share, rate)
+      if (ts%le%active) then
+        ! Lees-Edwards (doc/METHOD.md §7.4): the mean shear stress of the box, eta gamma_dot plus
+        ! the spheres' stresslets over its volume; the unit response is per unit rate
+        per_rate = 1.0_dp
+        PetscCall(fictitious_domain_solve_stress(ts%fd, ts%parts, ts%protocol%stress, rate_before, 1.0_dp, per_rate, 0.0_dp, rate, walls_share, ierr, lubrication=ts%lubrication, contacts=ts%contacts, grid=ts%grid, vel=fl%vel, response_vel=unit%vel, volume=product(ts%box)))
+        ! the images and the boundary's jump at the rate found; the offset after the step stays the
+        ! one the fluid's step took (the strain advances at the last step's rate, slide_fluid)
+        call fictitious_domain_set_image_speed(ts%fd, rate * ts%box(2))
+        call fluid_set_sliding(fl, fl%sliding_offset(1), fl%sliding_offset(2), rate * ts%box(2), rate * ts%box(2))
+        PetscCall(stage_push(STAGE_FLUID, ierr))
+        PetscCall(fluid_add_response(ts%grid, fl, unit, rate - rate_before, ierr))
+        PetscCall(stage_pop(ierr))
+        call shear_protocol_set_rate(ts%protocol, rate, rate + walls_share, rate_before)
+      else
+        ! the wall speed per unit rate, Ly/2
+        per_rate = 0.5_dp * ts%box(2)
+        fluid_stress = 0.5_dp * (fl%tau_bottom + fl%tau_top)
+        fluid_slope = per_rate * 0.5_dp * (unit%tau_bottom + unit%tau_top)
+        PetscCall(fictitious_domain_solve_stress(ts%fd, ts%parts, ts%protocol%stress, fluid_stress, fluid_slope, per_rate, ts%box(1) * ts%box(3), rate, walls_share, ierr, lubrication=ts%lubrication, contacts=ts%contacts))
+        PetscCall(stage_push(STAGE_FLUID, ierr))
+        PetscCall(fluid_add_response(ts%grid, fl, unit, (rate - rate_before) * per_rate, ierr))
+        PetscCall(stage_pop(ierr))
+        ! the stress reached: the fluid's wall stress of the step as it now is, and the walls' share
+        call shear_protocol_set_rate(ts%protocol, rate, 0.5_dp * (fl%tau_bottom + fl%tau_top) + walls_share, rate)
+      end if
     end associate
     call impose_rate(ts)
   end subroutine resolved_stress_control
@@ -363,6 +378,9 @@ contains
     real(dp) :: jump
     after = ts%le
     protocol_after = ts%protocol
+    ! under stress control the boundary slides at the last step's rate, the one the step starts
+    ! with (resolved_stress_control keeps it as the strain's advance)
+    if (protocol_after%control == CONTROL_STRESS) protocol_after%advance = protocol_after%rate
     call shear_protocol_end_step(protocol_after)
     call slide(after, protocol_after, ts%dt)
     jump = ts%protocol%rate * ts%box(2)

@@ -480,6 +480,9 @@ contains
     PetscCall(VecSet(fl%phi, 0.0_dp, ierr))
     fl%star_history = 0
     fl%wall_speed = 1.0_dp
+    ! Lees-Edwards: the response to a unit rate, the boundary's jump Ly (its offset does not
+    ! matter: the response does not depend on x)
+    if (grid%lees_edwards) call fluid_set_sliding(fl, 0.0_dp, 0.0_dp, grid%box(2), grid%box(2))
     PetscCall(fluid_step(grid, fl, ierr))
   end subroutine fluid_unit_response
 

@@ -845,9 +845,6 @@ contains
          'of the stress has the amplitude &shear stress (stress(t) = stress sin(2 pi t/period))')
     if (cfg%shear%protocol == 'oscillatory') &
       call check_real(cfg, 'shear', 'period', cfg%shear%period, 0.0_dp, 1.0e9_dp, .true.)
-    if (cfg%resolved .and. cfg%lees_edwards) call input_error(cfg%deck_file, 'shear', 'control', &
-         '''stress'' in the resolved DNS sets the walls'' speed from the mean wall stress: with y_boundary = '// &
-         '''lees-edwards'' it is not implemented yet; walls, or lubrication dynamics (&fluid model = ''none''), take it')
     if (cfg%resolved .and. cfg%fluid%viscous_theta /= 1.0_dp) call input_error(cfg%deck_file, 'fluid', &
          'viscous_theta', 'must be 1 (backward Euler) with &shear control = ''stress'': the wall speed jumps each '// &
          'step, and the Crank-Nicolson response of the wall cells to a jump overshoots (a wall stress that falls as '// &

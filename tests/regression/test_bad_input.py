@@ -126,10 +126,6 @@ cases = [
     # lubrication dynamics (issue 30)
     ('unknown fluid model', GOOD.replace('reynolds = 0.01', "reynolds = 0.01, model = 'stokes'"), [],
      ['bad.nml', '&fluid', 'model', 'stokes']),
-    ('stress control of the resolved DNS in a Lees-Edwards box', GOOD.replace('cells_per_radius = 5',
-     "cells_per_radius = 5, y_boundary = 'lees-edwards'").replace('reynolds = 0.01', 'reynolds = 0.01, viscous_theta = 1') +
-     "&shear rate = 1, control = 'stress', stress = 2 /\n&particles number = 1, position(:,1) = 1.6, 1.6, 1.6 /\n", [],
-     ['bad.nml', '&shear', 'control', 'lees-edwards']),
     ('sliding boundaries of the resolved fluid on the Krylov path', GOOD.replace('cells_per_radius = 5',
      "cells_per_radius = 5, y_boundary = 'lees-edwards', shear_rate = 1"), ['-fluid_solver', 'krylov'],
      ['bad.nml', '&domain', 'y_boundary', 'lees-edwards', 'direct solves']),
