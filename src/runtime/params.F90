@@ -825,8 +825,9 @@ contains
 
   ! Stress control (doc/INPUT.md "&shear", doc/METHOD.md §7.4): a non-zero stress (an
   ! oscillation's amplitude, with a period), a stress to measure (spheres or walls; in lubrication
-  ! dynamics with the statistics' weights, &rheology; in the DNS the mean wall stress, walls and
-  ! backward Euler), spheres that move freely; &shear rate stays the unit (positive).
+  ! dynamics with the statistics' weights, &rheology; in the DNS the mean wall stress, or the
+  ! Lees-Edwards box's mean stress, with backward Euler), spheres that move freely; &shear rate
+  ! stays the unit (positive).
   subroutine validate_stress_control(cfg)
     type(config_t), intent(inout) :: cfg
     logical :: spheres
