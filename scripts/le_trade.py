@@ -15,7 +15,9 @@ cross the grid at gamma_dot Ly/2 = 5a per strain, and dt 1e-3 keeps their force 
 1 % of their stresslet (doc/VALIDATION.md §5.3, §13); the walls cell's core edge moves at 5a per
 strain too and was run at dt 2e-3 (row dns_le_dt2e-3 measures what that step costs here).
 The DNS between walls are the records of doc/data/model_trade (phi 0.3, row dns_phi0.3) and
-doc/data/friction_phi04 (phi 0.4, row base). Records: doc/data/le_trade/<row>_mu<mu>/ (deck.nml,
+doc/data/friction_phi04 (phi 0.4, row base). Their spheres gather in the core (phi_core 0.327 and
+0.427 at bulk 0.3 and 0.4), so the Lees-Edwards box is also run at those fractions (rows
+*_phi0.327, *_phi0.427): the comparison of the two boundary kinds at the same phi. Records: doc/data/le_trade/<row>_mu<mu>/ (deck.nml,
 summary.json with the CPU seconds per strain); results: doc/VALIDATION.md §13.1.
 """
 import math
@@ -34,10 +36,19 @@ ROWS = {
                      dict(LE, phi=0.3, model='none')),
     'ld_le_phi0.4': ('lubrication dynamics, Lees-Edwards 8a x 10a x 8a, bulk phi 0.4',
                      dict(LE, phi=0.4, model='none')),
+    # the walls cell's core fractions (its spheres gather in the core: bulk 0.3 and 0.4 give 0.327 and
+    # 0.427 there), so that the two boundary kinds are compared at the same phi
+    'dns_le_phi0.327': ('DNS, Lees-Edwards 8a x 10a x 8a, phi 0.327 (the walls cell\'s core at bulk 0.3), dt 1e-3',
+                        dict(LE, phi=0.327, dt=1e-3)),
+    'ld_le_phi0.327': ('lubrication dynamics, Lees-Edwards 8a x 10a x 8a, phi 0.327', dict(LE, phi=0.327, model='none')),
+    'dns_le_phi0.427': ('DNS, Lees-Edwards 8a x 10a x 8a, phi 0.427 (the walls cell\'s core at bulk 0.4), dt 1e-3',
+                        dict(LE, phi=0.427, dt=1e-3)),
+    'ld_le_phi0.427': ('lubrication dynamics, Lees-Edwards 8a x 10a x 8a, phi 0.427', dict(LE, phi=0.427, model='none')),
     'dns_le_dt2e-3': ('DNS, Lees-Edwards 8a x 10a x 8a, bulk phi 0.4, dt 2e-3 (the walls cell\'s step)',
                       dict(LE, phi=0.4, dt=2e-3)),
 }
-DEFAULT = ['dns_le_phi0.3', 'ld_le_phi0.3', 'dns_le_phi0.4', 'ld_le_phi0.4']
+DEFAULT = ['dns_le_phi0.3', 'ld_le_phi0.3', 'dns_le_phi0.4', 'ld_le_phi0.4', 'dns_le_phi0.327', 'ld_le_phi0.327',
+           'dns_le_phi0.427', 'ld_le_phi0.427']
 WALLS = {0.3: (os.path.join(ROOT, 'doc', 'data', 'model_trade'), 'dns_phi0.3'),
          0.4: (os.path.join(ROOT, 'doc', 'data', 'friction_phi04'), 'base')}
 QUANTITIES = ('eta_r', 'eta_h', 'eta_c', 'N1/tau', 'N2/tau', 'Pi/tau', 'phi_core')
@@ -74,7 +85,9 @@ def table(study, rows):
             where, row = WALLS[phi]
             walls = load(os.path.join(where, run_name(row, mu), 'summary.json'))
             runs = [('DNS walls (core)', walls)]
-            for r in ('dns_le_phi%g' % phi, 'ld_le_phi%g' % phi) + (('dns_le_dt2e-3',) if phi == 0.4 else ()):
+            core = {0.3: 0.327, 0.4: 0.427}[phi]
+            for r in ('dns_le_phi%g' % phi, 'ld_le_phi%g' % phi, 'dns_le_phi%g' % core, 'ld_le_phi%g' % core) + \
+                    (('dns_le_dt2e-3',) if phi == 0.4 else ()):
                 runs.append((r, study.load_record(r, mu)))
             for model, s in runs:
                 if s is None:

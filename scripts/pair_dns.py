@@ -31,8 +31,8 @@ with the lubrication correction, plus contact), S_inf = (20/3) pi eta a^3 gamma_
 Also printed: the DNS pair's relative velocity against the exact free-pair one along its trajectory
 (mobility(): radial / tangential errors at four gaps in the approach and the separation), which
 tells a steady resistance error from a lag (doc/VALIDATION.md §4.4).
---lees-edwards: the same pair in a Lees-Edwards box, centred on the sliding boundary, so that one
-sphere always sees the other through it (doc/VALIDATION.md §13).
+--lees-edwards boundary|centre: the same pair in a Lees-Edwards box, centred on the sliding boundary,
+so that one sphere always sees the other through it, or in the box (doc/VALIDATION.md §13).
 Needs Debian's python3 with numpy, h5py and matplotlib (the shebang is /usr/bin/python3).
 """
 import argparse
@@ -123,9 +123,9 @@ def main():
     ap.add_argument('--figures', default=os.path.join(ROOT, 'doc', 'figures'))
     ap.add_argument('--tag', default='paper', help='figure names: pair_dns_<tag>_*.png')
     ap.add_argument('--plot-only', action='store_true')
-    ap.add_argument('--lees-edwards', action='store_true',
+    ap.add_argument('--lees-edwards', choices=['boundary', 'centre'],
                     help='a Lees-Edwards box instead of walls, the pair centred on the sliding boundary y = 0 '
-                         '(doc/METHOD.md §3.9)')
+                         'or in the box (doc/METHOD.md §3.9)')
     args = ap.parse_args()
     if args.start >= -2:
         ap.error('--start must be below -2 (the spheres would overlap)')

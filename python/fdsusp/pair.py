@@ -83,15 +83,16 @@ def record_every(dt):
 
 
 def prepare(case, d, box, cells, dt, start, eps_bar=0.05, reynolds=0.01, theta=0.5, hours=0.0, steps_factor=1.05,
-            steps=None, branched=False, lees_edwards=False):
+            steps=None, branched=False, lees_edwards=None):
     """Write the case's decks, run pairtraj; return the DNS command (continuing from a checkpoint
     when there is one). The DNS runs for steps_factor times pairtraj's transit time, or to step
     `steps` when given. branched: the case was branched from the trunk (branch()), so its
     checkpoint may be the trunk's, of other contact physics: fdsusp continues it with -branch,
     which takes this deck's contact model (doc/INPUT.md "Restart"); with the case's own
     checkpoint -branch checks what -restart does. lees_edwards: a Lees-Edwards box instead of the
-    Couette cell, the pair centred on the sliding boundary y = 0 (sphere 1 below it, in the top of
-    the box; doc/METHOD.md §3.9), so that it crosses the boundary throughout."""
+    Couette cell, with the pair centred on the sliding boundary y = 0 ('boundary': sphere 1 below
+    it, in the top of the box; doc/METHOD.md §3.9), so that it crosses the boundary throughout, or
+    centred in the box ('centre')."""
     os.makedirs(d, exist_ok=True)
     ref = pairtraj(case, d, start, eps_bar)
     _, eps_r, mu_d = CASES[case]
@@ -102,7 +103,7 @@ def prepare(case, d, box, cells, dt, start, eps_bar=0.05, reynolds=0.01, theta=0
     c = box / 2.0
     # smooth spheres (eps_r = 0) get no &contact group (above)
     contact = None if eps_r == 0 else {'roughness': eps_r, 'eps_bar': eps_bar, 'friction': mu_d}
-    y1, y2 = (box - Y0 / 2, Y0 / 2) if lees_edwards else (c - Y0 / 2, c + Y0 / 2)
+    y1, y2 = (box - Y0 / 2, Y0 / 2) if lees_edwards == 'boundary' else (c - Y0 / 2, c + Y0 / 2)
     fdeck.write(os.path.join(d, 'deck.nml'),
                 dns_deck(case, box, cells, reynolds, theta, dt, steps, hours, x1=c - start / 2, y1=y1,
                          x2=c + start / 2, y2=y2, c=c, contact=contact,
