@@ -32,17 +32,16 @@ module mod_fluid
   use mod_grid, only: grid_t, grid_position, grid_fixed_row, field_names, FIELD_U, FIELD_V, FIELD_W, FIELD_P, &
                       direct_solves_wanted
   use mod_solvers, only: solver_t, solver_create, solver_solve, solver_destroy, solver_cold_solve, &
-                         fft_planner_flags
-  use mod_errors, only: log_line, input_error
+                         fft_planner_flags, solver_set_sliding_shift
+  use mod_errors, only: log_line
   use mod_manufactured, only: mms_forcing
   use mod_columns, only: column_t, column
   use mod_sliding_boundary, only: sliding_shift_rows
-  use mod_fft_solver, only: fft_set_sliding_shift
   implicit none
   private
   public :: fluid_t, fluid_create, fluid_step, fluid_destroy, fluid_mean_profile, fluid_columns
   public :: fluid_options_check, fluid_bench_cold_poisson, fluid_unit_response, fluid_add_response
-  public :: fluid_set_sliding, fluid_ghosted, fluid_deck_check
+  public :: fluid_set_sliding, fluid_ghosted
   integer, parameter :: AT_START = 1, AT_END = 2  ! the step's two instants t_n, t_{n+1} (Lees-Edwards)
   integer, parameter :: STAR_HISTORY_FULL = 2   ! u*^n and u*^{n-1} known: extrapolate
 
@@ -326,7 +325,7 @@ contains
     PetscCall(ghosted(grid, fl, FIELD_P, fl%pressure, loc_p, ierr, AT_START))
     PetscCall(DMDAVecGetArrayReadF90(grid%da(FIELD_P), loc_p, p, ierr))
     ! the implicit solves and the projection see the boundary at t_{n+1}
-    if (grid%lees_edwards) call fft_set_sliding_shift(fl%sliding_offset(AT_END) / h)
+    if (grid%lees_edwards) call solver_set_sliding_shift(fl%sliding_offset(AT_END) / h)
     force = 0.0_dp
     do c = 1, 3
       e = 0
@@ -685,16 +684,6 @@ contains
     integer :: plan
     if (direct_solves_wanted()) plan = fft_planner_flags()
   end subroutine fluid_options_check
-
-  ! What the deck asks of the fluid that the command line's solver choice cannot give, refused
-  ! before any work: the Lees-Edwards boundary exists on the direct solves only (doc/METHOD.md §2.4).
-  subroutine fluid_deck_check(cfg)
-    type(config_t), intent(in) :: cfg
-    if (.not. (cfg%resolved .and. cfg%lees_edwards)) return
-    if (.not. direct_solves_wanted()) &
-      call input_error(cfg%deck_file, 'domain', 'y_boundary', '''lees-edwards'' with the resolved fluid needs '// &
-           'the direct solves (-fluid_solver fft, the default): the Krylov path has no sliding boundary')
-  end subroutine fluid_deck_check
 
   ! -bench_cold_poisson: time one pressure solve from a zero guess to 1e-8 (doc/BENCHMARKS.md),
   ! logged. The yardstick is the multigrid solve whatever solves the steps (-fluid_solver fft

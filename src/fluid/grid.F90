@@ -104,10 +104,7 @@ contains
     if (direct_solves_wanted() .and. product(m) <= grid%n(3) / 2) m = [1, 1, product(m)]
     if (grid%lees_edwards) then
       ! the sliding boundary shifts whole rows in x across y = 0, Ly on the rank that holds them
-      ! (mod_sliding_boundary): z-slabs only, and only the direct solves diagonalise the twist
-      if (.not. direct_solves_wanted()) call fatal_error('fdsusp: error: y_boundary = ''lees-edwards'' with the '// &
-           'resolved fluid needs the direct solves (-fluid_solver fft, the default): the Krylov path has no '// &
-           'sliding boundary (doc/DESIGN.md "Lees-Edwards")', 2)
+      ! (mod_sliding_boundary): z-slabs only
       if (product(m) > grid%n(3)) call fatal_error('fdsusp: error: y_boundary = ''lees-edwards'' splits the grid in '// &
            'z-slabs only: at most one rank per cell in z', 2)
       m = [1, 1, product(m)]

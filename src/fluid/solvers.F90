@@ -7,6 +7,9 @@
 ! multigrid level by compute_operator, which knows the walls (see mod_grid for the layout); what it
 ! needs comes with each solver (operator_context_t, the callback's context), so solvers of
 ! different coefficients coexist.
+! With a Lees-Edwards boundary (doc/METHOD.md §2.4) the Krylov solvers' operator is the twisted one
+! (twisted_mult: the periodic stencil plus the shifted rows across y = 0 and y = Ly), preconditioned
+! by multigrid (or Jacobi) of the periodic operator assembled as above.
 #include <petsc/finclude/petscksp.h>
 module mod_solvers
   use petscksp
@@ -17,11 +20,12 @@ module mod_solvers
                       grid_create_star_layout
   use mod_errors, only: fatal_error, log_line
   use mod_petsc_options, only: set_default_option
-  use mod_fft_solver, only: fft_solver_t, fft_create, fft_solve, fft_destroy
+  use mod_fft_solver, only: fft_solver_t, fft_create, fft_solve, fft_destroy, fft_set_sliding_shift
+  use mod_sliding_boundary, only: sliding_shift_rows
   implicit none
   private
   public :: solver_t, solver_create, solver_solve, solver_destroy
-  public :: solver_cold_solve, fft_planner_flags
+  public :: solver_cold_solve, fft_planner_flags, solver_set_sliding_shift
 
   ! What compute_operator needs to assemble a solver's operator on any multigrid level: PETSc
   ! hands it to the callback as its context (KSPSetComputeOperators), and DMCoarsen passes it on
@@ -32,7 +36,22 @@ module mod_solvers
     real(dp) :: diffusion = 0.0_dp
     real(dp) :: box(3) = 1.0_dp     ! box lengths: the cell size of a level is box(1)/cells
     logical :: walls = .true.       ! walls at y = 0 and y = Ly
+    ! Lees-Edwards, Krylov path: the assembled periodic operator (the preconditioner's) and the
+    ! layout the twisted operator reads its rows with (twisted_mult)
+    Mat :: periodic
+    DM :: dm
   end type operator_context_t
+
+  ! The twisted operators alive, found by their handle when PETSc calls twisted_mult (PETSc's
+  ! Fortran binding of MatShellGetContext has no typed interface)
+  type :: twisted_entry
+    Mat :: shell
+    type(operator_context_t), pointer :: context => null()
+  end type twisted_entry
+  type(twisted_entry), save :: twisted(8)
+
+  ! The Lees-Edwards offset delta/h of the solves to come (solver_set_sliding_shift)
+  real(dp), save :: sliding_shift = 0.0_dp
 
   type :: solver_t
     KSP :: ksp
@@ -45,6 +64,8 @@ module mod_solvers
     ! a Krylov solver beside the direct solves' shared box layout has its own star DMDA (mod_grid)
     logical :: owns_dm = .false.
     DM :: dm
+    logical :: sliding = .false.    ! Krylov with Lees-Edwards: the operator is the shell `twisted_op`
+    Mat :: twisted_op
     type(fft_solver_t) :: fft
     ! the callback's context, on the heap: PETSc keeps its address, which must not move when the
     ! solver_t is copied or its holder reallocated
@@ -144,7 +165,112 @@ contains
       PetscCall(MatNullSpaceCreate(PETSC_COMM_WORLD, PETSC_TRUE, 0, PETSC_NULL_VEC, s%nullspace, ierr))
     end if
     PetscCall(KSPSetUp(s%ksp, ierr))
+    if (grid%lees_edwards) then
+      PetscCall(use_twisted_operator(s, ierr))
+    end if
   end subroutine solver_create
+
+  ! The Lees-Edwards boundary on the Krylov path (doc/METHOD.md §2.4): the solver's operator becomes
+  ! the twisted one (a shell, twisted_mult), while its preconditioner stays the one just set up from
+  ! the periodic operator, which is not made again (KSPSetDMActive false, the preconditioner
+  ! reused). Why this preconditions well: for x-mode m the twist only moves the y-wavenumbers by
+  ! theta/Ly, |theta| <= pi, so the twisted and periodic operators are spectrally equivalent with
+  ! a constant ~ 1 + (Lx/(2 m Ly))^2 that does not grow with the grid, and the twisted operator is
+  ! symmetric (the shift by -delta is the transpose of the shift by delta), so CG applies. The
+  ! offset changes every step; the preconditioner never has to.
+  subroutine use_twisted_operator(s, ierr)
+    type(solver_t), intent(inout) :: s
+    PetscErrorCode, intent(out) :: ierr
+    Mat :: A, P
+    Vec :: v
+    PetscInt :: nlocal, nglobal, dim, m(3), procs(3), dof, sw, bt(3), st
+    integer :: slot
+    PetscCall(DMDAGetInfo(s%dm, dim, m(1), m(2), m(3), procs(1), procs(2), procs(3), dof, sw, bt(1), bt(2), bt(3), st, ierr))
+    if (procs(1) /= 1 .or. procs(2) /= 1) call fatal_error('fdsusp: internal: the Lees-Edwards operator '// &
+         'needs whole x-y planes on each rank (mod_grid splits the grid in z only)', 4)
+    PetscCall(KSPGetOperators(s%ksp, A, P, ierr))
+    s%context%periodic = P
+    s%context%dm = s%dm
+    PetscCall(DMGetGlobalVector(s%dm, v, ierr))
+    PetscCall(VecGetLocalSize(v, nlocal, ierr))
+    PetscCall(VecGetSize(v, nglobal, ierr))
+    PetscCall(DMRestoreGlobalVector(s%dm, v, ierr))
+    PetscCall(MatCreateShell(PETSC_COMM_WORLD, nlocal, nlocal, nglobal, nglobal, 0, s%twisted_op, ierr))
+    PetscCall(MatShellSetOperation(s%twisted_op, MATOP_MULT, twisted_mult, ierr))
+    PetscCall(MatSetOption(s%twisted_op, MAT_SYMMETRIC, PETSC_TRUE, ierr))
+    if (s%singular) then
+      PetscCall(MatSetNullSpace(s%twisted_op, s%nullspace, ierr))
+    end if
+    slot = 1
+    do while (slot <= size(twisted))
+      if (.not. associated(twisted(slot)%context)) exit
+      slot = slot + 1
+    end do
+    if (slot > size(twisted)) call fatal_error('fdsusp: internal: more than 8 Lees-Edwards Krylov solvers at once', 4)
+    twisted(slot)%shell = s%twisted_op
+    twisted(slot)%context => s%context
+    PetscCall(KSPSetOperators(s%ksp, s%twisted_op, P, ierr))
+    PetscCall(KSPSetDMActive(s%ksp, PETSC_FALSE, ierr))
+    PetscCall(KSPSetReusePreconditioner(s%ksp, PETSC_TRUE, ierr))
+    s%sliding = .true.
+  end subroutine use_twisted_operator
+
+  ! y := A x for the twisted operator of the shell A: the periodic stencil (its assembled matrix),
+  ! then the rows across the boundary corrected. Periodic in y, row j = 0 reads the top row
+  ! x(:, ny-1) as its neighbour below; across the sliding boundary it reads that row at x + delta
+  ! instead (and row ny-1 reads the bottom row at x - delta above), the coupling off = -diffusion
+  ! h (rows scaled by h^3 as in compute_operator): y += off (S(+-delta) row - row). The rows are
+  ! this rank's (z-slabs). Called by PETSc.
+  subroutine twisted_mult(A, x, y, ierr)
+    Mat :: A
+    Vec :: x, y
+    PetscErrorCode :: ierr
+    type(operator_context_t), pointer :: c
+    PetscScalar, pointer :: xa(:,:,:), ya(:,:,:)
+    PetscInt :: xs, ys, zs, xm, ym, zm
+    real(dp), allocatable :: rows(:, :)
+    real(dp) :: h, off
+    integer :: slot, nx, ny, k
+    c => null()
+    do slot = 1, size(twisted)
+      if (associated(twisted(slot)%context)) then
+        if (twisted(slot)%shell%v == A%v) c => twisted(slot)%context
+      end if
+    end do
+    if (.not. associated(c)) call fatal_error('fdsusp: internal: an unknown Lees-Edwards operator', 4)
+    PetscCall(MatMult(c%periodic, x, y, ierr))
+    PetscCall(DMDAGetCorners(c%dm, xs, ys, zs, xm, ym, zm, ierr))
+    nx = xm
+    ny = ym
+    h = c%box(1) / nx
+    off = -merge(1.0_dp, c%diffusion, c%field == FIELD_P) * h
+    PetscCall(DMDAVecGetArrayReadF90(c%dm, x, xa, ierr))
+    PetscCall(DMDAVecGetArrayF90(c%dm, y, ya, ierr))
+    allocate(rows(0:nx - 1, zs:zs + zm - 1))
+    do k = zs, zs + zm - 1
+      rows(:, k) = xa(0:nx - 1, ny - 1, k)
+    end do
+    call sliding_shift_rows(rows, sliding_shift)
+    do k = zs, zs + zm - 1
+      ya(0:nx - 1, 0, k) = ya(0:nx - 1, 0, k) + off * (rows(:, k) - xa(0:nx - 1, ny - 1, k))
+      rows(:, k) = xa(0:nx - 1, 0, k)
+    end do
+    call sliding_shift_rows(rows, -sliding_shift)
+    do k = zs, zs + zm - 1
+      ya(0:nx - 1, ny - 1, k) = ya(0:nx - 1, ny - 1, k) + off * (rows(:, k) - xa(0:nx - 1, 0, k))
+    end do
+    PetscCall(DMDAVecRestoreArrayF90(c%dm, y, ya, ierr))
+    PetscCall(DMDAVecRestoreArrayReadF90(c%dm, x, xa, ierr))
+    ierr = 0
+  end subroutine twisted_mult
+
+  ! The Lees-Edwards offset delta/h (in cells) of the solves to come, on both paths: the direct
+  ! solves' twist (mod_fft_solver) and the Krylov path's twisted operator (twisted_mult).
+  subroutine solver_set_sliding_shift(shift)
+    real(dp), intent(in) :: shift
+    sliding_shift = shift
+    call fft_set_sliding_shift(shift)
+  end subroutine solver_set_sliding_shift
 
   ! The pressure lives at cell centres, but the DMDA's own multigrid transfer is vertex-centred
   ! trilinear (Q1): it places each coarse unknown on a fine one, half a fine cell from where the
@@ -413,10 +539,20 @@ contains
   subroutine solver_destroy(s, ierr)
     type(solver_t), intent(inout) :: s
     PetscErrorCode, intent(out) :: ierr
+    integer :: slot
     if (s%direct) then
       PetscCall(fft_destroy(s%fft, ierr))
     else
       PetscCall(KSPDestroy(s%ksp, ierr))
+      if (s%sliding) then
+        do slot = 1, size(twisted)
+          if (associated(twisted(slot)%context)) then
+            if (twisted(slot)%shell%v == s%twisted_op%v) twisted(slot)%context => null()
+          end if
+        end do
+        PetscCall(MatDestroy(s%twisted_op, ierr))
+        s%sliding = .false.
+      end if
       if (s%owns_dm) then
         PetscCall(DMDestroy(s%dm, ierr))
       end if

@@ -21,7 +21,7 @@ program fdsusp
   use mod_h5util, only: h5util_init
   use mod_grid, only: grid_t, grid_create, grid_destroy
   use mod_fluid, only: fluid_t, fluid_create, fluid_destroy, fluid_options_check, fluid_bench_cold_poisson, &
-                       fluid_unit_response, fluid_deck_check
+                       fluid_unit_response
   use mod_fluid_verification, only: fluid_errors_vs_manufactured
   use mod_particles, only: particles_t, MOTION_FREE
   use mod_particles_io, only: particles_load
@@ -90,7 +90,6 @@ program fdsusp
   call command_line(deck, restart, restarting, continuing, branching)
   call fluid_options_check()
   call read_deck(deck, cfg)
-  call fluid_deck_check(cfg)
   call log_line('fdsusp: '//trim(cfg%run%title))
   call echo_deck(cfg)
   call prepare_output_directory(cfg)

@@ -126,9 +126,6 @@ cases = [
     # lubrication dynamics (issue 30)
     ('unknown fluid model', GOOD.replace('reynolds = 0.01', "reynolds = 0.01, model = 'stokes'"), [],
      ['bad.nml', '&fluid', 'model', 'stokes']),
-    ('sliding boundaries of the resolved fluid on the Krylov path', GOOD.replace('cells_per_radius = 5',
-     "cells_per_radius = 5, y_boundary = 'lees-edwards', shear_rate = 1"), ['-fluid_solver', 'krylov'],
-     ['bad.nml', '&domain', 'y_boundary', 'lees-edwards', 'direct solves']),
     ('lubrication dynamics without particles', GOOD.replace('reynolds = 0.01', "model = 'none'"), [],
      ['bad.nml', '&fluid', 'model', 'particles']),
     ('simple lubrication without a fluid', LD + "&lubrication model = 'simple' /\n", [],
