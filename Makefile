@@ -2,6 +2,7 @@
 #   make            build bin/fdsusp, bin/fdsusp-pack, bin/pairtraj and the unit-test programs (optimised)
 #   make debug      the same in bin/debug/ with bounds checks and floating-point traps
 #   make check      build and run the whole test suite; last line "N passed, N failed"
+#                   (RANKS=3: the tests' parallel runs on 3 ranks instead of 2)
 #   make install    programs, lubrication tables, decks, docs and the Python package under PREFIX
 #                   (default /usr/local)
 #   make run        run input/demo.nml on 2 ranks
@@ -162,9 +163,11 @@ install: all
 	install -m 755 $(PY_INSTALLED_SCRIPTS) $(PREFIX)/share/fdsusp/scripts
 	install -m 644 scripts/_fdsusp_path.py $(PREFIX)/share/fdsusp/scripts
 
-# TESTS=pattern runs only the tests whose path contains pattern.
+# TESTS=pattern runs only the tests whose path contains pattern. RANKS=n (default 2): the rank
+# count of the tests' parallel runs (tests/fdsusp_testlib.py; tests of their own counts keep them).
+RANKS ?= 2
 check: all
-	@bash tests/run_tests.sh $(BUILD)/tests $(TESTS)
+	@FDSUSP_TEST_RANKS=$(RANKS) bash tests/run_tests.sh $(BUILD)/tests $(TESTS)
 
 bench: all
 	@bash scripts/bench.sh

@@ -21,8 +21,9 @@
 ! lubrication dynamics (no fluid mass on the diagonal) CG takes 64-97 iterations at 1000 spheres and
 ! is still the faster, ~7x at 500 spheres (doc/BENCHMARKS.md §11). The sparse solve is shared out
 ! (since 2026-11-28, issue 45): the matrix and vectors live on PETSC_COMM_WORLD, each rank owns the
-! block rows of a contiguous range of spheres (particle_solver_split) and sets only those, CG runs
-! in parallel, and the shares of the solution are gathered (doc/DESIGN.md "Parallelism"). Each
+! block rows of the spheres in its z-slab (mod_sphere_ownership, since 2026-11-29; before, a
+! contiguous range of indices) and sets only those, CG runs in parallel, and the shares of the
+! solution are gathered (doc/DESIGN.md "Parallelism"). Each
 ! rank's system holds every block of its own rows: the one-body and contact blocks are replicated,
 ! and a rank holds the lubrication links of its own spheres (mod_lubrication_links); the blocks of
 ! other rows it may hold are ignored. One rank gives the same numbers as before, bitwise; more
@@ -36,10 +37,10 @@ module mod_particle_solver
   use mod_particle_system, only: particle_system_t, particle_system_solve
   use mod_petsc_options, only: set_default_option
   use mod_errors, only: fatal_error
+  use mod_sphere_ownership, only: sphere_ownership_t, sphere_ownership_of
   implicit none
   private
-  public :: particle_solver_t, particle_solver_create, particle_solver_solve, particle_solver_destroy, &
-            particle_solver_split
+  public :: particle_solver_t, particle_solver_create, particle_solver_solve, particle_solver_destroy
 
   type :: particle_solver_t
     type(particle_system_t) :: system   ! the 6N system of the step, assembled by the caller
@@ -47,6 +48,7 @@ module mod_particle_solver
     KSP :: ksp
     logical :: created = .false.
     integer :: solves = 0               ! sparse (KSP) solves
+    integer :: owned_rows = -1          ! this rank's rows in the last sparse solve (-1: none yet)
     real(dp) :: seconds = 0.0_dp        ! their assembly + solve, summed over the run
   end type particle_solver_t
 
@@ -99,13 +101,13 @@ contains
       end if
     else
       t0 = MPI_Wtime()
-      PetscCall(ksp_solve(ps%ksp, ps%system, rhs, x, ps%iterations, reason, ierr))
+      PetscCall(ksp_solve(ps%ksp, ps%system, rhs, x, ps%iterations, reason, ps%owned_rows, ierr))
       if (reason == KSP_DIVERGED_DTOL) then
         ! a right-hand side far below the residual of the last step's velocities (an imposed rate
         ! through zero, doc/INPUT.md "&shear"): the divergence test measures against |rhs|, so the
         ! solve starts again from zero
         x = 0.0_dp
-        PetscCall(ksp_solve(ps%ksp, ps%system, rhs, x, ps%iterations, reason, ierr))
+        PetscCall(ksp_solve(ps%ksp, ps%system, rhs, x, ps%iterations, reason, ps%owned_rows, ierr))
       end if
       ps%solves = ps%solves + 1
       ps%seconds = ps%seconds + (MPI_Wtime() - t0)
@@ -121,42 +123,45 @@ contains
 
   !> Solve sys x = rhs (both 6 x n) by ksp, from the guess in x: assembly of the sparse matrix,
   !> then the solve. The converged reason is returned in reason (negative: not converged);
-  !> iterations as KSP counts them.
-  subroutine ksp_solve(ksp, sys, rhs, x, iterations, reason, ierr)
+  !> iterations as KSP counts them. owned_rows: this rank's rows in the last solve, updated.
+  subroutine ksp_solve(ksp, sys, rhs, x, iterations, reason, owned_rows, ierr)
     KSP, intent(in) :: ksp
     type(particle_system_t), intent(in) :: sys
     real(dp), intent(in) :: rhs(:, :)
     real(dp), intent(inout) :: x(:, :)
     integer, intent(out) :: iterations
     KSPConvergedReason, intent(out) :: reason
+    integer, intent(inout) :: owned_rows
     PetscErrorCode, intent(out) :: ierr
     Mat :: a
     Vec :: vx, vb
-    PetscInt :: n6, row(1), col(1), its, owned, first
+    PetscInt :: n6, row(1), col(1), its, owned
     PetscInt, parameter :: one = 1, six = 6
     PetscInt, allocatable :: diagonal(:), off(:), upper(:), upper_off(:)
     PetscBool :: sbaij, sbaij_parallel
     KSPType :: ksp_type
     PetscScalar, pointer :: p(:)
-    integer :: q, i, j, e, rank, ranks, lo, hi
-    integer, allocatable :: counts(:), displs(:)
+    integer :: q, i, j, e, rank, ranks
+    integer, allocatable :: mine(:)
+    real(dp), allocatable :: rows(:, :)
+    type(sphere_ownership_t) :: o
+    logical :: reshared
 
     n6 = 6 * sys%n
-    ! The spheres' block rows are shared out in contiguous ranges (PETSc's split): this rank owns
-    ! spheres lo..hi. Its system holds every block of those rows (the header), so each rank sets its
-    ! own rows and nothing crosses ranks in the assembly; the solve then runs on every rank's share.
+    ! This rank owns the block rows of the spheres `mine` (mod_sphere_ownership: its z-slab's),
+    ! rows o%displs(rank + 1) onwards. Its system holds every block of those rows (the header), so
+    ! each rank sets its own rows and nothing crosses ranks in the assembly; the solve then runs
+    ! on every rank's share.
     PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, ranks, ierr))
     PetscCallMPI(MPI_Comm_rank(PETSC_COMM_WORLD, rank, ierr))
-    call particle_solver_split(sys%n, ranks, counts, displs)
-    lo = displs(rank + 1) + 1
-    hi = displs(rank + 1) + counts(rank + 1)
-    owned = counts(rank + 1)
-    first = lo - 1
+    o = sphere_ownership_of(sys%n)
+    owned = o%counts(rank + 1)
+    mine = o%sphere(o%displs(rank + 1) + 1:o%displs(rank + 1) + owned)
     ! block rows of this rank's spheres: the diagonal block and one block per pair, in the columns
     ! this rank owns (diagonal) or not (off); a pair may come more than once (lubrication and
     ! contact stiffness): its blocks add up in one, and a row never holds more blocks than there
-    ! are columns. The upper triangle alone (sbaij): the pairs whose other sphere is later.
-    allocate(diagonal(lo:hi), off(lo:hi), upper(lo:hi), upper_off(lo:hi))
+    ! are columns. The upper triangle alone (sbaij): the pairs whose other sphere's row is later.
+    allocate(diagonal(sys%n), off(sys%n), upper(sys%n), upper_off(sys%n))
     diagonal = 1
     off = 0
     upper = 1
@@ -165,13 +170,13 @@ contains
       do e = 1, 2
         i = sys%pair(e, q)
         j = sys%pair(3 - e, q)
-        if (i < lo .or. i > hi) cycle
-        if (j >= lo .and. j <= hi) then
+        if (o%owner(i) /= rank) cycle
+        if (o%owner(j) == rank) then
           diagonal(i) = diagonal(i) + 1
-          if (j > i) upper(i) = upper(i) + 1
+          if (o%row(j) > o%row(i)) upper(i) = upper(i) + 1
         else
           off(i) = off(i) + 1
-          if (j > i) upper_off(i) = upper_off(i) + 1
+          if (o%row(j) > o%row(i)) upper_off(i) = upper_off(i) + 1
         end if
       end do
     end do
@@ -188,26 +193,26 @@ contains
     PetscCall(MatSetType(a, MATBAIJ, ierr))
     PetscCall(MatSetOptionsPrefix(a, 'particles_', ierr))
     PetscCall(MatSetFromOptions(a, ierr))
-    PetscCall(MatXAIJSetPreallocation(a, six, diagonal, off, upper, upper_off, ierr))
+    PetscCall(MatXAIJSetPreallocation(a, six, diagonal(mine), off(mine), upper(mine), upper_off(mine), ierr))
     PetscCall(MatSetOption(a, MAT_SYMMETRIC, PETSC_TRUE, ierr))
     PetscCall(PetscObjectTypeCompare(a, MATSEQSBAIJ, sbaij, ierr))
     PetscCall(PetscObjectTypeCompare(a, MATMPISBAIJ, sbaij_parallel, ierr))
     if (sbaij .or. sbaij_parallel) then
       PetscCall(MatSetOption(a, MAT_IGNORE_LOWER_TRIANGULAR, PETSC_TRUE, ierr))
     end if
-    do q = lo, hi
-      row(1) = q - 1
-      PetscCall(MatSetValuesBlocked(a, one, row, one, row, row_major(sys%diag(:, :, q)), ADD_VALUES, ierr))
+    do q = 1, int(owned)
+      row(1) = o%row(mine(q))
+      PetscCall(MatSetValuesBlocked(a, one, row, one, row, row_major(sys%diag(:, :, mine(q))), ADD_VALUES, ierr))
     end do
     do q = 1, sys%npairs
       i = sys%pair(1, q)
       j = sys%pair(2, q)
-      row(1) = i - 1
-      col(1) = j - 1
-      if (i >= lo .and. i <= hi) then
+      row(1) = o%row(i)
+      col(1) = o%row(j)
+      if (o%owner(i) == rank) then
         PetscCall(MatSetValuesBlocked(a, one, row, one, col, row_major(sys%block(:, :, q)), ADD_VALUES, ierr))
       end if
-      if (j >= lo .and. j <= hi) then
+      if (o%owner(j) == rank) then
         PetscCall(MatSetValuesBlocked(a, one, col, one, row, row_major(transpose(sys%block(:, :, q))), ADD_VALUES, ierr))
       end if
     end do
@@ -215,10 +220,10 @@ contains
     PetscCall(MatAssemblyEnd(a, MAT_FINAL_ASSEMBLY, ierr))
     PetscCall(MatCreateVecs(a, vx, vb, ierr))
     PetscCall(VecGetArrayF90(vb, p, ierr))
-    p = reshape(rhs(:, lo:hi), [6 * owned])
+    p = reshape(rhs(:, mine), [6 * owned])
     PetscCall(VecRestoreArrayF90(vb, p, ierr))
     PetscCall(VecGetArrayF90(vx, p, ierr))
-    p = reshape(x(:, lo:hi), [6 * owned])
+    p = reshape(x(:, mine), [6 * owned])
     PetscCall(VecRestoreArrayF90(vx, p, ierr))
     ! a direct solve (preonly) takes no guess
     PetscCall(KSPGetType(ksp, ksp_type, ierr))
@@ -227,40 +232,38 @@ contains
     else
       PetscCall(KSPSetInitialGuessNonzero(ksp, PETSC_TRUE, ierr))
     end if
+    ! a sphere that crossed a slab face since the last solve changes the ranks' shares of rows,
+    ! which a set-up solver cannot take (PCSetOperators): it is reset to its options first, on
+    ! every rank (collective) when any rank's share changed
+    reshared = owned_rows >= 0 .and. owned_rows /= 6 * owned
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, reshared, 1, MPI_LOGICAL, MPI_LOR, PETSC_COMM_WORLD, ierr))
+    if (reshared) then
+      PetscCall(KSPReset(ksp, ierr))
+    end if
+    owned_rows = 6 * owned
     PetscCall(KSPSetOperators(ksp, a, a, ierr))
     PetscCall(KSPSolve(ksp, vb, vx, ierr))
     PetscCall(KSPGetConvergedReason(ksp, reason, ierr))
     PetscCall(KSPGetIterationNumber(ksp, its, ierr))
     iterations = int(its)
     ! every rank holds every sphere's velocity (the particle state is replicated): the shares are
-    ! gathered (6 N doubles, doc/DESIGN.md "Parallelism")
+    ! gathered in row order (6 N doubles, doc/DESIGN.md "Parallelism") and put back by sphere
     PetscCall(VecGetArrayReadF90(vx, p, ierr))
-    x(:, lo:hi) = reshape(p, [6, int(owned)])
+    if (ranks == 1) then
+      x = reshape(p, [6, sys%n])
+    else
+      allocate(rows(6, sys%n))
+      rows(:, o%displs(rank + 1) + 1:o%displs(rank + 1) + owned) = reshape(p, [6, int(owned)])
+    end if
     PetscCall(VecRestoreArrayReadF90(vx, p, ierr))
     if (ranks > 1) then
-      PetscCallMPI(MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, x, 6 * counts, 6 * displs, MPI_DOUBLE_PRECISION, PETSC_COMM_WORLD, ierr))
+      PetscCallMPI(MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, rows, 6 * o%counts, 6 * o%displs, MPI_DOUBLE_PRECISION, PETSC_COMM_WORLD, ierr))
+      x(:, o%sphere) = rows
     end if
     PetscCall(VecDestroy(vx, ierr))
     PetscCall(VecDestroy(vb, ierr))
     PetscCall(MatDestroy(a, ierr))
   end subroutine ksp_solve
-
-  !> The contiguous ranges of spheres whose block rows the ranks own (PETSc's split of n over
-  !> ranks): rank r (0-based) owns spheres displs(r + 1) + 1 .. displs(r + 1) + counts(r + 1).
-  !> mod_lubrication_links shares the links out by the same ranges.
-  pure subroutine particle_solver_split(n, ranks, counts, displs)
-    integer, intent(in) :: n, ranks
-    integer, allocatable, intent(out) :: counts(:), displs(:)
-    integer :: i
-    allocate(counts(ranks), displs(ranks))
-    do i = 1, ranks
-      counts(i) = n / ranks + merge(1, 0, i - 1 < mod(n, ranks))
-    end do
-    displs(1) = 0
-    do i = 2, ranks
-      displs(i) = displs(i - 1) + counts(i - 1)
-    end do
-  end subroutine particle_solver_split
 
   ! PETSc takes a block row by row
   pure function row_major(b) result(v)

@@ -2,7 +2,7 @@
 ! lubricating pairs and sphere-wall links, and per step the 6x6 / 12x12 blocks that the implicit
 ! particle system takes (doc/METHOD.md §3.2 equation (1)) and the corrections once the velocities are
 ! known. Pure: no PETSc, MPI or files. Particle data is replicated; on several ranks each evaluates
-! the links of a range of spheres (particle_lubrication_links' owned) and mod_lubrication_links
+! the links of a set of spheres (particle_lubrication_links' owned) and mod_lubrication_links
 ! combines what the ranks need of them.
 !
 ! The undisturbed flow is the imposed shear of the Couette cell: U_inf = shear_rate (y - Ly/2) e_x,
@@ -234,14 +234,14 @@ contains
   !> The lubrication links at positions x (3, np): which pairs and walls are within the outer
   !> cut-off, and their blocks. Call once per step before the particle problem. A block that
   !> cannot be decomposed is named in pl%failed_link for the caller to report.
-  !> owned (optional): the spheres owned(1)..owned(2); only the pair candidates with a sphere among
-  !> them, in the order of all candidates, so that each owned sphere has all its pair links, in the
+  !> owned (optional, np): the spheres this caller owns; only the pair candidates with a sphere
+  !> among them, in the order of all candidates, so that each owned sphere has all its pair links, in the
   !> order all links would have them (mod_lubrication_links); walls always all.
   !> offset (optional): the Lees-Edwards offset delta of this configuration (runs created with le).
   subroutine particle_lubrication_links(pl, x, owned, offset)
     type(particle_lubrication_t), intent(inout) :: pl
     real(dp), intent(in) :: x(:, :)
-    integer, intent(in), optional :: owned(2)
+    logical, intent(in), optional :: owned(:)
     real(dp), intent(in), optional :: offset
     integer :: c, i, j, side, status
     real(dp) :: r(3), dist, gap, d(3), om_inf(3), e_inf(3, 3), u_inf(3, 2), normal(3), u_wall(3), w(n_wall_scalars)
@@ -266,7 +266,7 @@ contains
       i = pl%cand(1, c)
       j = pl%cand(2, c)
       if (present(owned)) then
-        if ((i < owned(1) .or. i > owned(2)) .and. (j < owned(1) .or. j > owned(2))) cycle
+        if (.not. (owned(i) .or. owned(j))) cycle
       end if
       r = separation(i, j)
       dist = norm2(r)

@@ -41,7 +41,7 @@ DECK = """&domain box = 7.0, 12.0, 7.0, cells_per_radius = 4, y_boundary = 'wall
 """
 TOL = 5e-3
 d = T.scratch('contact_chatter' + ('_explicit' if EXPLICIT else ''))
-T.run(T.write_deck(d, 'deck.nml', DECK.format(implicit='.false.' if EXPLICIT else '.true.')), d, np_ranks=2)
+T.run(T.write_deck(d, 'deck.nml', DECK.format(implicit='.false.' if EXPLICIT else '.true.')), d, np_ranks=T.RANKS)
 s = T.series(os.path.join(d, 'out'))
 step = s['step']
 h = s['core/stress_hydro'][:, :4]

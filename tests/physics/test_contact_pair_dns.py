@@ -41,7 +41,7 @@ DECK = """&domain box = 6.4, 4.8, 4.8, cells_per_radius = 5, y_boundary = 'walls
 """
 d = T.scratch('contact_pair_dns')
 T.run(T.write_deck(d, 'pair.nml', DECK.format(x1=3.2 - D0 / 2, x2=3.2 + D0 / 2, f=F, mf=-F, eps_r=EPS_R,
-                                              kn=KN)), d, np_ranks=2)
+                                              kn=KN)), d, np_ranks=T.RANKS)
 s = T.series(os.path.join(d, 'out'))
 fc = s['particles/force_contact']          # records x 2 x 3, computed at the positions before the step
 tc = s['particles/torque_contact']

@@ -56,7 +56,7 @@ DECK = """&domain box = 6.4, 6.4, 6.4, cells_per_radius = 5, y_boundary = 'walls
 &particles number = 1, motion = 'prescribed', position(:,1) = 3.2, 3.2, 3.2, velocity(:,1) = 2, 0, 0 /
 """
 d = T.scratch('fd_moving_sphere')
-T.run(T.write_deck(d, 'm.nml', DECK.format(dt=1e-3, steps=400)), d, np_ranks=2)
+T.run(T.write_deck(d, 'm.nml', DECK.format(dt=1e-3, steps=400)), d, np_ranks=T.RANKS)
 s = T.series(os.path.join(d, 'out'))
 f = s['particles/force_hydro'][:, 0, :]
 t = s['particles/torque_hydro'][:, 0, :]
@@ -71,7 +71,7 @@ tq = np.abs(t[200:400]).max() / abs(fx.mean())
 T.check(tq < 1e-6, 'no torque: max|T|/|F_x| = %.1e < 1e-6' % tq)
 
 d = T.scratch('fd_moving_sphere_big_step')
-T.run(T.write_deck(d, 'm.nml', DECK.format(dt=1e-2, steps=100)), d, np_ranks=2)
+T.run(T.write_deck(d, 'm.nml', DECK.format(dt=1e-2, steps=100)), d, np_ranks=T.RANKS)
 f_big = T.series(os.path.join(d, 'out'))['particles/force_hydro'][50:100, 0, 0]
 change = f_big.mean() / fx.mean() - 1
 ripple = (f_big.max() - f_big.min()) / abs(f_big.mean())
@@ -92,7 +92,7 @@ phi = 4 * math.pi / 3 / V
 kref = k_reference(phi)
 fb = -6 * math.pi * kref * U / V
 d = T.scratch('fd_moving_sphere_array')
-T.run(T.write_deck(d, 'a.nml', ARRAY.format(L=L, re=re, fb=fb, dt=dt, steps=steps, c=0.37 * L, U=U)), d, np_ranks=2)
+T.run(T.write_deck(d, 'a.nml', ARRAY.format(L=L, re=re, fb=fb, dt=dt, steps=steps, c=0.37 * L, U=U)), d, np_ranks=T.RANKS)
 s = T.series(os.path.join(d, 'out'))
 fx = s['particles/force_hydro'][:, 0, 0]
 u_mean = np.cumsum(dt * (fb * V - fx)) / (re * V)          # the box's momentum budget, rho = Re

@@ -33,7 +33,7 @@ for L, tol in ((6.0, 0.03), (4.0, 0.03), (3.2, 0.03), (2.8, 0.05)):
     d = T.scratch('fd_array_%g' % L)
     # off-centre start: the sphere also drifts 0.02 a over the run, so the test sees a generic position
     deck = T.write_deck(d, 'a.nml', DECK.format(L=L, c=0.37 * L, F=F, fb=-F / L ** 3))
-    T.run(deck, d, np_ranks=2)
+    T.run(deck, d, np_ranks=T.RANKS)
     s = T.series(os.path.join(d, 'out'))
     u = s['particles/velocity'][:, 0, 0]
     k = F / (6 * math.pi * u[60:80].mean())

@@ -33,7 +33,7 @@ DECK = """&domain box = 10, 20, 10, cells_per_radius = 4, y_boundary = 'walls', 
 S_EXACT = 10 / 3 * math.pi
 
 d = T.scratch('fd_sphere_shear_centre')
-T.run(T.write_deck(d, 's.nml', DECK.format(y=10.0, steps=200, dt=5e-3, theta=1)), d, np_ranks=2)
+T.run(T.write_deck(d, 's.nml', DECK.format(y=10.0, steps=200, dt=5e-3, theta=1)), d, np_ranks=T.RANKS)
 s = T.series(os.path.join(d, 'out'))
 om = s['particles/omega'][:, 0, :]
 st = s['particles/stresslet_hydro'][:, 0, :, :]
@@ -51,7 +51,7 @@ T.check(np.abs(u[-1]).max() < 1e-6, 'centre: the sphere stays in place (|U| = %.
 T.check(abs(st[-1, 0, 1] - st[-1, 1, 0]) < 1e-10 * abs(sxy), 'the stresslet is symmetric')
 
 d = T.scratch('fd_sphere_shear_offcentre')
-T.run(T.write_deck(d, 's.nml', DECK.format(y=13.0, steps=150, dt=1e-3, theta=0.5)), d, np_ranks=2)
+T.run(T.write_deck(d, 's.nml', DECK.format(y=13.0, steps=150, dt=1e-3, theta=0.5)), d, np_ranks=T.RANKS)
 s = T.series(os.path.join(d, 'out'))
 u = s['particles/velocity'][:, 0, :]
 om = s['particles/omega'][:, 0, :]

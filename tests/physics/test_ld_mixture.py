@@ -135,8 +135,8 @@ T.check(np.abs(whole).max() <= bound and np.abs(late).max() <= bound,
         'gamma_dot a' % (np.array2string(whole, precision=4), np.array2string(late, precision=4), bound))
 
 # 4: two ranks share out the pair links (the unequal pairs' 22/21 scalars gathered with them)
-T.run(T.write_deck(d, 'le2.nml', LE.replace("directory = 'out'", "directory = 'out2'")), d, np_ranks=2)
-T.compare_h5(os.path.join(d, 'out', 'series.h5'), os.path.join(d, 'out2', 'series.h5'), '2 ranks against 1',
+T.run(T.write_deck(d, 'le2.nml', LE.replace("directory = 'out'", "directory = 'out2'")), d, np_ranks=T.RANKS)
+T.compare_h5(os.path.join(d, 'out', 'series.h5'), os.path.join(d, 'out2', 'series.h5'), '%d ranks against 1' % T.RANKS,
              skip=('wall_time', 'deck@output.directory'), rtol=1e-9)
 
 # 5: per species

@@ -91,9 +91,9 @@ T.check(miss <= 1e-6 * np.max(np.abs(predicted)),
 
 # C. two ranks
 d2 = T.scratch('le_fluid_startup_2')
-T.run(T.write_deck(d2, 'startup.nml', STARTUP), d2, np_ranks=2)
+T.run(T.write_deck(d2, 'startup.nml', STARTUP), d2, np_ranks=T.RANKS)
 T.compare_h5(os.path.join(d, 'out', 'series.h5'), os.path.join(d2, 'out', 'series.h5'),
-             'start-up, 2 ranks against 1', rtol=1e-12, skip=('wall_time',))
+             'start-up, %d ranks against 1' % T.RANKS, rtol=1e-12, skip=('wall_time',))
 
 # D. restart
 a = T.scratch('le_fluid_restart_straight')

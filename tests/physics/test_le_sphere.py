@@ -55,7 +55,7 @@ def final(d):
 results = {}
 for name, y in (('centre', 4.0), ('straddling', 0.3)):
     d = T.scratch('le_sphere_' + name)
-    T.run(T.write_deck(d, 's.nml', DECK.format(y=y, steps=400)), d, np_ranks=2)
+    T.run(T.write_deck(d, 's.nml', DECK.format(y=y, steps=400)), d, np_ranks=T.RANKS)
     s, omega, sxy, ux = final(d)
     results[name] = (d, sxy)
     T.check(abs(omega / -0.5 - 1) <= 0.01, '%s: Omega_z = %.5f, exact -0.5 (error %+.2f %%, <= 1 %%)'
@@ -77,7 +77,7 @@ T.check(abs(sxy_s / sxy_c - 1) <= 0.01, 'S_xy straddling the boundary %.4f = cen
 d1 = T.scratch('le_sphere_straddling_1')
 T.run(T.write_deck(d1, 's.nml', DECK.format(y=0.3, steps=400)), d1)
 T.compare_h5(os.path.join(d1, 'out', 'series.h5'), os.path.join(results['straddling'][0], 'out', 'series.h5'),
-             'straddling, 2 ranks against 1', rtol=1e-10, skip=('wall_time',))
+             'straddling, %d ranks against 1' % T.RANKS, rtol=1e-10, skip=('wall_time',))
 
 # 4. restart across the boundary
 b = T.scratch('le_sphere_restart')
@@ -95,7 +95,7 @@ PAIR = PAIR.replace("&particles number = 1, position(:,1) = 4.0, {y}, 4.0 /",
 pair = {}
 for name, ya, yb in (('centre', 3.4, 4.8496), ('across', 7.4, 0.8496)):
     d = T.scratch('le_pair_' + name)
-    T.run(T.write_deck(d, 'p.nml', PAIR.format(ya=ya, yb=yb)), d, np_ranks=2)
+    T.run(T.write_deck(d, 'p.nml', PAIR.format(ya=ya, yb=yb)), d, np_ranks=T.RANKS)
     s = T.series(os.path.join(d, 'out'))
     du = s['particles/velocity'][-1, 1] - s['particles/velocity'][-1, 0]
     if name == 'across':

@@ -37,7 +37,7 @@ def deck(model, steps):
 
 
 d = T.scratch('lubrication_stability')
-T.run(T.write_deck(d, 'full.nml', deck('full', 200)), d, np_ranks=2)
+T.run(T.write_deck(d, 'full.nml', deck('full', 200)), d, np_ranks=T.RANKS)
 s = T.series(os.path.join(d, 'out_full'))
 x = s['particles/position']
 gap = (x[:, 1, 0] - x[:, 0, 0]) - 2.0
@@ -66,7 +66,7 @@ for n in range(stop + 1):
 T.check(worst <= 0.05, 'approach speed within 5 %% of exact at every gap in [2e-4, 1e-2] (worst %.2f %%)' % (100 * worst))
 
 # without the correction: recorded only
-T.run(T.write_deck(d, 'none.nml', deck('none', 10)), d, np_ranks=2)
+T.run(T.write_deck(d, 'none.nml', deck('none', 10)), d, np_ranks=T.RANKS)
 s = T.series(os.path.join(d, 'out_none'))
 x = s['particles/position']
 gap = (x[:, 1, 0] - x[:, 0, 0]) - 2.0

@@ -25,7 +25,7 @@ for yb, shear in (('periodic', 0), ('walls', 1)):
     for cpr in (5, 10, 20):
         d = T.scratch('mms_%s_%d' % (yb, cpr))
         deck = T.write_deck(d, 'mms.nml', DECK.format(cpr=cpr, yb=yb, shear=shear))
-        status, out, err = T.run(deck, d, np_ranks=2 if cpr == 20 else 1)
+        status, out, err = T.run(deck, d, np_ranks=T.RANKS if cpr == 20 else 1)
         T.check('steady state at step' in out, '%s a/Delta=%d reached its steady state' % (yb, cpr))
         s = T.series(os.path.join(d, 'out'))
         e = (s['mms_error_velocity_max'][-1], s['mms_error_pressure_max'][-1], s['mms_error_pressure_rms'][-1])

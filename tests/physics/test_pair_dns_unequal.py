@@ -53,7 +53,7 @@ DECK = f"""&domain box = {BOX[0]}, {BOX[1]}, {BOX[2]}, cells_per_radius = {CELLS
 &contact roughness = 1.0e-2, eps_bar = {EPS_BAR}, friction = 0.0 /
 """
 d = T.scratch('pair_dns_unequal')
-T.run(T.write_deck(d, 'pair.nml', DECK), d, np_ranks=2, timeout=3600)
+T.run(T.write_deck(d, 'pair.nml', DECK), d, np_ranks=T.RANKS, timeout=3600)
 s = T.series(os.path.join(d, 'out'))
 r = s['particles/position'][:, 1, :] - s['particles/position'][:, 0, :]
 r[:, [0, 2]] -= np.array(BOX)[[0, 2]] * np.round(r[:, [0, 2]] / np.array(BOX)[[0, 2]])

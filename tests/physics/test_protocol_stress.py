@@ -113,7 +113,7 @@ WALLS = LD.replace("y_boundary = 'lees-edwards'", "y_boundary = 'walls'").replac
     .replace('solid_fraction = 0.4, seed = 1', 'solid_fraction = 0.35, seed = 4') \
     .replace('discard_strain = 1.0, average_strain = 14.0, blocks = 7', 'discard_strain = 0.0, average_strain = 0.7, blocks = 2')
 w = {}
-for ranks in (1, 2):
+for ranks in (1, T.RANKS):
     w[ranks] = T.scratch('protocol_stress_walls_%d' % ranks)
     T.run(T.write_deck(w[ranks], 'walls.nml', WALLS.format(shear="control = 'stress', stress = 5.0", out='walls')),
           w[ranks], np_ranks=ranks)
@@ -122,8 +122,8 @@ miss = max(np.max(np.abs(s['shear/stress'] - 5.0)),
            np.max(np.abs(s['shear/rate'] + s['core/stress_hydro'][:, 3] + s['core/stress_contact'][:, 3] - 5.0))) / 5.0
 T.check(miss < 1e-12 and np.any(s['contacts_wall'] > 0) and np.all(s['lubrication_walls'] > 0),
         'walls: the stress is 5 at every record, wall contacts and wall lubrication in the step (%.1e)' % miss)
-T.compare_h5(os.path.join(w[1], 'walls', 'series.h5'), os.path.join(w[2], 'walls', 'series.h5'),
-             'walls: 2 ranks (the links shared out, the solve in parallel) against 1', rtol=1e-10, skip=('wall_time',))
+T.compare_h5(os.path.join(w[1], 'walls', 'series.h5'), os.path.join(w[T.RANKS], 'walls', 'series.h5'),
+             'walls: %d ranks (the links shared out, the solve in parallel) against 1' % T.RANKS, rtol=1e-10, skip=('wall_time',))
 
 # B. the fluid alone between walls
 FLUID = """&domain box = 4.0, 4.0, 4.0, cells_per_radius = 2 /

@@ -127,7 +127,7 @@ def text(path):
 try:
     # the uninterrupted reference
     ref = T.scratch('batch_chain_reference')
-    T.run(T.write_deck(ref, 'deck.nml', DECK), ref, np_ranks=2)
+    T.run(T.write_deck(ref, 'deck.nml', DECK), ref, np_ranks=T.RANKS)
 
     d = T.scratch('batch_chain')
     T.write_deck(d, 'deck.nml', DECK)

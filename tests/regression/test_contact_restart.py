@@ -43,16 +43,16 @@ def springs(d):
 
 
 a = T.scratch('contact_restart_straight')
-T.run(T.write_deck(a, 'd.nml', DECK.format(steps=20)), a, np_ranks=2)
+T.run(T.write_deck(a, 'd.nml', DECK.format(steps=20)), a, np_ranks=T.RANKS)
 b = T.scratch('contact_restart_split')
-T.run(T.write_deck(b, 'd10.nml', DECK.format(steps=10)), b, np_ranks=2)
+T.run(T.write_deck(b, 'd10.nml', DECK.format(steps=10)), b, np_ranks=T.RANKS)
 ids, ups = springs(b)
 T.check(len(ids) == 2 and [1, 2] in ids.tolist() and [3, -1] in ids.tolist(),
         'checkpoint at step 10 holds the springs of contacts (1,2) and (3, lower wall): %s' % ids.tolist())
 norms = np.linalg.norm(ups, axis=1) if len(ups) else np.zeros(0)
 T.check(len(norms) == 2 and norms.min() > 1e-4,
         'the springs are not zero: |Upsilon| = %s a' % ', '.join('%.2e' % v for v in norms))
-_, out, _ = T.run(T.write_deck(b, 'd.nml', DECK.format(steps=20)), b, np_ranks=2,
+_, out, _ = T.run(T.write_deck(b, 'd.nml', DECK.format(steps=20)), b, np_ranks=T.RANKS,
                   args=['-restart', os.path.join(b, 'out', 'checkpoint.h5')])
 T.check('friction on' in out, "the run log's models line says contacts and friction are on")
 

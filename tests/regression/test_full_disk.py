@@ -75,7 +75,7 @@ def check_stop(what, deck_text, size, np_ranks, reference):
             'run\'s first records' % (what, size, k, len(same), len(reference) - 1))
 
 
-for what, text, ranks, sizes in (('fluid-free', LD, 1, ('1500k', '2500k')), ('DNS', DNS, 2, ('5000k', '9000k'))):
+for what, text, ranks, sizes in (('fluid-free', LD, 1, ('1500k', '2500k')), ('DNS', DNS, T.RANKS, ('5000k', '9000k'))):
     ref = T.scratch('full_disk_ref_' + what)
     T.run(T.write_deck(ref, 'r.nml', text), ref, np_ranks=ranks)
     reference = T.series(os.path.join(ref, 'out'))

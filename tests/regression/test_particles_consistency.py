@@ -49,13 +49,13 @@ diff = max(np.abs(f1[k] - f2[k]).max() for k in ('u', 'v', 'w'))
 T.check(diff <= 1e-12, 'order: velocity fields equal (max diff %.1e <= 1e-12)' % diff)
 
 d3 = T.scratch('particles_ranks2')
-T.run(deck(d3, [0, 1, 2], 20), d3, np_ranks=2)
+T.run(deck(d3, [0, 1, 2], 20), d3, np_ranks=T.RANKS)
 s3, f3 = results(d3)
 for name in ('particles/velocity', 'particles/omega', 'particles/force_hydro'):
     diff = np.abs(s1[name] - s3[name]).max()
-    T.check(diff <= 1e-10, 'ranks: %s on 1 and 2 ranks (max diff %.1e <= 1e-10)' % (name, diff))
+    T.check(diff <= 1e-10, 'ranks: %s on 1 and %d ranks (max diff %.1e <= 1e-10)' % (name, T.RANKS, diff))
 diff = max(np.abs(f1[k] - f3[k]).max() for k in ('u', 'v', 'w', 'p'))
-T.check(diff <= 1e-10, 'ranks: fields on 1 and 2 ranks (max diff %.1e <= 1e-10)' % diff)
+T.check(diff <= 1e-10, 'ranks: fields on 1 and %d ranks (max diff %.1e <= 1e-10)' % (T.RANKS, diff))
 
 d4 = T.scratch('particles_restart')
 T.run(deck(d4, [0, 1, 2], 10), d4)

@@ -120,7 +120,7 @@ T.check(np.any(s['core/stress_contact'][:, 3] != 0), 'oscillation: contacts carr
 s = split('reversal', REV, 150)
 flips = s['step'][1:][np.sign(s['shear/rate'][1:]) != np.sign(s['shear/rate'][:-1])]
 T.check(list(flips) == [61, 121], 'reversal: the rate flips at steps 61 and 121, across the restart: %s' % list(flips))
-split('fluid', FLUID, 60, ranks=2)
+split('fluid', FLUID, 60, ranks=T.RANKS)
 s = split('stress', STRESS, 200)
 T.check(np.all(np.abs(s['shear/stress'] - 8.0) < 1e-12) and np.ptp(s['shear/rate']) > 0,
         'stress control: the stress is 8 at every record, the rate varies (%.3f .. %.3f)'
@@ -135,9 +135,9 @@ T.check(len(flips) >= 2 and flips[0] < 101 < flips[-1] and np.all(np.abs(np.abs(
 s = split('stress_oscillation', STRESS_OSCILLATION, 200)
 T.check(np.all(np.abs(s['shear/stress'] - 8.0 * np.sin(2 * np.pi * (s['step'] - 1) * 5.0e-3 / 0.75)) < 1e-11),
         'stress oscillation: the stress is 8 sin(2 pi t_n/T) at every record (the restart at 2/3 of a period)')
-s = split('stress_fluid', STRESS_FLUID, 60, ranks=2)
+s = split('stress_fluid', STRESS_FLUID, 60, ranks=T.RANKS)
 T.check(np.all(np.abs(s['shear/stress'] - 2.5) < 1e-12), 'stress control of the fluid alone: the stress is 2.5 at every record')
-s = split('stress_dns', STRESS_DNS, 60, ranks=2)
+s = split('stress_dns', STRESS_DNS, 60, ranks=T.RANKS)
 T.check(np.all(np.abs(s['shear/stress'] - 3.0) < 1e-12) and np.any(s['contacts_pair'] > 0),
         'stress control of the DNS with spheres: the wall stress is 3 at every record, contacts in the steps')
 s = split('stress_dns_reversal', STRESS_DNS_REVERSAL, 100)

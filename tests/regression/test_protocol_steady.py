@@ -52,5 +52,5 @@ def pair(name, deck, rate, ranks=1):
 
 pair('LD Lees-Edwards', LD.replace('{boundary}', 'lees-edwards').replace('{steps}', '60'), -0.75)
 pair('LD walls', LD.replace('{boundary}', 'walls').replace('{steps}', '30'), 1.0)
-pair('DNS walls', DNS, 1.0, ranks=2)
+pair('DNS walls', DNS, 1.0, ranks=T.RANKS)
 T.finish()

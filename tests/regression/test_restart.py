@@ -61,8 +61,8 @@ compare(e, c, 'SIGTERM at step %d + restart + 10 vs %d straight' % (k, k + 10))
 # SIGUSR1 through mpiexec on 2 ranks
 f = T.scratch('restart_sigusr1')
 status, out = T.run_until_then_signal(T.write_deck(f, 'long.nml', DECK.format(steps=100000, progress=1)), f, 3,
-                                      sig=signal.SIGUSR1, np_ranks=2)
-T.check(status == 0, 'SIGUSR1 on 2 ranks: exit status %d == 0' % status)
+                                      sig=signal.SIGUSR1, np_ranks=T.RANKS)
+T.check(status == 0, 'SIGUSR1 on %d ranks: exit status %d == 0' % (T.RANKS, status))
 T.check('stopped by signal 10' in out, 'SIGUSR1: the log says the run stopped on the signal')
 k = int(T.h5_attr(os.path.join(f, 'out', 'checkpoint.h5'), 'step')[0])
 T.check(k >= 3, 'SIGUSR1: checkpoint written at step %d' % k)

@@ -69,8 +69,8 @@ def flat(s):
 
 a = T.scratch('rheology_restart_a')
 b = T.scratch('rheology_restart_b')
-T.run(T.write_deck(a, 'deck.nml', DECK.format(steps=60, discard=0.02, average=0.1)), a, np_ranks=2)
-T.run(T.write_deck(b, 'deck.nml', DECK.format(steps=35, discard=0.02, average=0.1)), b, np_ranks=2)
+T.run(T.write_deck(a, 'deck.nml', DECK.format(steps=60, discard=0.02, average=0.1)), a, np_ranks=T.RANKS)
+T.run(T.write_deck(b, 'deck.nml', DECK.format(steps=35, discard=0.02, average=0.1)), b, np_ranks=T.RANKS)
 sb_partial = summary(b)
 T.check(sb_partial['blocks_complete'] == 2 and not sb_partial['complete'],
         'the run stopped at step 35 reports 2 complete blocks of 5 (%d)' % sb_partial['blocks_complete'])
@@ -78,7 +78,7 @@ T.check(sb_partial['blocks_complete'] == 2 and not sb_partial['complete'],
 c = T.scratch('rheology_restart_c')
 shutil.rmtree(os.path.join(c, 'out'), ignore_errors=True)
 shutil.copytree(os.path.join(b, 'out'), os.path.join(c, 'out'))
-T.run(T.write_deck(b, 'deck.nml', DECK.format(steps=60, discard=0.02, average=0.1)), b, np_ranks=2, args=['-restart', 'out/checkpoint.h5'])
+T.run(T.write_deck(b, 'deck.nml', DECK.format(steps=60, discard=0.02, average=0.1)), b, np_ranks=T.RANKS, args=['-restart', 'out/checkpoint.h5'])
 
 for d, name in ((a, 'uninterrupted'), (b, 'restarted')):
     p = subprocess.run([sys.executable, RHEOLOGY, os.path.join(d, 'out'), '--compare'], capture_output=True, text=True)
@@ -119,14 +119,14 @@ with open(os.path.join(a, 'out', 'particles.xmf')) as f:
 # (5) another window: refused once begun, afresh when it begins after the checkpoint
 checkpoint_c = os.path.join(c, 'out', 'checkpoint.h5')
 before = open(checkpoint_c, 'rb').read()
-status, out, err = T.run(T.write_deck(c, 'deck.nml', DECK.format(steps=60, discard=0.02, average=0.2)), c, np_ranks=2,
+status, out, err = T.run(T.write_deck(c, 'deck.nml', DECK.format(steps=60, discard=0.02, average=0.2)), c, np_ranks=T.RANKS,
                          args=['-restart', 'out/checkpoint.h5'], expect_ok=False)
 T.check(status != 0 and 'rheology/accumulators' in err and 'blocks begun cannot be cut anew' in err
         and '&rheology' in err and not any(line.startswith('step ') for line in out.splitlines()),
         'a restart with another average_strain over a begun window is refused before any step (%d): %s'
         % (status, err.strip()[-300:]))
 T.check(open(checkpoint_c, 'rb').read() == before, 'the refused restart leaves its checkpoint bitwise as it was')
-T.run(T.write_deck(c, 'deck.nml', DECK.format(steps=90, discard=0.08, average=0.1)), c, np_ranks=2,
+T.run(T.write_deck(c, 'deck.nml', DECK.format(steps=90, discard=0.08, average=0.1)), c, np_ranks=T.RANKS,
       args=['-restart', 'out/checkpoint.h5'])
 sc = summary(c)
 T.check(sc['complete'] and sc['discard_step'] == 40 and sc['block_steps'] == 10,

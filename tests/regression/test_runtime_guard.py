@@ -32,7 +32,7 @@ DECK = """&domain box = 3.2, 6.4, 3.2, cells_per_radius = 5, y_boundary = 'walls
 """
 d = T.scratch('runtime_guard')
 deck = T.write_deck(d, 'g.nml', DECK.format(steps=20))
-status, out, err = T.run(deck, d, np_ranks=2, args=['-fault_nan_step', '12'], expect_ok=False)
+status, out, err = T.run(deck, d, np_ranks=T.RANKS, args=['-fault_nan_step', '12'], expect_ok=False)
 messages = [l for l in err.splitlines() if l.startswith('fdsusp:')]
 T.check(status == 5, 'the run stops with status 5 (got %d)' % status)
 T.check(len(messages) == 1 and 'step 12' in messages[0] and 'velocity' in messages[0],
@@ -45,11 +45,11 @@ T.check(step == 10 and np.isfinite(u).all(), 'checkpoint.h5 is still the good on
 s = T.series(os.path.join(d, 'out'))
 T.check(s['step'].max() <= 12, 'series.h5 ends at the failure (last step %d)' % s['step'].max())
 deck = T.write_deck(d, 'g.nml', DECK.format(steps=14))
-status, out, err = T.run(deck, d, np_ranks=2, args=['-restart', ck], expect_ok=False)
+status, out, err = T.run(deck, d, np_ranks=T.RANKS, args=['-restart', ck], expect_ok=False)
 T.check(status == 0 and 'finished at step 14' in out, 'restart from the kept checkpoint runs to step 14 (status %d)' % status)
 os.replace(ck, os.path.join(d, 'good.h5'))
 deck = T.write_deck(d, 'g.nml', DECK.format(steps=30))
-status, out, err = T.run(deck, d, np_ranks=2, args=['-restart', 'good.h5', '-fluid_solver', 'krylov', '-p_ksp_max_it', '1'], expect_ok=False)
+status, out, err = T.run(deck, d, np_ranks=T.RANKS, args=['-restart', 'good.h5', '-fluid_solver', 'krylov', '-p_ksp_max_it', '1'], expect_ok=False)
 messages = [l for l in err.splitlines() if l.startswith('fdsusp:')]
 T.check(status == 3 and len(messages) == 1 and 'p solver diverged' in messages[0] and 'KSPConvergedReason -3' in messages[0],
         'a pressure solve that does not converge stops the run: status %d, %s' % (status, messages[:1]))
@@ -82,7 +82,7 @@ deck = T.write_deck(d, 'o.nml', """&domain box = 6.4, 6.4, 6.4, cells_per_radius
   external_force(:,1) = 20, 0, 0, external_force(:,2) = -20, 0, 0 /
 &contact roughness = 0.01, normal_stiffness = 1e3 /
 """)
-status, out, err = T.run(deck, d, np_ranks=2, expect_ok=False)
+status, out, err = T.run(deck, d, np_ranks=T.RANKS, expect_ok=False)
 messages = [l for l in err.splitlines() if l.startswith('fdsusp: fatal')]
 T.check(status == 5 and len(messages) == 1 and 'particle 1 and particle 2' in messages[0] and 'exceeds' in messages[0],
         'an overlap beyond h_r stops the run: status %d, %s' % (status, messages[:1]))
@@ -106,11 +106,11 @@ PAIR = """&domain box = 6.4, 6.4, 6.4, cells_per_radius = 5, y_boundary = 'walls
 &lubrication model = 'full' /
 """
 deck = T.write_deck(d, 'p.nml', PAIR.format(steps=5))
-status, out, err = T.run(deck, d, np_ranks=2)
+status, out, err = T.run(deck, d, np_ranks=T.RANKS)
 ck = os.path.join(d, 'out', 'checkpoint.h5')
 os.replace(ck, os.path.join(d, 'good.h5'))
 deck = T.write_deck(d, 'p.nml', PAIR.format(steps=10))
-status, out, err = T.run(deck, d, np_ranks=2, args=['-restart', 'good.h5', '-particles_ksp_max_it', '1'],
+status, out, err = T.run(deck, d, np_ranks=T.RANKS, args=['-restart', 'good.h5', '-particles_ksp_max_it', '1'],
                          expect_ok=False)
 messages = [l for l in err.splitlines() if l.startswith('fdsusp:')]
 T.check(status == 4 and len(messages) == 1 and 'particle system solve failed' in messages[0]
