@@ -111,6 +111,8 @@ contains
       end do
       call require_free_space(dir, bytes, tmp)
       PetscCall(PetscViewerHDF5Open(PETSC_COMM_WORLD, trim(tmp), FILE_MODE_WRITE, viewer, ierr))
+      ! every rank writes its slab in one collective MPI-IO transfer (issue 45; doc/DESIGN.md "Files")
+      PetscCall(PetscViewerHDF5SetCollective(viewer, PETSC_TRUE, ierr))
       do k = 1, size(fields)
         if (len_trim(stand_in(k)) > 0) then
           ! the zeros of u*^{n-1} of the direct solves, which keep none (mod_fluid)
@@ -706,6 +708,7 @@ contains
       state%fl%star_history = stars(1)
       fields = field_vectors(state, stars(1) > 0, stand_in)
       PetscCall(PetscViewerHDF5Open(PETSC_COMM_WORLD, trim(path), FILE_MODE_READ, viewer, ierr))
+      PetscCall(PetscViewerHDF5SetCollective(viewer, PETSC_TRUE, ierr))
       do k = 1, size(fields)
         PetscCall(VecLoad(fields(k), viewer, ierr))
       end do

@@ -46,6 +46,11 @@ contains
     call require_free_space(outdir, 32.0_dp * product(real(grid%n, dp)), path)
     call PetscViewerHDF5Open(PETSC_COMM_WORLD, trim(path)//'.tmp', FILE_MODE_WRITE, viewer, ierr)
     failed = ierr /= 0
+    ! every rank writes its slab in one collective MPI-IO transfer (issue 45; doc/DESIGN.md "Files")
+    if (.not. failed) then
+      call PetscViewerHDF5SetCollective(viewer, PETSC_TRUE, ierr)
+      failed = ierr /= 0
+    end if
     PetscCall(DMGetGlobalVector(grid%da(FIELD_P), centre, ierr))
     do f = 1, 3
       e = 0
