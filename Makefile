@@ -2,7 +2,7 @@
 #   make            build bin/fdsusp, bin/fdsusp-pack, bin/pairtraj and the unit-test programs (optimised)
 #   make debug      the same in bin/debug/ with bounds checks and floating-point traps
 #   make check      build and run the whole test suite; last line "N passed, N failed"
-#                   (RANKS=3: the tests' parallel runs on 3 ranks instead of 2)
+#                   (RANKS=3: the tests' parallel runs on 3 ranks instead of 2; RANKS=1: on one)
 #   make install    programs, lubrication tables, decks, docs and the Python package under PREFIX
 #                   (default /usr/local)
 #   make run        run input/demo.nml on 2 ranks
