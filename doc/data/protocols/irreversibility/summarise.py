@@ -6,6 +6,8 @@ threshold gamma_c, into summary.json and doc/figures/irreversibility_ld.png.
 OUT: out/protocols/irreversibility. The runs are the decks osc_p*_g*.nml here (phi, gamma_0 and the
 number of cycles read from each deck); a deck not run (yet) is skipped.
 
+The series' first record is at step series_every, not at the start: the displacements seen are
+those over cycles 2, 3, ... of the run (msd_per_cycle[i]: over cycle i + 2).
 States (after the run's last cycle; m = msd per cycle, f = fraction moved):
   reversible  f = 0 in every cycle (no sphere ever came back farther than THRESHOLD)
   absorbing   f > 0 in the first cycles, f = 0 in the last LAST cycles (it organised)
@@ -58,7 +60,7 @@ def entry(phi, gamma_0, cycles, msd, moved, source):
             'msd_per_cycle': [float(x) for x in msd], 'moved_per_cycle': [float(x) for x in moved],
             'msd_late': float(msd[-LAST:].mean()), 'moved_late': float(moved[-LAST:].mean()),
             'late_over_early': float(msd[-LAST:].mean() / msd[:LAST].mean()),
-            'no_move_from_cycle': (absorbed[0] + 1) if absorbed else None, 'state': state(msd, moved)}
+            'no_move_from_cycle': (absorbed[0] + 2) if absorbed else None, 'state': state(msd, moved)}
 
 
 # a run whose output is gone (out/ is not kept) keeps the per-cycle values summary.json holds
@@ -66,7 +68,9 @@ try:
     kept = json.load(open(os.path.join(HERE, 'summary.json')))['runs']
 except (OSError, ValueError, KeyError):
     kept = {}
-result = {'threshold_a': THRESHOLD, 'late_cycles': LAST, 'decay_ratio': DECAY, 'runs': {}, 'phi': {}}
+result = {'cycle_numbering': 'msd_per_cycle[i], moved_per_cycle[i]: over cycle i + 2 of the run (between the ends of cycles '
+                             'i + 1 and i + 2; the run\'s start is not a record, so cycle 1 is not seen); no_move_from_cycle: '
+                             'the first cycle from which no sphere moved', 'threshold_a': THRESHOLD, 'late_cycles': LAST, 'decay_ratio': DECAY, 'runs': {}, 'phi': {}}
 for deck in sorted(glob.glob(os.path.join(HERE, 'osc_p*_g*.nml'))):
     name = os.path.basename(deck)[:-4]
     phi, gamma_0, cycles = deck_values(deck)
@@ -99,11 +103,12 @@ for phi, b in result['phi'].items():
     print('phi %s: gamma_c in (%s, %s]  decaying at %s' % (phi, b['gamma_lo'], b['gamma_hi'], b['decaying']))
     for name in b['runs']:
         r = result['runs'][name]
-        k5 = min(4, r['cycles'] - 1)
-        print('  %-16s gamma_0 %-4g cycles %2d  msd %.2g -> %.2g -> %.2g a^2  moved %.2f -> %.2f -> %.2f  '
+        k5 = min(4, r['cycles'] - 1)     # cycle 6
+        print('  %-16s gamma_0 %-4g cycles %2d  msd (cycle 2 -> 6 -> last) %.2g -> %.2g -> %.2g a^2  moved %.2f -> %.2f -> %.2f  '
               'late/early %.2g  %s' % (name, r['gamma_0'], r['cycles'], r['msd_per_cycle'][0], r['msd_per_cycle'][k5],
                                        r['msd_per_cycle'][-1], r['moved_per_cycle'][0], r['moved_per_cycle'][k5],
-                                       r['moved_per_cycle'][-1], r['late_over_early'], r['state']))
+                                       r['moved_per_cycle'][-1], r['late_over_early'], r['state'])
+              + ('' if r['no_move_from_cycle'] is None else ' (none moved from cycle %d)' % r['no_move_from_cycle']))
 
 import matplotlib
 matplotlib.use('Agg')
@@ -114,7 +119,7 @@ for j, phi in enumerate(phis):
     top, bottom = axes[0, j], axes[1, j]
     for name in result['phi'][phi]['runs']:
         r = result['runs'][name]
-        k = np.arange(1, r['cycles'] + 1)
+        k = np.arange(2, r['cycles'] + 2)    # cycle i + 2 of the run (its start is not a record)
         label = 'gamma_0 = %g%s: %s' % (r['gamma_0'], '' if r['cycles_asked'] == 10 else ' (%d cycles)' % r['cycles_asked'],
                                         r['state'])
         top.semilogy(k, np.maximum(r['msd_per_cycle'], 1e-12), 'o-', ms=3, label=label)
