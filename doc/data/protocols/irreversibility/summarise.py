@@ -45,6 +45,12 @@ def deck_values(path):
     return phi, gamma_0, cycles
 
 
+def bracket(b):
+    lo, hi = b['gamma_lo'], b['gamma_hi']
+    text = ('%g < gamma_c' % lo if lo is not None else 'gamma_c') + (' <= %g' % hi if hi is not None else ' (no active run)')
+    return text + ('; decaying at %s' % ', '.join('%g' % g for g in b['decaying']) if b['decaying'] else '')
+
+
 def state(msd, moved):
     if np.all(moved == 0):
         return 'reversible'
@@ -100,7 +106,7 @@ for phi in sorted({r['phi'] for r in result['runs'].values()}):
 json.dump(result, open(os.path.join(HERE, 'summary.json'), 'w'), indent=1)
 
 for phi, b in result['phi'].items():
-    print('phi %s: gamma_c in (%s, %s]  decaying at %s' % (phi, b['gamma_lo'], b['gamma_hi'], b['decaying']))
+    print('phi %s: %s' % (phi, bracket(b)))
     for name in b['runs']:
         r = result['runs'][name]
         k5 = min(4, r['cycles'] - 1)     # cycle 6
@@ -119,13 +125,16 @@ for j, phi in enumerate(phis):
     top, bottom = axes[0, j], axes[1, j]
     for name in result['phi'][phi]['runs']:
         r = result['runs'][name]
+        if any(q['phi'] == r['phi'] and q['gamma_0'] == r['gamma_0'] and q['cycles'] > r['cycles']
+               for q in result['runs'].values()):
+            continue        # a longer run at this gamma_0 holds these cycles too (it was continued from this one or redid it)
         k = np.arange(2, r['cycles'] + 2)    # cycle i + 2 of the run (its start is not a record)
         label = 'gamma_0 = %g%s: %s' % (r['gamma_0'], '' if r['cycles_asked'] == 10 else ' (%d cycles)' % r['cycles_asked'],
                                         r['state'])
         top.semilogy(k, np.maximum(r['msd_per_cycle'], 1e-12), 'o-', ms=3, label=label)
         bottom.plot(k, r['moved_per_cycle'], 'o-', ms=3, label=label)
     b = result['phi'][phi]
-    top.set_title('phi %s: gamma_c in (%s, %s]' % (phi, b['gamma_lo'], b['gamma_hi']), fontsize=9)
+    top.set_title('phi %s: %s' % (phi, bracket(b)), fontsize=9)
     top.set_ylabel(r'stroboscopic $\langle|\Delta x|^2\rangle$ per cycle [$a^2$]')
     bottom.set_ylabel('fraction of spheres moved > %g a' % THRESHOLD)
     bottom.set_xlabel('cycle')
