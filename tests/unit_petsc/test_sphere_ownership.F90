@@ -9,7 +9,8 @@
 !   4. the contiguous split (the fallback) gives rank r the indices PETSc's split would, the first
 !      mod(n, P) ranks one more;
 !   5. sphere_ownership_of returns the step's ownership for its n and the contiguous one otherwise.
-! Exact integer checks (no tolerance). The program runs as an MPI singleton (tests/run_tests.sh).
+! Exact integer checks (no tolerance). The program runs as an MPI singleton (tests/run_tests.sh) and
+! on 3 ranks (test_unit_petsc_ranks), where 5 takes the communicator's size.
 #include <petsc/finclude/petscsys.h>
 program test_sphere_ownership
   use petscsys
@@ -25,6 +26,7 @@ program test_sphere_ownership
   type(sphere_ownership_t) :: o, slabs
   real(dp) :: x(3, n), zw
   integer :: ranks, i, r
+  PetscMPIInt :: size_world
   logical :: ok_slab, ok_perm, ok_order, ok_split
   integer, allocatable :: seen(:)
   character(len=80) :: what
@@ -72,11 +74,13 @@ program test_sphere_ownership
   end do
   call sphere_ownership_set(x, lz)
   o = sphere_ownership_of(n)
-  slabs = sphere_ownership_by_slab(x, lz, 1)
+  call MPI_Comm_size(PETSC_COMM_WORLD, size_world, ierr)
+  slabs = sphere_ownership_by_slab(x, lz, size_world)
   call check(all(o%owner == slabs%owner) .and. o%n == n, &
              'sphere_ownership_of(n) is the step''s ownership')
   o = sphere_ownership_of(n - 1)
-  call check(o%n == n - 1 .and. all(o%row == [(i - 1, i = 1, n - 1)]), &
+  slabs = sphere_ownership_contiguous(n - 1, size_world)
+  call check(o%n == n - 1 .and. all(o%row == slabs%row) .and. all(o%owner == slabs%owner), &
              'sphere_ownership_of another n is the contiguous split')
   call finish('test_sphere_ownership')
   PetscCallA(PetscFinalize(ierr))
