@@ -14,7 +14,17 @@
 !      local copy contributing 1: the owner's total is 1 + the brute-force count of such ranks);
 !   5. after the spheres move by less than reach, a second migrate and build hold 1 and 2 again;
 !   6. a move shorter than reach takes the neighbours' path on every rank;
-!   7. the bytes a rank sends in a forward of k values are 8 k times the copies it sends.
+!   7. the bytes a rank sends in a forward of k values are 8 k times the copies it sends;
+!   8. weak scaling (doc/SCALING.md §1): 500 spheres a rank, uniform in an L x L x P L box (phi 0.4
+!      of spheres of radius a), reach 3.2a (the lubrication cut-off, a gap of 1a, plus the skin
+!      0.2a): a rank sends each step 8 x 9 B for each copy of its own spheres (a forward of the
+!      centre, U and Omega) and 8 x 15 B for each ghost it holds (a reverse of the links' force,
+!      torque and stresslet), and its copies are
+!      those of a slab within reach of its faces: 500 x 2 x 3.2/L on average from 2 ranks on
+!      (each face's copies go to its neighbour; at 2 ranks one neighbour takes both), so the
+!      largest rank's count is within 30 % of it (a binomial count of ~180, sd 7 %, over up to 8
+!      ranks; one face only when the two slabs are one neighbour's: counted once per copy, as
+!      sent). The table line printed is doc/SCALING.md's.
 ! Exact checks (no tolerance: positions and values are copied, not computed). Runs as a singleton
 ! (tests/run_tests.sh) and on 3 and 5 ranks (test_unit_petsc_ranks).
 #include <petsc/finclude/petscsys.h>
@@ -117,10 +127,62 @@ program test_sphere_halo
     x = x_all(:, id)
   end do
 
+  call weak_scaling()
   call finish('test_sphere_halo')
   PetscCallA(PetscFinalize(ierr))
 
 contains
+
+  ! 8: the halo's bytes per rank and step at fixed spheres per rank
+  subroutine weak_scaling()
+    integer, parameter :: per_rank = 500
+    real(dp), parameter :: reach_w = 3.2_dp, phi = 0.4_dp
+    type(sphere_halo_t) :: hw
+    real(dp) :: side, expected, u(3)
+    real(dp), allocatable :: xw(:, :), dw(:, :), vw(:, :)
+    integer, allocatable :: idw(:)
+    integer :: nw, j, copies, most
+    integer(kind=8) :: sent, most_sent
+    integer(kind=4), allocatable :: seed(:)
+    character(len=160) :: line
+    side = (4.0_dp / 3.0_dp * acos(-1.0_dp) * per_rank / phi)**(1.0_dp / 3.0_dp)
+    nw = per_rank * ranks
+    ! every rank draws the same centres, keeps a contiguous range and migrates them
+    call random_seed(size=j)
+    allocate(seed(j))
+    seed = 20261129
+    call random_seed(put=seed)
+    allocate(xw(3, nw))
+    do j = 1, nw
+      call random_number(u)
+      xw(:, j) = u * [side, side, side * ranks]
+    end do
+    idw = [(j, j = rank * per_rank + 1, (rank + 1) * per_rank)]
+    xw = xw(:, idw)
+    allocate(dw(0, size(idw)))
+    call sphere_halo_create(hw, side * ranks, reach_w)
+    call sphere_halo_migrate(hw, idw, xw, dw, ierr)
+    call sphere_halo_build(hw, xw, ierr)
+    allocate(vw(24, size(hw%id)))
+    vw = 1.0_dp
+    sent = hw%bytes_sent
+    call sphere_halo_forward(hw, vw(1:9, :), ierr)
+    call sphere_halo_reverse(hw, vw(10:24, :), ierr)
+    sent = hw%bytes_sent - sent
+    copies = size(hw%send_local)
+    most = copies
+    most_sent = sent
+    call MPI_Allreduce(MPI_IN_PLACE, most, 1, MPI_INTEGER, MPI_MAX, PETSC_COMM_WORLD, ierr)
+    call MPI_Allreduce(MPI_IN_PLACE, most_sent, 1, MPI_INTEGER8, MPI_MAX, PETSC_COMM_WORLD, ierr)
+    call check(sent == 8_8 * (9 * copies + 15 * size(hw%recv_local)), &
+               label('weak scaling: 8 x 9 B per copy sent and 8 x 15 B per ghost held, each step'))
+    expected = merge(0.0_dp, per_rank * 2.0_dp * reach_w / side, ranks == 1)
+    call check(abs(most - expected) <= 0.3_dp * expected, label('weak scaling: the copies of a slab within reach'))
+    write(line, '(a,i0,a,i0,a,i0,a,f6.1,a,i0,a)') 'halo weak scaling: ', ranks, ' ranks, ', nw, &
+         ' spheres, most copies sent by a rank ', most, ' (expected ', expected, '), bytes per rank and step ', &
+         most_sent, ' (forward 9 + reverse 15 values)'
+    if (rank == 0) write(*, '(a)') trim(line)
+  end subroutine weak_scaling
 
   pure function carried(i) result(v)
     integer, intent(in) :: i
