@@ -24,7 +24,7 @@
 !             compares with its own deck before any work (doc/INPUT.md "Restart")
 ! Checksums: every dataset written through mod_h5util (particles, contacts, statistics) carries
 ! HDF5's Fletcher-32 filter; the fields, written by PETSc's viewer (which sets no filter), carry
-! the attribute checksum (data_checksum, over the file's content, so independent of the number of
+! the attribute checksum (checksum_continue, over the file's content, so independent of the number of
 ! ranks). A restart reads every dataset once before any work (verify_datasets): a flipped bit
 ! stops it naming the dataset. Checkpoints written before 2026-11-27 have no checksums: they are
 ! read, and the log says their data could not be verified.
@@ -440,7 +440,8 @@ contains
     call h5fclose_f(file, err)
   end subroutine inspect
 
-  ! Every dataset under GROUP (whose path is PREFIX), recursively, read whole: the read verifies the
+  ! Every dataset under GROUP (whose path is PREFIX), recursively, read through (in blocks of at
+  ! most 2^16 values, check_dataset): the read verifies the
   ! Fletcher-32 checksum of a dataset that has one, and the values are compared with the checksum
   ! attribute of one that has it. sign: instead, give every dataset without Fletcher-32 its
   ! checksum attribute (checkpoint_write). A fault sets item (the dataset's path) and message;
@@ -488,36 +489,71 @@ contains
     logical, intent(in) :: sign
     character(len=*), intent(inout) :: item, message
     integer, intent(inout) :: unverified
-    integer(HID_T) :: space, ftype
+    ! values read at a time: the dataset is read in blocks of its slowest dimension (contiguous
+    ! runs of the file's order), so the rank that signs or verifies a checkpoint holds one block,
+    ! not a whole field (a 1000^3 field is 8 GB; issue 45)
+    integer(HSIZE_T), parameter :: BLOCK_VALUES = 2_HSIZE_T**16
+    integer(HID_T) :: space, ftype, memspace
     integer(HSSIZE_T) :: npoints
-    integer :: err, class, e
+    integer(HSIZE_T) :: dims(7), maxdims(7), start(7), counts(7), plane, rows, first
+    integer :: err, class, e, ndims
+    integer(int64) :: sums(2)
     logical :: fletcher
     real(dp) :: stored(2), computed(2)
     real(dp), allocatable, target :: values(:)
     type(c_ptr) :: buffer
     call h5dget_space_f(dset, space, err)
     call h5sget_simple_extent_npoints_f(space, npoints, e)
-    call h5sclose_f(space, e)
+    call h5sget_simple_extent_ndims_f(space, ndims, e)
+    dims = 1
+    if (ndims > 0) call h5sget_simple_extent_dims_f(space, dims(1:ndims), maxdims(1:ndims), e)
     call h5dget_type_f(dset, ftype, e)
     call h5tget_class_f(ftype, class, e)
     call h5tclose_f(ftype, e)
     fletcher = has_fletcher32(dset)
     if (class /= H5T_FLOAT_F .and. class /= H5T_INTEGER_F) then
+      call h5sclose_f(space, e)
       if (.not. fletcher) unverified = unverified + 1
       return
     end if
-    ! numbers are read as doubles (integers of 32 bits convert exactly)
-    allocate(values(max(1_HSSIZE_T, npoints)))
-    values = 0.0_dp
-    buffer = c_loc(values)
-    if (err == 0 .and. npoints > 0) call h5dread_f(dset, H5T_NATIVE_DOUBLE, buffer, err)
+    ! numbers are read as doubles (integers of 32 bits convert exactly), a block of rows of the
+    ! slowest dimension (the last in Fortran's order) at a time; a scalar dataset in one read
+    sums = 0
+    if (err == 0 .and. npoints > 0) then
+      if (ndims == 0) then
+        allocate(values(1))
+        buffer = c_loc(values)
+        call h5dread_f(dset, H5T_NATIVE_DOUBLE, buffer, err)
+        if (err == 0) call checksum_continue(values, sums)
+      else
+        plane = product(dims(1:ndims - 1))
+        rows = max(1_HSIZE_T, BLOCK_VALUES / plane)
+        allocate(values(min(int(npoints, HSIZE_T), rows * plane)))
+        buffer = c_loc(values)
+        first = 0
+        do while (first < dims(ndims) .and. err == 0)
+          start(1:ndims) = 0
+          start(ndims) = first
+          counts(1:ndims) = dims(1:ndims)
+          counts(ndims) = min(rows, dims(ndims) - first)
+          call h5sselect_hyperslab_f(space, H5S_SELECT_SET_F, start(1:ndims), counts(1:ndims), err)
+          if (err == 0) call h5screate_simple_f(ndims, counts(1:ndims), memspace, err)
+          if (err /= 0) exit
+          call h5dread_f(dset, H5T_NATIVE_DOUBLE, buffer, err, mem_space_id=memspace, file_space_id=space)
+          call h5sclose_f(memspace, e)
+          if (err == 0) call checksum_continue(values(1:counts(ndims) * plane), sums)
+          first = first + counts(ndims)
+        end do
+      end if
+    end if
+    call h5sclose_f(space, e)
     if (err /= 0) then
       item = path
       message = 'cannot be read: its data fail their Fletcher-32 checksum or the file is damaged (restart from '// &
                 'an earlier checkpoint)'
       return
     end if
-    computed = data_checksum(values(1:npoints))
+    computed = real(sums, dp)
     if (sign) then
       if (.not. fletcher) then
         call write_attribute(dset, 'checksum', computed, err)
@@ -562,14 +598,16 @@ contains
   ! 32-bit halves of each value's IEEE bit pattern, modulo the prime 4294967291, as two exact
   ! doubles. A changed bit changes the first sum, the order of the values the second; computed on
   ! the file's content in its order, it does not depend on the number of ranks that wrote it.
-  pure function data_checksum(x) result(c)
+  ! Running: sums (the two, from 0 at the first value) continue over the next values x, so a
+  ! dataset read block by block in the file's order gives the sums of one read.
+  pure subroutine checksum_continue(x, sums)
     real(dp), intent(in) :: x(:)
-    real(dp) :: c(2)
+    integer(int64), intent(inout) :: sums(2)
     integer(int64), parameter :: prime = 4294967291_int64, low = 4294967295_int64
     integer(int64) :: a, b, bits
     integer :: i
-    a = 0
-    b = 0
+    a = sums(1)
+    b = sums(2)
     do i = 1, size(x)
       bits = transfer(x(i), bits)
       a = mod(a + iand(bits, low), prime)
@@ -577,8 +615,8 @@ contains
       a = mod(a + iand(shiftr(bits, 32), low), prime)
       b = mod(b + a, prime)
     end do
-    c = real([a, b], dp)
-  end function data_checksum
+    sums = [a, b]
+  end subroutine checksum_continue
 
   ! The statistics of FILE against this run's &rheology (RH; doc/INPUT.md "&rheology"): afresh = 1
   ! when the deck's window begins after the checkpoint's step (the statistics start from zero,
