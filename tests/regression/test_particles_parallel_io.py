@@ -17,7 +17,13 @@ state, in the layout one writer gave them, on any number of ranks:
     tests/regression/test_ld_rank_independence.py);
  4. a restart on 1 rank from the checkpoint 3 ranks wrote (its checks: checksums, deck, particle
     count) continues as the uninterrupted 1-rank run does: the records after it within 1e-10
-    (test_ld_rank_independence restarts from 2 ranks on 3).
+    (test_ld_rank_independence restarts from 2 ranks on 3);
+ 5. a collective write that fails (injected: a directory, not removable, where the .tmp must be
+    created) stops every rank of a 3-rank run with status 3 and one message naming the file, and
+    the last checkpoint stays whole: a snapshot (particles_00000010.h5.tmp), and a checkpoint of a
+    run continued from a step-10 checkpoint (checkpoint.h5.tmp), which keeps step 10.
+    (tests/regression/test_full_disk.py covers the full disk, which the free-space check before
+    every parallel write catches.)
 Decks: lubrication dynamics, 24 rough frictional spheres (phi 0.2) in a Lees-Edwards cube of 8 a,
 30 steps (the 3-rank run 20, then its restart to 30 on 1 rank), snapshots every 10 steps; DNS, a
 20 x 20 x 30-cell channel with walls, 10 steps, snapshots and checkpoints every 5. ~15 s on 2 cores."""
@@ -138,4 +144,30 @@ for q in STATE:
     T.check(diff <= TOL, 'restart on 1 rank from 3 ranks\' checkpoint: particles/%s of steps 21-30 within %.0e of '
             'the uninterrupted run (%.1e)' % (q, TOL, diff))
 against_series(ld3, 'LD 3 ranks + restart on 1')
+
+
+def failing(name, blocker, deck, args=(), before=None):
+    """Run deck on 3 ranks with out/BLOCKER a directory holding a file; (status, stderr, out)."""
+    d = T.scratch(name)
+    out = os.path.join(d, 'out')
+    deck_path = T.write_deck(d, 'deck.nml', deck)
+    if before:
+        T.run(T.write_deck(d, 'before.nml', before), d, np_ranks=3)
+    os.makedirs(os.path.join(out, blocker, 'x'))
+    status, _, err = T.run(deck_path, d, np_ranks=3, args=list(args), expect_ok=False, timeout=120)
+    return status, err, out
+
+
+status, err, out = failing('pio_fail_snapshot', 'particles_00000010.h5.tmp', LD.format(steps=20))
+T.check(status == 3 and 'fdsusp: fatal: out/particles_00000010.h5 cannot be created' in err,
+        'snapshot write fails on 3 ranks: status %d, the message names the file' % status)
+T.check(int(T.h5_attr(os.path.join(out, 'checkpoint.h5'), 'step')[0]) == 0, 'snapshot write fails: the last '
+        'checkpoint (step 0) is whole')
+status, err, out = failing('pio_fail_checkpoint', 'checkpoint.h5.tmp', LD.format(steps=20),
+                           ['-restart', 'out/checkpoint.h5'], before=LD.format(steps=10))
+T.check(status == 3 and 'fdsusp: fatal: out/checkpoint.h5.tmp cannot be created' in err and
+        'out/checkpoint.h5, is kept' in err, 'checkpoint write fails on 3 ranks: status %d, the message names '
+        'the file and keeps the last checkpoint' % status)
+T.check(int(T.h5_attr(os.path.join(out, 'checkpoint.h5'), 'step')[0]) == 10, 'checkpoint write fails: the last '
+        'checkpoint (step 10) is whole')
 T.finish()
