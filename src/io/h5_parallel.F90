@@ -19,6 +19,11 @@ module mod_h5_parallel
   private
   public :: h5_parallel_create, h5_parallel_open, h5_parallel_close, h5_parallel_write_columns, h5_parallel_agree
 
+  ! the most runs of consecutive columns selected as a union of hyperslabs (more: element by
+  ! element; h5_parallel_write_columns): few enough that both ways serve in the tests'
+  ! small scenes (tests/regression/test_particles_parallel_io.py: 2 to 6 runs a rank)
+  integer, parameter :: max_hyperslabs = 4
+
 contains
 
   !> Create (truncate) the file PATH for every rank through MPI-IO on PETSC_COMM_WORLD. Collective.
@@ -67,7 +72,8 @@ contains
     integer, intent(out) :: err
     integer(HID_T) :: file_space, memory_space, dcpl, dxpl, dset
     integer(HSIZE_T) :: dims(2)
-    integer :: e, m, j, first
+    integer :: e, m, j, c, first, runs
+    integer(HSIZE_T), allocatable :: points(:, :)
     integer, allocatable :: order(:)
     real(dp), allocatable, target :: buffer(:, :)
     type(c_ptr) :: data
@@ -93,24 +99,47 @@ contains
       return
     end if
 
-    ! the file's columns of this rank, a union of hyperslabs (one per run of consecutive indices),
-    ! which HDF5 transfers in the file's order: the buffer holds the columns by ascending index
+    ! the file's columns of this rank, which HDF5 transfers in the file's order: the buffer holds
+    ! them by ascending index. Selected as a union of hyperslabs (one per run of consecutive
+    ! indices) when the runs are few, else element by element: HDF5 1.10's union of hyperslabs
+    ! costs about quadratically in the runs (1934 spheres in z-slabs on 2 ranks, ~970 runs a
+    ! rank: 72 ms a step of a checkpoint and a snapshot, by elements 16 ms; doc/BENCHMARKS.md
+    ! §18), while the elements cost in proportion to the values (all spheres on one rank, 1 run:
+    ! 21 ms a step by elements, 13 ms by one hyperslab).
     order = ascending(columns)
     allocate(buffer(size(values, 1), max(1, m)))
     buffer = 0.0_dp
     if (m > 0) buffer(:, 1:m) = values(:, order)
-    call h5sselect_none_f(file_space, err)
-    first = 1
+    runs = 0
     do j = 1, m
-      if (err /= 0) exit
-      if (j < m) then
-        if (columns(order(j + 1)) == columns(order(j)) + 1) cycle
+      if (j == 1) then
+        runs = 1
+      else if (columns(order(j)) /= columns(order(j - 1)) + 1) then
+        runs = runs + 1
       end if
-      ! the run columns(order(first:j))
-      call h5sselect_hyperslab_f(file_space, H5S_SELECT_OR_F, [0_HSIZE_T, int(columns(order(first)) - 1, HSIZE_T)], &
-                                 [dims(1), int(j - first + 1, HSIZE_T)], err)
-      first = j + 1
     end do
+    call h5sselect_none_f(file_space, err)
+    if (runs > max_hyperslabs) then
+      allocate(points(2, size(values, 1) * m))
+      do j = 1, m
+        do c = 1, size(values, 1)
+          points(:, (j - 1) * size(values, 1) + c) = [int(c, HSIZE_T), int(columns(order(j)), HSIZE_T)]
+        end do
+      end do
+      call h5sselect_elements_f(file_space, H5S_SELECT_SET_F, 2, size(points, 2, kind=SIZE_T), points, err)
+    else
+      first = 1
+      do j = 1, m
+        if (err /= 0) exit
+        if (j < m) then
+          if (columns(order(j + 1)) == columns(order(j)) + 1) cycle
+        end if
+        ! the run columns(order(first:j))
+        call h5sselect_hyperslab_f(file_space, H5S_SELECT_OR_F, [0_HSIZE_T, int(columns(order(first)) - 1, HSIZE_T)], &
+                                   [dims(1), int(j - first + 1, HSIZE_T)], err)
+        first = j + 1
+      end do
+    end if
     call h5screate_simple_f(1, [size(buffer, kind=HSIZE_T)], memory_space, e)
     err = max(err, abs(e))
     if (m == 0) call h5sselect_none_f(memory_space, e)
