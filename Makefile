@@ -44,7 +44,7 @@ MODE ?= opt
 ifeq ($(MODE),debug)
   BUILD := build/debug
   BIN := bin/debug
-  OPTFLAGS := -O0 -g -fcheck=all -ffpe-trap=invalid,zero,overflow -fbacktrace -finit-real=snan
+  OPTFLAGS := -O0 -g -fcheck=all -ffpe-trap=invalid,zero,overflow -fbacktrace -finit-real=snan -DFDSUSP_DEBUG
   COPTFLAGS := -O0 -g
 else
   BUILD := build/opt

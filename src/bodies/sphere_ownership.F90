@@ -20,7 +20,7 @@ module mod_sphere_ownership
   implicit none
   private
   public :: sphere_ownership_t, sphere_ownership_by_slab, sphere_ownership_contiguous, sphere_ownership_set, &
-            sphere_ownership_of
+            sphere_ownership_of, sphere_ownership_mine
 
   type :: sphere_ownership_t
     integer :: n = 0                         ! spheres
@@ -115,5 +115,20 @@ contains
     call MPI_Comm_size(PETSC_COMM_WORLD, ranks, ierr)
     o = sphere_ownership_contiguous(n, ranks)
   end function sphere_ownership_of
+
+  !> The spheres this rank owns at positions x (3, n) in a box of height lz along z
+  !> (sphere_ownership_by_slab), in index order: the rows of the per-sphere datasets it writes in
+  !> the particle files and checkpoints (mod_particles_io, owned_spheres_rule). Not collective.
+  function sphere_ownership_mine(x, lz) result(mine)
+    real(dp), intent(in) :: x(:, :), lz
+    integer, allocatable :: mine(:)
+    PetscMPIInt :: rank, ranks
+    PetscErrorCode :: ierr
+    type(sphere_ownership_t) :: o
+    call MPI_Comm_size(PETSC_COMM_WORLD, ranks, ierr)
+    call MPI_Comm_rank(PETSC_COMM_WORLD, rank, ierr)
+    o = sphere_ownership_by_slab(x, lz, ranks)
+    mine = o%sphere(o%displs(rank + 1) + 1:o%displs(rank + 1) + o%counts(rank + 1))
+  end function sphere_ownership_mine
 
 end module mod_sphere_ownership

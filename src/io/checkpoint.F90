@@ -22,17 +22,20 @@
 !             reversals, last rate of the imposed shear, exactly; doc/INPUT.md "&shear")
 !   group /deck: the deck's variables, one attribute each (mod_restart_deck), which a restart
 !             compares with its own deck before any work (doc/INPUT.md "Restart")
-! Checksums: every dataset written through mod_h5util (particles, contacts, statistics) carries
-! HDF5's Fletcher-32 filter; the fields, written by PETSc's viewer (which sets no filter), carry
-! the attribute checksum (checksum_continue, over the file's content, so independent of the number of
+! Checksums: every dataset written through mod_h5util or mod_h5_parallel (particles, contacts,
+! statistics) carries HDF5's Fletcher-32 filter; the fields, written by PETSc's viewer (which sets
+! no filter), carry the attribute checksum (checksum_continue, over the file's content, so
+! independent of the number of
 ! ranks). A restart reads every dataset once before any work (verify_datasets): a flipped bit
 ! stops it naming the dataset. Checkpoints written before 2026-11-27 have no checksums: they are
 ! read, and the log says their data could not be verified.
 ! What a file holds is what the run has: one checkpoint_state_t, set up once by the program,
 ! names the pieces (fluid, Lambda, particles, contact history, statistics, offset) for the
 ! checkpoints, the restart and failed_state.h5 alike.
-! Written in parallel to NAME.tmp by PETSc's HDF5 viewer, completed by rank 0, flushed to disk
-! and renamed over NAME: the previous checkpoint survives until the new one is whole.
+! Written in parallel to NAME.tmp: the fields by PETSc's HDF5 viewer, then the per-sphere datasets
+! of /particles by every rank through MPI-IO (mod_particles_io, mod_h5_parallel); completed by
+! rank 0 (signatures, attributes, /contacts, /rheology), flushed to disk and renamed over NAME:
+! the previous checkpoint survives until the new one is whole.
 #include <petsc/finclude/petscdmda.h>
 module mod_checkpoint
   use petscdmda
@@ -47,10 +50,11 @@ module mod_checkpoint
                         write_dataset, read_dataset, has_attribute
   use mod_os_services, only: publish_file
   use mod_file_services, only: require_free_space, write_failure_cause, errno_text, remove_file, directory_of
-  use mod_errors, only: is_root, abort_run, file_error_from_root, input_error, log_line
+  use mod_errors, only: is_root, abort_run, abort_if_any, file_error_from_root, input_error, log_line
   use mod_restart_deck, only: deck_record, deck_compare
   use mod_particles, only: particles_t
-  use mod_particles_io, only: particles_write, particles_read_state
+  use mod_particles_io, only: particles_write, particles_read_state, owned_spheres, owned_spheres_rule
+  use mod_h5_parallel, only: h5_parallel_create, h5_parallel_open, h5_parallel_close
   use mod_contact, only: contact_history_t
   use mod_contacts_io, only: contacts_write, contacts_read
   use mod_rheology, only: rheology_t, rheo_state, rheo_restore
@@ -74,6 +78,9 @@ module mod_checkpoint
     type(rheology_t), pointer :: rh => null()               ! &rheology: its accumulators (rheo_state)
     real(dp), pointer :: offset => null()                   ! the Lees-Edwards offset (y_boundary = 'lees-edwards')
     type(shear_protocol_t), pointer :: protocol => null()   ! the imposed shear's state (&shear)
+    ! the spheres whose rows of the per-sphere datasets each rank writes (mod_particles_io;
+    ! absent: rank 0 writes them all)
+    procedure(owned_spheres_rule), pointer, nopass :: owned_spheres => null()
   end type checkpoint_state_t
 
 contains
@@ -93,7 +100,7 @@ contains
     character(len=400) :: item, message
     character(len=1100) :: tmp, dir
     PetscInt :: length
-    real(dp) :: bytes
+    real(dp) :: bytes, particle_bytes
     Vec, allocatable :: fields(:)
     character(len=16), allocatable :: stand_in(:)
     real(dp), allocatable :: statistics(:)
@@ -101,10 +108,13 @@ contains
     tmp = trim(path)//'.tmp'
     dir = directory_of(path)
     stars = 0
+    ! the per-sphere datasets (position, velocity, omega, velocity_prev, a mixture's radius)
+    particle_bytes = 0.0_dp
+    if (associated(state%parts)) particle_bytes = 8.0_dp * 13 * state%parts%n
     if (associated(state%fl)) then
       fields = field_vectors(state, .true., stand_in)
       ! a full disk must stop every rank here, before the parallel write (mod_file_services)
-      bytes = 0.0_dp
+      bytes = particle_bytes
       do k = 1, size(fields)
         PetscCall(VecGetSize(fields(k), length, ierr))
         bytes = bytes + 8.0_dp * length
@@ -123,18 +133,37 @@ contains
       end do
       PetscCall(PetscViewerDestroy(viewer, ierr))
       stars = state%fl%star_history
-    else if (is_root()) then
-      ! no fields: rank 0 makes the file alone
-      call h5fcreate_f(trim(tmp), H5F_ACC_TRUNC_F, file, err)
-      if (err /= 0) call write_failed('cannot be created')
-      call h5fclose_f(file, err)
+    else
+      call require_free_space(dir, particle_bytes, tmp)
     end if
 
+    ! The per-sphere datasets: every rank reopens the file through MPI-IO (or makes it, without
+    ! fields) and writes the rows of the spheres it owns, collectively (doc/DESIGN.md "Files");
+    ! the file is closed on every rank before rank 0 completes it below.
+    if (associated(state%fl)) then
+      call h5_parallel_open(trim(tmp), file, err)
+      if (err /= 0) call write_failed_everywhere('cannot be reopened for the particles')
+    else
+      call h5_parallel_create(trim(tmp), file, err)
+      if (err /= 0) call write_failed_everywhere('cannot be created')
+    end if
+    if (associated(state%parts)) then
+      call particles_write(file, state%parts, cfg%domain%box, .true., &
+                           owned_spheres(state%owned_spheres, state%parts, cfg%domain%box), message)
+      if (len_trim(message) > 0) call write_failed_everywhere(trim(message))
+    end if
+    call h5_parallel_close(file, err)
+    if (err /= 0) call write_failed_everywhere('cannot be completed (closing it failed)')
+
+    ! The rest by rank 0 alone: the signatures of the datasets, the attributes, the contact
+    ! history (whose order in the file depends on the ranks' shares: one writer keeps it that of
+    ! one rank) and the statistics; then the file is published.
     if (is_root()) then
       call h5fopen_f(trim(tmp), H5F_ACC_RDWR_F, file, err)
       if (err /= 0) call write_failed('cannot be reopened to complete the checkpoint')
       failed = .false.
-      ! the fields PETSc wrote (the only datasets so far): their checksums
+      ! the fields PETSc wrote: their checksums (the particles', written with Fletcher-32, are
+      ! read and verified)
       unsigned = 0
       item = ''
       message = ''
@@ -162,7 +191,6 @@ contains
       end if
       failed = failed .or. err /= 0
       if (associated(state%parts)) then
-        call particles_write(file, state%parts, cfg%domain%box, .true.)
         if (associated(state%history)) call contacts_write(file, state%history, state%parts%n)
       end if
       if (associated(state%rh)) then
@@ -193,6 +221,16 @@ contains
       call abort_run(trim(tmp)//' '//what//': '//write_failure_cause(dir, 0.0_dp)//'; the last checkpoint, '// &
                      trim(path)//', is kept')
     end subroutine write_failed
+
+    ! A collective write of the checkpoint failed (every rank knows it): rank 0 removes the partial
+    ! .tmp, the last checkpoint stays, every rank stops.
+    subroutine write_failed_everywhere(what)
+      character(len=*), intent(in) :: what
+      integer :: e
+      if (is_root()) e = remove_file(tmp)
+      call abort_if_any(.true., trim(tmp)//' '//what//': '//write_failure_cause(dir, 0.0_dp)// &
+                        '; the last checkpoint, '//trim(path)//', is kept')
+    end subroutine write_failed_everywhere
 
     subroutine put_int(name, values)
       character(len=*), intent(in) :: name

@@ -2,7 +2,9 @@
 ! (N x 3 as seen from C/Python, units of a) and the attribute box (Lx, Ly, Lz) in every file that
 ! holds particles, plus in checkpoints the state an exact restart needs (velocity, omega, the
 ! Adams-Bashforth history). Reading is done by rank 0 and broadcast; a bad file stops the run
-! with one message naming the file and the item.
+! with one message naming the file and the item. Writing is collective (issue 45): every rank
+! writes the rows of the spheres it owns into the same datasets through parallel HDF5
+! (mod_h5_parallel), so that the writers already take only what a rank owns.
 #include <petsc/finclude/petscsys.h>
 module mod_particles_io
   use hdf5
@@ -10,13 +12,26 @@ module mod_particles_io
   use mod_kinds, only: dp
   use mod_params, only: config_t
   use mod_particles, only: particles_t, particles_init, motion_code, configuration_fault
-  use mod_h5util, only: read_values, write_attribute, read_attribute, has_object, write_dataset, read_dataset, dataset_dims
-  use mod_errors, only: is_root, input_error, file_error, file_error_from_root, abort_run
+  use mod_h5util, only: read_values, write_attribute, read_attribute, has_object, read_dataset, dataset_dims
+  use mod_h5_parallel, only: h5_parallel_create, h5_parallel_close, h5_parallel_write_columns, h5_parallel_agree
+  use mod_errors, only: is_root, input_error, file_error, file_error_from_root, abort_run, abort_if_any
   use mod_os_services, only: publish_file
-  use mod_file_services, only: errno_text, write_failure_cause, directory_of
+  use mod_file_services, only: errno_text, write_failure_cause, directory_of, require_free_space
   implicit none
   private
-  public :: particles_load, particles_write, particles_read_state, particles_snapshot
+  public :: particles_load, particles_write, particles_read_state, particles_snapshot, owned_spheres, owned_spheres_rule
+
+  ! The spheres this rank writes, given the particles' positions x (3, n) in a box of height lz:
+  ! their global indices (1-based, ascending). Every sphere is written by exactly one rank. The
+  ! program sets the rule (mod_sphere_ownership: the rank whose z-slab holds the sphere's centre);
+  ! without one, rank 0 writes every sphere (owned_spheres).
+  abstract interface
+    function owned_spheres_rule(x, lz) result(owned)
+      import :: dp
+      real(dp), intent(in) :: x(:, :), lz
+      integer, allocatable :: owned(:)
+    end function owned_spheres_rule
+  end interface
 
 contains
 
@@ -170,45 +185,130 @@ contains
     call h5fclose_f(file, err)
   end subroutine read_positions
 
-  ! Write /particles into an open file (rank 0 only): position with attribute box, and with
-  ! state = .true. everything an exact restart needs.
-  subroutine particles_write(file, parts, box, state)
+  ! Write /particles into a file open on every rank through MPI-IO (mod_h5_parallel; doc/DESIGN.md
+  ! "Files"): position with attribute box, and with state = .true. everything an exact restart
+  ! needs. Collective: every rank makes the same metadata calls (the group, the datasets and
+  ! their attributes, with the replicated values), and each writes the columns of the spheres
+  ! OWNED (global indices, unique over the ranks: owned_spheres) in one collective transfer per
+  ! dataset. message: '' or what failed, the same on every rank.
+  subroutine particles_write(file, parts, box, state, owned, message)
     integer(HID_T), intent(in) :: file
     type(particles_t), intent(in) :: parts
     real(dp), intent(in) :: box(3)
     logical, intent(in) :: state
+    integer, intent(in) :: owned(:)
+    character(len=*), intent(out) :: message
     integer(HID_T) :: group, dset
-    integer :: err, e
+    integer :: err, e, attributes
+    message = ''
+    call check_partition(owned, parts%n)
     call h5gcreate_f(file, 'particles', group, err)
-    if (err /= 0) call abort_run('cannot create the group /particles')
-    call write_matrix(group, 'position', parts%position)
-    call h5dopen_f(group, 'position', dset, err)
-    call write_attribute(dset, 'box', box, e)
-    call h5dclose_f(dset, err)
-    call write_attribute(group, 'box', box, e)
-    call write_attribute(group, 'radius', [parts%radius], e)
-    if (state) then
-      call write_matrix(group, 'velocity', parts%velocity)
-      call write_matrix(group, 'omega', parts%omega)
-      call write_matrix(group, 'velocity_prev', parts%velocity_prev)
+    call h5_parallel_agree(err)
+    if (err /= 0) then
+      message = 'cannot take the group /particles'
+      return
+    end if
+    ! the attributes' failures, agreed once at the end (they are metadata, which every rank
+    ! writes alike in its cache and rank 0 writes to the file)
+    attributes = 0
+    call particle_columns(group, 'position', parts%position(:, owned), parts%n, owned, message)
+    if (len_trim(message) == 0) then
+      call h5dopen_f(group, 'position', dset, err)
+      attributes = max(attributes, abs(err))
+      if (err == 0) then
+        call write_attribute(dset, 'box', box, e)
+        attributes = max(attributes, abs(e))
+        call h5dclose_f(dset, e)
+      end if
+      call write_attribute(group, 'box', box, e)
+      attributes = max(attributes, abs(e))
+      call write_attribute(group, 'radius', [parts%radius], e)
+      attributes = max(attributes, abs(e))
+    end if
+    if (state .and. len_trim(message) == 0) then
+      call particle_columns(group, 'velocity', parts%velocity(:, owned), parts%n, owned, message)
+      call particle_columns(group, 'omega', parts%omega(:, owned), parts%n, owned, message)
+      call particle_columns(group, 'velocity_prev', parts%velocity_prev(:, owned), parts%n, owned, message)
       call write_attribute(group, 'have_prev', [merge(1, 0, parts%have_prev)], e)
+      attributes = max(attributes, abs(e))
       call write_attribute(group, 'motion', [parts%motion], e)
+      attributes = max(attributes, abs(e))
       ! a mixture's radii, which a restart checks against its deck's (equal spheres: the attribute)
-      if (any(parts%radii /= parts%radius)) call write_dataset(group, 'radius', reshape(parts%radii, [1, parts%n]), e)
+      if (any(parts%radii /= parts%radius)) &
+        call particle_columns(group, 'radius', reshape(parts%radii(owned), [1, size(owned)]), parts%n, owned, message)
     end if
     call h5gclose_f(group, err)
+    attributes = max(attributes, abs(err))
+    call h5_parallel_agree(attributes)
+    if (attributes /= 0 .and. len_trim(message) == 0) message = 'cannot take the attributes of /particles'
   end subroutine particles_write
 
-  ! A particle snapshot for viewing (rank 0): OUTDIR/particles_NNNNNNNN.h5 (/particles: position,
-  ! velocity, omega, and radius per sphere for glyph scaling) and OUTDIR/particles.xmf, the XDMF
-  ! time series of the snapshots written so far by this run (ParaView: open it, apply Glyph
-  ! Sphere scaled by radius).
-  subroutine particles_snapshot(outdir, parts, box, step, time)
+  ! The dataset /particles/NAME (k, n) from this rank's columns VALUES of the spheres OWNED, unless
+  ! an earlier dataset failed (message set). Collective.
+  subroutine particle_columns(group, name, values, n, owned, message)
+    integer(HID_T), intent(in) :: group
+    character(len=*), intent(in) :: name
+    real(dp), intent(in) :: values(:, :)
+    integer, intent(in) :: n, owned(:)
+    character(len=*), intent(inout) :: message
+    integer :: err
+    if (len_trim(message) > 0) return
+    call h5_parallel_write_columns(group, name, n, owned, values, err)
+    if (err /= 0) message = 'cannot take /particles/'//name
+  end subroutine particle_columns
+
+  ! Every one of the n spheres is written by exactly one rank: the ranks' counts add up to n
+  ! (always: one reduction of an integer), and in a debug build (make debug) each sphere is
+  ! counted once over the ranks (a reduction of n integers). A fault is the program's: stop.
+  ! Collective.
+  subroutine check_partition(owned, n)
+    integer, intent(in) :: owned(:), n
+    integer :: total
+    PetscErrorCode :: ierr
+#ifdef FDSUSP_DEBUG
+    integer :: times(n)
+#endif
+    call MPI_Allreduce(size(owned), total, 1, MPI_INTEGER, MPI_SUM, PETSC_COMM_WORLD, ierr)
+    call abort_if_any(total /= n .or. any(owned < 1 .or. owned > n), &
+                      'internal error: the ranks own other spheres than the n of the particles (mod_particles_io)')
+#ifdef FDSUSP_DEBUG
+    times = 0
+    times(owned) = times(owned) + 1
+    call MPI_Allreduce(MPI_IN_PLACE, times, n, MPI_INTEGER, MPI_SUM, PETSC_COMM_WORLD, ierr)
+    call abort_if_any(any(times /= 1), 'internal error: a sphere is written by more than one rank or by none '// &
+                      '(mod_particles_io)')
+#endif
+  end subroutine check_partition
+
+  ! The spheres this rank writes: RULE's (set by the program: checkpoint_state_t%owned_spheres) at
+  ! the particles' positions, or, without a rule, every sphere on rank 0 and none elsewhere.
+  function owned_spheres(rule, parts, box) result(owned)
+    procedure(owned_spheres_rule), pointer, intent(in) :: rule
+    type(particles_t), intent(in) :: parts
+    real(dp), intent(in) :: box(3)
+    integer, allocatable :: owned(:)
+    integer :: i
+    if (associated(rule)) then
+      owned = rule(parts%position, box(3))
+    else if (is_root()) then
+      owned = [(i, i = 1, parts%n)]
+    else
+      allocate(owned(0))
+    end if
+  end function owned_spheres
+
+  ! A particle snapshot for viewing: OUTDIR/particles_NNNNNNNN.h5 (/particles: position,
+  ! velocity, omega, and radius per sphere for glyph scaling), written by every rank, each the
+  ! spheres OWNED (owned_spheres), and OUTDIR/particles.xmf, the XDMF time series of the snapshots
+  ! written so far by this run (ParaView: open it, apply Glyph Sphere scaled by radius), written by
+  ! rank 0. Collective.
+  subroutine particles_snapshot(outdir, parts, box, step, time, owned)
     character(len=*), intent(in) :: outdir
     type(particles_t), intent(in) :: parts
     real(dp), intent(in) :: box(3)
     integer, intent(in) :: step
     real(dp), intent(in) :: time
+    integer, intent(in) :: owned(:)
     integer, save :: nsnap = 0
     integer, allocatable, save :: steps(:)
     real(dp), allocatable, save :: times(:)
@@ -217,10 +317,10 @@ contains
     character(len=32) :: h5
     character(len=64) :: dims
     character(len=1100) :: path
-    character(len=200) :: line
+    character(len=200) :: line, message
     character(len=:), allocatable :: doc
     character(len=1) :: nl
-    if (.not. is_root()) return
+    ! (every rank keeps the list of snapshots, so that every rank skips the same ones)
     if (.not. allocated(steps)) allocate(steps(0), times(0))
     if (nsnap > 0) then
       if (steps(nsnap) == step) return          ! already written (last record of the run)
@@ -228,22 +328,30 @@ contains
     write(h5, '(a,i8.8,a)') 'particles_', step, '.h5'
     ! written to .tmp and renamed: a snapshot on disk is whole (a full disk stops the run, naming it)
     path = trim(outdir)//'/'//trim(h5)
-    call h5fcreate_f(trim(path)//'.tmp', H5F_ACC_TRUNC_F, file, err)
-    if (err /= 0) call write_failed(path, 'cannot be created')
-    call particles_write(file, parts, box, .false.)
-    call h5gopen_f(file, 'particles', group, err)
-    call write_matrix(group, 'velocity', parts%velocity)
-    call write_matrix(group, 'omega', parts%omega)
-    call write_dataset(group, 'radius', reshape(parts%radii, [1, parts%n]), err)
-    if (err /= 0) call write_failed(path, 'cannot take /particles/radius')
-    call h5gclose_f(group, err)
-    call h5fclose_f(file, err)
-    if (err /= 0) call write_failed(path, 'cannot be completed (closing it failed)')
-    err = publish_file(trim(path)//'.tmp', path)
-    if (err /= 0) call write_failed(path, 'cannot be published ('//errno_text(err)//')')
+    ! a full disk stops every rank here, before the parallel write (mod_file_services)
+    call require_free_space(outdir, 8.0_dp * 10 * parts%n, trim(path)//'.tmp')
+    call h5_parallel_create(trim(path)//'.tmp', file, err)
+    if (err /= 0) call write_failed_everywhere(path, 'cannot be created')
+    call particles_write(file, parts, box, .false., owned, message)
+    if (len_trim(message) == 0) then
+      call h5gopen_f(file, 'particles', group, err)
+      call h5_parallel_agree(err)
+      if (err /= 0) message = 'cannot take /particles'
+      call particle_columns(group, 'velocity', parts%velocity(:, owned), parts%n, owned, message)
+      call particle_columns(group, 'omega', parts%omega(:, owned), parts%n, owned, message)
+      call particle_columns(group, 'radius', reshape(parts%radii(owned), [1, size(owned)]), parts%n, owned, message)
+      if (err == 0) call h5gclose_f(group, err)
+    end if
+    if (len_trim(message) > 0) call write_failed_everywhere(path, trim(message))
+    call h5_parallel_close(file, err)
+    if (err /= 0) call write_failed_everywhere(path, 'cannot be completed (closing it failed)')
     nsnap = nsnap + 1
     steps = [steps, step]
     times = [times, time]
+    ! every rank has closed the file: rank 0 publishes it and writes the index
+    if (.not. is_root()) return
+    err = publish_file(trim(path)//'.tmp', path)
+    if (err /= 0) call write_failed(path, 'cannot be published ('//errno_text(err)//')')
     write(dims, '(i0,a)') parts%n, ' 3'
     ! the XDMF index, assembled whole and written with one checked statement
     nl = new_line('a')
@@ -285,27 +393,18 @@ contains
     end subroutine attribute
   end subroutine particles_snapshot
 
-  subroutine write_matrix(group, name, values)
-    integer(HID_T), intent(in) :: group
-    character(len=*), intent(in) :: name
-    real(dp), intent(in) :: values(:, :)
-    integer :: err
-    character(len=1024) :: file
-    integer(SIZE_T) :: length
-    call write_dataset(group, name, values, err)
-    if (err /= 0) then
-      file = ''
-      call h5fget_name_f(group, file, length, err)
-      call abort_run(trim(file)//' cannot take /particles/'//name//': '// &
-                     write_failure_cause(directory_of(file), 8.0_dp * size(values)))
-    end if
-  end subroutine write_matrix
-
   ! A write of a particle file failed: stop the run naming the file and the cause.
   subroutine write_failed(path, what)
     character(len=*), intent(in) :: path, what
     call abort_run(trim(path)//' '//what//': '//write_failure_cause(directory_of(path), 0.0_dp))
   end subroutine write_failed
+
+  ! A collective write of a particle file failed (every rank knows it): stop the run naming the
+  ! file and the cause (rank 0 prints, every rank stops).
+  subroutine write_failed_everywhere(path, what)
+    character(len=*), intent(in) :: path, what
+    call abort_if_any(.true., trim(path)//' '//what//': '//write_failure_cause(directory_of(path), 0.0_dp))
+  end subroutine write_failed_everywhere
 
   ! Restart: positions, velocities and history from a checkpoint (collective). The particle count
   ! must match the deck's.

@@ -20,7 +20,7 @@ module mod_run_output
   use mod_output, only: write_fields, progress_line
   use mod_checkpoint, only: checkpoint_state_t, checkpoint_write
   use mod_particles, only: particles_t, particles_columns
-  use mod_particles_io, only: particles_snapshot
+  use mod_particles_io, only: particles_snapshot, owned_spheres
   use mod_particle_contacts, only: particle_contacts_t, particle_contacts_columns
   use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_columns
   use mod_rheology, only: rheology_t, rheo_accumulate, rheo_summarise, rheo_columns, summary_names, NSUMMARY, &
@@ -170,7 +170,8 @@ contains
       end if
       if (schedule%particles_every > 0 .and. associated(out%parts)) then
         if (mod(step, schedule%particles_every) == 0) &
-          call particles_snapshot(schedule%directory, out%parts, out%cfg%domain%box, step, time)
+          call particles_snapshot(schedule%directory, out%parts, out%cfg%domain%box, step, time, &
+                                  owned_spheres(out%state%owned_spheres, out%parts, out%cfg%domain%box))
       end if
       if (schedule%checkpoint_every > 0) then
         if (mod(step, schedule%checkpoint_every) == 0) then
@@ -207,7 +208,8 @@ contains
         PetscCall(write_fields(out%cfg%output%directory, out%grid, out%fluid, step, time, ierr))
       end if
       if (associated(out%parts)) call particles_snapshot(out%cfg%output%directory, out%parts, out%cfg%domain%box, &
-                                                         step, time)
+                                                         step, time, owned_spheres(out%state%owned_spheres, &
+                                                         out%parts, out%cfg%domain%box))
       PetscCall(run_output_checkpoint(out, step, time, ierr))
     end if
     if (associated(out%rheology)) call summary(out, step)

@@ -40,6 +40,7 @@ program fdsusp
                                    fictitious_domain_pair_lag_limit, fictitious_domain_stresslet_lag_limit
   use mod_lubrication_dynamics, only: lubrication_dynamics_t, lubrication_dynamics_create
   use mod_particle_solver, only: particle_solver_t, particle_solver_create, particle_solver_destroy
+  use mod_sphere_ownership, only: sphere_ownership_mine
   use mod_checkpoint, only: checkpoint_state_t, checkpoint_check, checkpoint_read
   use mod_time_step, only: time_step_t, time_step_create, time_step_advance, time_step_guard, time_step_report
   use mod_run_output, only: run_output_t, run_output_open, run_output_step, run_output_checkpoint, &
@@ -380,6 +381,8 @@ contains
     if (has_particles) then
       parts_p => parts
       state%parts => parts
+      ! each rank writes the per-sphere rows of the spheres in its z-slab (mod_particles_io)
+      state%owned_spheres => sphere_ownership_mine
       if (cfg%resolved) state%lambda => fd%lambda
     end if
     if (allocated(pc)) then

@@ -18,7 +18,8 @@
 ! stresslets, prescribed motion and external loads), which each step recomputes or the deck gives.
 ! The fluid runs the Krylov path (-fluid_solver krylov), the one that keeps u*^{n-1}.
 ! Singleton here; on 3 ranks (tests/regression/test_unit_petsc_ranks.sh) the fields go through
-! PETSc's parallel HDF5 viewer.
+! PETSc's parallel HDF5 viewer, and each rank writes the /particles rows of the spheres in its
+! z-slab (mod_particles_io), as the program does.
 #include <petsc/finclude/petscdmda.h>
 program test_checkpoint_roundtrip
   use, intrinsic :: iso_fortran_env, only: output_unit
@@ -31,6 +32,7 @@ program test_checkpoint_roundtrip
   use mod_contact, only: contact_history_t, history_unpack, wall_lower, wall_upper
   use mod_rheology, only: rheology_t, rheo_create, rheo_state
   use mod_checkpoint, only: checkpoint_state_t, checkpoint_write, checkpoint_check, checkpoint_read
+  use mod_sphere_ownership, only: sphere_ownership_mine
   use mod_h5util, only: h5util_init
   use mod_os_services, only: make_directory
   use mod_unit_checks, only: check, finish
@@ -140,6 +142,7 @@ program test_checkpoint_roundtrip
   state%fl => fl
   state%lambda => lambda
   state%parts => parts
+  state%owned_spheres => sphere_ownership_mine
   state%history => history
   state%rh => rh
   PetscCallA(checkpoint_write(path, cfg, state, saved_step, saved_time, ierr))

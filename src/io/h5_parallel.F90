@@ -1,0 +1,212 @@
+! Parallel HDF5 (MPI-IO) for the files every rank writes together (doc/DESIGN.md "Files", issue 45):
+! open or create a file collectively, and write a (k, N) dataset of doubles, one column per sphere,
+! from the columns each rank owns, given their global indices (any set: a rank with none takes
+! part all the same). The dataset is the one write_dataset_2d (mod_h5util) makes: one chunk with
+! HDF5's Fletcher-32 checksum. HDF5 1.10.2 and later (Debian bookworm has 1.10.8) write filtered
+! datasets in parallel, collectively only: every transfer here is collective (H5FD_MPIO_COLLECTIVE),
+! and the ranks send their columns to the rank that owns the chunk, which filters and writes it.
+! Every call is collective and returns an err agreed by all ranks (the largest): a failure seen by
+! one rank is seen by every rank, so that no rank waits in the next collective call for ever.
+! In parallel HDF5 every rank must make the same metadata calls (groups, datasets, attributes)
+! with the same values: the callers make them on every rank with the replicated values.
+#include <petsc/finclude/petscsys.h>
+module mod_h5_parallel
+  use hdf5
+  use petscsys
+  use, intrinsic :: iso_c_binding, only: c_loc, c_ptr
+  use mod_kinds, only: dp
+  implicit none
+  private
+  public :: h5_parallel_create, h5_parallel_open, h5_parallel_close, h5_parallel_write_columns, h5_parallel_agree
+
+  ! the most runs of consecutive columns selected as a union of hyperslabs (more: element by
+  ! element; h5_parallel_write_columns): few enough that both ways serve in the tests'
+  ! small scenes (tests/regression/test_particles_parallel_io.py: 2 to 6 runs a rank)
+  integer, parameter :: max_hyperslabs = 4
+
+contains
+
+  !> Create (truncate) the file PATH for every rank through MPI-IO on PETSC_COMM_WORLD. Collective.
+  subroutine h5_parallel_create(path, file, err)
+    character(len=*), intent(in) :: path
+    integer(HID_T), intent(out) :: file
+    integer, intent(out) :: err
+    integer(HID_T) :: fapl
+    call mpio_access(fapl, err)
+    if (err == 0) call h5fcreate_f(path, H5F_ACC_TRUNC_F, file, err, access_prp=fapl)
+    call close_plist(fapl)
+    call h5_parallel_agree(err)
+  end subroutine h5_parallel_create
+
+  !> Open the existing file PATH read-write for every rank through MPI-IO. Collective.
+  subroutine h5_parallel_open(path, file, err)
+    character(len=*), intent(in) :: path
+    integer(HID_T), intent(out) :: file
+    integer, intent(out) :: err
+    integer(HID_T) :: fapl
+    call mpio_access(fapl, err)
+    if (err == 0) call h5fopen_f(path, H5F_ACC_RDWR_F, file, err, access_prp=fapl)
+    call close_plist(fapl)
+    call h5_parallel_agree(err)
+  end subroutine h5_parallel_open
+
+  !> Close a file opened by h5_parallel_create or h5_parallel_open (its metadata are written
+  !> now). Collective.
+  subroutine h5_parallel_close(file, err)
+    integer(HID_T), intent(in) :: file
+    integer, intent(out) :: err
+    call h5fclose_f(file, err)
+    call h5_parallel_agree(err)
+  end subroutine h5_parallel_close
+
+  !> The dataset NAME (k, n) in LOC, of doubles, one chunk with Fletcher-32 (as mod_h5util's
+  !> write_dataset): this rank writes its columns values(:, j) into the file's columns
+  !> columns(j) (1-based global indices, unique over all ranks, in any order; none: size 0), in
+  !> one collective transfer. Collective; every rank passes the same name, k and n.
+  subroutine h5_parallel_write_columns(loc, name, n, columns, values, err)
+    integer(HID_T), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: n
+    integer, intent(in) :: columns(:)
+    real(dp), intent(in) :: values(:, :)
+    integer, intent(out) :: err
+    integer(HID_T) :: file_space, memory_space, dcpl, dxpl, dset
+    integer(HSIZE_T) :: dims(2)
+    integer :: e, m, j, c, first, runs
+    integer(HSIZE_T), allocatable :: points(:, :)
+    integer, allocatable :: order(:)
+    real(dp), allocatable, target :: buffer(:, :)
+    type(c_ptr) :: data
+
+    m = size(columns)
+    dims = [size(values, 1, kind=HSIZE_T), int(n, HSIZE_T)]
+    dset = -1
+    call h5screate_simple_f(2, dims, file_space, err)
+    ! one chunk with Fletcher-32, as a dataset of mod_h5util (a dataset of no elements cannot be
+    ! chunked); HDF5 allocates the chunk of a parallel file when the dataset is created
+    call h5pcreate_f(H5P_DATASET_CREATE_F, dcpl, e)
+    err = max(err, abs(e))
+    if (err == 0 .and. all(dims > 0)) then
+      call h5pset_chunk_f(dcpl, 2, dims, err)
+      if (err == 0) call h5pset_fletcher32_f(dcpl, err)
+    end if
+    if (err == 0) call h5dcreate_f(loc, name, H5T_NATIVE_DOUBLE, file_space, dset, err, dcpl)
+    call close_plist(dcpl)
+    call h5_parallel_agree(err)
+    if (err /= 0) then
+      if (dset >= 0) call h5dclose_f(dset, e)
+      call h5sclose_f(file_space, e)
+      return
+    end if
+
+    ! the file's columns of this rank, which HDF5 transfers in the file's order: the buffer holds
+    ! them by ascending index. Selected as a union of hyperslabs (one per run of consecutive
+    ! indices) when the runs are few, else element by element: HDF5 1.10's union of hyperslabs
+    ! costs about quadratically in the runs (1934 spheres in z-slabs on 2 ranks, ~970 runs a
+    ! rank: 72 ms a step of a checkpoint and a snapshot, by elements 16 ms; doc/BENCHMARKS.md
+    ! §18), while the elements cost in proportion to the values (all spheres on one rank, 1 run:
+    ! 21 ms a step by elements, 13 ms by one hyperslab).
+    order = ascending(columns)
+    allocate(buffer(size(values, 1), max(1, m)))
+    buffer = 0.0_dp
+    if (m > 0) buffer(:, 1:m) = values(:, order)
+    runs = 0
+    do j = 1, m
+      if (j == 1) then
+        runs = 1
+      else if (columns(order(j)) /= columns(order(j - 1)) + 1) then
+        runs = runs + 1
+      end if
+    end do
+    call h5sselect_none_f(file_space, err)
+    if (runs > max_hyperslabs) then
+      allocate(points(2, size(values, 1) * m))
+      do j = 1, m
+        do c = 1, size(values, 1)
+          points(:, (j - 1) * size(values, 1) + c) = [int(c, HSIZE_T), int(columns(order(j)), HSIZE_T)]
+        end do
+      end do
+      call h5sselect_elements_f(file_space, H5S_SELECT_SET_F, 2, size(points, 2, kind=SIZE_T), points, err)
+    else
+      first = 1
+      do j = 1, m
+        if (err /= 0) exit
+        if (j < m) then
+          if (columns(order(j + 1)) == columns(order(j)) + 1) cycle
+        end if
+        ! the run columns(order(first:j))
+        call h5sselect_hyperslab_f(file_space, H5S_SELECT_OR_F, [0_HSIZE_T, int(columns(order(first)) - 1, HSIZE_T)], &
+                                   [dims(1), int(j - first + 1, HSIZE_T)], err)
+        first = j + 1
+      end do
+    end if
+    call h5screate_simple_f(1, [size(buffer, kind=HSIZE_T)], memory_space, e)
+    err = max(err, abs(e))
+    if (m == 0) call h5sselect_none_f(memory_space, e)
+    err = max(err, abs(e))
+    call h5pcreate_f(H5P_DATASET_XFER_F, dxpl, e)
+    err = max(err, abs(e))
+    call h5pset_dxpl_mpio_f(dxpl, H5FD_MPIO_COLLECTIVE_F, e)
+    err = max(err, abs(e))
+    ! a rank whose selections failed still takes part (selecting nothing), so that the
+    ! collective transfer completes on every rank; the failure is agreed after it
+    if (err /= 0) then
+      call h5sselect_none_f(file_space, e)
+      call h5sselect_none_f(memory_space, e)
+    end if
+    data = c_loc(buffer)
+    call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, data, e, mem_space_id=memory_space, file_space_id=file_space, &
+                    xfer_prp=dxpl)
+    err = max(err, abs(e))
+    call close_plist(dxpl)
+    call h5sclose_f(memory_space, e)
+    call h5sclose_f(file_space, e)
+    call h5dclose_f(dset, e)
+    err = max(err, abs(e))
+    call h5_parallel_agree(err)
+  end subroutine h5_parallel_write_columns
+
+  !> err becomes the largest of all ranks' (0 when no rank failed). Collective.
+  subroutine h5_parallel_agree(err)
+    integer, intent(inout) :: err
+    integer :: mine
+    PetscErrorCode :: ierr
+    mine = abs(err)
+    call MPI_Allreduce(mine, err, 1, MPI_INTEGER, MPI_MAX, PETSC_COMM_WORLD, ierr)
+    if (ierr /= 0) err = max(1, mine)
+  end subroutine h5_parallel_agree
+
+  ! A file access list for MPI-IO on PETSC_COMM_WORLD.
+  subroutine mpio_access(fapl, err)
+    integer(HID_T), intent(out) :: fapl
+    integer, intent(out) :: err
+    call h5pcreate_f(H5P_FILE_ACCESS_F, fapl, err)
+    if (err == 0) call h5pset_fapl_mpio_f(fapl, PETSC_COMM_WORLD, MPI_INFO_NULL, err)
+  end subroutine mpio_access
+
+  subroutine close_plist(plist)
+    integer(HID_T), intent(in) :: plist
+    integer :: e
+    call h5pclose_f(plist, e)
+  end subroutine close_plist
+
+  ! The permutation that sorts x ascending (insertion sort: a rank's spheres come nearly sorted,
+  ! in index order, from their ownership).
+  pure function ascending(x) result(order)
+    integer, intent(in) :: x(:)
+    integer :: order(size(x))
+    integer :: i, j, t
+    order = [(i, i = 1, size(x))]
+    do i = 2, size(x)
+      t = order(i)
+      j = i - 1
+      do while (j >= 1)
+        if (x(order(j)) <= x(t)) exit
+        order(j + 1) = order(j)
+        j = j - 1
+      end do
+      order(j + 1) = t
+    end do
+  end function ascending
+
+end module mod_h5_parallel
