@@ -24,6 +24,7 @@
 module mod_sphere_halo
   use petscsys
   use mod_kinds, only: dp
+  use mod_sorting, only: ascending_order
   implicit none
   private
   public :: sphere_halo_t, sphere_halo_create, sphere_halo_migrate, sphere_halo_build, sphere_halo_forward, &
@@ -124,9 +125,8 @@ contains
     logical, intent(out), optional :: far
     integer :: n, k, i, m, w, nb, total, kept, beyond, ndest
     integer, allocatable :: dest(:), send_count(:), recv_count(:), order(:), new_id(:), offset(:), roffset(:)
-    integer, allocatable :: requests(:), send_displ(:), recv_displ(:)
+    integer, allocatable :: send_displ(:), recv_displ(:)
     real(dp), allocatable :: send_buf(:), recv_buf(:), new_x(:, :), new_data(:, :)
-    integer :: nreq
 
     ierr = 0
     n = size(id)
@@ -189,11 +189,7 @@ contains
       call MPI_Alltoallv(send_buf, send_count * w, send_displ, MPI_DOUBLE_PRECISION, recv_buf, recv_count * w, &
                          recv_displ, MPI_DOUBLE_PRECISION, PETSC_COMM_WORLD, ierr)
     else
-      allocate(requests(2 * nb))
-      nreq = 0
-      call post(h, send_buf, offset, recv_buf, roffset, requests, nreq, ierr)
-      if (ierr /= 0) return
-      call MPI_Waitall(nreq, requests, MPI_STATUSES_IGNORE, ierr)
+      call swap(h, send_buf, offset, recv_buf, roffset, ierr)
     end if
     if (ierr /= 0) return
     h%bytes_sent = h%bytes_sent + 8_8 * offset(ndest + 1)
@@ -215,7 +211,7 @@ contains
       new_x(:, m) = recv_buf((i - 1) * w + 2:(i - 1) * w + 4)
       new_data(:, m) = recv_buf((i - 1) * w + 5:i * w)
     end do
-    order = ascending(new_id)
+    order = ascending_order(new_id)
     id = new_id(order)
     x = new_x(:, order)
     data = new_data(:, order)
@@ -238,8 +234,8 @@ contains
     type(sphere_halo_t), intent(inout) :: h
     real(dp), allocatable, intent(inout) :: x(:, :)
     PetscErrorCode, intent(out) :: ierr
-    integer :: nb, m, i, n, g, total, nreq
-    integer, allocatable :: send_count(:), recv_count(:), order(:), own_id(:), all_id(:), requests(:)
+    integer :: nb, m, i, n, g, total
+    integer, allocatable :: send_count(:), recv_count(:), order(:), own_id(:), all_id(:)
     integer, allocatable :: send_own(:)
     real(dp), allocatable :: send_buf(:), recv_buf(:), own_x(:, :)
     integer :: offset(size(h%neighbour) + 1), roffset(size(h%neighbour) + 1)
@@ -247,6 +243,7 @@ contains
     ierr = 0
     nb = size(h%neighbour)
     n = h%owned
+    allocate(own_id(n), own_x(3, n))
     own_id = h%id(1:n)
     own_x = x(:, 1:n)
     ! what goes to each neighbour: the own spheres within reach of its slab, ascending
@@ -280,11 +277,7 @@ contains
     do g = 1, size(send_own)
       send_buf(4 * g - 3:4 * g) = [real(own_id(send_own(g)), dp), own_x(:, send_own(g))]
     end do
-    allocate(requests(2 * nb))
-    nreq = 0
-    call post(h, send_buf, offset, recv_buf, roffset, requests, nreq, ierr)
-    if (ierr /= 0) return
-    call MPI_Waitall(nreq, requests, MPI_STATUSES_IGNORE, ierr)
+    call swap(h, send_buf, offset, recv_buf, roffset, ierr)
     if (ierr /= 0) return
     h%bytes_sent = h%bytes_sent + 8_8 * offset(nb + 1)
     ! the local set: own spheres and ghosts merged in ascending global index
@@ -295,7 +288,7 @@ contains
     do g = 1, h%ghosts
       all_id(n + g) = nint(recv_buf(4 * g - 3))
     end do
-    order = ascending(all_id)        ! local slot l holds entry order(l) of [own; received]
+    order = ascending_order(all_id)        ! local slot l holds entry order(l) of [own; received]
     h%id = all_id(order)
     h%is_owned = order <= n
     deallocate(x)
@@ -360,9 +353,8 @@ contains
     integer, intent(in) :: from(:), from_start(:), to(:), to_start(:)
     real(dp), allocatable, intent(out) :: send_buf(:, :), recv_buf(:, :)
     PetscErrorCode, intent(out) :: ierr
-    integer :: k, nb, m, nreq
+    integer :: k, nb, m
     integer :: offset(size(h%neighbour) + 1), roffset(size(h%neighbour) + 1)
-    integer, allocatable :: requests(:)
     k = size(values, 1)
     nb = size(h%neighbour)
     send_buf = values(:, from)
@@ -371,38 +363,34 @@ contains
       offset(m) = k * (from_start(m) - 1)
       roffset(m) = k * (to_start(m) - 1)
     end do
-    allocate(requests(2 * nb))
-    nreq = 0
-    call post(h, send_buf, offset, recv_buf, roffset, requests, nreq, ierr)
-    if (ierr /= 0) return
-    call MPI_Waitall(nreq, requests, MPI_STATUSES_IGNORE, ierr)
+    call swap(h, send_buf, offset, recv_buf, roffset, ierr)
     h%bytes_sent = h%bytes_sent + 8_8 * offset(nb + 1)
   end subroutine move
 
-  ! Post the receives and sends of one exchange: neighbour m gets send_buf(offset(m)+1:offset(m+1))
-  ! and its part arrives in recv_buf(roffset(m)+1:roffset(m+1)) (flat, any shape).
-  subroutine post(h, send_buf, offset, recv_buf, roffset, requests, nreq, ierr)
+  ! One exchange with the neighbours: neighbour m gets send_buf(offset(m)+1:offset(m+1)) and its
+  ! part arrives in recv_buf(roffset(m)+1:roffset(m+1)) (flat, any shape); returns when both are done.
+  subroutine swap(h, send_buf, offset, recv_buf, roffset, ierr)
     type(sphere_halo_t), intent(in) :: h
     real(dp), intent(in), target :: send_buf(*)
     real(dp), intent(inout), target :: recv_buf(*)
     integer, intent(in) :: offset(:), roffset(:)
-    integer, intent(inout) :: requests(:), nreq
     PetscErrorCode, intent(out) :: ierr
-    integer :: m
+    integer :: m, nb
+    integer :: requests(2 * size(h%neighbour))
+    nb = size(h%neighbour)
     ierr = 0
-    do m = 1, size(h%neighbour)
-      nreq = nreq + 1
+    do m = 1, nb
       call MPI_Irecv(recv_buf(roffset(m) + 1), roffset(m + 1) - roffset(m), MPI_DOUBLE_PRECISION, h%neighbour(m), &
-                     TAG_DATA, PETSC_COMM_WORLD, requests(nreq), ierr)
+                     TAG_DATA, PETSC_COMM_WORLD, requests(m), ierr)
       if (ierr /= 0) return
     end do
-    do m = 1, size(h%neighbour)
-      nreq = nreq + 1
+    do m = 1, nb
       call MPI_Isend(send_buf(offset(m) + 1), offset(m + 1) - offset(m), MPI_DOUBLE_PRECISION, h%neighbour(m), &
-                     TAG_DATA, PETSC_COMM_WORLD, requests(nreq), ierr)
+                     TAG_DATA, PETSC_COMM_WORLD, requests(nb + m), ierr)
       if (ierr /= 0) return
     end do
-  end subroutine post
+    call MPI_Waitall(2 * nb, requests, MPI_STATUSES_IGNORE, ierr)
+  end subroutine swap
 
   ! How many records each neighbour will send: one integer each way per neighbour.
   subroutine exchange_counts(h, send_count, recv_count, ierr)
@@ -426,38 +414,5 @@ contains
     call MPI_Waitall(2 * nb, requests, MPI_STATUSES_IGNORE, ierr)
     h%bytes_sent = h%bytes_sent + 4_8 * nb
   end subroutine exchange_counts
-
-  ! The permutation that sorts distinct integers ascending (a merge sort: n log n, stable).
-  function ascending(key) result(order)
-    integer, intent(in) :: key(:)
-    integer :: order(size(key))
-    integer :: work(size(key)), n, width, lo, mid, hi, i, j, k
-    n = size(key)
-    order = [(i, i = 1, n)]
-    width = 1
-    do while (width < n)
-      lo = 1
-      do while (lo <= n)
-        mid = min(lo + width - 1, n)
-        hi = min(lo + 2 * width - 1, n)
-        i = lo
-        j = mid + 1
-        do k = lo, hi
-          if (j > hi) then
-            work(k) = order(i); i = i + 1
-          else if (i > mid) then
-            work(k) = order(j); j = j + 1
-          else if (key(order(j)) < key(order(i))) then
-            work(k) = order(j); j = j + 1
-          else
-            work(k) = order(i); i = i + 1
-          end if
-        end do
-        lo = hi + 1
-      end do
-      order = work
-      width = 2 * width
-    end do
-  end function ascending
 
 end module mod_sphere_halo

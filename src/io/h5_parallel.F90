@@ -15,6 +15,7 @@ module mod_h5_parallel
   use petscsys
   use, intrinsic :: iso_c_binding, only: c_loc, c_ptr
   use mod_kinds, only: dp
+  use mod_sorting, only: ascending_order
   implicit none
   private
   public :: h5_parallel_create, h5_parallel_open, h5_parallel_close, h5_parallel_write_columns, h5_parallel_agree
@@ -106,7 +107,7 @@ contains
     ! rank: 72 ms a step of a checkpoint and a snapshot, by elements 16 ms; doc/BENCHMARKS.md
     ! §18), while the elements cost in proportion to the values (all spheres on one rank, 1 run:
     ! 21 ms a step by elements, 13 ms by one hyperslab).
-    order = ascending(columns)
+    order = ascending_order(columns)
     allocate(buffer(size(values, 1), max(1, m)))
     buffer = 0.0_dp
     if (m > 0) buffer(:, 1:m) = values(:, order)
@@ -189,24 +190,5 @@ contains
     integer :: e
     call h5pclose_f(plist, e)
   end subroutine close_plist
-
-  ! The permutation that sorts x ascending (insertion sort: a rank's spheres come nearly sorted,
-  ! in index order, from their ownership).
-  pure function ascending(x) result(order)
-    integer, intent(in) :: x(:)
-    integer :: order(size(x))
-    integer :: i, j, t
-    order = [(i, i = 1, size(x))]
-    do i = 2, size(x)
-      t = order(i)
-      j = i - 1
-      do while (j >= 1)
-        if (x(order(j)) <= x(t)) exit
-        order(j + 1) = order(j)
-        j = j - 1
-      end do
-      order(j + 1) = t
-    end do
-  end function ascending
 
 end module mod_h5_parallel
