@@ -295,8 +295,9 @@ contains
     call ensure_spline()
   end subroutine resistance_init
 
-  !> Build the clamped cubic splines of the remainder (once).
-  subroutine ensure_spline()
+  !> Build the clamped cubic splines of the remainder (once). Recursive: it evaluates series_scalars,
+  !> which calls it back and returns at once (spline_ready is set before).
+  recursive subroutine ensure_spline()
     integer :: k, nt, k0, m, fam
     real(dp) :: xin, s_end, slope_lo(n_pair_scalars), slope_hi(n_pair_scalars), g(3), sig, mm, h
     real(dp) :: x11, x12, f0(n_pair_scalars), fp(n_pair_scalars), fm(n_pair_scalars)
