@@ -105,7 +105,7 @@ contains
     ! indices) when the runs are few, else element by element: HDF5 1.10's union of hyperslabs
     ! costs about quadratically in the runs (1934 spheres in z-slabs on 2 ranks, ~970 runs a
     ! rank: 72 ms a step of a checkpoint and a snapshot, by elements 16 ms; doc/BENCHMARKS.md
-    ! §18), while the elements cost in proportion to the values (all spheres on one rank, 1 run:
+    ! §19), while the elements cost in proportion to the values (all spheres on one rank, 1 run:
     ! 21 ms a step by elements, 13 ms by one hyperslab).
     order = ascending_order(columns)
     allocate(buffer(size(values, 1), max(1, m)))
