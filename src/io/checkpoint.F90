@@ -33,9 +33,11 @@
 ! names the pieces (fluid, Lambda, particles, contact history, statistics, offset) for the
 ! checkpoints, the restart and failed_state.h5 alike.
 ! Written in parallel to NAME.tmp: the fields by PETSc's HDF5 viewer, then the per-sphere datasets
-! of /particles by every rank through MPI-IO (mod_particles_io, mod_h5_parallel); completed by
-! rank 0 (signatures, attributes, /contacts, /rheology), flushed to disk and renamed over NAME:
-! the previous checkpoint survives until the new one is whole.
+! of /particles by every rank through MPI-IO (mod_particles_io, mod_h5_parallel), and the fields'
+! checksums with every rank reading a share of each field's rows (the sums of the shares joined in
+! the file's order: joined_sums); completed by rank 0 (attributes, /contacts, /rheology), flushed
+! to disk and renamed over NAME: the previous checkpoint survives until the new one is whole. A
+! restart verifies the fields the same way, in parallel, before rank 0 inspects the rest.
 #include <petsc/finclude/petscdmda.h>
 module mod_checkpoint
   use petscdmda
@@ -82,6 +84,9 @@ module mod_checkpoint
     ! absent: rank 0 writes them all)
     procedure(owned_spheres_rule), pointer, nopass :: owned_spheres => null()
   end type checkpoint_state_t
+
+  ! which datasets walk_datasets reads (see there)
+  integer, parameter :: SHARE_ALL = 0, SHARE_FIELDS = 1, SHARE_REST = 2
 
 contains
 
@@ -152,6 +157,12 @@ contains
                            owned_spheres(state%owned_spheres, state%parts, cfg%domain%box), message)
       if (len_trim(message) > 0) call write_failed_everywhere(trim(message))
     end if
+    ! the fields' checksums, each rank reading a share of their rows (no rank holds a field)
+    unsigned = 0
+    item = ''
+    message = ''
+    call walk_datasets(file, '/', .true., item, message, unsigned, SHARE_FIELDS)
+    if (len_trim(message) > 0) call write_failed_everywhere('cannot sign '//trim(item)//': '//trim(message))
     call h5_parallel_close(file, err)
     if (err /= 0) call write_failed_everywhere('cannot be completed (closing it failed)')
 
@@ -162,12 +173,11 @@ contains
       call h5fopen_f(trim(tmp), H5F_ACC_RDWR_F, file, err)
       if (err /= 0) call write_failed('cannot be reopened to complete the checkpoint')
       failed = .false.
-      ! the fields PETSc wrote: their checksums (the particles', written with Fletcher-32, are
-      ! read and verified)
+      ! the other datasets: the particles', written with Fletcher-32, are read and so verified
       unsigned = 0
       item = ''
       message = ''
-      call walk_datasets(file, '/', .true., item, message, unsigned)
+      call walk_datasets(file, '/', .true., item, message, unsigned, SHARE_REST)
       if (len_trim(message) > 0) call abort_run('cannot sign '//trim(item)//' of '//trim(tmp)//': '//trim(message))
       call put_int('format_version', [checkpoint_format_version])
       call put_int('step', [step])
@@ -303,7 +313,11 @@ contains
     group = ''
     variable = ''
     values = 0.0_dp
-    if (is_root()) call inspect(path, cfg, particles, branch, item, message, values, group, variable, rh)
+    ! the fields against their checksums first, each rank reading a share of their rows (a file
+    ! that cannot be opened so is left to inspect, which names what is wrong with it)
+    call verify_fields(path, item, message)
+    if (is_root() .and. len_trim(message) == 0) &
+      call inspect(path, cfg, particles, branch, item, message, values, group, variable, rh)
     call MPI_Bcast(item, len(item), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
     call MPI_Bcast(group, len(group), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
     call MPI_Bcast(variable, len(variable), MPI_CHARACTER, 0, PETSC_COMM_WORLD, ierr)
@@ -316,6 +330,24 @@ contains
     step = nint(values(1))
     time = values(2)
   end subroutine checkpoint_check
+
+  ! The grid fields of the checkpoint PATH against their checksum attributes, every rank reading
+  ! a share of each field's rows (walk_datasets, SHARE_FIELDS): item and message say the first
+  ! that fails, the same on every rank; nothing when the file cannot be opened through MPI-IO.
+  ! Collective.
+  subroutine verify_fields(path, item, message)
+    character(len=*), intent(in) :: path
+    character(len=*), intent(out) :: item, message
+    integer(HID_T) :: file
+    integer :: err, unverified
+    item = ''
+    message = ''
+    call h5_parallel_open(path, file, err, read_only=.true.)
+    if (err /= 0) return
+    unverified = 0
+    call walk_datasets(file, '/', .false., item, message, unverified, SHARE_FIELDS)
+    call h5_parallel_close(file, err)
+  end subroutine verify_fields
 
   subroutine inspect(path, cfg, particles, branch, item, message, values, group, variable, rh)
     character(len=*), intent(in) :: path
@@ -460,7 +492,7 @@ contains
     ! the data: every dataset read once, against its checksum
     if (len_trim(message) == 0) then
       unverified = 0
-      call walk_datasets(file, '/', .false., item, message, unverified)
+      call walk_datasets(file, '/', .false., item, message, unverified, SHARE_REST)
       if (len_trim(message) == 0 .and. unverified > 0) then
         write(line, '(i0,a)') unverified, ' datasets of the checkpoint carry no checksum (written before '// &
              '2026-11-27): their data cannot be verified'
@@ -479,17 +511,20 @@ contains
   end subroutine inspect
 
   ! Every dataset under GROUP (whose path is PREFIX), recursively, read through (in blocks of at
-  ! most 2^16 values, check_dataset): the read verifies the
-  ! Fletcher-32 checksum of a dataset that has one, and the values are compared with the checksum
-  ! attribute of one that has it. sign: instead, give every dataset without Fletcher-32 its
-  ! checksum attribute (checkpoint_write). A fault sets item (the dataset's path) and message;
-  ! unverified counts the datasets with neither checksum.
-  recursive subroutine walk_datasets(group, prefix, sign, item, message, unverified)
+  ! most 2^16 values, check_dataset): the read verifies the Fletcher-32 checksum of a dataset that
+  ! has one, and the values are compared with the checksum attribute of one that has it. sign:
+  ! instead, give every dataset without Fletcher-32 its checksum attribute (checkpoint_write). A
+  ! fault sets item (the dataset's path) and message; unverified counts the datasets with neither
+  ! checksum. share: which datasets (SHARE_ALL; SHARE_FIELDS, the arrays without Fletcher-32, the
+  ! grid fields, each rank reading a share of the rows, collectively: every rank of
+  ! PETSC_COMM_WORLD walks the file opened through MPI-IO; SHARE_REST, the others, by one rank).
+  recursive subroutine walk_datasets(group, prefix, sign, item, message, unverified, share)
     integer(HID_T), intent(in) :: group
     character(len=*), intent(in) :: prefix
     logical, intent(in) :: sign
     character(len=*), intent(inout) :: item, message
     integer, intent(inout) :: unverified
+    integer, intent(in) :: share
     integer :: storage, nlinks, max_corder, err, k, kind
     integer(HSIZE_T) :: index
     integer(SIZE_T) :: length
@@ -513,33 +548,28 @@ contains
       end if
       call h5iget_type_f(object, kind, err)
       if (kind == H5I_GROUP_F) then
-        call walk_datasets(object, prefix//trim(name)//'/', sign, item, message, unverified)
+        call walk_datasets(object, prefix//trim(name)//'/', sign, item, message, unverified, share)
       else if (kind == H5I_DATASET_F) then
-        call check_dataset(object, prefix//trim(name), sign, item, message, unverified)
+        call check_dataset(object, prefix//trim(name), sign, item, message, unverified, share)
       end if
       call h5oclose_f(object, err)
     end do
   end subroutine walk_datasets
 
-  subroutine check_dataset(dset, path, sign, item, message, unverified)
+  subroutine check_dataset(dset, path, sign, item, message, unverified, share)
     integer(HID_T), intent(in) :: dset
     character(len=*), intent(in) :: path
     logical, intent(in) :: sign
     character(len=*), intent(inout) :: item, message
     integer, intent(inout) :: unverified
-    ! values read at a time: the dataset is read in blocks of its slowest dimension (contiguous
-    ! runs of the file's order), so the rank that signs or verifies a checkpoint holds one block,
-    ! not a whole field (a 1000^3 field is 8 GB; issue 45)
-    integer(HSIZE_T), parameter :: BLOCK_VALUES = 2_HSIZE_T**16
-    integer(HID_T) :: space, ftype, memspace
+    integer, intent(in) :: share
+    integer(HID_T) :: space, ftype
     integer(HSSIZE_T) :: npoints
-    integer(HSIZE_T) :: dims(7), maxdims(7), start(7), counts(7), plane, rows, first
-    integer :: err, class, e, ndims
-    integer(int64) :: sums(2)
-    logical :: fletcher
+    integer(HSIZE_T) :: dims(7), maxdims(7), lo, hi
+    integer :: err, class, e, ndims, rank, ranks
+    integer(int64) :: sums(2), words
+    logical :: fletcher, numeric, field, signed
     real(dp) :: stored(2), computed(2)
-    real(dp), allocatable, target :: values(:)
-    type(c_ptr) :: buffer
     call h5dget_space_f(dset, space, err)
     call h5sget_simple_extent_npoints_f(space, npoints, e)
     call h5sget_simple_extent_ndims_f(space, ndims, e)
@@ -549,42 +579,41 @@ contains
     call h5tget_class_f(ftype, class, e)
     call h5tclose_f(ftype, e)
     fletcher = has_fletcher32(dset)
-    if (class /= H5T_FLOAT_F .and. class /= H5T_INTEGER_F) then
-      call h5sclose_f(space, e)
-      if (.not. fletcher) unverified = unverified + 1
-      return
-    end if
-    ! numbers are read as doubles (integers of 32 bits convert exactly), a block of rows of the
-    ! slowest dimension (the last in Fortran's order) at a time; a scalar dataset in one read
-    sums = 0
-    if (err == 0 .and. npoints > 0) then
-      if (ndims == 0) then
-        allocate(values(1))
-        buffer = c_loc(values)
-        call h5dread_f(dset, H5T_NATIVE_DOUBLE, buffer, err)
-        if (err == 0) call checksum_continue(values, sums)
-      else
-        plane = product(dims(1:ndims - 1))
-        rows = max(1_HSIZE_T, BLOCK_VALUES / plane)
-        allocate(values(min(int(npoints, HSIZE_T), rows * plane)))
-        buffer = c_loc(values)
-        first = 0
-        do while (first < dims(ndims) .and. err == 0)
-          start(1:ndims) = 0
-          start(ndims) = first
-          counts(1:ndims) = dims(1:ndims)
-          counts(ndims) = min(rows, dims(ndims) - first)
-          call h5sselect_hyperslab_f(space, H5S_SELECT_SET_F, start(1:ndims), counts(1:ndims), err)
-          if (err == 0) call h5screate_simple_f(ndims, counts(1:ndims), memspace, err)
-          if (err /= 0) exit
-          call h5dread_f(dset, H5T_NATIVE_DOUBLE, buffer, err, mem_space_id=memspace, file_space_id=space)
-          call h5sclose_f(memspace, e)
-          if (err == 0) call checksum_continue(values(1:counts(ndims) * plane), sums)
-          first = first + counts(ndims)
-        end do
+    signed = has_attribute(dset, 'checksum')
+    numeric = class == H5T_FLOAT_F .or. class == H5T_INTEGER_F
+    ! the fields: arrays of numbers without Fletcher-32 (PETSc's), shared out by rows
+    field = numeric .and. .not. fletcher .and. ndims >= 1 .and. err == 0
+    if (share == SHARE_FIELDS .neqv. field) then
+      if (share == SHARE_REST .and. field .and. .not. signed) unverified = unverified + 1
+      if (share /= SHARE_ALL) then
+        call h5sclose_f(space, e)
+        return
       end if
     end if
+    if (.not. numeric .or. (share == SHARE_FIELDS .and. .not. sign .and. .not. signed)) then
+      ! nothing to check (the field of a checkpoint written before checksums: SHARE_REST counts it)
+      call h5sclose_f(space, e)
+      if (.not. fletcher .and. share /= SHARE_FIELDS) unverified = unverified + 1
+      return
+    end if
+    ! the rows of the slowest dimension (the last in Fortran's order) this rank reads: all of
+    ! them, or with SHARE_FIELDS its share
+    rank = 0
+    ranks = 1
+    if (share == SHARE_FIELDS) then
+      call MPI_Comm_rank(PETSC_COMM_WORLD, rank, e)
+      call MPI_Comm_size(PETSC_COMM_WORLD, ranks, e)
+    end if
+    lo = dims(max(1, ndims)) * rank / ranks
+    hi = dims(max(1, ndims)) * (rank + 1) / ranks
+    sums = 0
+    if (err == 0 .and. npoints > 0) call dataset_sums(dset, space, ndims, dims, lo, hi, sums, err)
     call h5sclose_f(space, e)
+    if (share == SHARE_FIELDS) then
+      ! the ranks' sums joined in the file's order (every rank the same), a failed read agreed
+      words = 2_int64 * product(dims(1:ndims - 1)) * int(hi - lo, int64)
+      call joined_sums(sums, words, err)
+    end if
     if (err /= 0) then
       item = path
       message = 'cannot be read: its data fail their Fletcher-32 checksum or the file is damaged (restart from '// &
@@ -594,13 +623,14 @@ contains
     computed = real(sums, dp)
     if (sign) then
       if (.not. fletcher) then
+        ! (SHARE_FIELDS: every rank writes the same attribute, as parallel HDF5 asks)
         call write_attribute(dset, 'checksum', computed, err)
         if (err /= 0) then
           item = path
           message = 'cannot write its checksum attribute'
         end if
       end if
-    else if (has_attribute(dset, 'checksum')) then
+    else if (signed) then
       call read_attribute(dset, 'checksum', stored, err)
       if (err /= 0 .or. any(stored /= computed)) then
         item = path
@@ -610,6 +640,76 @@ contains
       unverified = unverified + 1
     end if
   end subroutine check_dataset
+
+  ! The checksum's running sums over rows lo..hi-1 of the slowest dimension of a dataset of ndims
+  ! >= 1 dimensions dims (0: a scalar, read whole), read as doubles (integers of 32 bits convert
+  ! exactly) in blocks of rows of at most 2^16 values, so that no rank holds a whole field (a
+  ! 1000^3 field is 8 GB; issue 45). err /= 0: a read failed.
+  subroutine dataset_sums(dset, space, ndims, dims, lo, hi, sums, err)
+    integer(HID_T), intent(in) :: dset, space
+    integer, intent(in) :: ndims
+    integer(HSIZE_T), intent(in) :: dims(:), lo, hi
+    integer(int64), intent(inout) :: sums(2)
+    integer, intent(out) :: err
+    integer(HSIZE_T), parameter :: BLOCK_VALUES = 2_HSIZE_T**16
+    integer(HID_T) :: memspace
+    integer(HSIZE_T) :: start(7), counts(7), plane, rows, first
+    integer :: e
+    real(dp), allocatable, target :: values(:)
+    type(c_ptr) :: buffer
+    err = 0
+    if (ndims == 0) then
+      allocate(values(1))
+      buffer = c_loc(values)
+      call h5dread_f(dset, H5T_NATIVE_DOUBLE, buffer, err)
+      if (err == 0) call checksum_continue(values, sums)
+      return
+    end if
+    plane = product(dims(1:ndims - 1))
+    rows = max(1_HSIZE_T, BLOCK_VALUES / plane)
+    allocate(values(max(1_HSIZE_T, min(hi - lo, rows) * plane)))
+    buffer = c_loc(values)
+    first = lo
+    do while (first < hi .and. err == 0)
+      start(1:ndims) = 0
+      start(ndims) = first
+      counts(1:ndims) = dims(1:ndims)
+      counts(ndims) = min(rows, hi - first)
+      call h5sselect_hyperslab_f(space, H5S_SELECT_SET_F, start(1:ndims), counts(1:ndims), err)
+      if (err == 0) call h5screate_simple_f(ndims, counts(1:ndims), memspace, err)
+      if (err /= 0) exit
+      call h5dread_f(dset, H5T_NATIVE_DOUBLE, buffer, err, mem_space_id=memspace, file_space_id=space)
+      call h5sclose_f(memspace, e)
+      if (err == 0) call checksum_continue(values(1:counts(ndims) * plane), sums)
+      first = first + counts(ndims)
+    end do
+  end subroutine dataset_sums
+
+  ! Each rank's running sums, made from zero over its piece of `words` 32-bit words, become the
+  ! sums of the whole in the ranks' order, on every rank: a piece of m words with sums (a, b)
+  ! after a prefix with (A, B) gives (A + a, B + m A + b) (checksum_continue: every word adds the
+  ! running a to b). err: the largest over the ranks. Collective.
+  subroutine joined_sums(sums, words, err)
+    integer(int64), intent(inout) :: sums(2)
+    integer(int64), intent(in) :: words
+    integer, intent(inout) :: err
+    integer, parameter :: wide = selected_int_kind(30)
+    integer(int64), parameter :: prime = 4294967291_int64
+    integer(int64), allocatable :: all(:, :)
+    integer(int64) :: mine(4)
+    integer :: ranks, r, e
+    call MPI_Comm_size(PETSC_COMM_WORLD, ranks, e)
+    allocate(all(4, ranks))
+    mine = [sums(1), sums(2), words, int(err, int64)]
+    call MPI_Allgather(mine, 4, MPI_INTEGER8, all, 4, MPI_INTEGER8, PETSC_COMM_WORLD, e)
+    err = max(int(maxval(all(4, :))), abs(e))
+    sums = 0
+    do r = 1, ranks
+      sums(2) = int(mod(int(sums(2), wide) + int(mod(all(3, r), prime), wide) * sums(1) + all(2, r), &
+                        int(prime, wide)), int64)
+      sums(1) = mod(sums(1) + all(1, r), prime)
+    end do
+  end subroutine joined_sums
 
   ! Does the dataset carry HDF5's Fletcher-32 filter?
   logical function has_fletcher32(dset)

@@ -39,14 +39,21 @@ contains
     call h5_parallel_agree(err)
   end subroutine h5_parallel_create
 
-  !> Open the existing file PATH read-write for every rank through MPI-IO. Collective.
-  subroutine h5_parallel_open(path, file, err)
+  !> Open the existing file PATH read-write (read_only: read only) for every rank through MPI-IO.
+  !> Collective.
+  subroutine h5_parallel_open(path, file, err, read_only)
     character(len=*), intent(in) :: path
     integer(HID_T), intent(out) :: file
     integer, intent(out) :: err
+    logical, intent(in), optional :: read_only
     integer(HID_T) :: fapl
+    integer :: mode
+    mode = H5F_ACC_RDWR_F
+    if (present(read_only)) then
+      if (read_only) mode = H5F_ACC_RDONLY_F
+    end if
     call mpio_access(fapl, err)
-    if (err == 0) call h5fopen_f(path, H5F_ACC_RDWR_F, file, err, access_prp=fapl)
+    if (err == 0) call h5fopen_f(path, mode, file, err, access_prp=fapl)
     call close_plist(fapl)
     call h5_parallel_agree(err)
   end subroutine h5_parallel_open
