@@ -21,8 +21,8 @@ the uninterrupted run ends, whatever stops its jobs, signals sent the way they a
     least 1; bitwise in practice: restarts are exact, test_restart).
 sbatch and scancel are stand-ins that record their calls (FDSUSP_SUBMIT, FDSUSP_CANCEL); the
 successor 'Slurm would start' is started here by hand with the environment the stand-in was given.
-Set-up: the three spheres of test_contact_restart (contacts with friction, full lubrication), 2
-ranks, 3000 steps, a checkpoint every 2500, so that the kill of job 1 comes before the first and
+Set-up: the three spheres of test_contact_restart (contacts with friction, full lubrication), the
+rank count of the suite (make check RANKS=n) for the chain and the reference alike, 3000 steps, a checkpoint every 2500, so that the kill of job 1 comes before the first and
 before the end: Open MPI lets the ranks run ~1 s after the SIGTERM, and since the direct fluid
 solves (issue 31) this scene takes 2-4 ms per step (with 100 steps, job 1 had finished the run)"""
 import os
@@ -74,7 +74,7 @@ def last_step(log):
 def job(d, job_id, link):
     """Start scripts/slurm/fdsusp.sbatch as job job_id (the batch shell Slurm would start)."""
     env = dict(T.ENV, SLURM_JOB_ID=str(job_id), FDSUSP_LINK=str(link), FDSUSP=T.FDSUSP,
-               FDSUSP_LAUNCH='mpiexec --oversubscribe -n 2', FDSUSP_SUBMIT=os.path.join(d, 'sbatch'),
+               FDSUSP_LAUNCH='mpiexec --oversubscribe -n %d' % T.RANKS, FDSUSP_SUBMIT=os.path.join(d, 'sbatch'),
                FDSUSP_CANCEL=os.path.join(d, 'scancel'))
     out = open(os.path.join(d, 'job-%d.out' % job_id), 'w')
     p = subprocess.Popen(['bash', SCRIPT, 'deck.nml'], cwd=d, env=env, stdout=out, stderr=subprocess.STDOUT)
