@@ -1,5 +1,5 @@
 ! Spheres held by the rank whose z-slab holds their centre, with ghost copies within an interaction
-! range (issue 45 item 2; doc/DESIGN.md "Parallelism", doc/SCALING.md §3 step 4). The building
+! range (issue 45 item 2; doc/DESIGN.md "Spheres held by their slab", doc/SCALING.md §3). The building
 ! block of a particle state that is not replicated: each rank holds its own spheres and copies of
 ! the others' spheres whose centres lie within `reach` of its slab (reach: the largest distance at
 ! which two spheres interact through a kernel, the contact and lubrication cut-offs and the
@@ -11,7 +11,8 @@
 ! order one rank would, so sums over the pairs of local spheres can follow one rank's order.
 !   sphere_halo_create     the slabs (P equal slabs of Lz, those of mod_sphere_ownership) and reach
 !   sphere_halo_migrate    after the spheres moved: each sphere with its data to the rank of its
-!                          slab (collective among neighbours; any rank within reach)
+!                          slab (among neighbours; one all-to-all when a sphere went farther, as
+!                          at the first distribution; one integer reduction decides which)
 !   sphere_halo_build      the ghosts of the own spheres' positions; their global indices and
 !                          slots, and the lists of what goes to each neighbour
 !   sphere_halo_forward    owners' values -> their ghost copies (positions, velocities)
