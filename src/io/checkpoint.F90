@@ -85,9 +85,6 @@ module mod_checkpoint
     procedure(owned_spheres_rule), pointer, nopass :: owned_spheres => null()
   end type checkpoint_state_t
 
-  ! which datasets walk_datasets reads (see there)
-  integer, parameter :: SHARE_ALL = 0, SHARE_FIELDS = 1, SHARE_REST = 2
-
 contains
 
   ! The checkpoint of STATE at step and time, published as PATH once whole.
@@ -161,7 +158,7 @@ contains
     unsigned = 0
     item = ''
     message = ''
-    call walk_datasets(file, '/', .true., item, message, unsigned, SHARE_FIELDS)
+    call walk_datasets(file, '/', .true., item, message, unsigned, fields=.true.)
     if (len_trim(message) > 0) call write_failed_everywhere('cannot sign '//trim(item)//': '//trim(message))
     call h5_parallel_close(file, err)
     if (err /= 0) call write_failed_everywhere('cannot be completed (closing it failed)')
@@ -177,7 +174,7 @@ contains
       unsigned = 0
       item = ''
       message = ''
-      call walk_datasets(file, '/', .true., item, message, unsigned, SHARE_REST)
+      call walk_datasets(file, '/', .true., item, message, unsigned, fields=.false.)
       if (len_trim(message) > 0) call abort_run('cannot sign '//trim(item)//' of '//trim(tmp)//': '//trim(message))
       call put_int('format_version', [checkpoint_format_version])
       call put_int('step', [step])
@@ -332,7 +329,7 @@ contains
   end subroutine checkpoint_check
 
   ! The grid fields of the checkpoint PATH against their checksum attributes, every rank reading
-  ! a share of each field's rows (walk_datasets, SHARE_FIELDS): item and message say the first
+  ! a share of each field's rows (walk_datasets with fields): item and message say the first
   ! that fails, the same on every rank; nothing when the file cannot be opened through MPI-IO.
   ! Collective.
   subroutine verify_fields(path, item, message)
@@ -345,7 +342,7 @@ contains
     call h5_parallel_open(path, file, err, read_only=.true.)
     if (err /= 0) return
     unverified = 0
-    call walk_datasets(file, '/', .false., item, message, unverified, SHARE_FIELDS)
+    call walk_datasets(file, '/', .false., item, message, unverified, fields=.true.)
     call h5_parallel_close(file, err)
   end subroutine verify_fields
 
@@ -492,7 +489,7 @@ contains
     ! the data: every dataset read once, against its checksum
     if (len_trim(message) == 0) then
       unverified = 0
-      call walk_datasets(file, '/', .false., item, message, unverified, SHARE_REST)
+      call walk_datasets(file, '/', .false., item, message, unverified, fields=.false.)
       if (len_trim(message) == 0 .and. unverified > 0) then
         write(line, '(i0,a)') unverified, ' datasets of the checkpoint carry no checksum (written before '// &
              '2026-11-27): their data cannot be verified'
@@ -515,16 +512,17 @@ contains
   ! has one, and the values are compared with the checksum attribute of one that has it. sign:
   ! instead, give every dataset without Fletcher-32 its checksum attribute (checkpoint_write). A
   ! fault sets item (the dataset's path) and message; unverified counts the datasets with neither
-  ! checksum. share: which datasets (SHARE_ALL; SHARE_FIELDS, the arrays without Fletcher-32, the
-  ! grid fields, each rank reading a share of the rows, collectively: every rank of
-  ! PETSC_COMM_WORLD walks the file opened through MPI-IO; SHARE_REST, the others, by one rank).
-  recursive subroutine walk_datasets(group, prefix, sign, item, message, unverified, share)
+  ! checksum. fields: only the arrays without Fletcher-32 (PETSc's grid fields), each rank reading
+  ! a share of their rows, collectively: every rank of PETSC_COMM_WORLD walks the file opened
+  ! through MPI-IO; else only the other datasets, by one rank (the fields without a checksum
+  ! counted in unverified).
+  recursive subroutine walk_datasets(group, prefix, sign, item, message, unverified, fields)
     integer(HID_T), intent(in) :: group
     character(len=*), intent(in) :: prefix
     logical, intent(in) :: sign
     character(len=*), intent(inout) :: item, message
     integer, intent(inout) :: unverified
-    integer, intent(in) :: share
+    logical, intent(in) :: fields
     integer :: storage, nlinks, max_corder, err, k, kind
     integer(HSIZE_T) :: index
     integer(SIZE_T) :: length
@@ -548,21 +546,21 @@ contains
       end if
       call h5iget_type_f(object, kind, err)
       if (kind == H5I_GROUP_F) then
-        call walk_datasets(object, prefix//trim(name)//'/', sign, item, message, unverified, share)
+        call walk_datasets(object, prefix//trim(name)//'/', sign, item, message, unverified, fields)
       else if (kind == H5I_DATASET_F) then
-        call check_dataset(object, prefix//trim(name), sign, item, message, unverified, share)
+        call check_dataset(object, prefix//trim(name), sign, item, message, unverified, fields)
       end if
       call h5oclose_f(object, err)
     end do
   end subroutine walk_datasets
 
-  subroutine check_dataset(dset, path, sign, item, message, unverified, share)
+  subroutine check_dataset(dset, path, sign, item, message, unverified, fields)
     integer(HID_T), intent(in) :: dset
     character(len=*), intent(in) :: path
     logical, intent(in) :: sign
     character(len=*), intent(inout) :: item, message
     integer, intent(inout) :: unverified
-    integer, intent(in) :: share
+    logical, intent(in) :: fields
     integer(HID_T) :: space, ftype
     integer(HSSIZE_T) :: npoints
     integer(HSIZE_T) :: dims(7), maxdims(7), lo, hi
@@ -583,24 +581,23 @@ contains
     numeric = class == H5T_FLOAT_F .or. class == H5T_INTEGER_F
     ! the fields: arrays of numbers without Fletcher-32 (PETSc's), shared out by rows
     field = numeric .and. .not. fletcher .and. ndims >= 1 .and. err == 0
-    if (share == SHARE_FIELDS .neqv. field) then
-      if (share == SHARE_REST .and. field .and. .not. signed) unverified = unverified + 1
-      if (share /= SHARE_ALL) then
-        call h5sclose_f(space, e)
-        return
-      end if
-    end if
-    if (.not. numeric .or. (share == SHARE_FIELDS .and. .not. sign .and. .not. signed)) then
-      ! nothing to check (the field of a checkpoint written before checksums: SHARE_REST counts it)
+    if (fields .neqv. field) then
+      ! another walk's dataset (a field without a checksum: counted by the walk of the others)
+      if (field .and. .not. signed) unverified = unverified + 1
       call h5sclose_f(space, e)
-      if (.not. fletcher .and. share /= SHARE_FIELDS) unverified = unverified + 1
+      return
+    end if
+    if (.not. numeric .or. (fields .and. .not. sign .and. .not. signed)) then
+      ! nothing to check (a field of a checkpoint written before checksums: counted above)
+      call h5sclose_f(space, e)
+      if (.not. fletcher .and. .not. fields) unverified = unverified + 1
       return
     end if
     ! the rows of the slowest dimension (the last in Fortran's order) this rank reads: all of
-    ! them, or with SHARE_FIELDS its share
+    ! them, or for the fields its share
     rank = 0
     ranks = 1
-    if (share == SHARE_FIELDS) then
+    if (fields) then
       call MPI_Comm_rank(PETSC_COMM_WORLD, rank, e)
       call MPI_Comm_size(PETSC_COMM_WORLD, ranks, e)
     end if
@@ -609,7 +606,7 @@ contains
     sums = 0
     if (err == 0 .and. npoints > 0) call dataset_sums(dset, space, ndims, dims, lo, hi, sums, err)
     call h5sclose_f(space, e)
-    if (share == SHARE_FIELDS) then
+    if (fields) then
       ! the ranks' sums joined in the file's order (every rank the same), a failed read agreed
       words = 2_int64 * product(dims(1:ndims - 1)) * int(hi - lo, int64)
       call joined_sums(sums, words, err)
@@ -623,7 +620,7 @@ contains
     computed = real(sums, dp)
     if (sign) then
       if (.not. fletcher) then
-        ! (SHARE_FIELDS: every rank writes the same attribute, as parallel HDF5 asks)
+        ! (the fields: every rank writes the same attribute, as parallel HDF5 asks)
         call write_attribute(dset, 'checksum', computed, err)
         if (err /= 0) then
           item = path
