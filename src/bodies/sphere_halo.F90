@@ -125,8 +125,7 @@ contains
     PetscErrorCode, intent(out) :: ierr
     logical, intent(out), optional :: far
     integer :: n, k, i, m, w, nb, total, kept, beyond, ndest
-    integer, allocatable :: dest(:), send_count(:), recv_count(:), order(:), new_id(:), offset(:), roffset(:)
-    integer, allocatable :: send_displ(:), recv_displ(:)
+    integer, allocatable :: slab(:), dest(:), send_count(:), recv_count(:), order(:), new_id(:), offset(:), roffset(:)
     real(dp), allocatable :: send_buf(:), recv_buf(:), new_x(:, :), new_data(:, :)
 
     ierr = 0
@@ -135,13 +134,13 @@ contains
     w = 4 + k                    ! the record of a sphere: id, x (3), data (k)
     nb = size(h%neighbour)
     ! the destination of each sphere: 0 kept, else a neighbour's position in h%neighbour
-    allocate(dest(n))
+    allocate(slab(n), dest(n))
     beyond = 0
     do i = 1, n
-      m = sphere_halo_slab_of(h, x(3, i))
+      slab(i) = sphere_halo_slab_of(h, x(3, i))
       dest(i) = 0
-      if (m /= h%rank) dest(i) = findloc(h%neighbour, m, dim=1)
-      if (m /= h%rank .and. dest(i) == 0) beyond = beyond + 1
+      if (slab(i) /= h%rank) dest(i) = findloc(h%neighbour, slab(i), dim=1)
+      if (slab(i) /= h%rank .and. dest(i) == 0) beyond = beyond + 1
     end do
     ! whether any rank must reach beyond its neighbours (one integer)
     call MPI_Allreduce(MPI_IN_PLACE, beyond, 1, MPI_INTEGER, MPI_SUM, PETSC_COMM_WORLD, ierr)
@@ -149,10 +148,7 @@ contains
     if (present(far)) far = beyond > 0
     if (beyond > 0) then
       ! every rank a destination: dest is the rank + 1, 0 for kept
-      do i = 1, n
-        m = sphere_halo_slab_of(h, x(3, i))
-        dest(i) = merge(0, m + 1, m == h%rank)
-      end do
+      dest = merge(0, slab + 1, slab == h%rank)
       ndest = h%ranks
     else
       ndest = nb
@@ -185,10 +181,8 @@ contains
       send_count(m) = send_count(m) + 1
     end do
     if (beyond > 0) then
-      send_displ = offset(1:ndest)
-      recv_displ = roffset(1:ndest)
-      call MPI_Alltoallv(send_buf, send_count * w, send_displ, MPI_DOUBLE_PRECISION, recv_buf, recv_count * w, &
-                         recv_displ, MPI_DOUBLE_PRECISION, PETSC_COMM_WORLD, ierr)
+      call MPI_Alltoallv(send_buf, send_count * w, offset(1:ndest), MPI_DOUBLE_PRECISION, recv_buf, recv_count * w, &
+                         roffset(1:ndest), MPI_DOUBLE_PRECISION, PETSC_COMM_WORLD, ierr)
     else
       call swap(h, send_buf, offset, recv_buf, roffset, ierr)
     end if
