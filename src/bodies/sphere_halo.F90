@@ -231,7 +231,7 @@ contains
     PetscErrorCode, intent(out) :: ierr
     integer :: nb, m, i, n, g, total
     integer, allocatable :: send_count(:), recv_count(:), order(:), own_id(:), all_id(:)
-    integer, allocatable :: send_own(:)
+    integer, allocatable :: send_own(:), near(:)
     real(dp), allocatable :: send_buf(:), recv_buf(:), own_x(:, :)
     integer :: offset(size(h%neighbour) + 1), roffset(size(h%neighbour) + 1)
 
@@ -242,22 +242,11 @@ contains
     own_id = h%id(1:n)
     own_x = x(:, 1:n)
     ! what goes to each neighbour: the own spheres within reach of its slab, ascending
-    allocate(send_count(nb), recv_count(nb))
+    allocate(send_count(nb), recv_count(nb), send_own(0))
     do m = 1, nb
-      send_count(m) = 0
-      do i = 1, n
-        if (sphere_halo_distance(h, own_x(3, i), h%neighbour(m)) < h%reach) send_count(m) = send_count(m) + 1
-      end do
-    end do
-    allocate(send_own(sum(send_count)))
-    g = 0
-    do m = 1, nb
-      do i = 1, n
-        if (sphere_halo_distance(h, own_x(3, i), h%neighbour(m)) < h%reach) then
-          g = g + 1
-          send_own(g) = i
-        end if
-      end do
+      near = pack([(i, i = 1, n)], [(sphere_halo_distance(h, own_x(3, i), h%neighbour(m)) < h%reach, i = 1, n)])
+      send_count(m) = size(near)
+      send_own = [send_own, near]
     end do
     call exchange_counts(h, send_count, recv_count, ierr)
     if (ierr /= 0) return
