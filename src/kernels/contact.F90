@@ -35,6 +35,7 @@ module mod_contact
   use mod_vector, only: cross
   use mod_lees_edwards, only: lees_edwards_t, le_separation
   use mod_limits, only: limit_finding_t, add_finding, LIMIT_WARN, LIMIT_REFUSE
+  use mod_sorting, only: ascending_order
   implicit none
   private
   public :: contact_params_t, contact_setup, contact_stats_t
@@ -124,15 +125,15 @@ module mod_contact
     real(dp), allocatable :: image_velocity_before(:,:)   ! (3, n)
   end type contact_links_t
 
-  !> Tangential springs of the open contacts, in compressed-row form over the owner particle:
-  !> the contacts owned by particle i (i < partner, or i with a wall) are entries
-  !> first(i) .. first(i+1)-1, sorted by partner. A plain data structure: history_pack and
-  !> history_unpack convert it to and from flat arrays for checkpoints.
+  !> Tangential springs of the open contacts, keyed by the global indices of the pair (owner i <
+  !> partner, or i with a wall), sorted by owner, then partner: a rank that holds part of the
+  !> spheres keys them as one rank would. A plain data structure: history_pack and history_unpack
+  !> convert it to and from flat arrays for checkpoints.
   type :: contact_history_t
-    integer :: np = 0                   ! particle count it was built for (0: empty)
+    integer :: np = 0                   ! spheres of the whole system (0: empty)
     integer :: n = 0                    ! stored contacts
-    integer, allocatable :: first(:)    ! (np + 1)
-    integer, allocatable :: partner(:)  ! (n)
+    integer, allocatable :: owner(:)    ! (n) global index of the first sphere, ascending
+    integer, allocatable :: partner(:)  ! (n) its partner's (or the wall's), ascending per owner
     real(dp), allocatable :: ups(:,:)   ! (3, n): Upsilon [a]
   end type contact_history_t
 
@@ -776,20 +777,32 @@ contains
     type(contact_history_t), intent(inout) :: h
     h%np = 0
     h%n = 0
-    if (allocated(h%first)) deallocate(h%first)
+    if (allocated(h%owner)) deallocate(h%owner)
     if (allocated(h%partner)) deallocate(h%partner)
     if (allocated(h%ups)) deallocate(h%ups)
   end subroutine history_clear
 
-  !> The stored spring of contact (i, partner), i < partner or partner < 0; 0 if none.
+  !> The stored spring of contact (i, partner) (global indices), i < partner or partner < 0; 0 if
+  !> none. A bisection for i's first contact, then its few partners.
   pure function history_lookup(h, i, partner) result(ups)
     type(contact_history_t), intent(in) :: h
     integer, intent(in) :: i, partner
     real(dp) :: ups(3)
-    integer :: k
+    integer :: k, lo, hi, mid
     ups = 0
-    if (h%n == 0 .or. i < 1 .or. i > h%np) return
-    do k = h%first(i), h%first(i + 1) - 1
+    if (h%n == 0) return
+    lo = 1
+    hi = h%n + 1
+    do while (lo < hi)
+      mid = (lo + hi) / 2
+      if (h%owner(mid) < i) then
+        lo = mid + 1
+      else
+        hi = mid
+      end if
+    end do
+    do k = lo, h%n
+      if (h%owner(k) /= i .or. h%partner(k) > partner) return
       if (h%partner(k) == partner) then
         ups = h%ups(:, k)
         return
@@ -797,17 +810,19 @@ contains
     end do
   end function history_lookup
 
-  !> (Re)build h from an unordered list of contacts: bucket by owner, sort each owner's
-  !> partners. info = 2 for an invalid id, 3 for a duplicate contact (h is then left empty).
+  !> (Re)build h from an unordered list of n contacts (owner, partner, ups) of a system of np
+  !> spheres: sorted by owner, then partner (the walls, -2 and -1, before the spheres), whatever
+  !> the input order. info = 2 for an invalid index, 3 for a duplicate contact (h is then left
+  !> empty). The storage is O(contacts), not O(np): a rank holding part of the spheres holds the
+  !> springs of its own contacts only (doc/DESIGN.md "Spheres held by their slab").
   subroutine history_build(h, np, n, owner, partner, ups, info)
     type(contact_history_t), intent(inout) :: h
     integer, intent(in) :: np, n
     integer, intent(in) :: owner(:), partner(:)
     real(dp), intent(in) :: ups(:,:)
     integer, intent(out) :: info
-    integer :: k, i, pos, a, b, q, tmp_p
-    integer, allocatable :: fill(:)
-    real(dp) :: tmp_u(3)
+    integer :: k
+    integer, allocatable :: order(:)
     info = 0
     call history_clear(h)
     if (np < 1) then
@@ -815,51 +830,24 @@ contains
       return
     end if
     do k = 1, n
-      i = owner(k)
-      if (i < 1 .or. i > np .or. .not. (partner(k) == wall_lower .or. partner(k) == wall_upper &
-          .or. (partner(k) > i .and. partner(k) <= np))) then
+      if (owner(k) < 1 .or. owner(k) > np .or. .not. (partner(k) == wall_lower .or. partner(k) == wall_upper &
+          .or. (partner(k) > owner(k) .and. partner(k) <= np))) then
         info = 2
         return
       end if
     end do
+    ! lexicographic: a stable sort by owner of the list sorted by partner
+    allocate(order(n))
+    order = ascending_order(partner(1:n))
+    order = order(ascending_order(owner(order)))
     h%np = np
     h%n = n
-    allocate(h%first(np + 1), h%partner(n), h%ups(3, n), fill(np))
-    h%first = 0
-    do k = 1, n
-      h%first(owner(k) + 1) = h%first(owner(k) + 1) + 1
-    end do
-    h%first(1) = 1
-    do i = 1, np
-      h%first(i + 1) = h%first(i + 1) + h%first(i)
-    end do
-    fill = h%first(1:np)
-    do k = 1, n
-      pos = fill(owner(k))
-      fill(owner(k)) = pos + 1
-      h%partner(pos) = partner(k)
-      h%ups(:, pos) = ups(:, k)
-    end do
-    ! insertion sort of each owner's few partners: a canonical order, whatever the input order
-    do i = 1, np
-      a = h%first(i)
-      b = h%first(i + 1) - 1
-      do k = a + 1, b
-        tmp_p = h%partner(k)
-        tmp_u = h%ups(:, k)
-        q = k - 1
-        do while (q >= a)
-          if (h%partner(q) <= tmp_p) exit
-          h%partner(q + 1) = h%partner(q)
-          h%ups(:, q + 1) = h%ups(:, q)
-          q = q - 1
-        end do
-        h%partner(q + 1) = tmp_p
-        h%ups(:, q + 1) = tmp_u
-      end do
-      do k = a + 1, b
-        if (h%partner(k) == h%partner(k - 1)) info = 3
-      end do
+    allocate(h%owner(n), h%partner(n), h%ups(3, n))
+    h%owner = owner(order)
+    h%partner = partner(order)
+    h%ups = ups(:, order)
+    do k = 2, n
+      if (h%owner(k) == h%owner(k - 1) .and. h%partner(k) == h%partner(k - 1)) info = 3
     end do
     if (info /= 0) call history_clear(h)
   end subroutine history_build
@@ -872,15 +860,10 @@ contains
     integer, intent(out) :: np
     integer, intent(out) :: ids(:,:)
     real(dp), intent(out) :: ups(:,:)
-    integer :: i, k
     np = h%np
-    do i = 1, h%np
-      do k = h%first(i), h%first(i + 1) - 1
-        ids(1, k) = i
-        ids(2, k) = h%partner(k)
-        ups(:, k) = h%ups(:, k)
-      end do
-    end do
+    ids(1, 1:h%n) = h%owner(1:h%n)
+    ids(2, 1:h%n) = h%partner(1:h%n)
+    ups(:, 1:h%n) = h%ups(:, 1:h%n)
   end subroutine history_pack
 
   !> Inverse of history_pack: n contacts ids(2, n), ups(3, n) of a system of np particles, in any

@@ -194,8 +194,8 @@ program test_contact_history
     xa = xa + u * dt
   end do
   print '(a,i0,a,l1)', '4. mu_d = 0: contacts ', st%pair_contacts + st%wall_contacts, &
-    ', history allocated ', allocated(hbad%partner) .or. allocated(hbad%first)
-  call check(.not. (allocated(hbad%partner) .or. allocated(hbad%first) .or. history_size(hbad) /= 0 .or. &
+    ', history allocated ', allocated(hbad%partner) .or. allocated(hbad%owner)
+  call check(.not. (allocated(hbad%partner) .or. allocated(hbad%owner) .or. history_size(hbad) /= 0 .or. &
              st%pair_contacts == 0), 'mu_d = 0 allocates no history')
 
   call finish('test_contact_history')

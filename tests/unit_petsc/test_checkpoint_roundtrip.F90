@@ -185,7 +185,7 @@ program test_checkpoint_roundtrip
              parts2%have_prev, trim(scene)//': particle positions, velocities, angular velocities, '// &
              'Adams-Bashforth history and have_prev bitwise equal')
   same = history2%np == history%np .and. history2%n == history%n
-  if (same) same = all(history2%first == history%first) .and. all(history2%partner == history%partner) .and. &
+  if (same) same = all(history2%owner == history%owner) .and. all(history2%partner == history%partner) .and. &
                    all(history2%ups == history%ups)
   call check(same, trim(scene)//': the contact history (4 springs, two of them on the walls) bitwise equal')
   call check(all(rheo_state(rh2) == rheo_state(rh)), trim(scene)//': the &rheology accumulators bitwise equal')
