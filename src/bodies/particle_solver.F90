@@ -40,7 +40,8 @@ module mod_particle_solver
   use mod_sphere_ownership, only: sphere_ownership_t, sphere_ownership_of
   implicit none
   private
-  public :: particle_solver_t, particle_solver_create, particle_solver_solve, particle_solver_destroy
+  public :: particle_solver_t, particle_solver_create, particle_solver_solve, particle_solver_destroy, &
+            particle_solver_set_local
 
   type :: particle_solver_t
     type(particle_system_t) :: system   ! the 6N system of the step, assembled by the caller
@@ -50,6 +51,10 @@ module mod_particle_solver
     integer :: solves = 0               ! sparse (KSP) solves
     integer :: owned_rows = -1          ! this rank's rows in the last sparse solve (-1: none yet)
     real(dp) :: seconds = 0.0_dp        ! their assembly + solve, summed over the run
+    ! a rank's local set (particle_solver_set_local; not allocated: every sphere, on every rank)
+    integer, allocatable :: rows(:)     ! (n) the 0-based block row of each local sphere
+    logical, allocatable :: owned(:)    ! (n) the spheres this rank owns (and whose rows it sets)
+    integer :: total = 0                ! spheres of the whole system
   end type particle_solver_t
 
 contains
@@ -66,6 +71,21 @@ contains
     PetscCall(KSPSetFromOptions(ps%ksp, ierr))
     ps%created = .true.
   end subroutine particle_solver_create
+
+  !> The spheres this rank holds from now on (doc/DESIGN.md "Spheres held by their slab"): rows (n)
+  !> the global 0-based block row of each local sphere (an owned sphere's its own, a ghost's its
+  !> owner's), owned (n) those whose rows this rank owns, total the spheres of the whole system.
+  !> The rows of a rank are contiguous, numbered rank by rank. A solve then sets the owned rows
+  !> and writes back the velocities of the owned spheres only (the caller forwards them to their
+  !> ghosts): nothing of size N is gathered.
+  subroutine particle_solver_set_local(ps, rows, owned, total)
+    type(particle_solver_t), intent(inout) :: ps
+    integer, intent(in) :: rows(:), total
+    logical, intent(in) :: owned(:)
+    ps%rows = rows
+    ps%owned = owned
+    ps%total = total
+  end subroutine particle_solver_set_local
 
   !> The velocities of the spheres from ps%system (U, Omega) = rhs (6 x n): the solution starts
   !> from parts%velocity, parts%omega (the last step's: a restart, which reads them from the
@@ -101,13 +121,13 @@ contains
       end if
     else
       t0 = MPI_Wtime()
-      PetscCall(ksp_solve(ps%ksp, ps%system, rhs, x, ps%iterations, reason, ps%owned_rows, ierr))
+      PetscCall(ksp_solve(ps, rhs, x, reason, ierr))
       if (reason == KSP_DIVERGED_DTOL) then
         ! a right-hand side far below the residual of the last step's velocities (an imposed rate
         ! through zero, doc/INPUT.md "&shear"): the divergence test measures against |rhs|, so the
         ! solve starts again from zero
         x = 0.0_dp
-        PetscCall(ksp_solve(ps%ksp, ps%system, rhs, x, ps%iterations, reason, ps%owned_rows, ierr))
+        PetscCall(ksp_solve(ps, rhs, x, reason, ierr))
       end if
       ps%solves = ps%solves + 1
       ps%seconds = ps%seconds + (MPI_Wtime() - t0)
@@ -124,14 +144,11 @@ contains
   !> Solve sys x = rhs (both 6 x n) by ksp, from the guess in x: assembly of the sparse matrix,
   !> then the solve. The converged reason is returned in reason (negative: not converged);
   !> iterations as KSP counts them. owned_rows: this rank's rows in the last solve, updated.
-  subroutine ksp_solve(ksp, sys, rhs, x, iterations, reason, owned_rows, ierr)
-    KSP, intent(in) :: ksp
-    type(particle_system_t), intent(in) :: sys
+  subroutine ksp_solve(ps, rhs, x, reason, ierr)
+    type(particle_solver_t), intent(inout) :: ps
     real(dp), intent(in) :: rhs(:, :)
     real(dp), intent(inout) :: x(:, :)
-    integer, intent(out) :: iterations
     KSPConvergedReason, intent(out) :: reason
-    integer, intent(inout) :: owned_rows
     PetscErrorCode, intent(out) :: ierr
     Mat :: a
     Vec :: vx, vb
@@ -141,27 +158,42 @@ contains
     PetscBool :: sbaij, sbaij_parallel
     KSPType :: ksp_type
     PetscScalar, pointer :: p(:)
-    integer :: q, i, j, e, rank, ranks
-    integer, allocatable :: mine(:)
+    integer :: q, i, j, e, rank, ranks, n, total
+    integer, allocatable :: mine(:), rows_of(:)
+    logical, allocatable :: is_mine(:)
     real(dp), allocatable :: rows(:, :)
     type(sphere_ownership_t) :: o
-    logical :: reshared
+    logical :: reshared, local
 
-    n6 = 6 * sys%n
     ! This rank owns the block rows of the spheres `mine` (mod_sphere_ownership: its z-slab's),
-    ! rows o%displs(rank + 1) onwards. Its system holds every block of those rows (the header), so
-    ! each rank sets its own rows and nothing crosses ranks in the assembly; the solve then runs
-    ! on every rank's share.
+    ! numbered rank by rank. Its system holds every block of those rows (the header), so each rank
+    ! sets its own rows and nothing crosses ranks in the assembly; the solve then runs on every
+    ! rank's share. The spheres of the system are every sphere (replicated) or this rank's local
+    ! set (particle_solver_set_local: its own spheres and their ghosts).
+    associate(sys => ps%system)
     PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, ranks, ierr))
     PetscCallMPI(MPI_Comm_rank(PETSC_COMM_WORLD, rank, ierr))
-    o = sphere_ownership_of(sys%n)
-    owned = o%counts(rank + 1)
-    mine = o%sphere(o%displs(rank + 1) + 1:o%displs(rank + 1) + owned)
+    n = sys%n
+    local = allocated(ps%rows)
+    if (local) then
+      total = ps%total
+      is_mine = ps%owned
+      rows_of = ps%rows
+    else
+      total = n
+      o = sphere_ownership_of(n)
+      is_mine = o%owner == rank
+      rows_of = o%row
+    end if
+    n6 = 6 * total
+    owned = count(is_mine)
+    allocate(mine(owned))
+    mine = pack([(q, q = 1, n)], is_mine)
     ! block rows of this rank's spheres: the diagonal block and one block per pair, in the columns
     ! this rank owns (diagonal) or not (off); a pair may come more than once (lubrication and
     ! contact stiffness): its blocks add up in one, and a row never holds more blocks than there
     ! are columns. The upper triangle alone (sbaij): the pairs whose other sphere's row is later.
-    allocate(diagonal(sys%n), off(sys%n), upper(sys%n), upper_off(sys%n))
+    allocate(diagonal(n), off(n), upper(n), upper_off(n))
     diagonal = 1
     off = 0
     upper = 1
@@ -170,20 +202,20 @@ contains
       do e = 1, 2
         i = sys%pair(e, q)
         j = sys%pair(3 - e, q)
-        if (o%owner(i) /= rank) cycle
-        if (o%owner(j) == rank) then
+        if (.not. is_mine(i)) cycle
+        if (is_mine(j)) then
           diagonal(i) = diagonal(i) + 1
-          if (o%row(j) > o%row(i)) upper(i) = upper(i) + 1
+          if (rows_of(j) > rows_of(i)) upper(i) = upper(i) + 1
         else
           off(i) = off(i) + 1
-          if (o%row(j) > o%row(i)) upper_off(i) = upper_off(i) + 1
+          if (rows_of(j) > rows_of(i)) upper_off(i) = upper_off(i) + 1
         end if
       end do
     end do
     diagonal = min(diagonal, owned)
     upper = min(upper, owned)
-    off = min(off, sys%n - owned)
-    upper_off = min(upper_off, sys%n - owned)
+    off = min(off, total - owned)
+    upper_off = min(upper_off, total - owned)
     ! BAIJ (sequential on one rank, distributed on more) unless -particles_mat_type says otherwise
     ! (sbaij or aij for a sparse Cholesky on one rank: PETSc's CHOLMOD factors only those; sbaij
     ! keeps the upper triangle, the lower is ignored)
@@ -201,18 +233,18 @@ contains
       PetscCall(MatSetOption(a, MAT_IGNORE_LOWER_TRIANGULAR, PETSC_TRUE, ierr))
     end if
     do q = 1, int(owned)
-      row(1) = o%row(mine(q))
+      row(1) = rows_of(mine(q))
       PetscCall(MatSetValuesBlocked(a, one, row, one, row, row_major(sys%diag(:, :, mine(q))), ADD_VALUES, ierr))
     end do
     do q = 1, sys%npairs
       i = sys%pair(1, q)
       j = sys%pair(2, q)
-      row(1) = o%row(i)
-      col(1) = o%row(j)
-      if (o%owner(i) == rank) then
+      row(1) = rows_of(i)
+      col(1) = rows_of(j)
+      if (is_mine(i)) then
         PetscCall(MatSetValuesBlocked(a, one, row, one, col, row_major(sys%block(:, :, q)), ADD_VALUES, ierr))
       end if
-      if (o%owner(j) == rank) then
+      if (is_mine(j)) then
         PetscCall(MatSetValuesBlocked(a, one, col, one, row, row_major(transpose(sys%block(:, :, q))), ADD_VALUES, ierr))
       end if
     end do
@@ -226,43 +258,45 @@ contains
     p = reshape(x(:, mine), [6 * owned])
     PetscCall(VecRestoreArrayF90(vx, p, ierr))
     ! a direct solve (preonly) takes no guess
-    PetscCall(KSPGetType(ksp, ksp_type, ierr))
+    PetscCall(KSPGetType(ps%ksp, ksp_type, ierr))
     if (trim(ksp_type) == trim(KSPPREONLY)) then
-      PetscCall(KSPSetInitialGuessNonzero(ksp, PETSC_FALSE, ierr))
+      PetscCall(KSPSetInitialGuessNonzero(ps%ksp, PETSC_FALSE, ierr))
     else
-      PetscCall(KSPSetInitialGuessNonzero(ksp, PETSC_TRUE, ierr))
+      PetscCall(KSPSetInitialGuessNonzero(ps%ksp, PETSC_TRUE, ierr))
     end if
     ! a sphere that crossed a slab face since the last solve changes the ranks' shares of rows,
     ! which a set-up solver cannot take (PCSetOperators): it is reset to its options first, on
     ! every rank (collective) when any rank's share changed
-    reshared = owned_rows >= 0 .and. owned_rows /= 6 * owned
+    reshared = ps%owned_rows >= 0 .and. ps%owned_rows /= 6 * owned
     PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, reshared, 1, MPI_LOGICAL, MPI_LOR, PETSC_COMM_WORLD, ierr))
     if (reshared) then
-      PetscCall(KSPReset(ksp, ierr))
+      PetscCall(KSPReset(ps%ksp, ierr))
     end if
-    owned_rows = 6 * owned
-    PetscCall(KSPSetOperators(ksp, a, a, ierr))
-    PetscCall(KSPSolve(ksp, vb, vx, ierr))
-    PetscCall(KSPGetConvergedReason(ksp, reason, ierr))
-    PetscCall(KSPGetIterationNumber(ksp, its, ierr))
-    iterations = int(its)
-    ! every rank holds every sphere's velocity (the particle state is replicated): the shares are
-    ! gathered in row order (6 N doubles, doc/DESIGN.md "Parallelism") and put back by sphere
+    ps%owned_rows = 6 * owned
+    PetscCall(KSPSetOperators(ps%ksp, a, a, ierr))
+    PetscCall(KSPSolve(ps%ksp, vb, vx, ierr))
+    PetscCall(KSPGetConvergedReason(ps%ksp, reason, ierr))
+    PetscCall(KSPGetIterationNumber(ps%ksp, its, ierr))
+    ps%iterations = int(its)
+    ! a local set keeps the velocities of its own spheres (the caller forwards them to their
+    ! ghosts); a replicated one holds every sphere's, so the shares are gathered in row order
+    ! (6 N doubles, doc/DESIGN.md "Parallelism") and put back by sphere
     PetscCall(VecGetArrayReadF90(vx, p, ierr))
-    if (ranks == 1) then
-      x = reshape(p, [6, sys%n])
+    if (local .or. ranks == 1) then
+      x(:, mine) = reshape(p, [6, int(owned)])
     else
       allocate(rows(6, sys%n))
       rows(:, o%displs(rank + 1) + 1:o%displs(rank + 1) + owned) = reshape(p, [6, int(owned)])
     end if
     PetscCall(VecRestoreArrayReadF90(vx, p, ierr))
-    if (ranks > 1) then
+    if (ranks > 1 .and. .not. local) then
       PetscCallMPI(MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, rows, 6 * o%counts, 6 * o%displs, MPI_DOUBLE_PRECISION, PETSC_COMM_WORLD, ierr))
       x(:, o%sphere) = rows
     end if
     PetscCall(VecDestroy(vx, ierr))
     PetscCall(VecDestroy(vb, ierr))
     PetscCall(MatDestroy(a, ierr))
+    end associate
   end subroutine ksp_solve
 
   ! PETSc takes a block row by row

@@ -568,8 +568,14 @@ contains
   !> spheres' radii in units of p%a (doc/CONTACT.md "Spheres of several sizes"); absent, all are
   !> p%a. A pair of unit spheres (radius exactly 1) takes the arithmetic of the equal-sphere law
   !> (contact_pair) whether radii is given or not, so that results are bitwise those without it.
+  !> A rank's local set (doc/DESIGN.md "Spheres held by their slab"): ids (np) the global index of
+  !> each sphere (ascending), owned (np) those the rank owns, total the spheres of the whole system.
+  !> Then only the pairs with an owned sphere are evaluated (an owned sphere has all its contacts,
+  !> in one rank's order), the walls of owned spheres only, the history is keyed and the
+  !> overlap's pair named by global index, and stats count each pair on the rank that owns its
+  !> first sphere (summed over ranks they are one rank's). Absent: every sphere, ids = 1..np.
   subroutine contact_forces(p, h, x, u, om, box, periodic, vw, pairs, npairs, walls, nwalls, dt, &
-                            force, torque, stresslet, stats, info, links, le, radii)
+                            force, torque, stresslet, stats, info, links, le, radii, ids, owned, total)
     type(contact_params_t), intent(in) :: p
     type(contact_history_t), intent(inout) :: h
     real(dp), intent(in) :: x(:,:), u(:,:), om(:,:), box(3), vw(3, 2), dt
@@ -581,7 +587,9 @@ contains
     type(contact_links_t), intent(inout), optional :: links
     type(lees_edwards_t), intent(in), optional :: le
     real(dp), intent(in), optional :: radii(:)
-    integer :: m, i, j, k, w, np, nnew
+    integer, intent(in), optional :: ids(:), total
+    logical, intent(in), optional :: owned(:)
+    integer :: m, i, j, k, w, np, nnew, gi, gj
     integer, allocatable :: new_owner(:), new_partner(:)
     real(dp), allocatable :: new_ups(:,:)
     real(dp) :: r(3), d, n(3), dlt, ups(3), f(3), tq(3), tqj(3), fn, scale, s(3, 3), sj(3, 3), vshift(3)
@@ -590,6 +598,7 @@ contains
 
     info = 0
     np = size(x, 2)
+    if (present(total)) np = total
     force = 0
     torque = 0
     stresslet = 0
@@ -611,6 +620,9 @@ contains
     do m = 1, npairs
       i = min(pairs(1, m), pairs(2, m))
       j = max(pairs(1, m), pairs(2, m))
+      if (present(owned)) then
+        if (.not. (owned(i) .or. owned(j))) cycle
+      end if
       r = x(:, j) - x(:, i)
       if (sliding_boundaries) then
         call le_separation(le, x(:, j) - x(:, i), r, vshift)
@@ -632,7 +644,9 @@ contains
       if (dlt > 0) cycle
       n = r / d
       ups = 0
-      if (tangential) ups = history_lookup(h, i, j)
+      gi = global(i)
+      gj = global(j)
+      if (tangential) ups = history_lookup(h, gi, gj)
       if (sized) then
         ! levers to the middle of the gap d - ai - aj (doc/CONTACT.md "Spheres of several sizes")
         kh = hertz_stiffness(p, ai, aj)
@@ -652,7 +666,7 @@ contains
         s = contact_stresslet(f, li)
         sj = s
       end if
-      if (tangential) call append(i, j)
+      if (tangential) call append(gi, gj)
       force(:, i) = force(:, i) + f
       force(:, j) = force(:, j) - f
       torque(:, i) = torque(:, i) + tq
@@ -660,12 +674,16 @@ contains
       stresslet(:, :, i) = stresslet(:, :, i) + s
       stresslet(:, :, j) = stresslet(:, :, j) + sj
       if (present(links)) call add_link(j, li, lj, [ai, aj], vshift, image_shift_of(r(2) - (x(2, j) - x(2, i))))
-      call tally(.false., j)
+      call tally(.false., gj)
     end do
 
     do m = 1, nwalls
       i = walls(1, m)
       w = walls(2, m)
+      if (present(owned)) then
+        if (.not. owned(i)) cycle
+      end if
+      gi = global(i)
       if (w == 1) then
         d = x(2, i)
         n = [0.0_dp, -1.0_dp, 0.0_dp]
@@ -678,11 +696,11 @@ contains
       dlt = d - ai - p%h_r
       if (dlt > 0) cycle
       ups = 0
-      if (tangential) ups = history_lookup(h, i, -w)
+      if (tangential) ups = history_lookup(h, gi, -w)
       ! a unit sphere: k_n and contact_pair's arithmetic exactly (ai = a)
       kh = hertz_stiffness(p, ai)
       call contact_pair_sized(p, kh, n, dlt, u(:, i) - vw(:, w), om(:, i), ai, dt, ups, f, tq, fn, sliding)
-      if (tangential) call append(i, -w)
+      if (tangential) call append(gi, -w)
       force(:, i) = force(:, i) + f
       stats%wall_force(:, w) = stats%wall_force(:, w) + f
       torque(:, i) = torque(:, i) + tq
@@ -695,6 +713,13 @@ contains
     if (tangential) call history_build(h, np, nnew, new_owner, new_partner, new_ups, info)
 
   contains
+
+    ! the global index of local sphere q
+    integer function global(q)
+      integer, intent(in) :: q
+      global = q
+      if (present(ids)) global = ids(q)
+    end function global
 
     subroutine append(owner, other)
       integer, intent(in) :: owner, other
@@ -730,9 +755,14 @@ contains
       if (sliding_boundaries) s = anint(dy / box(2))
     end function image_shift_of
 
+    ! partner: the global index of the other sphere, or the wall's id
     subroutine tally(wall, partner)
       logical, intent(in) :: wall
       integer, intent(in) :: partner
+      if (present(owned)) then
+        ! a pair across two ranks is counted by the owner of its first sphere
+        if (.not. owned(i)) return
+      end if
       if (wall) then
         stats%wall_contacts = stats%wall_contacts + 1
       else
@@ -741,7 +771,7 @@ contains
       if (sliding) stats%sliding = stats%sliding + 1
       if (-dlt / scale > stats%max_overlap) then
         stats%max_overlap = -dlt / scale
-        stats%max_overlap_pair = [i, partner]
+        stats%max_overlap_pair = [global(i), partner]
       end if
       stats%max_normal_force = max(stats%max_normal_force, fn)
     end subroutine tally

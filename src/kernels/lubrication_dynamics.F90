@@ -32,7 +32,7 @@ module mod_lubrication_dynamics
   private
   public :: lubrication_dynamics_t, lubrication_dynamics_create, lubrication_dynamics_ambient_velocity, &
             lubrication_dynamics_ambient_gradients, lubrication_dynamics_one_body_block, &
-            lubrication_dynamics_assemble, lubrication_dynamics_hydrodynamics
+            lubrication_dynamics_assemble, lubrication_dynamics_hydrodynamics, lubrication_dynamics_set_local
 
   type :: lubrication_dynamics_t
     real(dp) :: radius = 1.0_dp, viscosity = 1.0_dp
@@ -62,6 +62,14 @@ contains
     ld%box = box
     ld%sheared = sheared
   end subroutine lubrication_dynamics_create
+
+  !> The radii (units of ld%radius) of the spheres a rank holds from now on, its own and their
+  !> ghosts (doc/DESIGN.md "Spheres held by their slab"); nothing for equal spheres.
+  pure subroutine lubrication_dynamics_set_local(ld, radii)
+    type(lubrication_dynamics_t), intent(inout) :: ld
+    real(dp), intent(in) :: radii(:)
+    if (ld%sized) ld%radii = ld%radius * radii
+  end subroutine lubrication_dynamics_set_local
 
   !> U_inf at x: gamma_dot (y - Ly/2) e_x.
   pure function lubrication_dynamics_ambient_velocity(ld, x) result(u)

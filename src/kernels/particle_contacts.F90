@@ -33,7 +33,7 @@ module mod_particle_contacts
   public :: particle_contacts_settings_t, particle_contacts_t, particle_contacts_create, particle_contacts_step, &
             particle_contacts_description
   public :: particle_contacts_add_stiffness, particle_contacts_implicit_update, particle_contacts_columns, &
-            particle_contacts_set_rate
+            particle_contacts_set_rate, particle_contacts_set_local
 
   ! The deck's &contact (doc/INPUT.md): its variables, named as in the deck, with their defaults.
   type :: particle_contacts_settings_t
@@ -71,6 +71,11 @@ module mod_particle_contacts
     real(dp), allocatable :: u_before(:,:), om_before(:,:)   ! U^{n-1}, Omega^{n-1}
     type(lees_edwards_t) :: le               ! sliding boundaries in y (le%active), delta of the step
     real(dp), allocatable :: radii(:)        ! (np) in units of a; not allocated: all a
+    real(dp) :: skin = 0                     ! the neighbour list's
+    ! a rank's local set (particle_contacts_set_local; not allocated: every sphere, on every rank)
+    integer, allocatable :: ids(:)           ! (np) global index of each local sphere, ascending
+    logical, allocatable :: owned(:)         ! (np) the spheres this rank owns
+    integer :: total = 0                     ! spheres of the whole system
   end type particle_contacts_t
 
 contains
@@ -135,6 +140,8 @@ contains
       pc%radii = radii
       a_max = maxval(radii) * a
     end if
+    pc%total = np
+    pc%skin = settings%neighbour_skin
     call nlist_init(pc%nlist, np, box, pc%periodic, 2 * a_max + pc%params%h_r + settings%neighbour_skin, &
                     a_max + pc%params%h_r + settings%neighbour_skin, settings%neighbour_skin, info, pc%le)
     if (info /= 0) then
@@ -146,6 +153,33 @@ contains
     pc%torque = 0
     pc%stresslet = 0
   end subroutine particle_contacts_create
+
+  !> The spheres this rank holds from now on (doc/DESIGN.md "Spheres held by their slab"): ids (np)
+  !> their global indices, ascending, owned (np) those it owns, radii (np, units of a) theirs when
+  !> the run has several sizes. The contacts then take the local set's positions and velocities
+  !> (contact_forces' local set: the pairs with an owned sphere, the history by global index), the
+  !> per-sphere results are complete for the owned spheres, and the neighbour list starts afresh
+  !> for the new set (its cut-offs and skin kept). The history is kept: the caller brings the
+  !> springs of spheres that came to this rank (mod_contact's history).
+  subroutine particle_contacts_set_local(pc, ids, owned, radii)
+    type(particle_contacts_t), intent(inout) :: pc
+    integer, intent(in) :: ids(:)
+    logical, intent(in) :: owned(:)
+    real(dp), intent(in), optional :: radii(:)
+    integer :: np, info
+    np = size(ids)
+    pc%ids = ids
+    pc%owned = owned
+    pc%np = np
+    if (present(radii) .and. allocated(pc%radii)) pc%radii = radii
+    call nlist_init(pc%nlist, np, pc%box, pc%periodic, pc%nlist%cutoff, pc%nlist%wall_cutoff, pc%skin, info, pc%le)
+    pc%nlist%built = .false.
+    if (allocated(pc%force)) deallocate(pc%force, pc%torque, pc%stresslet)
+    allocate(pc%force(3, np), pc%torque(3, np), pc%stresslet(3, 3, np))
+    pc%force = 0
+    pc%torque = 0
+    pc%stresslet = 0
+  end subroutine particle_contacts_set_local
 
   !> One step: contacts at positions x (3, np) with velocities u, om (3, np). Results in
   !> pc%force, pc%torque, pc%stresslet (3, 3, np) and pc%stats; the history advances by one step.
@@ -163,12 +197,13 @@ contains
     if (pc%implicit) then
       call contact_forces(pc%params, pc%history, x, u, om, pc%box, pc%periodic, pc%wall_velocity, &
                           pc%pairs, pc%npairs, pc%walls, pc%nwalls, pc%dt, pc%force, pc%torque, &
-                          pc%stresslet, pc%stats, info, pc%links, pc%le, pc%radii)
+                          pc%stresslet, pc%stats, info, pc%links, pc%le, pc%radii, pc%ids, pc%owned, pc%total)
     else
       ! pc%radii unallocated: not present (all spheres of radius a)
       call contact_forces(pc%params, pc%history, x, u, om, pc%box, pc%periodic, pc%wall_velocity, &
                           pc%pairs, pc%npairs, pc%walls, pc%nwalls, pc%dt, pc%force, pc%torque, &
-                          pc%stresslet, pc%stats, info, le=pc%le, radii=pc%radii)
+                          pc%stresslet, pc%stats, info, le=pc%le, radii=pc%radii, ids=pc%ids, owned=pc%owned, &
+                          total=pc%total)
     end if
     if (info /= 0) return
     pc%wall_force = pc%stats%wall_force

@@ -44,7 +44,8 @@ module mod_particle_lubrication
   implicit none
   private
   public :: particle_lubrication_t, particle_lubrication_create, particle_lubrication_links, &
-            particle_lubrication_corrections, particle_lubrication_add_to_system, particle_lubrication_add_corrections, particle_lubrication_columns
+            particle_lubrication_corrections, particle_lubrication_add_to_system, particle_lubrication_add_corrections, &
+            particle_lubrication_columns, particle_lubrication_set_local
 
   type :: particle_lubrication_t
     type(lubrication_t) :: lub
@@ -85,7 +86,13 @@ module mod_particle_lubrication
     ! step (every rank holds every wall link: the same on every rank; the walls' share of the
     ! wall shear stress, doc/METHOD.md §7.4)
     real(dp) :: wall_force(3, 2) = 0
+    real(dp) :: skin = 0                                       ! the neighbour list's
+    ! a rank's local set (particle_lubrication_set_local; not allocated: every sphere)
+    logical, allocatable :: owned(:)                           ! (np) the spheres this rank owns
   end type particle_lubrication_t
+
+  ! the phases of particle_lubrication_links on a local set
+  integer, parameter, public :: LINKS_COUNT = 1, LINKS_EVALUATE = 2
 
 contains
 
@@ -148,6 +155,7 @@ contains
     ! a pair is in range while r < (a_i + a_j)(1 + outer_cutoff/2) <= 2 a_max + outer_cutoff a_max,
     ! a wall link while its height < a_i (1 + outer_cutoff) (a_max = a for equal spheres)
     reach = lub%outer_cutoff * a_max
+    pl%skin = skin
     call nlist_init(pl%nlist, np, box, pl%periodic, 2 * a_max + reach + skin, a_max + reach + skin, &
                     skin, info, pl%le)
     if (info /= 0) msg = 'lubrication: the neighbour search refuses this box (a periodic length below '// &
@@ -211,6 +219,43 @@ contains
     end subroutine set_sizes
   end subroutine particle_lubrication_create
 
+  !> The spheres this rank holds from now on (doc/DESIGN.md "Spheres held by their slab"): owned (np)
+  !> those it owns among its local set (own spheres and ghosts, ascending global index), radii (np,
+  !> units of lub%radius) theirs when the run has several sizes. The links then take the local
+  !> set's positions in two phases (particle_lubrication_links' phase): LINKS_COUNT finds the
+  !> candidates and counts each sphere's links (links_of, complete for the owned spheres only; the
+  !> caller brings the ghosts' counts from their owners, model 'exact' floors a pair by both
+  !> counts), LINKS_EVALUATE evaluates the pairs with an owned sphere and the walls of the owned
+  !> spheres. The neighbour list starts afresh for the new set.
+  subroutine particle_lubrication_set_local(pl, owned, radii)
+    type(particle_lubrication_t), intent(inout) :: pl
+    logical, intent(in) :: owned(:)
+    real(dp), intent(in), optional :: radii(:)
+    integer :: np, info, i
+    np = size(owned)
+    pl%np = np
+    pl%owned = owned
+    if (allocated(pl%links_of)) deallocate(pl%links_of)
+    if (allocated(pl%force)) deallocate(pl%force, pl%torque, pl%stresslet)
+    allocate(pl%links_of(np), pl%force(3, np), pl%torque(3, np), pl%stresslet(3, 3, np))
+    pl%links_of = 0
+    pl%force = 0
+    pl%torque = 0
+    pl%stresslet = 0
+    if (pl%sized .and. present(radii)) then
+      ! each radius is one of the species found at creation (to rounding of the units)
+      pl%radii = pl%lub%radius * radii
+      if (allocated(pl%species)) deallocate(pl%species)
+      allocate(pl%species(np))
+      do i = 1, np
+        pl%species(i) = minloc(abs(pl%species_radius - pl%radii(i)), 1)
+      end do
+    end if
+    if (pl%lub%model == LUB_NONE) return
+    call nlist_init(pl%nlist, np, pl%box, pl%periodic, pl%nlist%cutoff, pl%nlist%wall_cutoff, pl%skin, info, pl%le)
+    pl%nlist%built = .false.
+  end subroutine particle_lubrication_set_local
+
   pure function ambient_velocity(pl, x) result(u)
     type(particle_lubrication_t), intent(in) :: pl
     real(dp), intent(in) :: x(3)
@@ -238,12 +283,16 @@ contains
   !> among them, in the order of all candidates, so that each owned sphere has all its pair links, in the
   !> order all links would have them (mod_lubrication_links); walls always all.
   !> offset (optional): the Lees-Edwards offset delta of this configuration (runs created with le).
-  subroutine particle_lubrication_links(pl, x, owned, offset)
+  !> phase (optional, a local set only: particle_lubrication_set_local): LINKS_COUNT or
+  !> LINKS_EVALUATE; absent, both.
+  subroutine particle_lubrication_links(pl, x, owned, offset, phase)
     type(particle_lubrication_t), intent(inout) :: pl
     real(dp), intent(in) :: x(:, :)
     logical, intent(in), optional :: owned(:)
     real(dp), intent(in), optional :: offset
+    integer, intent(in), optional :: phase
     integer :: c, i, j, side, status
+    logical :: count_phase, evaluate_phase, local
     real(dp) :: r(3), dist, gap, d(3), om_inf(3), e_inf(3, 3), u_inf(3, 2), normal(3), u_wall(3), w(n_wall_scalars)
     real(dp) :: vshift(3), floor_scale, scale(12)
     pl%npairs = 0
@@ -253,20 +302,32 @@ contains
     pl%min_gap = huge(1.0_dp)
     pl%failed_link = 0
     if (pl%lub%model == LUB_NONE) return
-    if (present(offset)) pl%le%offset = offset
-    ! one sphere: its wall candidates were set once by particle_lubrication_create
-    if (pl%np > 1) call nlist_candidates(pl%nlist, x, pl%cand, pl%ncand, pl%cand_walls, pl%ncand_walls, pl%le%offset)
-    call ambient_gradients(pl, om_inf, e_inf)
-    if (pl%lub%model == LUB_EXACT) then
-      call count_links()
-      floor_scale = -0.5_dp * min(6.0_dp * pi * pl%lub%viscosity * pl%lub%radius, &
-                                  8.0_dp * pi * pl%lub%viscosity * pl%lub%radius**3)
+    local = allocated(pl%owned)
+    count_phase = .true.
+    evaluate_phase = .true.
+    if (present(phase)) then
+      count_phase = phase == LINKS_COUNT
+      evaluate_phase = phase == LINKS_EVALUATE
     end if
+    if (present(offset)) pl%le%offset = offset
+    if (count_phase) then
+      ! one sphere: its wall candidates were set once by particle_lubrication_create
+      if (pl%np > 1 .or. local) &
+        call nlist_candidates(pl%nlist, x, pl%cand, pl%ncand, pl%cand_walls, pl%ncand_walls, pl%le%offset)
+      if (pl%lub%model == LUB_EXACT) call count_links()
+    end if
+    if (.not. evaluate_phase) return
+    call ambient_gradients(pl, om_inf, e_inf)
+    if (pl%lub%model == LUB_EXACT) floor_scale = -0.5_dp * min(6.0_dp * pi * pl%lub%viscosity * pl%lub%radius, &
+                                                               8.0_dp * pi * pl%lub%viscosity * pl%lub%radius**3)
     do c = 1, pl%ncand
       i = pl%cand(1, c)
       j = pl%cand(2, c)
       if (present(owned)) then
         if (.not. (owned(i) .or. owned(j))) cycle
+      end if
+      if (local) then
+        if (.not. (pl%owned(i) .or. pl%owned(j))) cycle
       end if
       r = separation(i, j)
       dist = norm2(r)
@@ -315,6 +376,9 @@ contains
     do c = 1, pl%ncand_walls
       i = pl%cand_walls(1, c)
       side = pl%cand_walls(2, c)
+      if (local) then
+        if (.not. pl%owned(i)) cycle
+      end if
       gap = wall_gap(i, side)
       if (side == 1) then
         normal = [0.0_dp, 1.0_dp, 0.0_dp]
