@@ -15,7 +15,8 @@ module mod_ld_motion
   use mod_errors, only: fatal_error
   use mod_particles, only: particles_t, MOTION_FREE, MOTION_FROZEN, impose_motion
   use mod_particle_solver, only: particle_solver_t, particle_solver_solve
-  use mod_particle_lubrication, only: particle_lubrication_t
+  use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_corrections
+  use mod_ld_local, only: ld_local_t, ld_local_forward_velocities
   use mod_lubrication_links, only: lubrication_links_corrections
   use mod_particle_contacts, only: particle_contacts_t, particle_contacts_implicit_update, particle_contacts_set_rate
   use mod_lubrication_dynamics, only: lubrication_dynamics_t, lubrication_dynamics_assemble, &
@@ -30,14 +31,18 @@ contains
   !> U, Omega of the spheres at X^n (free and frozen: force- and torque-free apart from the
   !> external and contact forces; prescribed, resistance: imposed; fixed: at rest), then their
   !> hydrodynamics. solver: the owner of the 6N system, which it holds between steps.
-  !> lubrication, contacts: each absent when the run has none.
-  subroutine ld_motion_solve(ld, solver, parts, ierr, lubrication, contacts)
+  !> lubrication, contacts: each absent when the run has none. local (optional): parts is this
+  !> rank's local set (mod_ld_local): the solve gives the own spheres' velocities, the halo brings
+  !> the ghosts' before the contacts' update and the links' corrections (each rank's own sums
+  !> complete, nothing gathered).
+  subroutine ld_motion_solve(ld, solver, parts, ierr, lubrication, contacts, local)
     type(lubrication_dynamics_t), intent(in) :: ld
     type(particle_solver_t), intent(inout) :: solver
     type(particles_t), intent(inout) :: parts
     PetscErrorCode, intent(out) :: ierr
     type(particle_lubrication_t), intent(inout), optional :: lubrication
     type(particle_contacts_t), intent(inout), optional :: contacts
+    type(ld_local_t), intent(inout), optional :: local
     real(dp), allocatable :: rhs(:, :)
 
     ierr = 0
@@ -46,12 +51,19 @@ contains
       allocate(rhs(6, parts%n))
       call lubrication_dynamics_assemble(ld, parts, solver%system, rhs, lubrication, contacts)
       PetscCall(particle_solver_solve(solver, rhs, parts, ierr, ''))
+      if (present(local)) then
+        PetscCall(ld_local_forward_velocities(local, ierr))
+      end if
       if (present(contacts)) call particle_contacts_implicit_update(contacts, parts%velocity, parts%omega)
     case default                    ! prescribed, resistance, fixed
       call impose_motion(parts)
     end select
     if (present(lubrication)) then
-      PetscCall(lubrication_links_corrections(lubrication, parts%velocity, parts%omega, ierr))
+      if (present(local)) then
+        call particle_lubrication_corrections(lubrication, parts%velocity, parts%omega)
+      else
+        PetscCall(lubrication_links_corrections(lubrication, parts%velocity, parts%omega, ierr))
+      end if
     end if
     call lubrication_dynamics_hydrodynamics(ld, parts, lubrication)
   end subroutine ld_motion_solve

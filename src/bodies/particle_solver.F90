@@ -23,7 +23,9 @@
 ! (since 2026-11-28, issue 45): the matrix and vectors live on PETSC_COMM_WORLD, each rank owns the
 ! block rows of the spheres in its z-slab (mod_sphere_ownership, since 2026-11-29; before, a
 ! contiguous range of indices) and sets only those, CG runs in parallel, and the shares of the
-! solution are gathered (doc/DESIGN.md "Parallelism"). Each
+! solution are gathered (doc/DESIGN.md "Parallelism"); on a rank's local set
+! (particle_solver_set_local, lubrication dynamics since 2026-11-29) nothing is gathered: the own
+! spheres' velocities come back, their ghosts' from the halo. Each
 ! rank's system holds every block of its own rows: the one-body and contact blocks are replicated,
 ! and a rank holds the lubrication links of its own spheres (mod_lubrication_links); the blocks of
 ! other rows it may hold are ignored. One rank gives the same numbers as before, bitwise; more

@@ -35,6 +35,9 @@ module mod_time_step
   use mod_lubrication_links, only: lubrication_links_evaluate
   use mod_ld_motion, only: ld_motion_solve, ld_motion_solve_stress
   use mod_particle_solver, only: particle_solver_t
+  use mod_ld_local, only: ld_local_t, ld_local_create, ld_local_begin, ld_local_contacts_agree, ld_local_links, &
+                          ld_local_end
+  use mod_particles, only: MOTION_FREE, MOTION_FROZEN
   implicit none
   private
   public :: time_step_t, time_step_create, time_step_advance, time_step_guard, time_step_report
@@ -76,6 +79,8 @@ module mod_time_step
     type(shear_protocol_t), pointer :: protocol => null()   ! the imposed shear (&shear)
     real(dp), allocatable :: mean_flow(:)          ! x-z plane means of u per cell row (statistics)
     real(dp), allocatable :: position_before(:, :) ! X^n, then X^{n+1} - X^n
+    ! lubrication dynamics on more than one rank: each rank's own spheres and ghosts (mod_ld_local)
+    type(ld_local_t) :: local
   end type time_step_t
 
 contains
@@ -84,7 +89,7 @@ contains
   ! domain fd, or, without a fluid, their lubrication dynamics (ld, ld_solver); contacts,
   ! lubrication and rheology where the run has them; le: the Lees-Edwards boundaries (offset 0
   ! when inactive); protocol: the imposed shear in time (mod_shear_protocol). walls: walls in y.
-  ! Options: -fd_carry_lambda, -fault_nan_step. Collective (resolved: the geometry of X^n is built
+  ! Options: -fd_carry_lambda, -fault_nan_step, -ld_local_set. Collective (resolved: the geometry of X^n is built
   ! here).
   subroutine time_step_create(ts, dt, box, walls, le, protocol, ierr, grid, fluid, fd, parts, ld, ld_solver, &
                               contacts, lubrication, rheology, fluid_response)
@@ -104,8 +109,10 @@ contains
     type(particle_contacts_t), target, intent(in), optional :: contacts
     type(particle_lubrication_t), target, intent(in), optional :: lubrication
     type(rheology_t), target, intent(in), optional :: rheology
-    PetscBool :: set
+    PetscBool :: set, use_local
     PetscInt :: fault_step
+    real(dp) :: reach
+    character(len=200) :: text
     ierr = 0
     ts%dt = dt
     ts%box = box
@@ -134,6 +141,23 @@ contains
       ts%variant = TIME_STEP_FLUID_FREE
     end if
     if (associated(ts%rheology) .and. associated(ts%fluid)) allocate(ts%mean_flow(0:ts%grid%n(2) - 1))
+    if (ts%variant == TIME_STEP_FLUID_FREE) then
+      ! the reach of the local set: the largest neighbour-list cut-off of the contacts and links
+      reach = 0.0_dp
+      if (associated(ts%contacts)) reach = ts%contacts%nlist%cutoff
+      if (associated(ts%lubrication)) reach = max(reach, ts%lubrication%nlist%cutoff)
+      ! -ld_local_set 0: every rank evaluates the step for every sphere (the replicated state, as
+      ! before 2026-11-29; for comparisons)
+      use_local = PETSC_TRUE
+      PetscCall(PetscOptionsGetBool(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-ld_local_set', use_local, set, ierr))
+      if (.not. use_local) reach = 0.0_dp
+      call ld_local_create(ts%local, box(3), reach)
+      if (ts%local%active) then
+        write(text, '(a,f7.3,a)') 'lubrication dynamics on the ranks'' local sets: each rank steps the spheres of '// &
+             'its z-slab and their ghosts within ', reach, ' a (free or frozen spheres, rate control)'
+        call log_line(text)
+      end if
+    end if
     if (ts%variant == TIME_STEP_RESOLVED) then
       ! the geometry at X^n; each step then moves it, and Lambda with it, to X^{n+1}
       PetscCall(stage_push(STAGE_PARTICLES, ierr))
@@ -184,67 +208,74 @@ contains
       ! (Euler, as the first step does), and so does the implicit contacts' prediction of the
       ! motion (particle_contacts_add_stiffness), set from the same flag
       if (ts%protocol%reversed) parts%have_prev = .false.
-      if (associated(ts%contacts)) then
-        ! contacts at X^n with the latest velocities (those of the previous step)
-        PetscCall(stage_push(STAGE_CONTACTS, ierr))
-        call particle_contacts_step(ts%contacts, parts%position, parts%velocity, parts%omega, info, le%offset)
-        PetscCall(stage_pop(ierr))
-        if (info /= 0) then
-          ts%failure = contact_failure(ts%contacts, info)
-          return
-        end if
-      end if
-      if (associated(ts%lubrication)) then
-        ! the lubrication links at X^n, taken implicitly in the particle problem below (stress
-        ! control: their drives per unit rate, which the particle solve scales)
-        if (stress_control) then
-          ts%lubrication%shear_rate = 1.0_dp
-          ts%lubrication%le%shear_rate = 1.0_dp
-        end if
-        PetscCall(stage_push(STAGE_LUBRICATION, ierr))
-        PetscCall(lubrication_links_evaluate(ts%lubrication, parts%position, ierr, le%offset))
-        PetscCall(stage_pop(ierr))
-        if (ts%lubrication%failed_link(1) /= 0) then
-          ts%failure = lubrication_failure(ts%lubrication%failed_link)
-          return
-        end if
-      end if
-      ! (a disassociated pointer passed to an optional argument is absent: contacts, lubrication)
-      if (ts%variant == TIME_STEP_RESOLVED) then
-        ! (stress control: the fluid at the last step's wall speed, impose_rate)
-        PetscCall(stage_push(STAGE_FLUID, ierr))
-        PetscCall(fluid_step(ts%grid, ts%fluid, ierr, ts%fd%lambda))
-        PetscCall(stage_pop(ierr))
-        PetscCall(stage_push(STAGE_PARTICLES, ierr))
-        ! the particle sub-problem (doc/METHOD.md §3.2 eq. (1)): moments of u~ and Lambda^n, the
-        ! 6N system for U, Omega, then Lambda^{n+1}, u^{n+1} and the hydrodynamic force, torque,
-        ! stresslet
-        if (le%active) call fictitious_domain_set_image_speed(ts%fd, ts%protocol%rate * ts%box(2))
-        PetscCall(fictitious_domain_moments(ts%grid, ts%fd, ts%fluid%vel, parts%n, ierr))
-        if (stress_control) then
-          PetscCall(resolved_stress_control(ts, ierr))
-        else
-          PetscCall(fictitious_domain_solve_motion(ts%fd, parts, ierr, lubrication=ts%lubrication, contacts=ts%contacts))
-        end if
-        PetscCall(fictitious_domain_update(ts%grid, ts%fd, ts%fluid%vel, ts%fluid%pressure, parts, ierr, ts%lubrication))
+      if (ts%variant == TIME_STEP_FLUID_FREE .and. ts%local%active .and. .not. stress_control .and. &
+          (parts%motion == MOTION_FREE .or. parts%motion == MOTION_FROZEN)) then
+        ! lubrication dynamics on the ranks' local sets (mod_ld_local)
+        PetscCall(local_step(ts, ierr))
+        if (len_trim(ts%failure) > 0) return
       else
-        PetscCall(stage_push(STAGE_PARTICLES, ierr))
-        ! lubrication dynamics: the 6N Stokes balance of the spheres alone (one-body drag in the
-        ! imposed flow, the pair and wall links, the contacts), then their hydrodynamic force,
-        ! torque and stresslet (doc/METHOD.md §6); under stress control with the rate that sets the
-        ! mean shear stress, which every piece then takes (§7.4)
-        if (stress_control) then
-          rate = ts%protocol%rate
-          PetscCall(ld_motion_solve_stress(ts%ld, ts%ld_solver, parts, ts%protocol%stress, rate, reached, ierr, rheology=ts%rheology, lubrication=ts%lubrication, contacts=ts%contacts))
-          ! the strain and the offset advance with the spheres' Adams-Bashforth step (§7.4)
-          if (parts%have_prev) then
-            call shear_protocol_set_rate(ts%protocol, rate, reached, 1.5_dp * rate - 0.5_dp * ts%protocol%rate)
-          else
-            call shear_protocol_set_rate(ts%protocol, rate, reached, rate)
+        if (associated(ts%contacts)) then
+          ! contacts at X^n with the latest velocities (those of the previous step)
+          PetscCall(stage_push(STAGE_CONTACTS, ierr))
+          call particle_contacts_step(ts%contacts, parts%position, parts%velocity, parts%omega, info, le%offset)
+          PetscCall(stage_pop(ierr))
+          if (info /= 0) then
+            ts%failure = contact_failure(ts%contacts, info)
+            return
           end if
-          call impose_rate(ts)
+        end if
+        if (associated(ts%lubrication)) then
+          ! the lubrication links at X^n, taken implicitly in the particle problem below (stress
+          ! control: their drives per unit rate, which the particle solve scales)
+          if (stress_control) then
+            ts%lubrication%shear_rate = 1.0_dp
+            ts%lubrication%le%shear_rate = 1.0_dp
+          end if
+          PetscCall(stage_push(STAGE_LUBRICATION, ierr))
+          PetscCall(lubrication_links_evaluate(ts%lubrication, parts%position, ierr, le%offset))
+          PetscCall(stage_pop(ierr))
+          if (ts%lubrication%failed_link(1) /= 0) then
+            ts%failure = lubrication_failure(ts%lubrication%failed_link)
+            return
+          end if
+        end if
+        ! (a disassociated pointer passed to an optional argument is absent: contacts, lubrication)
+        if (ts%variant == TIME_STEP_RESOLVED) then
+          ! (stress control: the fluid at the last step's wall speed, impose_rate)
+          PetscCall(stage_push(STAGE_FLUID, ierr))
+          PetscCall(fluid_step(ts%grid, ts%fluid, ierr, ts%fd%lambda))
+          PetscCall(stage_pop(ierr))
+          PetscCall(stage_push(STAGE_PARTICLES, ierr))
+          ! the particle sub-problem (doc/METHOD.md §3.2 eq. (1)): moments of u~ and Lambda^n, the
+          ! 6N system for U, Omega, then Lambda^{n+1}, u^{n+1} and the hydrodynamic force, torque,
+          ! stresslet
+          if (le%active) call fictitious_domain_set_image_speed(ts%fd, ts%protocol%rate * ts%box(2))
+          PetscCall(fictitious_domain_moments(ts%grid, ts%fd, ts%fluid%vel, parts%n, ierr))
+          if (stress_control) then
+            PetscCall(resolved_stress_control(ts, ierr))
+          else
+            PetscCall(fictitious_domain_solve_motion(ts%fd, parts, ierr, lubrication=ts%lubrication, contacts=ts%contacts))
+          end if
+          PetscCall(fictitious_domain_update(ts%grid, ts%fd, ts%fluid%vel, ts%fluid%pressure, parts, ierr, ts%lubrication))
         else
-          PetscCall(ld_motion_solve(ts%ld, ts%ld_solver, parts, ierr, lubrication=ts%lubrication, contacts=ts%contacts))
+          PetscCall(stage_push(STAGE_PARTICLES, ierr))
+          ! lubrication dynamics: the 6N Stokes balance of the spheres alone (one-body drag in the
+          ! imposed flow, the pair and wall links, the contacts), then their hydrodynamic force,
+          ! torque and stresslet (doc/METHOD.md §6); under stress control with the rate that sets the
+          ! mean shear stress, which every piece then takes (§7.4)
+          if (stress_control) then
+            rate = ts%protocol%rate
+            PetscCall(ld_motion_solve_stress(ts%ld, ts%ld_solver, parts, ts%protocol%stress, rate, reached, ierr, rheology=ts%rheology, lubrication=ts%lubrication, contacts=ts%contacts))
+            ! the strain and the offset advance with the spheres' Adams-Bashforth step (§7.4)
+            if (parts%have_prev) then
+              call shear_protocol_set_rate(ts%protocol, rate, reached, 1.5_dp * rate - 0.5_dp * ts%protocol%rate)
+            else
+              call shear_protocol_set_rate(ts%protocol, rate, reached, rate)
+            end if
+            call impose_rate(ts)
+          else
+            PetscCall(ld_motion_solve(ts%ld, ts%ld_solver, parts, ierr, lubrication=ts%lubrication, contacts=ts%contacts))
+          end if
         end if
       end if
       ! the core statistics of this configuration, before it moves on
@@ -281,6 +312,48 @@ contains
     end associate
     call count_step(ts, step)
   end subroutine time_step_advance
+
+  ! The particle part of a lubrication-dynamics step on the ranks' local sets (mod_ld_local): the
+  ! local set of X^n, its contacts and links, the 6N solve of the own spheres' rows, and the own
+  ! spheres' results gathered back into ts%parts, which the statistics and the output read. A
+  ! failure (an overlap, a link) is described in ts%failure, the view left as at X^n (every stage
+  ! popped); otherwise the Particles stage is left pushed for the step's end. Collective.
+  subroutine local_step(ts, ierr)
+    type(time_step_t), intent(inout) :: ts
+    PetscErrorCode, intent(out) :: ierr
+    integer :: info
+    ierr = 0
+    associate(loc => ts%local, set => ts%local%set, le => ts%le)
+      PetscCall(stage_push(STAGE_PARTICLES, ierr))
+      PetscCall(ld_local_begin(loc, ts%parts, ts%ld, ts%ld_solver, ierr, ts%contacts, ts%lubrication))
+      PetscCall(stage_pop(ierr))
+      if (associated(ts%contacts)) then
+        PetscCall(stage_push(STAGE_CONTACTS, ierr))
+        call particle_contacts_step(ts%contacts, set%position, set%velocity, set%omega, info, le%offset)
+        PetscCall(ld_local_contacts_agree(ts%contacts, info, ierr))
+        PetscCall(stage_pop(ierr))
+        if (info /= 0) then
+          ts%failure = contact_failure(ts%contacts, info)
+          PetscCall(ld_local_end(loc, ts%parts, ierr, ts%contacts, ts%lubrication))
+          return
+        end if
+      end if
+      if (associated(ts%lubrication)) then
+        PetscCall(stage_push(STAGE_LUBRICATION, ierr))
+        PetscCall(ld_local_links(loc, ts%lubrication, ierr, le%offset))
+        PetscCall(stage_pop(ierr))
+        if (ts%lubrication%failed_link(1) /= 0) then
+          ts%failure = lubrication_failure(ts%lubrication%failed_link)
+          PetscCall(ld_local_end(loc, ts%parts, ierr, ts%contacts, ts%lubrication))
+          return
+        end if
+      end if
+      ! (the stage stays pushed for the rest of the step, as in time_step_advance)
+      PetscCall(stage_push(STAGE_PARTICLES, ierr))
+      PetscCall(ld_motion_solve(ts%ld, ts%ld_solver, set, ierr, lubrication=ts%lubrication, contacts=ts%contacts, local=loc))
+      PetscCall(ld_local_end(loc, ts%parts, ierr, ts%contacts, ts%lubrication))
+    end associate
+  end subroutine local_step
 
   ! Stress control of the DNS with spheres between walls (doc/METHOD.md §7.4): after the fluid step
   ! at the last step's wall speed and its moments, the rate gamma_dot^n whose mean wall shear stress

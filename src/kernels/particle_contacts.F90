@@ -1,7 +1,8 @@
 ! Contacts in the particle time step (doc/CONTACT.md, "Wiring into the time step"): the contact
 ! parameters, the neighbour list and the contact history of one run, and one call per step.
-! Pure: no PETSc, MPI or files. Particle data is replicated, so every rank holds the same state
-! and computes the same forces.
+! Pure: no PETSc, MPI or files. Every sphere on every rank (the replicated state), or a rank's local
+! set (particle_contacts_set_local: its own spheres and their ghosts; the pairs with an own sphere,
+! the springs keyed by global index; doc/DESIGN.md "Parallelism").
 !
 ! One step (doc/METHOD.md §7.1 item 2), at the positions X^n, before the particle sub-problem:
 !   1. the neighbour list (cutoff 2a + h_r + skin, walls a + h_r + skin, a the largest radius) is

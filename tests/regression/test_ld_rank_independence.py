@@ -6,13 +6,18 @@ the same sequential system). Scene: ~250 rough frictional spheres at phi 0.4 in 
 the sparse solve runs at every step.
  1. one rank solves on a sequential matrix (seqbaij), two and three ranks on a distributed one
     (mpibaij), as -particles_ksp_view reports;
- 2. 2 and 3 ranks (unequal shares on 3) agree with 1 rank at every step: positions, velocities
-    and angular velocities within 1e-10 of each quantity's largest magnitude;
+ 2. 2 and 3 ranks (unequal shares on 3) agree with 1 rank at every step: positions, velocities,
+    angular velocities, hydrodynamic and contact stresslets within 1e-10 of each quantity's
+    largest magnitude;
  3. 20 steps on 2 ranks, a checkpoint, 20 more on 3 agree with the 40 on 1 rank, likewise;
  4. the lubrication links stay on the ranks that evaluated them (mod_lubrication_links, issue 45):
     one rank holds all the pair links of the last step (the run log's count), on 2 and 3 ranks
     none does, each holding at least its share; the series' count of pair links (the whole
     system's) is 1 rank's at every step.
+ 5. on 2 and 3 ranks the step runs on each rank's own spheres and ghosts (mod_ld_local, since
+    2026-11-29: contacts, links, the 6N rows and the velocities of a rank's local set, its run log
+    says so), which the agreement in 2. and 3. then checks: an own sphere that missed a contact,
+    a link or a ghost's velocity would move at O(1) differently.
 Tolerance: the CG iterations run to a relative residual of 1e-12; on more ranks their inner
 products sum in another order, which changes the iterates at round-off and the converged solution
 within the solver's tolerance. Measured (2026-11-28): at most 4.2e-13 (omega, the smallest
@@ -32,7 +37,11 @@ DECK = """&domain box = 13.78, 13.78, 13.78, y_boundary = 'lees-edwards', shear_
 &contact roughness = 5e-3, friction = 0.5 /
 &run title = 'lubrication dynamics on several ranks' /
 """
-QUANTITIES = ['particles/position', 'particles/velocity', 'particles/omega']
+# the motion, and what the statistics take from the step: each sphere's hydrodynamic stresslet (the
+# links' corrections with the partners' velocities of the step) and contact stresslet (the implicit
+# contacts' update, likewise)
+QUANTITIES = ['particles/position', 'particles/velocity', 'particles/omega', 'particles/stresslet_hydro',
+              'particles/stresslet_contact']
 TOL = 1e-10
 
 
@@ -80,6 +89,8 @@ pairs1 = T.series(os.path.join(d1, 'out'))['lubrication_pairs']
 for n in (2, 3):
     d, out = run('ld_ranks_%d' % n, n)
     T.check(matrix_type(out) == 'mpibaij', '%d ranks: distributed matrix (%s)' % (n, matrix_type(out)))
+    T.check("on the ranks' local sets" in out and "on the ranks' local sets" not in out1,
+            '%d ranks: each rank steps its own spheres and ghosts (1 rank: every sphere)' % n)
     compare(ref, results(d), '%d ranks vs 1' % n)
     total, most = links(out)
     T.check(total == total1 and total / n <= most < total,

@@ -97,6 +97,28 @@ ck = os.path.join(d, 'out', 'checkpoint.h5')
 T.check(os.path.exists(ck) and int(T.h5_attr(ck, 'step')) % 5 == 0 and np.isfinite(T.read_h5(ck, ['u'])['u']).all(),
         'the last good checkpoint is kept (step %s)' % (T.h5_attr(ck, 'step') if os.path.exists(ck) else None))
 
+# The same guard in lubrication dynamics, the pair across the two ranks' slab face (z = Lz/2 on 2
+# ranks): on several ranks each rank evaluates the contacts of its own spheres (mod_ld_local), and
+# the largest overlap and its pair are reduced over the ranks, so the run stops at the same step,
+# with the same message, as on one rank.
+d = T.scratch('runtime_guard_overlap_ld')
+deck = T.write_deck(d, 'o.nml', """&domain box = 6.4, 6.4, 6.4, y_boundary = 'walls', shear_rate = 0 /
+&fluid model = 'none' /
+&time dt = 1e-3, steps = 200 /
+&output directory = 'out', progress_every = 10 /
+&lubrication model = 'none' /
+&particles number = 2, position(:,1) = 3.2, 3.2, 2.2, position(:,2) = 3.2, 3.2, 4.21,
+  external_force(:,1) = 0, 0, 20, external_force(:,2) = 0, 0, -20 /
+&contact roughness = 0.01, normal_stiffness = 1e3 /
+""")
+stops = []
+for ranks in sorted({1, max(2, T.RANKS)}):
+    status, out, err = T.run(deck, d, np_ranks=ranks, expect_ok=False)
+    messages = [l for l in err.splitlines() if l.startswith('fdsusp: fatal')]
+    stops.append(messages[0] if len(messages) == 1 and status == 5 else 'status %d, %s' % (status, messages[:1]))
+T.check(len(set(stops)) == 1 and 'particle 1 and particle 2' in stops[0],
+        'lubrication dynamics: the overlap across a slab face stops 1 and %d ranks alike: %s' % (max(2, T.RANKS), stops))
+
 d = T.scratch('runtime_guard_particle_solve')
 PAIR = """&domain box = 6.4, 6.4, 6.4, cells_per_radius = 5, y_boundary = 'walls', shear_rate = 1 /
 &fluid reynolds = 0.01, initial_flow = 'shear' /
