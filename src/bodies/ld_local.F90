@@ -31,10 +31,11 @@ module mod_ld_local
                                       particle_lubrication_links, LINKS_COUNT, LINKS_EVALUATE
   use mod_lubrication_dynamics, only: lubrication_dynamics_t, lubrication_dynamics_set_local
   use mod_particle_solver, only: particle_solver_t, particle_solver_set_local
+  use mod_rheology, only: rheology_t, rheo_set_local, rheo_sample, rheo_sample_shares, rheo_sample_finish
   implicit none
   private
   public :: ld_local_t, ld_local_create, ld_local_begin, ld_local_contacts_agree, ld_local_links, &
-            ld_local_forward_velocities, ld_local_end
+            ld_local_forward_velocities, ld_local_statistics, ld_local_end
 
   type :: ld_local_t
     logical :: active = .false.           ! the step runs on the local set
@@ -219,6 +220,31 @@ contains
     loc%set%velocity = v(1:3, :)
     loc%set%omega = v(4:6, :)
   end subroutine ld_local_forward_velocities
+
+  !> The statistics' sample of the configuration on the local set (mod_rheology's local set: sums
+  !> over the own spheres, each pair by the owner of its reference, the ghosts within reach of the
+  !> farthest shell, which ld_local_create's reach includes), the ranks' shares summed and the
+  !> sample finished: one rank's sample to round-off, one reduction of O(bins), not O(N).
+  !> stresslet_contact: the contacts' stresslets of the local set (absent: no contacts); offset:
+  !> the Lees-Edwards offset. Collective.
+  subroutine ld_local_statistics(loc, rheology, ierr, stresslet_contact, offset)
+    type(ld_local_t), intent(inout) :: loc
+    type(rheology_t), intent(inout) :: rheology
+    PetscErrorCode, intent(out) :: ierr
+    real(dp), intent(in), optional :: stresslet_contact(:, :, :)
+    real(dp), intent(in), optional :: offset
+    real(dp), allocatable :: shares(:)
+    real(dp) :: min_gap
+    associate(s => loc%set)
+      call rheo_set_local(rheology, loc%halo%is_owned, s%radii / s%radius)
+      call rheo_sample(rheology, s%position, s%velocity, s%stresslet_hydro, stresslet_contact, offset)
+    end associate
+    shares = rheo_sample_shares(rheology)
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, shares, size(shares), MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr))
+    min_gap = rheology%min_pair_gap
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, min_gap, 1, MPI_DOUBLE_PRECISION, MPI_MIN, PETSC_COMM_WORLD, ierr))
+    call rheo_sample_finish(rheology, shares, min_gap)
+  end subroutine ld_local_statistics
 
   !> The step's results of the own spheres gathered into the view parts (velocities, hydrodynamic
   !> force, torque, stresslet), and into the contacts' and the links' per-sphere arrays of every

@@ -23,7 +23,7 @@ module mod_time_step
   use mod_particles, only: particles_t, advance_positions, displacements
   use mod_particle_contacts, only: particle_contacts_t, particle_contacts_step
   use mod_particle_lubrication, only: particle_lubrication_t
-  use mod_rheology, only: rheology_t, rheo_sample, rheo_sample_flow
+  use mod_rheology, only: rheology_t, rheo_sample, rheo_sample_flow, rheo_reach
   use mod_lees_edwards, only: lees_edwards_t, le_wrap, le_advance, le_set_strain
   use mod_shear_protocol, only: shear_protocol_t, shear_protocol_begin_step, shear_protocol_end_step, &
                                 shear_protocol_varies, shear_protocol_set_rate, PROTOCOL_OSCILLATORY, CONTROL_STRESS
@@ -36,7 +36,7 @@ module mod_time_step
   use mod_ld_motion, only: ld_motion_solve, ld_motion_solve_stress
   use mod_particle_solver, only: particle_solver_t
   use mod_ld_local, only: ld_local_t, ld_local_create, ld_local_begin, ld_local_contacts_agree, ld_local_links, &
-                          ld_local_end
+                          ld_local_statistics, ld_local_end
   use mod_particles, only: MOTION_FREE, MOTION_FROZEN
   implicit none
   private
@@ -146,6 +146,8 @@ contains
       reach = 0.0_dp
       if (associated(ts%contacts)) reach = ts%contacts%nlist%cutoff
       if (associated(ts%lubrication)) reach = max(reach, ts%lubrication%nlist%cutoff)
+      ! (the statistics' shells too, which the local step samples: ghosts within their reach)
+      if (associated(ts%rheology) .and. reach > 0.0_dp) reach = max(reach, rheo_reach(ts%rheology))
       ! -ld_local_set 0: every rank evaluates the step for every sphere (the replicated state, as
       ! before 2026-11-29; for comparisons)
       use_local = PETSC_TRUE
@@ -175,7 +177,7 @@ contains
     PetscErrorCode, intent(out) :: ierr
     integer :: info
     real(dp) :: rate, reached
-    logical :: stress_control
+    logical :: stress_control, local
     ierr = 0
     ts%failure = ''
     ! the imposed rate of this step, gamma_dot(t_n), in every piece that uses it (stress control:
@@ -208,8 +210,9 @@ contains
       ! (Euler, as the first step does), and so does the implicit contacts' prediction of the
       ! motion (particle_contacts_add_stiffness), set from the same flag
       if (ts%protocol%reversed) parts%have_prev = .false.
-      if (ts%variant == TIME_STEP_FLUID_FREE .and. ts%local%active .and. .not. stress_control .and. &
-          (parts%motion == MOTION_FREE .or. parts%motion == MOTION_FROZEN)) then
+      local = ts%variant == TIME_STEP_FLUID_FREE .and. ts%local%active .and. .not. stress_control .and. &
+              (parts%motion == MOTION_FREE .or. parts%motion == MOTION_FROZEN)
+      if (local) then
         ! lubrication dynamics on the ranks' local sets (mod_ld_local)
         PetscCall(local_step(ts, ierr))
         if (len_trim(ts%failure) > 0) return
@@ -278,8 +281,8 @@ contains
           end if
         end if
       end if
-      ! the core statistics of this configuration, before it moves on
-      if (associated(ts%rheology)) then
+      ! the core statistics of this configuration, before it moves on (the local step sampled it)
+      if (associated(ts%rheology) .and. .not. local) then
         if (associated(ts%contacts)) then
           call rheo_sample(ts%rheology, parts%position, parts%velocity, parts%stresslet_hydro, &
                            ts%contacts%stresslet, le%offset)
@@ -351,6 +354,14 @@ contains
       ! (the stage stays pushed for the rest of the step, as in time_step_advance)
       PetscCall(stage_push(STAGE_PARTICLES, ierr))
       PetscCall(ld_motion_solve(ts%ld, ts%ld_solver, set, ierr, lubrication=ts%lubrication, contacts=ts%contacts, local=loc))
+      ! the core statistics of this configuration, before it moves on: the own spheres' shares
+      if (associated(ts%rheology)) then
+        if (associated(ts%contacts)) then
+          PetscCall(ld_local_statistics(loc, ts%rheology, ierr, ts%contacts%stresslet, le%offset))
+        else
+          PetscCall(ld_local_statistics(loc, ts%rheology, ierr, offset=le%offset))
+        end if
+      end if
       PetscCall(ld_local_end(loc, ts%parts, ierr, ts%contacts, ts%lubrication))
     end associate
   end subroutine local_step

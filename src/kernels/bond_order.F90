@@ -13,7 +13,7 @@ module mod_bond_order
   use mod_kinds, only: dp, pi
   implicit none
   private
-  public :: bond_order_q6
+  public :: bond_order_q6, bond_order_shares, bond_order_global
 
   integer, parameter :: l = 6
 
@@ -46,6 +46,48 @@ contains
       if (bonds(i) > 0) q6_local(i) = invariant(q(:, i) / bonds(i))
     end do
   end subroutine bond_order_q6
+
+  !> A share of the global sums over some of the spheres (owned, np): sum of their q_6m(i) N_b(i)
+  !> (total) and of their N_b(i) (bonds), and q6 of each sphere (as bond_order_q6). Shares over a
+  !> partition of the spheres add up to the sums of bond_order_q6, whose Q6 bond_order_global gives.
+  pure subroutine bond_order_shares(np, nbonds, ends, r, owned, total, bonds, q6_local)
+    integer, intent(in) :: np, nbonds
+    integer, intent(in) :: ends(:, :)            ! (2, nbonds)
+    real(dp), intent(in) :: r(:, :)              ! (3, nbonds)
+    logical, intent(in) :: owned(:)              ! (np)
+    complex(dp), intent(out) :: total(0:l)
+    real(dp), intent(out) :: bonds
+    real(dp), intent(out) :: q6_local(np)
+    complex(dp) :: q(0:l, np), y(0:l)
+    integer :: count_of(np), k, i, e
+    q = (0.0_dp, 0.0_dp)
+    count_of = 0
+    do k = 1, nbonds
+      y = spherical_harmonics(r(:, k))
+      do e = 1, 2
+        i = ends(e, k)
+        q(:, i) = q(:, i) + y
+        count_of(i) = count_of(i) + 1
+      end do
+    end do
+    total = (0.0_dp, 0.0_dp)
+    bonds = 0
+    do i = 1, np
+      q6_local(i) = 0.0_dp
+      if (count_of(i) > 0) q6_local(i) = invariant(q(:, i) / count_of(i))
+      if (.not. owned(i)) cycle
+      total = total + q(:, i)
+      bonds = bonds + count_of(i)
+    end do
+  end subroutine bond_order_shares
+
+  !> Q6 from the sums of the shares (bond_order_shares): 0 without bonds.
+  pure real(dp) function bond_order_global(total, bonds) result(q6)
+    complex(dp), intent(in) :: total(0:l)
+    real(dp), intent(in) :: bonds
+    q6 = 0.0_dp
+    if (bonds > 0) q6 = invariant(total / bonds)
+  end function bond_order_global
 
   ! sqrt(4 pi/(2l+1) sum_{m=-l..l} |q_lm|^2) from m = 0..l (|q_l,-m| = |q_lm|).
   pure real(dp) function invariant(q) result(v)

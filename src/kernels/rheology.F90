@@ -1,6 +1,7 @@
 ! Suspension rheology in the core of the Couette cell (doc/RHEOLOGY.md; paper §4, eqs. (4.1)-(4.18)).
-! Pure kernels on plain arrays, no PETSc: every rank holds the same particles and computes the
-! same numbers.
+! Pure kernels on plain arrays, no PETSc: every sphere on every rank, or a rank's local set
+! (rheo_set_local: its own spheres and their ghosts; a sample is then this rank's share, which the
+! caller sums over the ranks before rheo_sample_finish; doc/DESIGN.md "Parallelism").
 !
 ! Per record (rheo_sample): the particle stress of the core region D^C = [0,Lx] x [y_lo,y_hi] x
 ! [0,Lz] (paper eq. (4.10): y_lo = Ly/4, y_hi = 3Ly/4), split into hydrodynamic and contact parts,
@@ -49,7 +50,7 @@ module mod_rheology
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates, min_image
   use mod_lees_edwards, only: lees_edwards_t, le_separation
   use mod_columns, only: column_t, column
-  use mod_bond_order, only: bond_order_q6
+  use mod_bond_order, only: bond_order_q6, bond_order_shares, bond_order_global
   implicit none
   private
   ! bonds of Q6: shorter than bond_factor (a_i + a_j)
@@ -70,7 +71,7 @@ module mod_rheology
   public :: species_summary_t, rheo_summarise_species, rheo_species_quantities, NSPECIES_Q, NQS, species_names
   public :: rheology_settings_t, rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, rheo_quantities, rheo_block_of, &
             rheo_state, rheo_restore, rheo_summarise, rheo_columns, NQ, NSUMMARY, summary_names, slab_volume, &
-            rheo_particle_shear_stress
+            rheo_particle_shear_stress, rheo_set_local, rheo_sample_shares, rheo_sample_finish, rheo_reach
 
   ! per-record values that are block-averaged: stress_hydro(5), stress_contact(5), phi_core,
   ! particle fit(5), suspension fit(5)
@@ -168,6 +169,14 @@ module mod_rheology
     integer :: nradial_volume = 0
     real(dp), allocatable :: radial_volume(:, :, :)                ! (nradial_volume, nspecies, nspecies)
     real(dp), allocatable :: block_radial_volume(:, :, :, :)       ! (nradial_volume, nspecies, nspecies, blocks)
+    ! a rank's local set (rheo_set_local; not allocated: every sphere): the spheres it owns; a
+    ! sample then leaves this rank's shares (rheo_sample_shares), which the caller sums over the
+    ! ranks before rheo_sample_finish
+    logical, allocatable :: owned(:)
+    ! Q6's sums of a sample: the bonds' harmonics over the owned spheres' ends and their count, the
+    ! owned spheres' local q6 and how many have bonds
+    complex(dp) :: q6_total(0:6) = (0.0_dp, 0.0_dp)
+    real(dp) :: q6_bonds = 0, q6_local_sum = 0, q6_local_count = 0
   end type rheology_t
 
   ! The per-species summary over the complete blocks (rheo_summarise_species): value and error of
@@ -239,6 +248,49 @@ contains
     r%order = bond_info == 0
     if (r%sized) call create_species(r, n, a_max, skin)
   end subroutine rheo_create
+
+  !> The spheres a rank holds from now on (doc/DESIGN.md "Parallelism"): its own (owned) and their
+  !> ghosts, in ascending global index, radii (units of r%radius) theirs for a mixture. A sample
+  !> then takes the local set's arrays and sums over the owned spheres only (a pair's counts by the
+  !> owner of the reference sphere, Q6's bonds at the owned ends), so that the shares of the ranks
+  !> add up to one rank's sample: the ghosts must reach the farthest shell, rheo_reach. The pair
+  !> searches start afresh for the new set.
+  subroutine rheo_set_local(r, owned, radii)
+    type(rheology_t), intent(inout) :: r
+    logical, intent(in) :: owned(:)
+    real(dp), intent(in), optional :: radii(:)
+    integer :: n, info, i
+    n = size(owned)
+    r%owned = owned
+    if (r%sized .and. present(radii)) then
+      r%radii = r%radius * radii
+      if (r%nspecies > 1) then
+        if (allocated(r%species_of)) deallocate(r%species_of)
+        allocate(r%species_of(n))
+        do i = 1, n
+          r%species_of(i) = findloc(r%species_radius, r%radii(i), 1)
+        end do
+      end if
+    end if
+    call renew(r%nl)
+    if (r%order) call renew(r%bond_list)
+    if (r%nradial > 0) call renew(r%radial_list)
+  contains
+    subroutine renew(list)
+      type(nlist_t), intent(inout) :: list
+      call nlist_init(list, n, r%box, list%periodic, list%cutoff, list%wall_cutoff, list%skin, info, r%le)
+      list%built = .false.
+    end subroutine renew
+  end subroutine rheo_set_local
+
+  !> The farthest a sample looks from a sphere [length]: its pair shells, Q6's bonds, the partial
+  !> g(r)'s range, each with its search skin (the reach of the ghosts of rheo_set_local).
+  pure real(dp) function rheo_reach(r) result(reach)
+    type(rheology_t), intent(in) :: r
+    reach = r%nl%cutoff
+    if (r%order) reach = max(reach, r%bond_list%cutoff)
+    if (r%nradial > 0) reach = max(reach, r%radial_list%cutoff)
+  end function rheo_reach
 
   ! The species of a mixture (distinct radii, smallest first), each sphere's species, and the
   ! per-species arrays and accumulators; the range of the partial g(r) (doc/RHEOLOGY.md "Per
@@ -328,7 +380,7 @@ contains
     real(dp) :: a, vp, v_core, w, y, u, dbin, d(3), dist, theta, sin_half, gap, ai, vi, phi, fit
     real(dp) :: r_outer, r_contact
     integer :: n, i, b, b1, b2, k, p, i1, i2, sp
-    logical :: ref_i, ref_j, species
+    logical :: ref_i, ref_j, species, local
 
     n = size(position, 2)
     a = r%radius
@@ -348,7 +400,11 @@ contains
     ai = a
     vi = vp
     phi = 0
+    local = allocated(r%owned)
     do i = 1, n
+      if (local) then
+        if (.not. r%owned(i)) cycle
+      end if
       y = position(2, i)
       u = velocity(1, i)
       if (r%sized) then
@@ -426,6 +482,11 @@ contains
       if (abs(d(3)) >= dist * sin_half) cycle
       ref_i = position(2, i1) >= r%core(1) .and. position(2, i1) < r%core(2)
       ref_j = position(2, i2) >= r%core(1) .and. position(2, i2) < r%core(2)
+      if (local) then
+        ! a reference's pairs are counted by its owner
+        ref_i = ref_i .and. r%owned(i1)
+        ref_j = ref_j .and. r%owned(i2)
+      end if
       ! seen from i the partner is at d; seen from j at -d (theta + pi)
       theta = modulo(atan2(d(2), d(1)), 2 * pi)
       if (ref_i) call count_pair(theta)
@@ -879,6 +940,9 @@ contains
     if (r%nradial_volume > 0) then
       r%radial_volume = 0
       do i = 1, size(position, 2)
+        if (allocated(r%owned)) then
+          if (.not. r%owned(i)) cycle
+        end if
         y = position(2, i)
         if (y < r%core(1) .or. y >= r%core(2)) cycle
         s1 = r%species_of(i)
@@ -903,9 +967,18 @@ contains
       k = min(r%nradial, int(dist / r%radial_width) + 1)
       s1 = r%species_of(i1)
       s2 = r%species_of(i2)
-      if (position(2, i1) >= r%core(1) .and. position(2, i1) < r%core(2)) r%radial(k, s2, s1) = r%radial(k, s2, s1) + 1
-      if (position(2, i2) >= r%core(1) .and. position(2, i2) < r%core(2)) r%radial(k, s1, s2) = r%radial(k, s1, s2) + 1
+      ! (a rank's local set: each reference counted by its owner)
+      if (position(2, i1) >= r%core(1) .and. position(2, i1) < r%core(2) .and. is_owned(i1)) &
+        r%radial(k, s2, s1) = r%radial(k, s2, s1) + 1
+      if (position(2, i2) >= r%core(1) .and. position(2, i2) < r%core(2) .and. is_owned(i2)) &
+        r%radial(k, s1, s2) = r%radial(k, s1, s2) + 1
     end do
+  contains
+    logical function is_owned(q)
+      integer, intent(in) :: q
+      is_owned = .true.
+      if (allocated(r%owned)) is_owned = r%owned(q)
+    end function is_owned
   end subroutine sample_radial
 
   ! Q6 of this configuration's bonds (mod_bond_order), the whole box's, and the mean local q6 of
@@ -946,8 +1019,75 @@ contains
       ends(:, nb) = r%bond_pairs(:, p)
       separation(:, nb) = d
     end do
+    if (allocated(r%owned)) then
+      ! this rank's share: the bonds at its owned spheres' ends (rheo_sample_finish takes the sums)
+      call bond_order_shares(n, nb, ends, separation, r%owned, r%q6_total, r%q6_bonds, local)
+      r%q6_local_sum = sum(local, mask=r%owned .and. local > 0)
+      r%q6_local_count = count(r%owned .and. local > 0)
+      return
+    end if
     call bond_order_q6(n, nb, ends, separation, r%q6, local)
     r%q6_local = sum(local) / max(1, count(local > 0))
   end subroutine sample_order
+
+  !> This rank's shares of the last sample on a local set (rheo_set_local), in one vector: the
+  !> stresses, phi_core and the particle fit's sums, the references, the profiles, the pair
+  !> counts, the per-species sums, the partial pair counts and shells, Q6's sums. Summed over the
+  !> ranks they are one rank's sample (to round-off: the order of the sums); rheo_sample_finish
+  !> takes the sum.
+  pure function rheo_sample_shares(r) result(v)
+    type(rheology_t), intent(in) :: r
+    real(dp), allocatable :: v(:)
+    v = [r%values(1:16), r%references, reshape(r%profile, [size(r%profile)]), reshape(r%angles, [size(r%angles)]), &
+         real(r%q6_total, dp), aimag(r%q6_total), r%q6_bonds, r%q6_local_sum, r%q6_local_count]
+    if (r%nspecies > 1) then
+      v = [v, reshape(r%species_values, [size(r%species_values)]), reshape(r%species_profile, [size(r%species_profile)]), &
+           r%species_references, reshape(r%radial, [size(r%radial)])]
+      if (r%nradial_volume > 0) v = [v, reshape(r%radial_volume, [size(r%radial_volume)])]
+    end if
+  end function rheo_sample_shares
+
+  !> The sample from v, the sum over the ranks of rheo_sample_shares, and min_gap, the smallest
+  !> pair gap over the ranks: the shares put back, and what is not a sum (the core's shear rate,
+  !> Q6 and the mean local q6) formed from them.
+  subroutine rheo_sample_finish(r, v, min_gap)
+    type(rheology_t), intent(inout) :: r
+    real(dp), intent(in) :: v(:)
+    real(dp), intent(in) :: min_gap
+    real(dp) :: re(0:6), im(0:6)
+    integer :: k
+    k = 0
+    r%values(1:16) = take(16)
+    r%references = sum(take(1))
+    r%profile = reshape(take(size(r%profile)), shape(r%profile))
+    r%angles = reshape(take(size(r%angles)), shape(r%angles))
+    ! (two statements: the order of two calls in one expression is the compiler's)
+    re = take(7)
+    im = take(7)
+    r%q6_total = cmplx(re, im, dp)
+    r%q6_bonds = sum(take(1))
+    r%q6_local_sum = sum(take(1))
+    r%q6_local_count = sum(take(1))
+    if (r%nspecies > 1) then
+      r%species_values = reshape(take(size(r%species_values)), shape(r%species_values))
+      r%species_profile = reshape(take(size(r%species_profile)), shape(r%species_profile))
+      r%species_references = take(size(r%species_references))
+      r%radial = reshape(take(size(r%radial)), shape(r%radial))
+      if (r%nradial_volume > 0) r%radial_volume = reshape(take(size(r%radial_volume)), shape(r%radial_volume))
+    end if
+    r%min_pair_gap = min_gap
+    r%shear_rate_core = line_slope(r%values(12:16))
+    if (r%order) then
+      r%q6 = bond_order_global(r%q6_total, r%q6_bonds)
+      r%q6_local = r%q6_local_sum / max(1.0_dp, r%q6_local_count)
+    end if
+  contains
+    function take(m) result(part)
+      integer, intent(in) :: m
+      real(dp) :: part(m)
+      part = v(k + 1:k + m)
+      k = k + m
+    end function take
+  end subroutine rheo_sample_finish
 
 end module mod_rheology

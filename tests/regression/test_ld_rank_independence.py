@@ -7,8 +7,9 @@ the sparse solve runs at every step.
  1. one rank solves on a sequential matrix (seqbaij), two and three ranks on a distributed one
     (mpibaij), as -particles_ksp_view reports;
  2. 2 and 3 ranks (unequal shares on 3) agree with 1 rank at every step: positions, velocities,
-    angular velocities, hydrodynamic and contact stresslets within 1e-10 of each quantity's
-    largest magnitude;
+    angular velocities, hydrodynamic and contact stresslets, and the statistics' samples (core
+    stresses, the particle velocity fit, pair counts, Q6, the smallest gap) within 1e-10 of each
+    quantity's largest magnitude;
  3. 20 steps on 2 ranks, a checkpoint, 20 more on 3 agree with the 40 on 1 rank, likewise;
  4. the lubrication links stay on the ranks that evaluated them (mod_lubrication_links, issue 45):
     one rank holds all the pair links of the last step (the run log's count), on 2 and 3 ranks
@@ -35,13 +36,18 @@ DECK = """&domain box = 13.78, 13.78, 13.78, y_boundary = 'lees-edwards', shear_
 &output directory = 'out', progress_every = 10, series_every = 1 /
 &particles solid_fraction = 0.4, seed = 1 /
 &contact roughness = 5e-3, friction = 0.5 /
+&rheology discard_strain = 0.02, average_strain = 0.06, blocks = 2 /
 &run title = 'lubrication dynamics on several ranks' /
 """
 # the motion, and what the statistics take from the step: each sphere's hydrodynamic stresslet (the
 # links' corrections with the partners' velocities of the step) and contact stresslet (the implicit
 # contacts' update, likewise)
 QUANTITIES = ['particles/position', 'particles/velocity', 'particles/omega', 'particles/stresslet_hydro',
-              'particles/stresslet_contact']
+              'particles/stresslet_contact',
+              # the statistics' samples, which the local step takes as each rank's shares summed
+              # (mod_ld_local): stresses, pair counts in the shells, Q6, the smallest gap
+              'core/stress_hydro', 'core/stress_contact', 'core/velocity_fit', 'pairs/shell', 'pairs/contact',
+              'pairs/references', 'structure/q6', 'structure/q6_local', 'min_pair_gap']
 TOL = 1e-10
 
 
@@ -62,7 +68,7 @@ def compare(ref, other, what):
         if ref[k].shape != other[k].shape:
             T.check(False, '%s: %s has shape %s, 1 rank %s' % (what, k, other[k].shape, ref[k].shape))
             continue
-        scale = np.abs(ref[k]).max()
+        scale = np.abs(ref[k]).max() or 1.0    # (a column of zeros: its absolute difference)
         diff = np.abs(other[k] - ref[k]).max() / scale
         T.check(diff <= TOL, '%s: %s max difference %.1e of its largest (%.3g) <= %.0e' % (what, k, diff, scale, TOL))
 

@@ -10,10 +10,13 @@
 !  3. disorder: 2000 spheres placed at random (an ideal gas) with bonds below 1.4 of the mean
 !     spacing: Q6 of the ~N_b bonds is of order N_b^(-1/2), here below 0.05, and the mean local q6
 !     well below the lattices' (< 0.45);
-!  4. a sphere without bonds has q6 = 0.
+!  4. a sphere without bonds has q6 = 0;
+!  5. shares (bond_order_shares, a rank's own spheres): over a partition of the ideal gas into
+!     three sets the shares' sums give Q6 (bond_order_global) to round-off (1e-12: the sums in
+!     another order) and every sphere's local q6 exactly.
 program test_bond_order
   use mod_kinds, only: dp
-  use mod_bond_order, only: bond_order_q6
+  use mod_bond_order, only: bond_order_q6, bond_order_shares, bond_order_global
   use mod_unit_checks, only: check, check_below, finish
   implicit none
   real(dp), allocatable :: x(:, :)
@@ -49,6 +52,10 @@ program test_bond_order
   ! 4. a lone sphere
   call bond_order_q6(1, 0, reshape([0], [2, 0]), reshape([0.0_dp], [3, 0]), q6, q6_local(1:1))
   call check(q6 == 0.0_dp .and. q6_local(1) == 0.0_dp, 'no bonds: Q6 = q6 = 0')
+
+  ! 5. the ideal gas shared out in three sets (by x)
+  call random_gas(2000, x, box)
+  call shared_out(x, box, 1.4_dp * (product(box) / 2000)**(1.0_dp / 3))
   call finish('test_bond_order')
 
 contains
@@ -117,8 +124,8 @@ contains
     side = n
   end subroutine cubic_cells
 
-  ! Q6 and the local q6 of the spheres at pos in a periodic box, bonds shorter than cutoff (an
-  ! O(N^2) search); turn, optional: the bond vectors rotated by it first.
+  ! Q6 and the local q6 of the spheres at pos in a periodic box, bonds shorter than cutoff;
+  ! turn, optional: the bond vectors rotated by it first.
   subroutine q6_of(pos, side, cutoff, value, local, turn)
     real(dp), intent(in) :: pos(:, :), side(3), cutoff
     real(dp), intent(out) :: value
@@ -126,10 +133,52 @@ contains
     real(dp), intent(in), optional :: turn(3, 3)
     integer, allocatable :: ends(:, :)
     real(dp), allocatable :: sep(:, :)
-    real(dp) :: d(3)
-    integer :: i, j, nb, n
+    integer :: nb
+    call bonds_of(pos, side, cutoff, ends, sep, nb, turn)
+    allocate(local(size(pos, 2)))
+    call bond_order_q6(size(pos, 2), nb, ends, sep, value, local)
+  end subroutine q6_of
+
+  ! Check 5: three sets of spheres by x, their shares summed against bond_order_q6.
+  subroutine shared_out(pos, side, cutoff)
+    real(dp), intent(in) :: pos(:, :), side(3), cutoff
+    integer, allocatable :: ends(:, :)
+    real(dp), allocatable :: sep(:, :)
+    real(dp) :: value, bonds, bonds_sum, q6_set(size(pos, 2)), local(size(pos, 2)), local_sets(size(pos, 2))
+    complex(dp) :: total(0:6), total_sum(0:6)
+    logical :: owned(size(pos, 2))
+    integer :: nb, set, n
     n = size(pos, 2)
-    allocate(ends(2, 8 * n), sep(3, 8 * n), local(n))
+    call bonds_of(pos, side, cutoff, ends, sep, nb)
+    call bond_order_q6(n, nb, ends, sep, value, local)
+    total_sum = (0.0_dp, 0.0_dp)
+    bonds_sum = 0
+    local_sets = -1
+    do set = 0, 2
+      owned = int(3 * pos(1, :) / side(1)) == set
+      call bond_order_shares(n, nb, ends, sep, owned, total, bonds, q6_set)
+      total_sum = total_sum + total
+      bonds_sum = bonds_sum + bonds
+      where (owned) local_sets = q6_set
+    end do
+    call check_below('three shares: |Q6 of the summed shares - Q6|', abs(bond_order_global(total_sum, bonds_sum) - value), &
+                     1.0e-12_dp)
+    call check(bonds_sum == 2 * nb .and. all(local_sets == local), 'three shares: every bond end counted once, '// &
+               'every local q6 as bond_order_q6''s')
+  end subroutine shared_out
+
+  ! The bonds shorter than cutoff of the spheres at pos in a periodic box (an O(N^2) search): ends
+  ! (2, nb) and separations (3, nb), turned by turn when present.
+  subroutine bonds_of(pos, side, cutoff, ends, sep, nb, turn)
+    real(dp), intent(in) :: pos(:, :), side(3), cutoff
+    integer, allocatable, intent(out) :: ends(:, :)
+    real(dp), allocatable, intent(out) :: sep(:, :)
+    integer, intent(out) :: nb
+    real(dp), intent(in), optional :: turn(3, 3)
+    real(dp) :: d(3)
+    integer :: i, j, n
+    n = size(pos, 2)
+    allocate(ends(2, 8 * n), sep(3, 8 * n))
     nb = 0
     do i = 1, n
       do j = i + 1, n
@@ -143,8 +192,7 @@ contains
         end if
       end do
     end do
-    call bond_order_q6(n, nb, ends, sep, value, local)
-  end subroutine q6_of
+  end subroutine bonds_of
 
   subroutine random_gas(n, pos, side)
     integer, intent(in) :: n
