@@ -9,6 +9,7 @@
 # flat (bytes against 2 ranks: one rank sends none); a column that grows like the rank count shows state or traffic that grows with the total.
 #   bash scripts/bench_weak_scaling.sh                              (ld and dns, 1 2 4 8 ranks)
 #   MODELS=ld RANKS="1 2" PER_RANK=500 bash scripts/bench_weak_scaling.sh
+#   OPTIONS="-ld_local_set 0" MODELS=ld bash scripts/bench_weak_scaling.sh   (options for every run)
 # Decks (z is the direction the grid is split in, so each rank's share is a slab of the same size):
 #   ld:  lubrication dynamics, the bench deck's physics (phi 0.4, mu_d 0.5, eps_r 5e-3, Lees-Edwards),
 #        PER_RANK spheres per rank (default 500) in a box L x L x (NP L);
@@ -22,6 +23,7 @@ BIN=${BIN:-bin}
 MODELS=${MODELS:-"ld dns"}
 RANKS=${RANKS:-"1 2 4 8"}
 PER_RANK=${PER_RANK:-500}
+OPTIONS=${OPTIONS:-}
 STEPS_SHORT=${STEPS_SHORT:-2}
 STEPS_LONG=${STEPS_LONG:-6}
 W=build/bench/weak_scaling
@@ -64,7 +66,7 @@ run() {
   deck "$model" "$np" "$steps" > "$tag.nml"
   rm -rf "$W/out_${model}_${np}_${steps}" "$tag".prof*
   mpiexec --oversubscribe -n "$np" --mca pml_monitoring_enable 2 --mca pml_monitoring_enable_output 3 \
-      --mca pml_monitoring_filename "$tag.prof" "$BIN/fdsusp" "$tag.nml" -memory_view > "$tag.log" 2>&1
+      --mca pml_monitoring_filename "$tag.prof" "$BIN/fdsusp" "$tag.nml" -memory_view $OPTIONS > "$tag.log" 2>&1
   local spheres mem
   spheres=$(awk '/^packing:/ {print $2; exit}' "$tag.log")
   mem=$(awk '/^Maximum .*process memory/ {print $(NF-2); exit}' "$tag.log")

@@ -9,9 +9,10 @@
 ! The particle state itself is still replicated between steps (the view: positions, velocities,
 ! the hydrodynamic and contact results, the springs), because the statistics, the output and the
 ! checkpoints read it: ld_local_begin takes each rank's local set from it, ld_local_end gathers the
-! own spheres' results and springs back into it (one MPI_Allgatherv of 52 doubles per sphere, and
-! 5 per spring). That gather is the step's one collective of size N; it goes once the statistics
-! and the output read the own spheres (doc/SCALING.md §3.1).
+! own spheres' velocities (7 doubles a sphere) and springs (5 a spring) back into it every step, and
+! their hydrodynamic, contact and link results (45 doubles) only when the output reads them
+! (RESULTS_NOW, or ld_local_complete_view). Those gathers are the step's collectives of size N; they
+! go once the output reads the own spheres and the state migrates with them (doc/SCALING.md §3.1).
 !
 ! With one rank, or without contacts and links (the block-diagonal one-body problem), the step keeps
 ! the replicated state (ld_local_t%active false). An owned sphere sees every contact and link in
@@ -35,14 +36,19 @@ module mod_ld_local
   implicit none
   private
   public :: ld_local_t, ld_local_create, ld_local_begin, ld_local_contacts_agree, ld_local_links, &
-            ld_local_forward_velocities, ld_local_statistics, ld_local_end
+            ld_local_forward_velocities, ld_local_statistics, ld_local_end, ld_local_complete_view
 
   type :: ld_local_t
     logical :: active = .false.           ! the step runs on the local set
     type(sphere_halo_t) :: halo           ! own spheres and ghosts (ascending global index)
     type(particles_t) :: set              ! their state during the step
     integer :: total = 0                  ! spheres of the whole system
+    ! the own spheres' results of the last step not yet in the view (ld_local_end, RESULTS_LATER)
+    real(dp), allocatable :: pending(:, :)
   end type ld_local_t
+
+  ! what ld_local_end does with the step's results (ld_local_end)
+  integer, parameter, public :: RESULTS_NOW = 1, RESULTS_LATER = 2, RESULTS_NONE = 3
 
   ! the values per own sphere that ld_local_end gathers into the view (after its global index):
   ! velocity, omega, hydrodynamic force, torque, stresslet; the contacts' force, torque,
@@ -66,9 +72,10 @@ contains
 
   !> The local set of the configuration in parts (the view): own spheres by slab, ghosts within
   !> reach through the halo, their state copied from the view; the contacts, the links, the
-  !> one-body model and the solver told the local set (their set_local), the block rows numbered by
-  !> slab (mod_sphere_ownership), and the springs of the pairs with an own sphere kept. Collective.
-  subroutine ld_local_begin(loc, parts, ld, solver, ierr, contacts, lubrication)
+  !> one-body model, the solver and the statistics told the local set (their set_local), the block
+  !> rows numbered by slab (mod_sphere_ownership), and the springs of the pairs with an own sphere
+  !> kept. Collective.
+  subroutine ld_local_begin(loc, parts, ld, solver, ierr, contacts, lubrication, rheology)
     type(ld_local_t), intent(inout) :: loc
     type(particles_t), intent(in) :: parts
     type(lubrication_dynamics_t), intent(inout) :: ld
@@ -76,6 +83,7 @@ contains
     PetscErrorCode, intent(out) :: ierr
     type(particle_contacts_t), intent(inout), optional :: contacts
     type(particle_lubrication_t), intent(inout), optional :: lubrication
+    type(rheology_t), intent(inout), optional :: rheology
     integer, allocatable :: id(:), keys(:, :)
     real(dp), allocatable :: x(:, :), data(:, :), springs(:, :)
     real(dp), allocatable :: radii(:)
@@ -105,16 +113,13 @@ contains
       s%have_prev = parts%have_prev
       s%external_force = parts%external_force(:, h%id)
       s%external_torque = parts%external_torque(:, h%id)
-      ! (a step that fails before the solve gathers these back unchanged)
-      s%force_hydro = parts%force_hydro(:, h%id)
-      s%torque_hydro = parts%torque_hydro(:, h%id)
-      s%stresslet_hydro = parts%stresslet_hydro(:, :, h%id)
       radii = s%radii / parts%radius
       ! the rows of the 6N system: numbered by slab, in ascending global index within a slab
       o = sphere_ownership_by_slab(parts%position, loc%halo%lz, h%ranks)
       call particle_solver_set_local(solver, o%row(h%id), h%is_owned, parts%n)
       call lubrication_dynamics_set_local(ld, radii)
       if (present(lubrication)) call particle_lubrication_set_local(lubrication, h%is_owned, radii)
+      if (present(rheology)) call rheo_set_local(rheology, h%is_owned, radii)
       if (present(contacts)) then
         ! the springs of the pairs with an own sphere (the view holds every spring)
         allocate(own_global(-2:parts%n))
@@ -194,6 +199,8 @@ contains
     ! each pair link counted by the owner of its first sphere
     pl%npairs_total = count(loc%halo%is_owned(pl%pair(1, 1:pl%npairs)))
     PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, pl%npairs_total, 1, MPI_INTEGER, MPI_SUM, PETSC_COMM_WORLD, ierr))
+    ! the wall links: each on the owner of its sphere
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, pl%nwalls_total, 1, MPI_INTEGER, MPI_SUM, PETSC_COMM_WORLD, ierr))
     PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, pl%min_gap, 1, MPI_DOUBLE_PRECISION, MPI_MIN, PETSC_COMM_WORLD, ierr))
     ! a failed link named by global index (the largest, so that every rank names the same one)
     most = [0, 0, pl%npairs]
@@ -235,8 +242,8 @@ contains
     real(dp), intent(in), optional :: offset
     real(dp), allocatable :: shares(:)
     real(dp) :: min_gap
+    ! (ld_local_begin told the statistics the local set)
     associate(s => loc%set)
-      call rheo_set_local(rheology, loc%halo%is_owned, s%radii / s%radius)
       call rheo_sample(rheology, s%position, s%velocity, s%stresslet_hydro, stresslet_contact, offset)
     end associate
     shares = rheo_sample_shares(rheology)
@@ -246,73 +253,80 @@ contains
     call rheo_sample_finish(rheology, shares, min_gap)
   end subroutine ld_local_statistics
 
-  !> The step's results of the own spheres gathered into the view parts (velocities, hydrodynamic
-  !> force, torque, stresslet), and into the contacts' and the links' per-sphere arrays of every
-  !> sphere with their springs (each spring from the owner of its pair's first sphere) and the
-  !> links' wall forces summed: everything the statistics, the series and the checkpoints read, as
-  !> one rank has it. The contacts and links are left set for every sphere (set_local of the view).
-  !> Collective.
-  subroutine ld_local_end(loc, parts, ierr, contacts, lubrication)
+  !> The end of the step on the local set, into the view (Collective):
+  !>  - the own spheres' velocities and angular velocities gathered into parts (the next step and
+  !>    the guard read them; 56 B a sphere), and the springs of the pairs whose first sphere is own
+  !>    into the contacts' history (the next step's local sets and the checkpoints take them);
+  !>  - results: RESULTS_NOW, the own spheres' hydrodynamic force, torque, stresslet, and the
+  !>    contacts' and the links' per-sphere force, torque, stresslet gathered too (the output reads
+  !>    them: a series record, a snapshot, a checkpoint); RESULTS_LATER, kept on their owner until
+  !>    ld_local_complete_view gathers them (a step without output sends none of them);
+  !>    RESULTS_NONE, a step that failed before its solve: those of the last step stay pending.
+  !> The contacts and the links are left set for every sphere (set_local of the view), their
+  !> per-sphere arrays zero until gathered; the links' wall forces summed over the ranks.
+  subroutine ld_local_end(loc, parts, results, ierr, contacts, lubrication)
     type(ld_local_t), intent(inout) :: loc
     type(particles_t), intent(inout) :: parts
+    integer, intent(in) :: results
     PetscErrorCode, intent(out) :: ierr
     type(particle_contacts_t), intent(inout), optional :: contacts
     type(particle_lubrication_t), intent(inout), optional :: lubrication
-    real(dp), allocatable :: mine(:, :), all(:, :), springs(:, :), all_springs(:, :), ups(:, :)
-    integer, allocatable :: counts(:), displs(:), keys(:, :), all_id(:)
-    integer :: q, k, np_hist, nsprings, i, info, r
-    PetscMPIInt :: ranks
+    real(dp), allocatable :: rows(:, :), all(:, :), springs(:, :), all_springs(:, :), ups(:, :)
+    integer, allocatable :: keys(:, :)
+    integer :: q, k, np_hist, nsprings, i, info
     logical, allocatable :: every(:)
 
     ierr = 0
-    PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, ranks, ierr))
     associate(h => loc%halo, s => loc%set)
-      allocate(mine(GATHERED + 1, h%owned))
-      k = 0
-      do q = 1, s%n
-        if (.not. h%is_owned(q)) cycle
-        k = k + 1
-        mine(1, k) = real(h%id(q), dp)
-        mine(2:4, k) = s%velocity(:, q)
-        mine(5:7, k) = s%omega(:, q)
-        mine(8:10, k) = s%force_hydro(:, q)
-        mine(11:13, k) = s%torque_hydro(:, q)
-        mine(14:22, k) = reshape(s%stresslet_hydro(:, :, q), [9])
-        mine(23:52, k) = 0.0_dp
-        if (present(contacts)) then
-          mine(23:25, k) = contacts%force(:, q)
-          mine(26:28, k) = contacts%torque(:, q)
-          mine(29:37, k) = reshape(contacts%stresslet(:, :, q), [9])
-        end if
-        if (present(lubrication)) then
-          mine(38:40, k) = lubrication%force(:, q)
-          mine(41:43, k) = lubrication%torque(:, q)
-          mine(44:52, k) = reshape(lubrication%stresslet(:, :, q), [9])
-        end if
-      end do
-      allocate(counts(ranks), displs(ranks), all(GATHERED + 1, loc%total))
-      PetscCallMPI(MPI_Allgather(h%owned, 1, MPI_INTEGER, counts, 1, MPI_INTEGER, PETSC_COMM_WORLD, ierr))
-      counts = counts * (GATHERED + 1)
-      displs(1) = 0
-      do r = 2, ranks
-        displs(r) = displs(r - 1) + counts(r - 1)
-      end do
-      PetscCallMPI(MPI_Allgatherv(mine, size(mine), MPI_DOUBLE_PRECISION, all, counts, displs, MPI_DOUBLE_PRECISION, PETSC_COMM_WORLD, ierr))
-      all_id = nint(all(1, :))
-      parts%velocity(:, all_id) = all(2:4, :)
-      parts%omega(:, all_id) = all(5:7, :)
-      parts%force_hydro(:, all_id) = all(8:10, :)
-      parts%torque_hydro(:, all_id) = all(11:13, :)
-      parts%stresslet_hydro(:, :, all_id) = reshape(all(14:22, :), [3, 3, loc%total])
+      if (results /= RESULTS_NONE) then
+        ! this step's results of the own spheres, one row each (after the global index)
+        allocate(rows(GATHERED + 1, h%owned))
+        k = 0
+        do q = 1, s%n
+          if (.not. h%is_owned(q)) cycle
+          k = k + 1
+          rows(1, k) = real(h%id(q), dp)
+          rows(2:4, k) = s%velocity(:, q)
+          rows(5:7, k) = s%omega(:, q)
+          rows(8:10, k) = s%force_hydro(:, q)
+          rows(11:13, k) = s%torque_hydro(:, q)
+          rows(14:22, k) = reshape(s%stresslet_hydro(:, :, q), [9])
+          rows(23:52, k) = 0.0_dp
+          if (present(contacts)) then
+            rows(23:25, k) = contacts%force(:, q)
+            rows(26:28, k) = contacts%torque(:, q)
+            rows(29:37, k) = reshape(contacts%stresslet(:, :, q), [9])
+          end if
+          if (present(lubrication)) then
+            rows(38:40, k) = lubrication%force(:, q)
+            rows(41:43, k) = lubrication%torque(:, q)
+            rows(44:52, k) = reshape(lubrication%stresslet(:, :, q), [9])
+          end if
+        end do
+        call move_alloc(rows, loc%pending)
+      end if
+      if (results == RESULTS_NOW) then
+        PetscCall(gather_rows(loc%pending, all, ierr))
+        deallocate(loc%pending)
+      else
+        ! the velocities now (of this step, or unchanged after a failed one), the rest later
+        allocate(rows(7, h%owned))
+        k = 0
+        do q = 1, s%n
+          if (.not. h%is_owned(q)) cycle
+          k = k + 1
+          rows(:, k) = [real(h%id(q), dp), s%velocity(:, q), s%omega(:, q)]
+        end do
+        PetscCall(gather_rows(rows, all, ierr))
+      end if
+      parts%velocity(:, nint(all(1, :))) = all(2:4, :)
+      parts%omega(:, nint(all(1, :))) = all(5:7, :)
       allocate(every(loc%total))
       every = .true.
       if (present(lubrication)) then
         PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, lubrication%wall_force, 6, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr))
         call particle_lubrication_set_local(lubrication, every, parts%radii / parts%radius)
         deallocate(lubrication%owned)
-        lubrication%force(:, all_id) = all(38:40, :)
-        lubrication%torque(:, all_id) = all(41:43, :)
-        lubrication%stresslet(:, :, all_id) = reshape(all(44:52, :), [3, 3, loc%total])
       end if
       if (present(contacts)) then
         ! the springs of the pairs whose first sphere is own (5 values each: the pair, the spring)
@@ -325,29 +339,20 @@ contains
           k = k + 1
           springs(:, k) = [real(keys(:, i), dp), ups(:, i)]
         end do
-        PetscCallMPI(MPI_Allgather(5 * k, 1, MPI_INTEGER, counts, 1, MPI_INTEGER, PETSC_COMM_WORLD, ierr))
-        displs(1) = 0
-        do r = 2, ranks
-          displs(r) = displs(r - 1) + counts(r - 1)
-        end do
-        allocate(all_springs(5, max(1, sum(counts) / 5)))
-        PetscCallMPI(MPI_Allgatherv(springs, 5 * k, MPI_DOUBLE_PRECISION, all_springs, counts, displs, MPI_DOUBLE_PRECISION, PETSC_COMM_WORLD, ierr))
-        nsprings = sum(counts) / 5
+        PetscCall(gather_rows(springs(:, 1:k), all_springs, ierr))
+        nsprings = size(all_springs, 2)
         call particle_contacts_set_local(contacts, [(i, i = 1, loc%total)], every, parts%radii / parts%radius)
         deallocate(contacts%ids, contacts%owned)
         if (contacts%params%mu_d > 0) then
-          call history_unpack(contacts%history, loc%total, nsprings, nint(all_springs(1:2, 1:nsprings)), &
-                              all_springs(3:5, 1:nsprings), info)
+          call history_unpack(contacts%history, loc%total, nsprings, nint(all_springs(1:2, :)), all_springs(3:5, :), info)
           if (info /= 0) then
             ierr = 1
             SETERRQ(PETSC_COMM_SELF, ierr, 'the springs gathered from the ranks do not form a history')
           end if
         end if
-        contacts%force(:, all_id) = all(23:25, :)
-        contacts%torque(:, all_id) = all(26:28, :)
-        contacts%stresslet(:, :, all_id) = reshape(all(29:37, :), [3, 3, loc%total])
       end if
     end associate
+    if (results == RESULTS_NOW) call put_results(all, parts, contacts, lubrication)
 
   contains
 
@@ -371,5 +376,67 @@ contains
       end do
     end function owned_global
   end subroutine ld_local_end
+
+  !> The results ld_local_end kept on their owners (RESULTS_LATER or RESULTS_NONE), gathered into
+  !> the view: parts' hydrodynamic force, torque, stresslet, the contacts' and the links' per-sphere
+  !> arrays. Nothing when none is pending (loc%pending is the same on every rank). Called before the
+  !> output reads them outside its cadence: a failure, the end of the run. Collective.
+  subroutine ld_local_complete_view(loc, parts, ierr, contacts, lubrication)
+    type(ld_local_t), intent(inout) :: loc
+    type(particles_t), intent(inout) :: parts
+    PetscErrorCode, intent(out) :: ierr
+    type(particle_contacts_t), intent(inout), optional :: contacts
+    type(particle_lubrication_t), intent(inout), optional :: lubrication
+    real(dp), allocatable :: all(:, :)
+    ierr = 0
+    if (.not. allocated(loc%pending)) return
+    PetscCall(gather_rows(loc%pending, all, ierr))
+    deallocate(loc%pending)
+    call put_results(all, parts, contacts, lubrication)
+  end subroutine ld_local_complete_view
+
+  ! The rows (k, m) of every rank, one after the other (rank order), on every rank. Collective.
+  subroutine gather_rows(rows, all, ierr)
+    real(dp), intent(in) :: rows(:, :)
+    real(dp), allocatable, intent(out) :: all(:, :)
+    PetscErrorCode, intent(out) :: ierr
+    integer, allocatable :: counts(:), displs(:)
+    integer :: r
+    PetscMPIInt :: ranks
+    PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, ranks, ierr))
+    allocate(counts(ranks), displs(ranks))
+    PetscCallMPI(MPI_Allgather(size(rows), 1, MPI_INTEGER, counts, 1, MPI_INTEGER, PETSC_COMM_WORLD, ierr))
+    displs(1) = 0
+    do r = 2, ranks
+      displs(r) = displs(r - 1) + counts(r - 1)
+    end do
+    allocate(all(size(rows, 1), sum(counts) / max(1, size(rows, 1))))
+    PetscCallMPI(MPI_Allgatherv(rows, size(rows), MPI_DOUBLE_PRECISION, all, counts, displs, MPI_DOUBLE_PRECISION, PETSC_COMM_WORLD, ierr))
+  end subroutine gather_rows
+
+  ! The gathered rows of ld_local_end (every sphere's) into the view's per-sphere results.
+  subroutine put_results(all, parts, contacts, lubrication)
+    real(dp), intent(in) :: all(:, :)
+    type(particles_t), intent(inout) :: parts
+    type(particle_contacts_t), intent(inout), optional :: contacts
+    type(particle_lubrication_t), intent(inout), optional :: lubrication
+    integer, allocatable :: id(:)
+    integer :: n
+    id = nint(all(1, :))
+    n = size(id)
+    parts%force_hydro(:, id) = all(8:10, :)
+    parts%torque_hydro(:, id) = all(11:13, :)
+    parts%stresslet_hydro(:, :, id) = reshape(all(14:22, :), [3, 3, n])
+    if (present(contacts)) then
+      contacts%force(:, id) = all(23:25, :)
+      contacts%torque(:, id) = all(26:28, :)
+      contacts%stresslet(:, :, id) = reshape(all(29:37, :), [3, 3, n])
+    end if
+    if (present(lubrication)) then
+      lubrication%force(:, id) = all(38:40, :)
+      lubrication%torque(:, id) = all(41:43, :)
+      lubrication%stresslet(:, :, id) = reshape(all(44:52, :), [3, 3, n])
+    end if
+  end subroutine put_results
 
 end module mod_ld_local

@@ -84,7 +84,10 @@ contains
   !> so that a restart repeats the iterations bitwise. rate: in, the last step's rate (the one the
   !> velocities U^{n-1} and the explicit contact forces went with); out, this step's. reached: the stress the step's velocities give (stress to round-off).
   !> rheology: the statistics' weights (mod_params asks for &rheology under stress control).
-  subroutine ld_motion_solve_stress(ld, solver, parts, stress, rate, reached, ierr, rheology, lubrication, contacts)
+  !> local (optional): parts is this rank's local set (mod_ld_local; the statistics told it too):
+  !> the two solves' own velocities forwarded to the ghosts, the links' corrections of the own
+  !> spheres, and the mean stress summed over the ranks' own spheres.
+  subroutine ld_motion_solve_stress(ld, solver, parts, stress, rate, reached, ierr, rheology, lubrication, contacts, local)
     type(lubrication_dynamics_t), intent(inout) :: ld
     type(particle_solver_t), intent(inout) :: solver
     type(particles_t), intent(inout) :: parts
@@ -95,6 +98,7 @@ contains
     type(rheology_t), intent(in), optional :: rheology
     type(particle_lubrication_t), intent(inout), optional :: lubrication
     type(particle_contacts_t), intent(inout), optional :: contacts
+    type(ld_local_t), intent(inout), optional :: local
     real(dp), allocatable :: rhs0(:, :), rhs1(:, :), u0(:, :), w0(:, :), u1(:, :), w1(:, :)
     real(dp), allocatable :: drive(:, :), wall_drive(:, :), uinf(:, :)
     real(dp), allocatable :: c_force(:, :), c_torque(:, :), c_stresslet(:, :, :)
@@ -135,11 +139,17 @@ contains
     parts%velocity = 0.0_dp
     parts%omega = 0.0_dp
     PetscCall(particle_solver_solve(solver, rhs0, parts, ierr, ' (stress control: the rate-independent part)'))
+    if (present(local)) then
+      PetscCall(ld_local_forward_velocities(local, ierr))
+    end if
     u0 = parts%velocity
     w0 = parts%omega
     parts%velocity = u1
     parts%omega = w1
     PetscCall(particle_solver_solve(solver, rhs1, parts, ierr, ' (stress control: the part per unit rate)'))
+    if (present(local)) then
+      PetscCall(ld_local_forward_velocities(local, ierr))
+    end if
     u1 = parts%velocity
     w1 = parts%omega
     ! the stress at rates 0 and 1; the contacts' step forces are kept for the final update
@@ -196,15 +206,23 @@ contains
         call particle_contacts_implicit_update(contacts, u, w)
       end if
       if (present(lubrication)) then
-        PetscCall(lubrication_links_corrections(lubrication, u, w, ierr))
+        if (present(local)) then
+          call particle_lubrication_corrections(lubrication, u, w)
+        else
+          PetscCall(lubrication_links_corrections(lubrication, u, w, ierr))
+        end if
       end if
       call lubrication_dynamics_hydrodynamics(ld, parts, lubrication)
       if (present(contacts)) then
-        sigma = ld%viscosity * r + rheo_particle_shear_stress(rheology, parts%position, &
-                                                               parts%stresslet_hydro + contacts%stresslet)
+        sigma = rheo_particle_shear_stress(rheology, parts%position, parts%stresslet_hydro + contacts%stresslet)
       else
-        sigma = ld%viscosity * r + rheo_particle_shear_stress(rheology, parts%position, parts%stresslet_hydro)
+        sigma = rheo_particle_shear_stress(rheology, parts%position, parts%stresslet_hydro)
       end if
+      ! (a local set: this rank's own spheres' share)
+      if (present(local)) then
+        PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, sigma, 1, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr))
+      end if
+      sigma = ld%viscosity * r + sigma
     end subroutine at_rate
   end subroutine ld_motion_solve_stress
 

@@ -36,11 +36,13 @@ module mod_time_step
   use mod_ld_motion, only: ld_motion_solve, ld_motion_solve_stress
   use mod_particle_solver, only: particle_solver_t
   use mod_ld_local, only: ld_local_t, ld_local_create, ld_local_begin, ld_local_contacts_agree, ld_local_links, &
-                          ld_local_statistics, ld_local_end
+                          ld_local_statistics, ld_local_end, ld_local_complete_view, RESULTS_NOW, RESULTS_LATER, &
+                          RESULTS_NONE
   use mod_particles, only: MOTION_FREE, MOTION_FROZEN
   implicit none
   private
-  public :: time_step_t, time_step_create, time_step_advance, time_step_guard, time_step_report
+  public :: time_step_t, time_step_create, time_step_advance, time_step_guard, time_step_report, &
+            time_step_complete_view
 
   ! the variants
   integer, parameter :: TIME_STEP_FLUID = 1       ! the fluid alone (no spheres)
@@ -79,8 +81,11 @@ module mod_time_step
     type(shear_protocol_t), pointer :: protocol => null()   ! the imposed shear (&shear)
     real(dp), allocatable :: mean_flow(:)          ! x-z plane means of u per cell row (statistics)
     real(dp), allocatable :: position_before(:, :) ! X^n, then X^{n+1} - X^n
-    ! lubrication dynamics on more than one rank: each rank's own spheres and ghosts (mod_ld_local)
+    ! lubrication dynamics on more than one rank: each rank's own spheres and ghosts (mod_ld_local);
+    ! complete_view: the next step gathers every sphere's results into parts, the contacts and the
+    ! links (the caller's output reads them after it), else they wait for time_step_complete_view
     type(ld_local_t) :: local
+    logical :: complete_view = .true.
   end type time_step_t
 
 contains
@@ -156,7 +161,7 @@ contains
       call ld_local_create(ts%local, box(3), reach)
       if (ts%local%active) then
         write(text, '(a,f7.3,a)') 'lubrication dynamics on the ranks'' local sets: each rank steps the spheres of '// &
-             'its z-slab and their ghosts within ', reach, ' a (free or frozen spheres, rate control)'
+             'its z-slab and their ghosts within ', reach, ' a (free or frozen spheres)'
         call log_line(text)
       end if
     end if
@@ -210,7 +215,7 @@ contains
       ! (Euler, as the first step does), and so does the implicit contacts' prediction of the
       ! motion (particle_contacts_add_stiffness), set from the same flag
       if (ts%protocol%reversed) parts%have_prev = .false.
-      local = ts%variant == TIME_STEP_FLUID_FREE .and. ts%local%active .and. .not. stress_control .and. &
+      local = ts%variant == TIME_STEP_FLUID_FREE .and. ts%local%active .and. &
               (parts%motion == MOTION_FREE .or. parts%motion == MOTION_FROZEN)
       if (local) then
         ! lubrication dynamics on the ranks' local sets (mod_ld_local)
@@ -325,10 +330,11 @@ contains
     type(time_step_t), intent(inout) :: ts
     PetscErrorCode, intent(out) :: ierr
     integer :: info
+    real(dp) :: rate, reached
     ierr = 0
     associate(loc => ts%local, set => ts%local%set, le => ts%le)
       PetscCall(stage_push(STAGE_PARTICLES, ierr))
-      PetscCall(ld_local_begin(loc, ts%parts, ts%ld, ts%ld_solver, ierr, ts%contacts, ts%lubrication))
+      PetscCall(ld_local_begin(loc, ts%parts, ts%ld, ts%ld_solver, ierr, ts%contacts, ts%lubrication, ts%rheology))
       PetscCall(stage_pop(ierr))
       if (associated(ts%contacts)) then
         PetscCall(stage_push(STAGE_CONTACTS, ierr))
@@ -337,23 +343,40 @@ contains
         PetscCall(stage_pop(ierr))
         if (info /= 0) then
           ts%failure = contact_failure(ts%contacts, info)
-          PetscCall(ld_local_end(loc, ts%parts, ierr, ts%contacts, ts%lubrication))
+          PetscCall(ld_local_end(loc, ts%parts, RESULTS_NONE, ierr, ts%contacts, ts%lubrication))
           return
         end if
       end if
       if (associated(ts%lubrication)) then
+        ! (stress control: the links' drives per unit rate, which the particle solve scales)
+        if (ts%protocol%control == CONTROL_STRESS) then
+          ts%lubrication%shear_rate = 1.0_dp
+          ts%lubrication%le%shear_rate = 1.0_dp
+        end if
         PetscCall(stage_push(STAGE_LUBRICATION, ierr))
         PetscCall(ld_local_links(loc, ts%lubrication, ierr, le%offset))
         PetscCall(stage_pop(ierr))
         if (ts%lubrication%failed_link(1) /= 0) then
           ts%failure = lubrication_failure(ts%lubrication%failed_link)
-          PetscCall(ld_local_end(loc, ts%parts, ierr, ts%contacts, ts%lubrication))
+          PetscCall(ld_local_end(loc, ts%parts, RESULTS_NONE, ierr, ts%contacts, ts%lubrication))
           return
         end if
       end if
       ! (the stage stays pushed for the rest of the step, as in time_step_advance)
       PetscCall(stage_push(STAGE_PARTICLES, ierr))
-      PetscCall(ld_motion_solve(ts%ld, ts%ld_solver, set, ierr, lubrication=ts%lubrication, contacts=ts%contacts, local=loc))
+      if (ts%protocol%control == CONTROL_STRESS) then
+        ! the rate that sets the mean shear stress (doc/METHOD.md §7.4), as time_step_advance
+        rate = ts%protocol%rate
+        PetscCall(ld_motion_solve_stress(ts%ld, ts%ld_solver, set, ts%protocol%stress, rate, reached, ierr, rheology=ts%rheology, lubrication=ts%lubrication, contacts=ts%contacts, local=loc))
+        if (set%have_prev) then
+          call shear_protocol_set_rate(ts%protocol, rate, reached, 1.5_dp * rate - 0.5_dp * ts%protocol%rate)
+        else
+          call shear_protocol_set_rate(ts%protocol, rate, reached, rate)
+        end if
+        call impose_rate(ts)
+      else
+        PetscCall(ld_motion_solve(ts%ld, ts%ld_solver, set, ierr, lubrication=ts%lubrication, contacts=ts%contacts, local=loc))
+      end if
       ! the core statistics of this configuration, before it moves on: the own spheres' shares
       if (associated(ts%rheology)) then
         if (associated(ts%contacts)) then
@@ -362,9 +385,20 @@ contains
           PetscCall(ld_local_statistics(loc, ts%rheology, ierr, offset=le%offset))
         end if
       end if
-      PetscCall(ld_local_end(loc, ts%parts, ierr, ts%contacts, ts%lubrication))
+      PetscCall(ld_local_end(loc, ts%parts, merge(RESULTS_NOW, RESULTS_LATER, ts%complete_view), ierr, ts%contacts, ts%lubrication))
     end associate
   end subroutine local_step
+
+  ! Every sphere's results of the last step in ts%parts, the contacts and the links, for output
+  ! outside its cadence (a failure, the end of the run): those the local step kept on their owners
+  ! (complete_view .false.) gathered. Collective.
+  subroutine time_step_complete_view(ts, ierr)
+    type(time_step_t), intent(inout) :: ts
+    PetscErrorCode, intent(out) :: ierr
+    ierr = 0
+    if (.not. ts%local%active) return
+    PetscCall(ld_local_complete_view(ts%local, ts%parts, ierr, ts%contacts, ts%lubrication))
+  end subroutine time_step_complete_view
 
   ! Stress control of the DNS with spheres between walls (doc/METHOD.md §7.4): after the fluid step
   ! at the last step's wall speed and its moments, the rate gamma_dot^n whose mean wall shear stress

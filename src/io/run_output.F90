@@ -30,7 +30,8 @@ module mod_run_output
   use mod_shear_protocol, only: shear_protocol_columns, shear_protocol_varies
   implicit none
   private
-  public :: run_output_t, run_output_open, run_output_step, run_output_checkpoint, run_output_fail, run_output_close
+  public :: run_output_t, run_output_open, run_output_step, run_output_checkpoint, run_output_fail, run_output_close, &
+            run_output_reads_spheres
 
   type :: run_output_t
     type(config_t) :: cfg
@@ -39,6 +40,7 @@ module mod_run_output
     character(len=max_line) :: checkpoint_path = ''
     real(dp) :: wall_start = 0.0_dp                   ! MPI_Wtime at the program's start
     integer :: first_step = 0                         ! the step this run started from
+    logical :: restarted = .false.                    ! from a checkpoint
     ! the pieces whose columns and snapshots are written (associated when the run has them)
     type(grid_t), pointer :: grid => null()
     type(fluid_t), pointer :: fluid => null()
@@ -80,6 +82,7 @@ contains
     out%checkpoint_path = trim(cfg%output%directory)//'/checkpoint.h5'
     out%wall_start = wall_start
     out%first_step = step
+    out%restarted = restarting
     if (present(grid)) out%grid => grid
     if (present(fluid)) out%fluid => fluid
     if (present(le)) out%le => le
@@ -142,6 +145,19 @@ contains
     write(s, '(a,i0)') name, k
   end function species_attribute
 
+  !> Whether the output of step reads the spheres' per-sphere results (a series record, a particle
+  !> snapshot, a checkpoint), so that a step on the ranks' local sets gathers them
+  !> (mod_time_step complete_view).
+  pure logical function run_output_reads_spheres(out, step) result(reads)
+    type(run_output_t), intent(in) :: out
+    integer, intent(in) :: step
+    associate(schedule => out%cfg%output)
+      reads = mod(step, schedule%series_every) == 0
+      if (schedule%particles_every > 0) reads = reads .or. mod(step, schedule%particles_every) == 0
+      if (schedule%checkpoint_every > 0) reads = reads .or. mod(step, schedule%checkpoint_every) == 0
+    end associate
+  end function run_output_reads_spheres
+
   ! The output of step (time), on the deck's &output cadences.
   subroutine run_output_step(out, step, time, ierr)
     type(run_output_t), intent(inout) :: out
@@ -194,6 +210,9 @@ contains
 
   ! The end of a run at step (time): the last record, the series closed, and when steps were taken
   ! the last fields, particles and a checkpoint to continue from; then the statistics' summary.
+  ! A run restarted at its last step (a batch chain's job after a kill between the last checkpoint
+  ! and the end of the last outputs) writes the last fields and particles again: the killed run may
+  ! not have published them (the checkpoint it restarts from already is the last one).
   subroutine run_output_close(out, step, time, ierr)
     type(run_output_t), intent(inout) :: out
     integer, intent(in) :: step
@@ -203,13 +222,15 @@ contains
     PetscCall(stage_push(STAGE_OUTPUT, ierr))
     if (step > out%first_step .and. mod(step, out%cfg%output%series_every) /= 0) call record(out, step, time)
     call series_close(out%series)
-    if (step > out%first_step) then
+    if (step > out%first_step .or. out%restarted) then
       if (associated(out%fluid)) then
         PetscCall(write_fields(out%cfg%output%directory, out%grid, out%fluid, step, time, ierr))
       end if
       if (associated(out%parts)) call particles_snapshot(out%cfg%output%directory, out%parts, out%cfg%domain%box, &
                                                          step, time, owned_spheres(out%state%owned_spheres, &
                                                          out%parts, out%cfg%domain%box))
+    end if
+    if (step > out%first_step) then
       PetscCall(run_output_checkpoint(out, step, time, ierr))
     end if
     if (associated(out%rheology)) call summary(out, step)

@@ -61,6 +61,7 @@ module mod_particle_lubrication
     ! sphere in the owned range; npairs_total, npairs_most: the pair links of the whole system and
     ! the most one rank holds, npairs on one rank, set by mod_lubrication_links on several)
     integer :: npairs = 0, nwalls = 0, npairs_total = 0, npairs_most = 0
+    integer :: nwalls_total = 0                                ! the wall links of the whole system
     integer, allocatable :: pair(:, :)                         ! (2, npairs)
     real(dp), allocatable :: pair_d(:, :), pair_f(:, :)        ! (3, :), (22, :)
     real(dp), allocatable :: pair_f2(:, :)                     ! (22, :) 22 and 21 scalars (sized)
@@ -298,6 +299,7 @@ contains
     pl%npairs = 0
     pl%nwalls = 0
     pl%npairs_total = 0
+    pl%nwalls_total = 0
     pl%npairs_most = 0
     pl%min_gap = huge(1.0_dp)
     pl%failed_link = 0
@@ -416,6 +418,7 @@ contains
     end do
     pl%npairs_total = pl%npairs
     pl%npairs_most = pl%npairs
+    pl%nwalls_total = pl%nwalls
 
   contains
 
@@ -627,7 +630,7 @@ contains
     ! element by element: an array constructor of column_t leaks their values (gfortran 12)
     allocate(c(merge(6, 5, pl%walls)))
     c(1) = column('lubrication_pairs', pl%npairs_total)
-    c(2) = column('lubrication_walls', pl%nwalls)
+    c(2) = column('lubrication_walls', pl%nwalls_total)
     c(3) = column('min_gap', pl%min_gap)
     c(4) = column('particles/force_lubrication', pl%force)
     c(5) = column('particles/torque_lubrication', pl%torque)

@@ -516,6 +516,10 @@ contains
     ai = r%radius
     vi = 4.0_dp / 3.0_dp * pi * ai**3
     do i = 1, size(position, 2)
+      ! (a local set: the own spheres' share, rheo_set_local)
+      if (allocated(r%owned)) then
+        if (.not. r%owned(i)) cycle
+      end if
       if (r%sized) then
         ai = r%radii(i)
         vi = 4.0_dp / 3.0_dp * pi * ai**3

@@ -42,9 +42,10 @@ program fdsusp
   use mod_particle_solver, only: particle_solver_t, particle_solver_create, particle_solver_destroy
   use mod_sphere_ownership, only: sphere_ownership_mine
   use mod_checkpoint, only: checkpoint_state_t, checkpoint_check, checkpoint_read
-  use mod_time_step, only: time_step_t, time_step_create, time_step_advance, time_step_guard, time_step_report
+  use mod_time_step, only: time_step_t, time_step_create, time_step_advance, time_step_guard, time_step_report, &
+                           time_step_complete_view
   use mod_run_output, only: run_output_t, run_output_open, run_output_step, run_output_checkpoint, &
-                            run_output_fail, run_output_close
+                            run_output_fail, run_output_close, run_output_reads_spheres
   implicit none
 
   PetscErrorCode :: ierr
@@ -211,19 +212,28 @@ program fdsusp
   stop_reason = RUN_GOES_ON
   if (step >= cfg%time%steps) stop_reason = RUN_DONE
   do while (stop_reason == RUN_GOES_ON)
+    ! (a step on the ranks' local sets gathers the spheres' results only when the output reads them)
+    ts%complete_view = run_output_reads_spheres(out, step + 1)
     PetscCallA(time_step_advance(ts, step, ierr))
-    if (len_trim(ts%failure) > 0) call run_output_fail(out, step, time, step + 1, ts%failure)
+    if (len_trim(ts%failure) > 0) then
+      PetscCallA(time_step_complete_view(ts, ierr))
+      call run_output_fail(out, step, time, step + 1, ts%failure)
+    end if
     step = step + 1
     time = time + cfg%time%dt
     PetscCallA(run_output_step(out, step, time, ierr))
     ! the runtime guard: a non-finite or escaped state stops the run with a diagnostic
     PetscCallA(time_step_guard(ts, step, ierr))
-    if (len_trim(ts%failure) > 0) call run_output_fail(out, step, time, step, ts%failure)
+    if (len_trim(ts%failure) > 0) then
+      PetscCallA(time_step_complete_view(ts, ierr))
+      call run_output_fail(out, step, time, step, ts%failure)
+    end if
     stop_reason = run_stop_reason(cfg, step, first_step, wall_start, steady_flow())
   end do
 
   ! ---- end of run: the series, the last fields and a checkpoint to continue from ----
   if (step > first_step) call time_step_report(ts, (MPI_Wtime() - wall_loop) / (step - first_step))
+  PetscCallA(time_step_complete_view(ts, ierr))
   PetscCallA(run_output_close(out, step, time, ierr))
   call log_line(run_stop_line(cfg, stop_reason, step, merge(fl%max_rate, 0.0_dp, cfg%resolved)))
   if (cfg%verification%manufactured_solution .and. cfg%resolved) then
