@@ -27,67 +27,28 @@ program test_packing_gr
                          min_separation
   use mod_packing_geometry, only: species_counts_total, species_box_for
   use mod_neighbours, only: nlist_t, nlist_init, nlist_build
-  use mod_unit_checks, only: check, fail, finish, checks, failures
-  use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
-  use, intrinsic :: iso_fortran_env, only: output_unit
+  use mod_unit_checks, only: check, finish, beside_t, beside, end_beside, collect_beside
   implicit none
   integer, parameter :: n = 2000, n_mix = 4000, nbin = 10, nsamp = 400, nblk = 10, gap_sweeps = 4
   real(dp), parameter :: dr = 0.02_dp
   real(dp), parameter :: phis(3) = [0.2_dp, 0.3_dp, 0.4_dp], phis_mix(2) = [0.3_dp, 0.4_dp]
   real(dp), parameter :: mix_radius(2) = [1.0_dp, 1.4_dp], mix_share(2) = [0.5_dp, 0.5_dp]
   integer :: k
-  integer(c_int) :: pid, fd, status
-  character(len=4096) :: child_log
-  interface
-    integer(c_int) function c_fork() bind(C, name='fork')
-      import :: c_int
-    end function c_fork
-    integer(c_int) function c_getpid() bind(C, name='getpid')
-      import :: c_int
-    end function c_getpid
-    integer(c_int) function c_waitpid(p, wstatus, options) bind(C, name='waitpid')
-      import :: c_int
-      integer(c_int), value :: p, options
-      integer(c_int), intent(out) :: wstatus
-    end function c_waitpid
-    integer(c_int) function c_creat(path, mode) bind(C, name='creat')
-      import :: c_int, c_char
-      character(kind=c_char), intent(in) :: path(*)
-      integer(c_int), value :: mode
-    end function c_creat
-    integer(c_int) function c_dup2(old, new) bind(C, name='dup2')
-      import :: c_int
-      integer(c_int), value :: old, new
-    end function c_dup2
-  end interface
+  type(beside_t) :: child
 
   ! The five cases are independent (each its own packing and seeds). The last, the mixture at phi
   ! 0.4 (a third of the run time), runs in a child process on the other core while this process
-  ! runs the other four; its output goes to a file that is printed after theirs, in the order of
-  ! the cases, and its check lines are counted with theirs (the same checks, the same verdict).
-  ! Where fork fails, it runs here.
-  call get_environment_variable('TMPDIR', child_log, status=k)
-  if (k /= 0 .or. len_trim(child_log) == 0) child_log = '/tmp'
-  write(child_log, '(2a,i0,a)') trim(child_log), '/test_packing_gr.', c_getpid(), '.log'
-  flush(output_unit)
-  pid = c_fork()
-  if (pid == 0) then
-    fd = c_creat(trim(child_log)//c_null_char, 384_c_int)         ! mode 0600
-    if (fd < 0) call exit(2)
-    if (c_dup2(fd, 1_c_int) < 0) call exit(2)
+  ! runs the other four (mod_unit_checks' beside); its output is printed after theirs, in the
+  ! order of the cases, and its checks counted with theirs: the same checks, the same verdict.
+  if (beside(child)) then
     call mixture_case(2)
-    flush(output_unit)
-    call exit(0)
+    call end_beside()
   end if
   do k = 1, size(phis)
     call contact_values([1.0_dp], [n], phis(k), 100 + k, 7 + k)
   end do
   call mixture_case(1)
-  if (pid > 0) then
-    call collect_child()
-  else
-    call mixture_case(2)
-  end if
+  if (.not. collect_beside(child)) call mixture_case(2)
 
   call finish('test_packing_gr')
 
@@ -98,32 +59,6 @@ contains
     call contact_values(mix_radius, species_counts_total(n_mix, mix_radius, mix_share, .true.), phis_mix(k), &
                         200 + k, 17 + k)
   end subroutine mixture_case
-
-  !> Wait for the child, print its output and count its checks (a line of mod_unit_checks'
-  !> '  ok    ' or '  FAIL  '); a child that did not end with status 0 fails the test.
-  subroutine collect_child()
-    integer :: u, ios
-    integer(c_int) :: waited
-    character(len=1000) :: line
-    waited = c_waitpid(pid, status, 0_c_int)
-    open(newunit=u, file=trim(child_log), status='old', action='read', iostat=ios)
-    if (ios /= 0) then
-      call fail('the process of the last case left no output ('//trim(child_log)//')')
-      return
-    end if
-    do
-      read(u, '(a)', iostat=ios) line
-      if (ios /= 0) exit
-      print '(a)', trim(line)
-      if (line(1:8) == '  ok    ') checks = checks + 1
-      if (line(1:8) == '  FAIL  ') then
-        checks = checks + 1
-        failures = failures + 1
-      end if
-    end do
-    close(u, status='delete')
-    if (waited /= pid .or. status /= 0) call fail('the process of the last case ended abnormally')
-  end subroutine collect_child
 
   !> Pack counts(k) spheres of radius radius(k) at phi in a periodic cube, sample, and check the
   !> contact value of every pair of species against BMCSL (Carnahan-Starling for one species).
