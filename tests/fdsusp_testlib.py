@@ -63,6 +63,56 @@ def run(deck, cwd, np_ranks=1, args=(), expect_ok=True, timeout=600):
     return p.returncode, p.stdout, p.stderr
 
 
+def run_many(runs, cores=2):
+    """Run independent fdsusp runs at the same time, each as run() would (runs: a list of dicts of
+    run()'s keywords: deck, cwd, np_ranks, args, expect_ok, timeout), started in the order given
+    with at most `cores` ranks under way at once (the CI machine has 2 cores and runs one test at a
+    time; a run of more ranks than cores runs alone). A run's result depends only on its own deck,
+    directory, arguments and rank count, never on what runs beside it: running them together
+    changes only the test's wall time. Returns their (status, stdout, stderr) in the order given; a
+    run that fails with expect_ok (the default) stops the test as run() does, once the others have
+    ended."""
+    import threading
+    turn = threading.Condition()
+    state = {'busy': 0, 'next': 0}
+    results = [None] * len(runs)
+    errors = {}
+
+    def one(k):
+        kw = dict(runs[k])
+        kw.pop('expect_ok', None)
+        ranks = min(kw.get('np_ranks', 1), cores)
+        with turn:
+            turn.wait_for(lambda: state['next'] == k and state['busy'] + ranks <= cores)
+            state['busy'] += ranks
+            state['next'] += 1
+            turn.notify_all()
+        try:
+            results[k] = run(expect_ok=False, **kw)
+        except Exception as e:  # noqa: BLE001 (a timeout: reported by the caller's thread)
+            errors[k] = e
+        finally:
+            with turn:
+                state['busy'] -= ranks
+                turn.notify_all()
+
+    threads = [threading.Thread(target=one, args=(k,)) for k in range(len(runs))]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    if errors:
+        k = min(errors)
+        raise SystemExit('fdsusp on %s: %s' % (runs[k]['deck'], errors[k]))
+    failed = [k for k in range(len(runs)) if runs[k].get('expect_ok', True) and results[k][0] != 0]
+    for k in failed:
+        print(results[k][1][-3000:])
+        print(results[k][2][-3000:])
+    if failed:
+        raise SystemExit('fdsusp failed with status %d on %s' % (results[failed[0]][0], runs[failed[0]]['deck']))
+    return results
+
+
 def run_until_then_signal(deck, cwd, min_step, sig=signal.SIGTERM, np_ranks=1, timeout=300):
     """Start fdsusp, wait until its progress line reports at least min_step, send sig.
     Return (exit status, stdout)."""

@@ -140,6 +140,17 @@ def deck_steps(d):
         return int(re.search(r'steps = (\d+)', f.read()).group(1))
 
 
+def continuation(d, box, start, dt):
+    """For a case whose DNS ran to its deck's last step: None when its pair has crossed x = -start,
+    else the step to continue it to (EXTEND of pairtraj's transit more, as scripts/pair_dns.py
+    does). A restart repeats the arithmetic of one longer run exactly (test_restart), so the
+    records of a continued case are those of a run given the longer deck from the start."""
+    if upto(load_dns(d, box), -start)[1] is not None:
+        return None
+    transit = float(read_pairtraj(d)['t'][-1])
+    return deck_steps(d) + int(math.ceil(EXTEND * transit / dt))
+
+
 def trunk_steps(refs, dt):
     """The trunk's last step: a record step before pairtraj's gap first falls below BRANCH_GAP in
     any of the cases (refs: their pairtraj rows)."""

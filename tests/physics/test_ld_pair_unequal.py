@@ -54,39 +54,50 @@ def crossing(r, t):
     return r[k - 1, 1] + w * (r[k, 1] - r[k - 1, 1]), t[k - 1] + w * (t[k] - t[k - 1])
 
 
-def run(case, lam, steps, extra, model='full'):
+def prepare(case, lam, steps, extra, model='full'):
+    """The run of a case in a directory of its own, for T.run_many."""
     d = T.scratch('ld_pair_unequal_%s_%s_%s' % (case, lam, model))
     pair_file(d, lam)
-    T.run(T.write_deck(d, 'p.nml', DECK.format(steps=steps, lam=lam) .replace("'full'", "'%s'" % model) + extra), d)
-    return path(os.path.join(d, 'out'))
+    return dict(deck=T.write_deck(d, 'p.nml', DECK.format(steps=steps, lam=lam) .replace("'full'", "'%s'" % model) + extra),
+                cwd=d)
 
 
-for case, deck, extra in (('smooth', 'pair_eps0', ''), ('rough', 'pair_eps1e-2_mu03', CONTACT)):
-    for lam, steps in ((1.4, 0), (2.0, 0)):
-        ref, rows = P.run_deck(deck, tag='ld_uneq_%s_%s' % (deck, lam), dt_out='0.01',
-                               x_end='6.0\n  size_ratio = %s' % lam)
-        steps = int(ref['final_t'] / 2e-3) + 200
-        r, t = run(case, lam, steps, extra)
-        y, tc = crossing(r, t)
-        ey = abs(y - ref['final_y']) / abs(ref['final_y'])
-        et = abs(tc - ref['final_t']) / ref['final_t']
-        T.check(ey <= 1e-3, '%s lambda %.1f: final offset y = %.6f a, pairtraj %.6f a, difference %.1e (<= 1e-3)'
-                % (case, lam, y, ref['final_y'], ey))
-        T.check(et <= 1e-3, '%s lambda %.1f: passage time %.4f, pairtraj %.4f, difference %.1e (<= 1e-3)'
-                % (case, lam, tc, ref['final_t'], et))
-        # the path y(x) on pairtraj's records inside the run's range
-        xs = np.array([q['x'] for q in rows])
-        ys = np.array([q['y'] for q in rows])
-        keep = r[:, 0] < 6.0
-        yp = np.interp(r[keep, 0], xs, ys)
-        dev = float(np.max(np.abs(r[keep, 1] - yp)))
-        T.check(dev <= 1e-3, '%s lambda %.1f: path max |y - y_pairtraj| at the same x = %.1e a (<= 1e-3 a)'
-                % (case, lam, dev))
-        if case == 'rough' and lam == 2.0:
-            # control: without the pair hydrodynamics the offset is far off
-            r0, t0 = run(case, lam, steps, extra, model='none')
-            y0, _ = crossing(r0, t0)
-            T.check(not abs(y0 / ref['final_y'] - 1) <= 0.01,
-                    'control: one-body drag alone gives y = %.4f a, %.0f %% from pairtraj'
-                    % (y0, 100 * abs(y0 / ref['final_y'] - 1)))
+# pairtraj for every case, then the five runs (the four cases and the control), which are
+# independent, together, two at a time; the checks in the cases' order
+CASES = [(case, deck, extra, lam) for case, deck, extra in (('smooth', 'pair_eps0', ''), ('rough', 'pair_eps1e-2_mu03', CONTACT))
+         for lam in (1.4, 2.0)]
+refs, runs = {}, []
+for case, deck, extra, lam in CASES:
+    refs[case, lam] = P.run_deck(deck, tag='ld_uneq_%s_%s' % (deck, lam), dt_out='0.01', x_end='6.0\n  size_ratio = %s' % lam)
+    steps = int(refs[case, lam][0]['final_t'] / 2e-3) + 200
+    runs.append(prepare(case, lam, steps, extra))
+    if case == 'rough' and lam == 2.0:
+        # control: without the pair hydrodynamics the offset is far off
+        control = prepare(case, lam, steps, extra, model='none')
+T.run_many(runs + [control])
+
+for (case, deck, extra, lam), one in zip(CASES, runs):
+    ref, rows = refs[case, lam]
+    r, t = path(os.path.join(one['cwd'], 'out'))
+    y, tc = crossing(r, t)
+    ey = abs(y - ref['final_y']) / abs(ref['final_y'])
+    et = abs(tc - ref['final_t']) / ref['final_t']
+    T.check(ey <= 1e-3, '%s lambda %.1f: final offset y = %.6f a, pairtraj %.6f a, difference %.1e (<= 1e-3)'
+            % (case, lam, y, ref['final_y'], ey))
+    T.check(et <= 1e-3, '%s lambda %.1f: passage time %.4f, pairtraj %.4f, difference %.1e (<= 1e-3)'
+            % (case, lam, tc, ref['final_t'], et))
+    # the path y(x) on pairtraj's records inside the run's range
+    xs = np.array([q['x'] for q in rows])
+    ys = np.array([q['y'] for q in rows])
+    keep = r[:, 0] < 6.0
+    yp = np.interp(r[keep, 0], xs, ys)
+    dev = float(np.max(np.abs(r[keep, 1] - yp)))
+    T.check(dev <= 1e-3, '%s lambda %.1f: path max |y - y_pairtraj| at the same x = %.1e a (<= 1e-3 a)'
+            % (case, lam, dev))
+    if case == 'rough' and lam == 2.0:
+        r0, t0 = path(os.path.join(control['cwd'], 'out'))
+        y0, _ = crossing(r0, t0)
+        T.check(not abs(y0 / ref['final_y'] - 1) <= 0.01,
+                'control: one-body drag alone gives y = %.4f a, %.0f %% from pairtraj'
+                % (y0, 100 * abs(y0 / ref['final_y'] - 1)))
 T.finish()

@@ -35,10 +35,23 @@ LD = """&domain box = 8.0, 8.0, 8.0, y_boundary = 'lees-edwards' /
 &rheology discard_strain = 0.0, average_strain = {average}, blocks = 2 /
 """
 d = T.scratch('protocol_steps')
+FLUID = """&domain box = 4.0, 4.0, 4.0, cells_per_radius = 2 /
+&shear control = 'stress', protocol = 'steps', step_by = 'time', levels = 2, step_at = 0.0, 1.5,
+       step_level = 1.0, 3.0 /
+&fluid reynolds = 0.01, viscous_theta = 1.0 /
+&time dt = 1.0e-2, steps = 300 /
+&output directory = 'fluid', progress_every = 1000 /
+"""
+RATE_STEPS = "rate = 2.0, protocol = 'steps', levels = 3, step_at = 0.0, 0.5, 1.5, step_level = 1.0, 2.0, -0.5"
+STRESS_STEPS = ("control = 'stress', protocol = 'steps', step_by = 'time', levels = 2, step_at = 0.0, 0.5, "
+                "step_level = 8.0, 12.0")
+# the three runs are independent (an output directory each): run together, two at a time
+T.run_many([dict(deck=T.write_deck(d, 'rate.nml', LD.format(shear=RATE_STEPS, steps=500, out='rate', average=4.9)), cwd=d),
+            dict(deck=T.write_deck(d, 'stress.nml', LD.format(shear=STRESS_STEPS, steps=200, out='stress',
+                                                                average=0.95)), cwd=d),
+            dict(deck=T.write_deck(d, 'fluid.nml', FLUID), cwd=d)])
 
 # A. rate steps by strain
-shear = "rate = 2.0, protocol = 'steps', levels = 3, step_at = 0.0, 0.5, 1.5, step_level = 1.0, 2.0, -0.5"
-T.run(T.write_deck(d, 'rate.nml', LD.format(shear=shear, steps=500, out='rate', average=4.9)), d)
 s = T.series(os.path.join(d, 'rate'))
 rate, step = s['shear/rate'], s['step']
 changes = step[1:][rate[1:] != rate[:-1]]
@@ -52,15 +65,7 @@ T.check(miss < 1e-12, 'A: the strain is the integral of the levels (%.1e)' % mis
 overlap = np.max(s['contact_overlap_over_roughness'])
 T.check(overlap < 0.5, 'A: the largest contact overlap stays below h_r/2 across the jumps (%.3f h_r)' % overlap)
 
-# B. the fluid alone, stress steps by time
-FLUID = """&domain box = 4.0, 4.0, 4.0, cells_per_radius = 2 /
-&shear control = 'stress', protocol = 'steps', step_by = 'time', levels = 2, step_at = 0.0, 1.5,
-       step_level = 1.0, 3.0 /
-&fluid reynolds = 0.01, viscous_theta = 1.0 /
-&time dt = 1.0e-2, steps = 300 /
-&output directory = 'fluid', progress_every = 1000 /
-"""
-T.run(T.write_deck(d, 'fluid.nml', FLUID), d)
+# B. the fluid alone, stress steps by time (run above)
 s = T.series(os.path.join(d, 'fluid'))
 t_n = s['time'] - 1.0e-2
 level = np.where(t_n < 1.5 - 1e-9, 1.0, 3.0)
@@ -73,9 +78,7 @@ rate = s['shear/rate']
 T.check(abs(rate[first - 1] - 1.0) < 1e-12 and abs(rate[-1] - 3.0) < 1e-12,
         'B: the rate reaches S/eta at each level: %.15f, %.15f' % (rate[first - 1], rate[-1]))
 
-# C. lubrication dynamics, stress steps by time
-shear = "control = 'stress', protocol = 'steps', step_by = 'time', levels = 2, step_at = 0.0, 0.5, step_level = 8.0, 12.0"
-T.run(T.write_deck(d, 'stress.nml', LD.format(shear=shear, steps=200, out='stress', average=0.95)), d)
+# C. lubrication dynamics, stress steps by time (run above)
 s = T.series(os.path.join(d, 'stress'))
 step, rate = s['step'], s['shear/rate']
 level = np.where(step <= 100, 8.0, 12.0)

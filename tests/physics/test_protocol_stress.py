@@ -33,10 +33,11 @@ B. DNS, the fluid alone between walls (4a cube, a/Delta = 2, Re 0.01, backward E
    multiple of its unit wall-speed response), both walls alike (the flow is antisymmetric), and
    once the viscous transient has died (Re Ly^2 = 0.16: 300 steps are 19 relaxation times of the
    slowest mode) the rate is the exact Couette rate S/eta = 2.5, to 1e-12.
-About a minute on one core."""
+About a minute on one core; C's and B's one-rank runs go beside A's first."""
 import os
 import subprocess
 import sys
+from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import fdsusp_testlib as T
 from fdsusp import protocols
@@ -60,8 +61,27 @@ def block_mean(x):
     return b.mean(), b.std(ddof=1) / np.sqrt(BLOCKS)
 
 
+# C. lubrication dynamics between walls, on 1 and 2 ranks; B. the fluid alone between walls
+WALLS = LD.replace("y_boundary = 'lees-edwards'", "y_boundary = 'walls'").replace('steps = 3000', 'steps = 150') \
+    .replace('solid_fraction = 0.4, seed = 1', 'solid_fraction = 0.35, seed = 4') \
+    .replace('discard_strain = 1.0, average_strain = 14.0, blocks = 7', 'discard_strain = 0.0, average_strain = 0.7, blocks = 2')
+FLUID = """&domain box = 4.0, 4.0, 4.0, cells_per_radius = 2 /
+&shear control = 'stress', stress = 2.5 /
+&fluid reynolds = 0.01, viscous_theta = 1.0 /
+&time dt = 1.0e-2, steps = 300 /
+&output directory = 'fluid', progress_every = 1000 /
+"""
 d = T.scratch('protocol_stress')
-T.run(T.write_deck(d, 'rate.nml', LD.format(shear='rate = 1.0', out='rate')), d)
+w = {ranks: T.scratch('protocol_stress_walls_%d' % ranks) for ranks in (1, T.RANKS)}
+walls = {ranks: T.write_deck(w[ranks], 'walls.nml', WALLS.format(shear="control = 'stress', stress = 5.0", out='walls'))
+         for ranks in w}
+# A's rate-controlled run goes on one core while the one-rank runs of C and B, independent of it and
+# of one another (each in its own output directory), run on the other; C's parallel run follows A
+rate_run = ThreadPoolExecutor(max_workers=1).submit(
+    T.run, T.write_deck(d, 'rate.nml', LD.format(shear='rate = 1.0', out='rate')), d)
+T.run(walls[1], w[1])
+T.run(T.write_deck(d, 'fluid.nml', FLUID), d)
+rate_run.result()
 s = T.series(os.path.join(d, 'rate'))
 window = s['step'] > DISCARD
 sigma = s['shear/rate'] + s['core/stress_hydro'][:, 3] + s['core/stress_contact'][:, 3]
@@ -108,15 +128,9 @@ p = subprocess.run([sys.executable, os.path.join(T.ROOT, 'scripts', 'rheology.py
 T.check(p.returncode == 0 and 'agrees to 1e-10' in p.stdout,
         'scripts/rheology.py reproduces summary.json of the stress-controlled run (stresses over gamma_dot_ref)')
 
-# C. lubrication dynamics between walls, on 1 and 2 ranks
-WALLS = LD.replace("y_boundary = 'lees-edwards'", "y_boundary = 'walls'").replace('steps = 3000', 'steps = 150') \
-    .replace('solid_fraction = 0.4, seed = 1', 'solid_fraction = 0.35, seed = 4') \
-    .replace('discard_strain = 1.0, average_strain = 14.0, blocks = 7', 'discard_strain = 0.0, average_strain = 0.7, blocks = 2')
-w = {}
-for ranks in (1, T.RANKS):
-    w[ranks] = T.scratch('protocol_stress_walls_%d' % ranks)
-    T.run(T.write_deck(w[ranks], 'walls.nml', WALLS.format(shear="control = 'stress', stress = 5.0", out='walls')),
-          w[ranks], np_ranks=ranks)
+# C. lubrication dynamics between walls, on 1 (run above) and 2 ranks
+if T.RANKS != 1:
+    T.run(walls[T.RANKS], w[T.RANKS], np_ranks=T.RANKS)
 s = T.series(os.path.join(w[1], 'walls'))
 miss = max(np.max(np.abs(s['shear/stress'] - 5.0)),
            np.max(np.abs(s['shear/rate'] + s['core/stress_hydro'][:, 3] + s['core/stress_contact'][:, 3] - 5.0))) / 5.0
@@ -125,14 +139,7 @@ T.check(miss < 1e-12 and np.any(s['contacts_wall'] > 0) and np.all(s['lubricatio
 T.compare_h5(os.path.join(w[1], 'walls', 'series.h5'), os.path.join(w[T.RANKS], 'walls', 'series.h5'),
              'walls: %d ranks (the links shared out, the solve in parallel) against 1' % T.RANKS, rtol=1e-10, skip=('wall_time',))
 
-# B. the fluid alone between walls
-FLUID = """&domain box = 4.0, 4.0, 4.0, cells_per_radius = 2 /
-&shear control = 'stress', stress = 2.5 /
-&fluid reynolds = 0.01, viscous_theta = 1.0 /
-&time dt = 1.0e-2, steps = 300 /
-&output directory = 'fluid', progress_every = 1000 /
-"""
-T.run(T.write_deck(d, 'fluid.nml', FLUID), d)
+# B. the fluid alone between walls (run above)
 s = T.series(os.path.join(d, 'fluid'))
 tau = 0.5 * (s['tau_wall_bottom'] + s['tau_wall_top'])
 miss = max(np.max(np.abs(tau - 2.5)), np.max(np.abs(s['tau_wall_bottom'] - s['tau_wall_top'])),

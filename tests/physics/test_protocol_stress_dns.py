@@ -45,10 +45,11 @@ D. the step is affine in the walls' speed (doc/METHOD.md §7.4), checked end to 
    step 81: 4.9e-13 (the particle CG stops at a relative residual of 1e-12; the FFT solves are exact);
    a rate-dependent term left out of the homogeneous step (a link's drive, the walls' velocity in
    the implicit contacts) would differ by its share of the step, orders of magnitude above.
-About 25 s on one core (40 s on the loaded 2-core machine)."""
+About 25 s on one core (40 s on the loaded 2-core machine); C and D run beside A's first run."""
 import json
 import os
 import shutil
+from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import fdsusp_testlib as T
 from fdsusp import protocols
@@ -81,50 +82,10 @@ def wall_stress(s):
 
 
 d = T.scratch('protocol_stress_dns')
-T.run(T.write_deck(d, 'rate.nml', DECK.format(shear='rate = 1.0', steps=1200, out='rate')), d)
-s = T.series(os.path.join(d, 'rate'))
-spheres = s['particles/force_contact'][:, :, 0].sum(axis=1)
-walls = s['wall_force_contact'][:, :, 0].sum(axis=1)
-scale = np.max(np.abs(s['particles/force_contact']))
-miss = np.max(np.abs(spheres - walls)) / scale
-T.check(miss < 1e-12 and np.max(np.abs(walls)) > 0,
-        'rate control: the spheres\' contact forces sum to the walls\' (pairs cancel; %.1e of the largest)' % miss)
-sigma = wall_stress(s)
-window = s['step'] > DISCARD
-S, S_err = block_mean(sigma[window])
-T.check(np.all(s['shear/rate'] == 1.0) and S_err > 0, 'rate control: the rate is 1 at every record')
-core = json.load(open(os.path.join(d, 'rate', 'summary.json')))['quantities']['tau']
-tolerance = 3.0 * np.hypot(S_err, core['error'])
-T.check(abs(core['value'] - S) <= tolerance,
-        'rate control: the core\'s shear stress (summary tau, from the stresslets) is the mean wall stress %.3f +- %.3f: '
-        '%.3f +- %.3f, within 3 sigma = %.3f' % (S, S_err, core['value'], core['error'], tolerance))
-
-T.run(T.write_deck(d, 'stress.nml', DECK.format(shear="control = 'stress', stress = %.15g" % S, steps=1200,
-                                                out='stress')), d)
-s = T.series(os.path.join(d, 'stress'))
-rate = s['shear/rate']
-miss = np.max(np.abs(s['shear/stress'] - S)) / S
-T.check(miss < 1e-12, 'the stress each step solved for is S = %.4f (largest relative miss %.1e)' % (S, miss))
-miss = np.max(np.abs(wall_stress(s) - S)) / S
-T.check(miss < 1e-12, 'the mean wall stress summed from the wall columns is S at every record (%.1e)' % miss)
-w = protocols.wall_shear_stress(os.path.join(d, 'stress'))
-miss = np.max(np.abs(w['sigma'] - wall_stress(s))) / S
-T.check(miss < 1e-12 and np.array_equal(w['step'], s['step']),
-        'fdsusp.protocols.wall_shear_stress sums the same (%.1e)' % miss)
-miss = np.max(np.abs(np.diff(s['shear/strain']) - DT * rate[:-1]))
-T.check(s['shear/strain'][0] == 0.0 and miss < 1e-12, 'the strain advances with the walls, dt rate_n (%.1e)' % miss)
-f = s['wall_force_lubrication'][:, :, 0]
-c = s['wall_force_contact'][:, :, 0]
-T.check(np.any(s['contacts_wall'] > 0) and np.all(s['lubrication_walls'] > 0) and np.max(np.abs(f)) > 0
-        and np.max(np.abs(c)) > 0, 'wall contacts and wall lubrication carry stress in the steps')
-mean, err = block_mean(rate[s['step'] > DISCARD])
-tolerance = 3.0 * np.hypot(err, S_err / S)
-print('S = %.4f +- %.4f; stress control at S: mean rate %.4f +- %.4f (rate range %.3f .. %.3f)'
-      % (S, S_err, mean, err, rate.min(), rate.max()))
-T.check(abs(mean - 1.0) <= tolerance,
-        'the mean rate under stress control gives back the rate 1: %.4f, |%.4f| <= 3 sigma = %.4f'
-        % (mean, mean - 1.0, tolerance))
-
+# A's rate-controlled run goes on one core while C and D, which do not need its S, run on the other
+# (independent runs, each in its own output directory); A and B follow D
+rate_run = ThreadPoolExecutor(max_workers=1).submit(
+    T.run, T.write_deck(d, 'rate.nml', DECK.format(shear='rate = 1.0', steps=1200, out='rate')), d)
 # C. the protocols of the stress
 T.run(T.write_deck(d, 'osc.nml', DECK.format(shear="control = 'stress', stress = 2.3, protocol = 'oscillatory', "
                                              "period = 0.25", steps=150, out='osc')), d)
@@ -168,5 +129,50 @@ for name in ('particles/position', 'particles/velocity', 'particles/omega', 'lam
     worst = max(worst, np.max(np.abs(a - b)) / np.max(np.abs(a)))
 T.check(worst < 1e-9, 'step %d under stress control (rate %.6f) = the rate-controlled step at that rate: spheres, '
         'Lambda, fluid within %.1e of each field\'s largest' % (n, found, worst))
+# A. rate control
+rate_run.result()
+s = T.series(os.path.join(d, 'rate'))
+spheres = s['particles/force_contact'][:, :, 0].sum(axis=1)
+walls = s['wall_force_contact'][:, :, 0].sum(axis=1)
+scale = np.max(np.abs(s['particles/force_contact']))
+miss = np.max(np.abs(spheres - walls)) / scale
+T.check(miss < 1e-12 and np.max(np.abs(walls)) > 0,
+        'rate control: the spheres\' contact forces sum to the walls\' (pairs cancel; %.1e of the largest)' % miss)
+sigma = wall_stress(s)
+window = s['step'] > DISCARD
+S, S_err = block_mean(sigma[window])
+T.check(np.all(s['shear/rate'] == 1.0) and S_err > 0, 'rate control: the rate is 1 at every record')
+core = json.load(open(os.path.join(d, 'rate', 'summary.json')))['quantities']['tau']
+tolerance = 3.0 * np.hypot(S_err, core['error'])
+T.check(abs(core['value'] - S) <= tolerance,
+        'rate control: the core\'s shear stress (summary tau, from the stresslets) is the mean wall stress %.3f +- %.3f: '
+        '%.3f +- %.3f, within 3 sigma = %.3f' % (S, S_err, core['value'], core['error'], tolerance))
+
+T.run(T.write_deck(d, 'stress.nml', DECK.format(shear="control = 'stress', stress = %.15g" % S, steps=1200,
+                                                out='stress')), d)
+s = T.series(os.path.join(d, 'stress'))
+rate = s['shear/rate']
+miss = np.max(np.abs(s['shear/stress'] - S)) / S
+T.check(miss < 1e-12, 'the stress each step solved for is S = %.4f (largest relative miss %.1e)' % (S, miss))
+miss = np.max(np.abs(wall_stress(s) - S)) / S
+T.check(miss < 1e-12, 'the mean wall stress summed from the wall columns is S at every record (%.1e)' % miss)
+w = protocols.wall_shear_stress(os.path.join(d, 'stress'))
+miss = np.max(np.abs(w['sigma'] - wall_stress(s))) / S
+T.check(miss < 1e-12 and np.array_equal(w['step'], s['step']),
+        'fdsusp.protocols.wall_shear_stress sums the same (%.1e)' % miss)
+miss = np.max(np.abs(np.diff(s['shear/strain']) - DT * rate[:-1]))
+T.check(s['shear/strain'][0] == 0.0 and miss < 1e-12, 'the strain advances with the walls, dt rate_n (%.1e)' % miss)
+f = s['wall_force_lubrication'][:, :, 0]
+c = s['wall_force_contact'][:, :, 0]
+T.check(np.any(s['contacts_wall'] > 0) and np.all(s['lubrication_walls'] > 0) and np.max(np.abs(f)) > 0
+        and np.max(np.abs(c)) > 0, 'wall contacts and wall lubrication carry stress in the steps')
+mean, err = block_mean(rate[s['step'] > DISCARD])
+tolerance = 3.0 * np.hypot(err, S_err / S)
+print('S = %.4f +- %.4f; stress control at S: mean rate %.4f +- %.4f (rate range %.3f .. %.3f)'
+      % (S, S_err, mean, err, rate.min(), rate.max()))
+T.check(abs(mean - 1.0) <= tolerance,
+        'the mean rate under stress control gives back the rate 1: %.4f, |%.4f| <= 3 sigma = %.4f'
+        % (mean, mean - 1.0, tolerance))
+
 T.finish()
 

@@ -56,18 +56,30 @@ REVERSAL = """&domain box = 8.0, 8.0, 8.0, y_boundary = 'lees-edwards' /
 DT, S0, PERIOD = 5.0e-3, 2.0, 0.5
 
 d = T.scratch('protocol_stress_varying')
+FLUID = """&domain box = 4.0, 4.0, 4.0, cells_per_radius = 2 /
+&shear control = 'stress', stress = 2.5, protocol = 'oscillatory', period = 1.0 /
+&fluid reynolds = 0.01, viscous_theta = 1.0 /
+&time dt = 1.0e-2, steps = 300 /
+&output directory = 'fluid', progress_every = 1000 /
+"""
+
+# The four runs are independent of one another (the oscillation's deck does not need eta_f, only
+# its checks do; each run has its own output directory): run together, two at a time
+T.run_many([
+    dict(deck=T.write_deck(d, 'osc.nml', FROZEN.format(shear="control = 'stress', stress = %r, protocol = 'oscillatory', "
+                                                          "period = %r" % (S0, PERIOD), steps=400, out='osc',
+                                                          average=1.0)), cwd=d),
+    dict(deck=T.write_deck(d, 'reversal.nml', REVERSAL), cwd=d),
+    dict(deck=T.write_deck(d, 'rate.nml', FROZEN.format(shear='rate = 1.0', steps=20, out='rate', average=0.1)), cwd=d),
+    dict(deck=T.write_deck(d, 'fluid.nml', FLUID), cwd=d)])
 
 # A. frozen spheres: eta_f from rate control, then an oscillation of the stress
-T.run(T.write_deck(d, 'rate.nml', FROZEN.format(shear='rate = 1.0', steps=20, out='rate', average=0.1)), d)
 s = T.series(os.path.join(d, 'rate'))
 sigma = s['shear/rate'] + s['core/stress_hydro'][:, 3] + s['core/stress_contact'][:, 3]
 eta_f = sigma.mean()
 T.check(np.ptp(sigma) <= 1e-12 * eta_f and eta_f > 1.0,
         'frozen spheres at rate 1: the stress is eta_f = %.6f at every record (spread %.1e)' % (eta_f, np.ptp(sigma)))
 
-T.run(T.write_deck(d, 'osc.nml', FROZEN.format(shear="control = 'stress', stress = %r, protocol = 'oscillatory', "
-                                                     "period = %r" % (S0, PERIOD), steps=400, out='osc',
-                                                     average=1.0)), d)
 s = T.series(os.path.join(d, 'osc'))
 t_n = (s['step'] - 1) * DT
 target = S0 * np.sin(2 * np.pi * t_n / PERIOD)
@@ -86,7 +98,6 @@ T.check(abs(S0 / in_phase - eta_f) <= 1e-10 * eta_f and abs(quadrature) <= 1e-10
         % (S0 / in_phase, abs(quadrature / in_phase)))
 
 # B. a reversal of the stress in a frictional suspension
-T.run(T.write_deck(d, 'reversal.nml', REVERSAL), d)
 s = T.series(os.path.join(d, 'reversal'))
 stress, rate = s['shear/stress'], s['shear/rate']
 T.check(np.all(np.abs(np.abs(stress) - 10.0) <= 1e-12 * 10.0), 'reversal: the stress is +-10 at every record')
@@ -108,14 +119,7 @@ T.check(after / before > 1.2, 'reversal: the suspension gives way after the firs
         '0.2 strain %.3f against %.3f before (x%.2f > 1.2; eta %.2f -> %.2f)' % (after, before, after / before,
                                                                           10.0 / before, 10.0 / after))
 
-# C. the fluid alone under an oscillating wall stress
-FLUID = """&domain box = 4.0, 4.0, 4.0, cells_per_radius = 2 /
-&shear control = 'stress', stress = 2.5, protocol = 'oscillatory', period = 1.0 /
-&fluid reynolds = 0.01, viscous_theta = 1.0 /
-&time dt = 1.0e-2, steps = 300 /
-&output directory = 'fluid', progress_every = 1000 /
-"""
-T.run(T.write_deck(d, 'fluid.nml', FLUID), d)
+# C. the fluid alone under an oscillating wall stress (run above)
 s = T.series(os.path.join(d, 'fluid'))
 t_n = (s['step'] - 1) * 1.0e-2
 target = 2.5 * np.sin(2 * np.pi * t_n)

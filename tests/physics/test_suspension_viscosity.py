@@ -33,7 +33,6 @@ tolerances 1e-6 (velocity) and 1e-8 (pressure): their effect on the steady stres
 Runs two at a time on one rank each (~3 min on 2 cores)."""
 import json
 import os
-import subprocess
 
 import fdsusp_testlib as T
 
@@ -46,22 +45,16 @@ DECK = """&domain box = 8, 20, 8, cells_per_radius = 4, shear_rate = 1 /
 """
 CASES = [('phi0.3', 0.3, 1, 0.75)] + [('dilute%d' % s, 0.05, s, 0.5) for s in range(1, 7)]
 
-pending = list(CASES)
-running = []
+# two at a time on one rank each, the next started as soon as either ends (fdsusp_testlib.run_many)
+runs = []
+for name, phi, seed, discard in CASES:
+    d = T.scratch('suspension_' + name)
+    runs.append(dict(deck=T.write_deck(d, 'deck.nml', DECK.format(phi=phi, seed=seed, discard=discard)), cwd=d,
+                     timeout=1800))
+T.run_many(runs)
 summary = {}
-while pending or running:
-    while pending and len(running) < 2:
-        name, phi, seed, discard = pending.pop(0)
-        d = T.scratch('suspension_' + name)
-        deck = T.write_deck(d, 'deck.nml', DECK.format(phi=phi, seed=seed, discard=discard))
-        running.append((name, d, subprocess.Popen(T.command(deck), cwd=d, env=T.ENV, stdout=subprocess.PIPE,
-                                                  stderr=subprocess.STDOUT, text=True)))
-    name, d, p = running.pop(0)
-    out, _ = p.communicate(timeout=1800)
-    if p.returncode != 0:
-        print(out[-3000:])
-        raise SystemExit('fdsusp failed on %s' % name)
-    with open(os.path.join(d, 'out', 'summary.json')) as f:
+for (name, _, _, _), run in zip(CASES, runs):
+    with open(os.path.join(run['cwd'], 'out', 'summary.json')) as f:
         summary[name] = json.load(f)['quantities']
 
 

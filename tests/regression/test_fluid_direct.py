@@ -33,15 +33,22 @@ DECK = """&domain box = 6.4, 6.4, 6.4, cells_per_radius = 5, y_boundary = '{boun
 &particles number = 1, motion = 'fixed', position(:,1) = 2.9, {y}, 3.3 /
 """
 
-for boundary, flow, shear, force, y in (('walls', 'shear', 1, '0, 0, 0', 3.5), ('periodic', 'rest', 0, '1.0, 0.3, 0.2', 3.5),
-                                        ('lees-edwards', 'shear', 1, '0, 0, 0', 0.6)):
+CASES = (('walls', 'shear', 1, '0, 0, 0', 3.5), ('periodic', 'rest', 0, '1.0, 0.3, 0.2', 3.5),
+         ('lees-edwards', 'shear', 1, '0, 0, 0', 0.6))
+# the 12 runs are independent (a directory each): run together, at most 2 ranks at a time (a
+# 3-rank run alone)
+runs, where = [], {}
+for boundary, flow, shear, force, y in CASES:
     for ranks in (1, 3):
-        fields = {}
         for solver in ('fft', 'krylov'):
-            d = T.scratch('fluid_direct_%s_%d_%s' % (boundary, ranks, solver))
+            d = where[boundary, ranks, solver] = T.scratch('fluid_direct_%s_%d_%s' % (boundary, ranks, solver))
             deck = T.write_deck(d, 'd.nml', DECK.format(boundary=boundary, flow=flow, shear=shear, force=force, y=y))
-            T.run(deck, d, np_ranks=ranks, args=['-fluid_solver', solver])
-            fields[solver] = T.read_h5(os.path.join(d, 'out', 'checkpoint.h5'), ['u', 'v', 'w', 'p'])
+            runs.append(dict(deck=deck, cwd=d, np_ranks=ranks, args=['-fluid_solver', solver]))
+T.run_many(runs)
+for boundary, flow, shear, force, y in CASES:
+    for ranks in (1, 3):
+        fields = {solver: T.read_h5(os.path.join(where[boundary, ranks, solver], 'out', 'checkpoint.h5'),
+                                    ['u', 'v', 'w', 'p']) for solver in ('fft', 'krylov')}
         for name in ('u', 'v', 'w', 'p'):
             a, b = fields['fft'][name], fields['krylov'][name]
             scale = max(np.abs(b).max(), 1e-300)

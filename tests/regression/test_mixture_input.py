@@ -40,16 +40,23 @@ def position_file(d, name, radii=None, shape=None):
             f.create_dataset('particles/radius', data=r.reshape(shape) if shape else r)
 
 
-def refused(d, name, particles, words):
-    out_dir = os.path.join(d, 'out')
-    if os.path.isdir(out_dir):
-        T.shutil.rmtree(out_dir)
-    T.write_deck(d, 'mix.nml', LD.format(particles=particles))
-    status, out, err = T.run('mix.nml', d, expect_ok=False)
-    messages = [line for line in err.splitlines() if line.startswith('fdsusp:') and 'warning' not in line]
-    T.check(status == 2 and len(messages) == 1 and all(w in messages[0] for w in words),
-            '%s: refused (status %d) with one message naming %s: %s' % (name, status, ', '.join(words), messages[:1]))
-    T.check(not any(line.startswith('step ') for line in out.splitlines()), '%s: no step taken' % name)
+def refused(cases):
+    """Each case (name, &particles text, words) in a directory of its own under d (the deck and
+    copies of the position files), the runs four at a time (a refused run spends its time on MPI
+    start-up): refused, one message naming the words, no step."""
+    runs = []
+    for k, (name, particles, words) in enumerate(cases):
+        where = os.path.join(d, 'refused_%d' % k)
+        os.makedirs(where)
+        for f in FILES:
+            T.shutil.copy(os.path.join(d, f), where)
+        T.write_deck(where, 'mix.nml', LD.format(particles=particles))
+        runs.append(dict(deck='mix.nml', cwd=where, expect_ok=False))
+    for (name, particles, words), (status, out, err) in zip(cases, T.run_many(runs, cores=4)):
+        messages = [line for line in err.splitlines() if line.startswith('fdsusp:') and 'warning' not in line]
+        T.check(status == 2 and len(messages) == 1 and all(w in messages[0] for w in words),
+                '%s: refused (status %d) with one message naming %s: %s' % (name, status, ', '.join(words), messages[:1]))
+        T.check(not any(line.startswith('step ') for line in out.splitlines()), '%s: no step taken' % name)
 
 
 d = T.scratch('mixture_input')
@@ -59,9 +66,10 @@ position_file(d, 'foreign.h5', [1.0, 1.0, 1.3])
 position_file(d, 'one_species.h5', [1.0, 1.0, 1.0])
 position_file(d, 'no_radius.h5')
 position_file(d, 'short_radius.h5', [1.0, 1.4])
+FILES = ('mixture.h5', 'mixture_2d.h5', 'foreign.h5', 'one_species.h5', 'no_radius.h5', 'short_radius.h5')
 
 MIX = "radius = 1.0, 1.4, volume_share = 0.5, 0.5, position_file = '{f}'"
-for name, particles, words in [
+refused([
     ('shares that do not sum to 1', "radius = 1.0, 1.4, volume_share = 0.5, 0.4, solid_fraction = 0.1",
      ['mix.nml', '&particles', 'variable volume_share', 'sums to']),
     ('both shares', "radius = 1.0, 1.4, volume_share = 0.5, 0.5, number_share = 0.5, 0.5, solid_fraction = 0.1",
@@ -90,8 +98,7 @@ for name, particles, words in [
                                                                       'one radius per sphere']),
     ('file radii of one size, deck another', "radius = 1.4, position_file = 'one_species.h5'",
      ['one_species.h5', 'particles/radius', 'not one of the deck']),
-]:
-    refused(d, name, particles, words)
+])
 
 # the resolved fluid moves a mixture (the fictitious domain takes each sphere's radius), from a
 # position file and inline (species), here without lubrication correction

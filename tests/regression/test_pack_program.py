@@ -23,6 +23,7 @@ import os
 import shutil
 import subprocess
 import time
+from concurrent.futures import ThreadPoolExecutor
 import fdsusp_testlib as T
 import h5py
 import numpy as np
@@ -31,13 +32,70 @@ PACK = os.path.join(T.BIN, 'fdsusp-pack')
 d = T.scratch('pack_program')
 
 
-def pack(deck, expect_ok=True):
+def pack(deck, expect_ok=True, cwd=d):
     t0 = time.time()
-    p = subprocess.run([PACK, deck], cwd=d, env=T.ENV, capture_output=True, text=True, timeout=300)
+    p = subprocess.run([PACK, deck], cwd=cwd, env=T.ENV, capture_output=True, text=True, timeout=300)
     if expect_ok and p.returncode != 0:
         print(p.stdout[-2000:], p.stderr[-2000:])
         raise SystemExit('fdsusp-pack failed on %s' % deck)
     return p, time.time() - t0
+
+
+# Every packing below is independent of the others (each its own deck and output directory; the bad
+# decks each in a directory of their own), so all are started here, four at a time (the bad decks
+# spend their time on MPI start-up), longest first, and each is checked where its section stands:
+# started(name) is its (CompletedProcess, seconds). The times printed are then those of runs
+# sharing the 2 cores.
+pool = ThreadPoolExecutor(max_workers=4)
+futures = {}
+
+
+def start(name, deck, text=None, cwd=d, expect_ok=True, inputs=()):
+    """Write text (None: no deck) as cwd/deck, copy the inputs into cwd, start fdsusp-pack on it."""
+    os.makedirs(cwd, exist_ok=True)
+    for path in inputs:
+        shutil.copy(path, cwd)
+    if text is not None:
+        T.write_deck(cwd, deck, text)
+    futures[name] = pool.submit(pack, deck, expect_ok, cwd)
+
+
+def started(name):
+    return futures[name].result()
+
+
+MIX = """&packing
+  box = 16, 16, 16
+  y_boundary = 'walls'
+  phi = 0.55
+  radius = 1.0, 1.4
+  volume_share = 0.5, 0.5
+  seed = 4
+  mc_sweeps = 100
+  directory = 'out/mix'
+/
+"""
+MIXN = """&packing
+  box = 1, 1, 1
+  y_boundary = 'periodic'
+  phi = 0.3
+  n_particles = 301
+  radius = 1.4, 1.0
+  number_share = 0.3, 0.7
+  mc_sweeps = 10
+  directory = 'out/mixn'
+/
+"""
+start('mix', 'mix.nml', MIX)
+for name in ('pack_periodic', 'pack_couette'):
+    shutil.copy(os.path.join(T.ROOT, 'input', name + '.nml'), d)
+    start(name, name + '.nml')
+# the same deck again, in a directory of its own (section 2)
+start('again', 'pack_couette.nml', cwd=os.path.join(d, 'again'), inputs=[os.path.join(d, 'pack_couette.nml')])
+with open(os.path.join(d, 'pack_couette.nml')) as f:
+    text = f.read()
+start('seed2', 'seed2.nml', text.replace('seed = 1', 'seed = 2').replace("'out/pack_couette'", "'out/seed2'"))
+start('mixn', 'mixn.nml', MIXN)
 
 
 def load(path):
@@ -65,8 +123,7 @@ def min_pair_distance(x, box, periodic, radius=None):
 # ---- 1. the shipped decks
 for name, n_expected, phi, periodic in [('pack_periodic', 2000, 0.3, (True, True, True)),
                                         ('pack_couette', 859, 0.45, (True, False, True))]:
-    shutil.copy(os.path.join(T.ROOT, 'input', name + '.nml'), d)
-    p, seconds = pack(name + '.nml')
+    p, seconds = started(name)
     path = os.path.join(d, 'out', name, 'packing.h5')
     T.check(os.path.exists(path), '%s: wrote out/%s/packing.h5 (%.1f s)' % (name, name, seconds))
     x, box = load(path)
@@ -90,13 +147,10 @@ for name, n_expected, phi, periodic in [('pack_periodic', 2000, 0.3, (True, True
 
 # ---- 2. reproducible
 first, _ = load(os.path.join(d, 'out', 'pack_couette', 'packing.h5'))
-pack('pack_couette.nml')
-again, _ = load(os.path.join(d, 'out', 'pack_couette', 'packing.h5'))
+started('again')
+again, _ = load(os.path.join(d, 'again', 'out', 'pack_couette', 'packing.h5'))
 T.check(np.array_equal(first, again), 'same deck, bit-identical positions')
-with open(os.path.join(d, 'pack_couette.nml')) as f:
-    text = f.read()
-T.write_deck(d, 'seed2.nml', text.replace('seed = 1', 'seed = 2').replace("'out/pack_couette'", "'out/seed2'"))
-pack('seed2.nml')
+started('seed2')
 other, _ = load(os.path.join(d, 'out', 'seed2', 'packing.h5'))
 T.check(not np.allclose(first, other), 'another seed, other positions')
 
@@ -154,32 +208,19 @@ cases = [
     ('mixture above phi_max', GOOD.replace('phi = 0.3', 'phi = 0.7, radius = 1, 1.4, volume_share = 0.5, 0.5'),
      ['bad.nml', '&packing', 'phi', 'out of range']),
 ]
-for name, text, words in cases:
-    deck = os.path.join(d, 'bad.nml')
-    if os.path.exists(deck):
-        os.remove(deck)
-    if text is not None:
-        T.write_deck(d, 'bad.nml', text)
-    p, _ = pack('bad.nml', expect_ok=False)
+for k, (name, text, words) in enumerate(cases):
+    start('bad %d' % k, 'bad.nml', text, cwd=os.path.join(d, 'bad_%d' % k), expect_ok=False,
+          inputs=[os.path.join(d, 'a_file')])
+for k, (name, text, words) in enumerate(cases):
+    p, _ = started('bad %d' % k)
     messages = [l for l in p.stderr.splitlines() if l.startswith('fdsusp')]
     T.check(p.returncode != 0, '%s: exit status %d != 0' % (name, p.returncode))
     T.check(len(messages) == 1, '%s: one message: %s' % (name, messages[:1]))
     T.check(all(w in p.stderr for w in words), '%s: the message names %s' % (name, ', '.join(words)))
-    T.check(not os.path.exists(os.path.join(d, 'bad_out', 'packing.h5')), '%s: no packing written' % name)
+    T.check(not os.path.exists(os.path.join(d, 'bad_%d' % k, 'bad_out', 'packing.h5')), '%s: no packing written' % name)
 
 # ---- 5. a mixture in the Couette cell
-T.write_deck(d, 'mix.nml', """&packing
-  box = 16, 16, 16
-  y_boundary = 'walls'
-  phi = 0.55
-  radius = 1.0, 1.4
-  volume_share = 0.5, 0.5
-  seed = 4
-  mc_sweeps = 100
-  directory = 'out/mix'
-/
-""")
-p, seconds = pack('mix.nml')
+p, seconds = started('mix')
 with h5py.File(os.path.join(d, 'out', 'mix', 'packing.h5'), 'r') as f:
     x = np.array(f['particles/position'])
     box = np.array(f['particles/position'].attrs['box'])
@@ -199,18 +240,7 @@ T.check((x[:, 1] - radius).min() >= -1e-12 and (box[1] - x[:, 1] - radius).min()
 T.check('species 2: radius 1.4000 a' in p.stdout, 'mixture: the log lists the species')
 
 # ---- 6. number shares with n_particles
-T.write_deck(d, 'mixn.nml', """&packing
-  box = 1, 1, 1
-  y_boundary = 'periodic'
-  phi = 0.3
-  n_particles = 301
-  radius = 1.4, 1.0
-  number_share = 0.3, 0.7
-  mc_sweeps = 10
-  directory = 'out/mixn'
-/
-""")
-pack('mixn.nml')
+started('mixn')
 with h5py.File(os.path.join(d, 'out', 'mixn', 'packing.h5'), 'r') as f:
     radius = np.array(f['particles/radius'])
     box = np.array(f['particles/position'].attrs['box'])

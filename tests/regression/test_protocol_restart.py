@@ -99,13 +99,41 @@ FLUID = """&domain box = 4.0, 4.0, 4.0, cells_per_radius = 2 /
 """
 
 
-def split(name, deck, steps, ranks=1):
+# Each case: the straight run and the first half of the split run, all independent of one
+# another, are run together (T.run_many: two ranks at a time), then the second halves; the
+# comparisons follow, each of a run with its own split twin.
+CASES = [('oscillation', OSC, 200, 1), ('reversal', REV, 150, 1), ('fluid', FLUID, 60, T.RANKS),
+         ('stress', STRESS, 200, 1), ('stress_steps', STEPS, 200, 1), ('stress_reversal', STRESS_REVERSAL, 200, 1),
+         ('stress_oscillation', STRESS_OSCILLATION, 200, 1), ('stress_fluid', STRESS_FLUID, 60, T.RANKS),
+         ('stress_dns', STRESS_DNS, 60, T.RANKS), ('stress_dns_reversal', STRESS_DNS_REVERSAL, 100, 1)]
+work = lambda name: os.path.join(T.ROOT, 'build', 'test-work', name)   # a directory T.scratch made
+first, second = [], []
+for name, deck, steps, ranks in CASES:
     a = T.scratch('protocol_restart_%s_straight' % name)
-    T.run(T.write_deck(a, 'd.nml', deck.format(steps=steps)), a, np_ranks=ranks)
+    first.append(dict(deck=T.write_deck(a, 'd.nml', deck.format(steps=steps)), cwd=a, np_ranks=ranks))
     b = T.scratch('protocol_restart_%s_split' % name)
-    T.run(T.write_deck(b, 'half.nml', deck.format(steps=steps // 2)), b, np_ranks=ranks)
-    T.run(T.write_deck(b, 'd.nml', deck.format(steps=steps)), b, np_ranks=ranks,
-          args=['-restart', 'out/checkpoint.h5'])
+    first.append(dict(deck=T.write_deck(b, 'half.nml', deck.format(steps=steps // 2)), cwd=b, np_ranks=ranks))
+# the branch cases' steady pre-shear (below)
+b = T.scratch('protocol_restart_branch')
+first.append(dict(deck=T.write_deck(b, 'steady.nml', STEADY.format(steps=100, shear='rate = 1.0')), cwd=b))
+first.sort(key=lambda r: -r.get('np_ranks', 1))     # the parallel runs first, while nothing else runs
+T.run_many(first)
+for name, deck, steps, ranks in CASES:
+    b = work('protocol_restart_%s_split' % name)
+    second.append(dict(deck=T.write_deck(b, 'd.nml', deck.format(steps=steps)), cwd=b, np_ranks=ranks,
+                       args=['-restart', 'out/checkpoint.h5']))
+BRANCHES = (('reversal', "rate = 1.0, protocol = 'reversal', reversal_strain = 0.25", 260),
+            ('oscillation', "protocol = 'oscillatory', strain_amplitude = 0.05, period = 0.3", 160))
+b = work('protocol_restart_branch')
+for name, shear, steps in BRANCHES:
+    second.append(dict(deck=T.write_deck(b, name + '.nml', STEADY.format(steps=steps, shear=shear).replace(
+        "directory = 'out'", "directory = '%s'" % name)), cwd=b, args=['-branch', 'out/checkpoint.h5']))
+branch_logs = [out for _, out, _ in T.run_many(second)[len(CASES):]]
+
+
+def split(name, steps):
+    a = work('protocol_restart_%s_straight' % name)
+    b = work('protocol_restart_%s_split' % name)
     T.compare_h5(os.path.join(a, 'out', 'checkpoint.h5'), os.path.join(b, 'out', 'checkpoint.h5'),
                  '%s: %d steps against %d + restart + %d, checkpoint' % (name, steps, steps // 2, steps // 2), rtol=0)
     T.compare_h5(os.path.join(a, 'out', 'series.h5'), os.path.join(b, 'out', 'series.h5'),
@@ -115,46 +143,42 @@ def split(name, deck, steps, ranks=1):
     return s
 
 
-s = split('oscillation', OSC, 200)
+s = split('oscillation', 200)
 T.check(np.any(s['core/stress_contact'][:, 3] != 0), 'oscillation: contacts carry stress (their springs restart too)')
-s = split('reversal', REV, 150)
+s = split('reversal', 150)
 flips = s['step'][1:][np.sign(s['shear/rate'][1:]) != np.sign(s['shear/rate'][:-1])]
 T.check(list(flips) == [61, 121], 'reversal: the rate flips at steps 61 and 121, across the restart: %s' % list(flips))
-split('fluid', FLUID, 60, ranks=T.RANKS)
-s = split('stress', STRESS, 200)
+split('fluid', 60)
+s = split('stress', 200)
 T.check(np.all(np.abs(s['shear/stress'] - 8.0) < 1e-12) and np.ptp(s['shear/rate']) > 0,
         'stress control: the stress is 8 at every record, the rate varies (%.3f .. %.3f)'
         % (s['shear/rate'].min(), s['shear/rate'].max()))
-s = split('stress_steps', STEPS, 200)
+s = split('stress_steps', 200)
 T.check(list(s['step'][1:][np.abs(np.diff(s['shear/stress'])) > 1]) == [61, 141],
         'stress steps: the stress changes at steps 61 and 141, on either side of the restart')
-s = split('stress_reversal', STRESS_REVERSAL, 200)
+s = split('stress_reversal', 200)
 flips = s['step'][1:][np.sign(s['shear/stress'][1:]) != np.sign(s['shear/stress'][:-1])]
 T.check(len(flips) >= 2 and flips[0] < 101 < flips[-1] and np.all(np.abs(np.abs(s['shear/stress']) - 8.0) < 1e-12),
         'stress reversal: the stress is +-8 and flips at steps %s, on either side of the restart' % list(flips))
-s = split('stress_oscillation', STRESS_OSCILLATION, 200)
+s = split('stress_oscillation', 200)
 T.check(np.all(np.abs(s['shear/stress'] - 8.0 * np.sin(2 * np.pi * (s['step'] - 1) * 5.0e-3 / 0.75)) < 1e-11),
         'stress oscillation: the stress is 8 sin(2 pi t_n/T) at every record (the restart at 2/3 of a period)')
-s = split('stress_fluid', STRESS_FLUID, 60, ranks=T.RANKS)
+s = split('stress_fluid', 60)
 T.check(np.all(np.abs(s['shear/stress'] - 2.5) < 1e-12), 'stress control of the fluid alone: the stress is 2.5 at every record')
-s = split('stress_dns', STRESS_DNS, 60, ranks=T.RANKS)
+s = split('stress_dns', 60)
 T.check(np.all(np.abs(s['shear/stress'] - 3.0) < 1e-12) and np.any(s['contacts_pair'] > 0),
         'stress control of the DNS with spheres: the wall stress is 3 at every record, contacts in the steps')
-s = split('stress_dns_reversal', STRESS_DNS_REVERSAL, 100)
+s = split('stress_dns_reversal', 100)
 flips = s['step'][1:][np.sign(s['shear/stress'][1:]) != np.sign(s['shear/stress'][:-1])]
 T.check(len(flips) >= 2 and flips[0] < 51 < flips[-1] and np.all(np.abs(np.abs(s['shear/stress']) - 3.0) < 1e-12),
         'stress reversal in the DNS with spheres: the wall stress is +-3 and flips at steps %s, on either side of '
         'the restart' % list(flips))
 
 # a branch starts the deck's protocol afresh from the configuration reached: a steady pre-shear of
-# 100 steps (Lees-Edwards), then a reversal every 50 steps' strain, and an oscillation
-b = T.scratch('protocol_restart_branch')
-T.run(T.write_deck(b, 'steady.nml', STEADY.format(steps=100, shear='rate = 1.0')), b)
+# 100 steps (Lees-Edwards), then a reversal every 50 steps' strain, and an oscillation (run above)
+b = work('protocol_restart_branch')
 pre = T.series(os.path.join(b, 'out'))
-for name, shear, steps in (('reversal', "rate = 1.0, protocol = 'reversal', reversal_strain = 0.25", 260),
-                           ('oscillation', "protocol = 'oscillatory', strain_amplitude = 0.05, period = 0.3", 160)):
-    _, out, _ = T.run(T.write_deck(b, name + '.nml', STEADY.format(steps=steps, shear=shear).replace(
-        "directory = 'out'", "directory = '%s'" % name)), b, args=['-branch', 'out/checkpoint.h5'])
+for (name, shear, steps), out in zip(BRANCHES, branch_logs):
     T.check("&shear protocol '%s' starts afresh" % ('reversal' if name == 'reversal' else 'oscillatory') in out
             and "&shear protocol changed from 'steady'" in out, '%s branch: the log names the change of protocol' % name)
     s = T.series(os.path.join(b, name))

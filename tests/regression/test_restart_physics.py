@@ -15,6 +15,7 @@ for friction names -branch. A checkpoint written before /deck existed (the group
 deleted) still restarts, the log saying which variables cannot be checked, and its root attributes
 dt, reynolds and shear_rate are still checked. Exact checks (message text, bytes, exit status):
 the values compared are the doubles the decks were read into, so no tolerance applies."""
+import itertools
 import os
 import shutil
 import fdsusp_testlib as T
@@ -42,18 +43,28 @@ def base(d, text):
     return path, open(path, 'rb').read()
 
 
-def refused(d, ckpt, before, name, text, words, how='-restart'):
-    """A restart (how: or a branch) from ckpt with this deck is refused before any work, naming words."""
-    shutil.rmtree(os.path.join(d, 'again'), ignore_errors=True)
-    T.write_deck(d, 'r.nml', text.format(out='again'))
-    status, out, err = T.run('r.nml', d, args=[how, ckpt], expect_ok=False)
-    messages = [line for line in err.splitlines() if line.startswith('fdsusp:') and 'warning' not in line]
-    T.check(status == 2, '%s: refused with status %d == 2' % (name, status))
-    T.check(len(messages) == 1 and all(w in messages[0] for w in words),
-            '%s: one message naming %s: %s' % (name, ', '.join(words), messages[:1]))
-    T.check(not any(line.startswith('step ') for line in out.splitlines())
-            and not os.path.exists(os.path.join(d, 'again')), '%s: no step taken, no output directory left' % name)
-    T.check(open(os.path.join(d, ckpt), 'rb').read() == before, '%s: the checkpoint is bitwise as it was' % name)
+def refused(d, cases):
+    """Each case (ckpt, checkpoint bytes, name, deck text, words, how), a restart (how: or a branch)
+    from ckpt with this deck, is refused before any work, naming words. The cases of a call run at
+    the same time, four at a time (a refused run spends its time on MPI start-up), each with a
+    deck and an output directory of its own (r_N.nml, again_N), all reading the same checkpoint."""
+    runs = []
+    for ckpt, before, name, text, words, how in cases:
+        k = next(COUNT)
+        T.write_deck(d, 'r_%d.nml' % k, text.format(out='again_%d' % k))
+        runs.append(dict(deck='r_%d.nml' % k, cwd=d, args=[how, ckpt], expect_ok=False, out='again_%d' % k))
+    results = T.run_many([{key: v for key, v in r.items() if key != 'out'} for r in runs], cores=4)
+    for (ckpt, before, name, text, words, how), run, (status, out, err) in zip(cases, runs, results):
+        messages = [line for line in err.splitlines() if line.startswith('fdsusp:') and 'warning' not in line]
+        T.check(status == 2, '%s: refused with status %d == 2' % (name, status))
+        T.check(len(messages) == 1 and all(w in messages[0] for w in words),
+                '%s: one message naming %s: %s' % (name, ', '.join(words), messages[:1]))
+        T.check(not any(line.startswith('step ') for line in out.splitlines())
+                and not os.path.exists(os.path.join(d, run['out'])), '%s: no step taken, no output directory left' % name)
+        T.check(open(os.path.join(d, ckpt), 'rb').read() == before, '%s: the checkpoint is bitwise as it was' % name)
+
+
+COUNT = itertools.count()
 
 
 def accepted(d, ckpt, name, text, notes, how='-restart'):
@@ -73,7 +84,8 @@ def accepted(d, ckpt, name, text, notes, how='-restart'):
 d = T.scratch('restart_physics_dns')
 ckpt, before = base(d, DNS)
 rel = os.path.join('base', 'checkpoint.h5')
-for name, text, words in [
+refused(d, [(rel, before, 'DNS ' + name, text, [rel, 'group ' + words[0]] + words[1:], '-restart')
+            for name, text, words in [
     ('dt', DNS.replace('dt = 0.005', 'dt = 0.0025'), ['&time', 'variable dt', 'dt = 5.0E-03', 'dt = 2.5E-03']),
     ('reynolds', DNS.replace('reynolds = 0.01', 'reynolds = 0.1'),
      ['&fluid', 'variable reynolds', 'reynolds = 1.0E-02', 'reynolds = 1.0E-01']),
@@ -85,8 +97,7 @@ for name, text, words in [
      ['&fluid', 'variable viscous_theta', 'viscous_theta = 5.0E-01', 'viscous_theta = 1:']),
     ('manufactured_solution', DNS + '&verification manufactured_solution = .true. /\n',
      ['&verification', 'variable manufactured_solution']),
-]:
-    refused(d, rel, before, 'DNS ' + name, text, [rel, 'group ' + words[0]] + words[1:])
+]])
 accepted(d, rel, 'DNS steps and pressure_tolerance',
          DNS.replace('steps = 4', 'steps = 6').replace('reynolds = 0.01', 'reynolds = 0.01, pressure_tolerance = 1e-8'),
          ['steps = 4 to steps = 6', 'pressure_tolerance = 1.0E-06 to pressure_tolerance = 1.0E-08'])
@@ -98,8 +109,8 @@ with open(old, 'wb') as f:
 with T.h5py.File(old, 'r+') as f:
     del f['deck']
 old_bytes = open(old, 'rb').read()
-refused(d, 'old.h5', old_bytes, 'checkpoint without /deck, dt', DNS.replace('dt = 0.005', 'dt = 0.0025'),
-        ['old.h5', 'group &time', 'variable dt'])
+refused(d, [('old.h5', old_bytes, 'checkpoint without /deck, dt', DNS.replace('dt = 0.005', 'dt = 0.0025'),
+             ['old.h5', 'group &time', 'variable dt'], '-restart')])
 out = accepted(d, 'old.h5', 'checkpoint without /deck', DNS.replace('steps = 4', 'steps = 6'),
                ['does not record', '&fluid viscous_theta', 'cannot be checked'])
 T.check(not any('&time dt' in line and 'does not record' in line for line in out.splitlines()),
@@ -108,7 +119,8 @@ T.check(not any('&time dt' in line and 'does not record' in line for line in out
 # ---- lubrication dynamics with contacts and statistics ----
 d = T.scratch('restart_physics_ld')
 ckpt, before = base(d, LD)
-for name, text, words in [
+refused(d, [(ckpt, before, 'lubrication dynamics ' + name, text, [ckpt, 'group ' + words[0]] + words[1:], '-restart')
+            for name, text, words in [
     ('dt with &rheology', LD.replace('dt = 0.002', 'dt = 0.001'), ['&time', 'variable dt', '2.0E-03', '1.0E-03']),
     ('radius', LD.replace('number = 2,', 'number = 2, radius = 0.9,'),
      ['&particles', 'variable radius', 'radius = 1,', 'radius = 9.0E-01']),
@@ -125,17 +137,17 @@ for name, text, words in [
      ['&lubrication', 'variable outer_cutoff']),
     ('contacts dropped', LD.replace('&contact roughness = 0.01, friction = 0.3 /\n', ''),
      ['&contact', 'had contacts']),
-]:
-    refused(d, ckpt, before, 'lubrication dynamics ' + name, text, [ckpt, 'group ' + words[0]] + words[1:])
+]] + [
+    # -branch: statistics begun at the checkpoint's step are still protected: their contact shell
+    # follows the roughness
+    (ckpt, before, 'branch of other roughness into begun statistics', LD.replace('roughness = 0.01', 'roughness = 0.02'),
+     ['group &rheology', 'variable contact_shell', 'start afresh'], '-branch')])
 accepted(d, ckpt, 'lubrication dynamics steps and neighbour_skin',
          LD.replace('steps = 4', 'steps = 6').replace('friction = 0.3', 'friction = 0.3, neighbour_skin = 0.3'),
          ['steps = 4 to steps = 6', 'neighbour_skin = 2.0E-01 to neighbour_skin = 3.0E-01'])
 
 # ---- -branch: the checkpoint's state, this deck's contact and lubrication physics ----
-# statistics begun at the checkpoint's step are still protected: their contact shell follows the
-# roughness
-refused(d, ckpt, before, 'branch of other roughness into begun statistics', LD.replace('roughness = 0.01', 'roughness = 0.02'),
-        ['group &rheology', 'variable contact_shell', 'start afresh'], how='-branch')
+# (a branch into begun statistics: refused above)
 # the branches' statistics begin after the branch point (step 4): they start afresh. TRUNK runs
 # to step 4, each branch on to step 12
 TRUNK = LD.replace('discard_strain = 0.004', 'discard_strain = 0.02')
@@ -154,14 +166,14 @@ accepted(d, ckpt, 'branch: contacts dropped', BRANCH.replace(NO_CONTACTS, ''),
 with T.h5py.File(os.path.join(d, 'again', 'checkpoint.h5'), 'r') as f:
     T.check(int(f.attrs['step'][0]) == 12 and 'contacts' not in f,
             'branch: contacts dropped: its checkpoint at step 12 holds no springs')
-for name, text, words in [
+refused(d, [(ckpt, before, 'branch ' + name, text, [ckpt, 'group ' + words[0]] + words[1:], '-branch')
+            for name, text, words in [
     ('dt', BRANCH.replace('dt = 0.002', 'dt = 0.001'), ['&time', 'variable dt']),
     ('radius', BRANCH.replace('number = 2,', 'number = 2, radius = 0.9,'), ['&particles', 'variable radius']),
-]:
-    refused(d, ckpt, before, 'branch ' + name, text, [ckpt, 'group ' + words[0]] + words[1:], how='-branch')
-# a restart refused for what a branch may change says so
-refused(d, ckpt, before, 'restart of other friction points to -branch', BRANCH.replace('friction = 0.3', 'friction = 0.5'),
-        ['variable friction', 'or branch from the checkpoint (-branch CHECKPOINT'])
+]] + [
+    # a restart refused for what a branch may change says so
+    (ckpt, before, 'restart of other friction points to -branch', BRANCH.replace('friction = 0.3', 'friction = 0.5'),
+     ['variable friction', 'or branch from the checkpoint (-branch CHECKPOINT'], '-restart')])
 ckpt, before = base(d, TRUNK.replace(NO_CONTACTS, ''))
 out = accepted(d, ckpt, 'branch: contacts added', BRANCH, ["the checkpoint's run had no contacts"], how='-branch')
 T.check(not any('does not record' in line for line in out.splitlines()),

@@ -56,12 +56,15 @@ T.check('fdsusp: warning: series.h5 will need about' in out and 'GB are free in 
 # 3. memory against the records written
 demo = open(os.path.join(T.ROOT, 'input', 'demo_lubrication_dynamics.nml')).read()
 peaks = []
-for steps in (500, 2000):
+children = {}
+for steps in (2000, 500):         # the two runs at once, one on each core (each in its own directory)
     f = T.scratch('series_memory_%d' % steps)
     text = demo.replace("out/demo_ld", "out").replace("dt = 5.0e-3", "dt = 5.0e-3, steps = %d" % steps)
     deck = T.write_deck(f, 'm.nml', text)
-    child = subprocess.Popen(T.command(deck, 1, ['-series_flush_seconds', '0']), cwd=f, env=T.ENV,
-                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    children[steps] = subprocess.Popen(T.command(deck, 1, ['-series_flush_seconds', '0']), cwd=f, env=T.ENV,
+                                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+for steps in (500, 2000):
+    child = children[steps]
     _, status, usage = os.wait4(child.pid, 0)      # this child's own peak, not the test's others
     child.returncode = os.waitstatus_to_exitcode(status)
     T.check(child.returncode == 0, '%d steps of the fluid-free demo run (status %d)' % (steps, child.returncode))
