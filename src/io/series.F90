@@ -544,7 +544,9 @@ contains
     slice = min(256, s%max_records)
     do k = 1, size(parts)
       part = trim(s%parts_dir)//'/'//trim(parts(k))
-      call h5_parallel_open(trim(part), source, err, read_only=.true.)
+      ! a part is only read: each rank opens it by itself (no collective call), and reads its share
+      call h5fopen_f(trim(part), H5F_ACC_RDONLY_F, source, err)
+      call h5_parallel_agree(err)
       problem = ''
       if (err /= 0) then
         problem = 'it cannot be read as HDF5'
@@ -552,7 +554,8 @@ contains
         call read_steps(s, source, steps, problem)
       end if
       if (len_trim(problem) > 0) then
-        if (err == 0) call h5_parallel_close(source, e)
+        if (err == 0) call h5fclose_f(source, e)
+        PetscCallMPIA(MPI_Barrier(PETSC_COMM_WORLD, ierr))
         if (is_root()) call keep_aside(part, problem)
         cycle
       end if
@@ -569,7 +572,7 @@ contains
         end do
         last = steps(i1)
       end if
-      call h5_parallel_close(source, e)
+      call h5fclose_f(source, e)
     end do
     call write_attributes(s, file, tmp)
     call close_file(s, file, tmp)
@@ -715,9 +718,10 @@ contains
     end if
   end subroutine read_steps
 
-  ! Records i0.. of every column of an open file: scalars(value, record) of the other columns
-  ! (rank 0's), dense(value, sphere, record) of the per-sphere ones for this rank's range of
-  ! spheres. Collective.
+  ! Records i0.. of every column of a file open on every rank (by itself: each rank reads its
+  ! share independently): scalars(value, record) of the other columns (rank 0's), dense(value,
+  ! sphere, record) of the per-sphere ones for this rank's range of spheres. Collective (a failure
+  ! is agreed once, at the end).
   subroutine read_records(s, file, name, i0, scalars, dense)
     type(series_t), intent(in) :: s
     integer(HID_T), intent(in) :: file
@@ -726,20 +730,21 @@ contains
     real(dp), intent(out) :: scalars(:, :), dense(:, :, :)
     integer(HID_T) :: dset
     integer(HSIZE_T) :: offset(4), count(4)
-    integer :: c, rank, err, e, w
+    integer :: c, rank, err, e, w, failed
     logical :: selected
     real(dp), allocatable :: values(:)
     scalars = 0.0_dp
     dense = 0.0_dp
+    failed = 0
     do c = 1, size(s%names)
       call box(s, c, i0 - 1, size(scalars, 2), rank, offset, count, selected)
-      allocate(values(max(1_HSIZE_T, product(count(1:rank)))))
+      if (.not. selected) cycle
+      allocate(values(product(count(1:rank))))
       call h5dopen_f(file, trim(s%names(c)), dset, err)
-      call transfer(dset, .false., s%per_sphere(c), selected, offset(1:rank), count(1:rank), values, e)
+      call transfer(dset, .false., .false., selected, offset(1:rank), count(1:rank), values, e)
       err = max(err, abs(e))
       call h5dclose_f(dset, e)
-      call h5_parallel_agree(err)
-      call abort_if_any(err /= 0, 'cannot read '//trim(s%names(c))//' from '//trim(name))
+      if (err /= 0 .and. failed == 0) failed = c
       w = s%width(c)
       if (selected .and. s%per_sphere(c)) then
         dense(s%first(c):s%first(c) + w - 1, :, :) = reshape(values, [w, size(dense, 2), size(dense, 3)])
@@ -748,6 +753,9 @@ contains
       end if
       deallocate(values)
     end do
+    ! the largest failing column of any rank
+    call h5_parallel_agree(failed)
+    if (failed /= 0) call abort_if_any(.true., 'cannot read '//trim(s%names(failed))//' from '//trim(name))
   end subroutine read_records
 
   ! Append records to every column of a file open on every rank: scalars(value, record) of the
