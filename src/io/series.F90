@@ -16,7 +16,8 @@
 ! values. At a flush the buffered rows go, in one all-to-all, to the rank that writes their sphere
 ! in the file (rank r writes the contiguous range of spheres r N / P + 1 .. (r + 1) N / P), so that
 ! each rank writes one box (its spheres x the records) of each per-sphere dataset in one
-! collective transfer; consolidation moves the records the same way, each rank its range. The
+! collective transfer; consolidation moves the records the same way, each rank its range (reading
+! the parts, which are only read, through its own serial open, so without collective calls). The
 ! layout is one writer's: the same datasets, shapes, types and chunks on any number of ranks.
 ! Every decision that leads to a collective call is the same on every rank: the wall-clock interval
 ! of progress flushes is rank 0's, broadcast; the parts, the steps and the files' problems are

@@ -34,9 +34,10 @@ state, in the layout one writer gave them, on any number of ranks:
     2026-11-29); in the DNS, whose spheres move as prescribed, their position, velocity and omega
     are bitwise 1 rank's;
  7. a collective write of the series that fails on every rank (injected with strace: the opening of
-    series.parts/0000000011.h5.tmp fails with ENOSPC on each of 3 ranks, in a run continued from
-    step 10) stops every rank with status 3 and one message naming the part, and the published
-    series stays whole: series.h5 holds steps 1..10 once each, no part is left.
+    series.parts/0000000021.h5.tmp fails with ENOSPC on each of 3 ranks, in the 3-rank run
+    continued from its step-20 checkpoint) stops every rank with status 3 and one message naming
+    the part, and the published series stays whole: series.h5 holds steps 1..20 once each, no part
+    is left.
     (tests/regression/test_full_disk.py covers the full disk, which the free-space check before
     every parallel write catches.)
 Decks: lubrication dynamics, 24 rough frictional spheres (phi 0.2) in a Lees-Edwards cube of 8 a,
@@ -44,6 +45,7 @@ Decks: lubrication dynamics, 24 rough frictional spheres (phi 0.2) in a Lees-Edw
 20 x 20 x 30-cell channel with walls, 10 steps, snapshots and checkpoints every 5. ~17 s on 2 cores.
 Needs strace (scripts/install-deps) for 7."""
 import os
+import shutil
 import subprocess
 import h5py
 import numpy as np
@@ -195,8 +197,11 @@ against_one_rank(ld1_20, ld3, 'LD 3 ranks', TOL)
 series_against_one_rank(ld1, ld2, 'LD 2 ranks')
 series_against_one_rank(ld1_20, ld3, 'LD 3 ranks')
 
-# restart on 1 rank from the 3 ranks' checkpoint (step 20)
+# restart on 1 rank from the 3 ranks' checkpoint (step 20); check 7 continues a copy on 3 ranks
 d3 = os.path.dirname(ld3)
+d7 = T.scratch('pio_fail_series')
+shutil.rmtree(d7)
+shutil.copytree(d3, d7)
 T.check(int(T.h5_attr(os.path.join(ld3, 'checkpoint.h5'), 'step')[0]) == 20, 'LD 3 ranks: checkpoint at step 20')
 run('pio_ld_3', LD.format(steps=30), 1, args=['-restart', 'out/checkpoint.h5'], d=d3)
 s1, s = T.series(ld1), T.series(ld3)
@@ -236,19 +241,18 @@ T.check(status == 3 and 'fdsusp: fatal: out/checkpoint.h5.tmp cannot be created'
 T.check(int(T.h5_attr(os.path.join(out, 'checkpoint.h5'), 'step')[0]) == 10, 'checkpoint write fails: the last '
         'checkpoint (step 10) is whole')
 
-# 7. the series' part cannot be created on any of 3 ranks (strace fails its opening with ENOSPC)
-d = T.scratch('pio_fail_series')
-T.run(T.write_deck(d, 'before.nml', LD.format(steps=10)), d, np_ranks=3)
-part = 'out/series.parts/0000000011.h5.tmp'
-cmd = T.command(T.write_deck(d, 'deck.nml', LD.format(steps=20)), 3, ['-restart', 'out/checkpoint.h5'])
+# 7. the series' part cannot be created on any of 3 ranks (strace fails its opening with ENOSPC), in
+# the 3-rank run continued from its step-20 checkpoint to 30 (a copy of it, made before the restart)
+part = 'out/series.parts/0000000021.h5.tmp'
+cmd = T.command(T.write_deck(d7, 'deck.nml', LD.format(steps=30)), 3, ['-restart', 'out/checkpoint.h5'])
 at = cmd.index(T.FDSUSP)
 cmd[at:at] = ['strace', '-f', '-o', '/dev/null', '-P', part, '-e', 'trace=openat', '-e', 'inject=openat:error=ENOSPC']
-p = subprocess.run(cmd, cwd=d, env=T.ENV, capture_output=True, text=True, timeout=120)
+p = subprocess.run(cmd, cwd=d7, env=T.ENV, capture_output=True, text=True, timeout=120)
 fatal = [l for l in p.stderr.splitlines() if l.startswith('fdsusp: fatal:')]
 T.check(p.returncode == 3 and len(fatal) == 1 and fatal[0].startswith('fdsusp: fatal: ' + part + ' cannot be created'),
         'a series part cannot be created on 3 ranks: status %d, one message naming it: %s'
         % (p.returncode, fatal or p.stderr[-300:]))
-steps = T.series(os.path.join(d, 'out'))['step']
-T.check(np.array_equal(steps, np.arange(1, 11)) and not os.listdir(os.path.join(d, 'out', 'series.parts')),
-        'a series part cannot be created: series.h5 keeps steps 1..10 once each, no part is left')
+steps = T.series(os.path.join(d7, 'out'))['step']
+T.check(np.array_equal(steps, np.arange(1, 21)) and not os.listdir(os.path.join(d7, 'out', 'series.parts')),
+        'a series part cannot be created: series.h5 keeps steps 1..20 once each, no part is left')
 T.finish()
