@@ -277,6 +277,7 @@ contains
     integer, intent(in) :: step
     real(dp), intent(in) :: time
     real(dp) :: err_vel, err_p_max, err_p_rms
+    integer, allocatable :: owned(:)
     PetscErrorCode :: ierr
     call series_column(out%series, 'step', step)
     call series_column(out%series, 'time', time)
@@ -295,9 +296,12 @@ contains
       call series_column(out%series, 'mms_error_pressure_rms', err_p_rms)
     end if
     if (.not. associated(out%parts)) return
-    call series_add(out%series, particles_columns(out%parts))
-    if (associated(out%lubrication)) call series_add(out%series, particle_lubrication_columns(out%lubrication))
-    if (associated(out%contacts)) call series_add(out%series, particle_contacts_columns(out%contacts))
+    ! the per-sphere columns: each rank gives the rows of the spheres it owns (as for the particle
+    ! files), the series writes them collectively (mod_series)
+    owned = owned_spheres(out%state%owned_spheres, out%parts, out%cfg%domain%box)
+    call series_add(out%series, particles_columns(out%parts, owned))
+    if (associated(out%lubrication)) call series_add(out%series, particle_lubrication_columns(out%lubrication, owned))
+    if (associated(out%contacts)) call series_add(out%series, particle_contacts_columns(out%contacts, owned))
     if (associated(out%rheology)) then
       call series_add(out%series, rheo_columns(out%rheology))
       if (associated(out%contacts)) call series_column(out%series, 'contact_overlap_over_roughness', &

@@ -28,7 +28,7 @@ module mod_particle_contacts
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates
   use mod_lees_edwards, only: lees_edwards_t
   use mod_particle_system, only: particle_system_t, particle_system_add_diagonal, particle_system_add_pair
-  use mod_columns, only: column_t, column
+  use mod_columns, only: column_t, column, sphere_column
   implicit none
   private
   public :: particle_contacts_settings_t, particle_contacts_t, particle_contacts_create, particle_contacts_step, &
@@ -343,8 +343,9 @@ contains
 
   !> The contacts' columns of the series: open and sliding contacts, the largest overlap, and the
   !> contact force, torque and stresslet on each sphere (doc/INPUT.md "&contact").
-  function particle_contacts_columns(pc) result(c)
+  function particle_contacts_columns(pc, owned) result(c)
     type(particle_contacts_t), intent(in) :: pc
+    integer, intent(in) :: owned(:)           ! the spheres whose rows this rank gives (mod_columns)
     type(column_t), allocatable :: c(:)
     ! element by element: an array constructor of column_t leaks their values (gfortran 12)
     allocate(c(merge(8, 7, .not. pc%periodic(2))))
@@ -352,9 +353,9 @@ contains
     c(2) = column('contacts_wall', pc%stats%wall_contacts)
     c(3) = column('contacts_sliding', pc%stats%sliding)
     c(4) = column('contact_max_overlap', pc%max_overlap)
-    c(5) = column('particles/force_contact', pc%force)
-    c(6) = column('particles/torque_contact', pc%torque)
-    c(7) = column('particles/stresslet_contact', pc%stresslet)
+    c(5) = sphere_column('particles/force_contact', size(pc%force, 2), owned, pc%force(:, owned))
+    c(6) = sphere_column('particles/torque_contact', size(pc%torque, 2), owned, pc%torque(:, owned))
+    c(7) = sphere_column('particles/stresslet_contact', size(pc%stresslet, 3), owned, pc%stresslet(:, :, owned))
     ! between walls: the force of the lower and the upper wall on the spheres (3 x 2)
     if (.not. pc%periodic(2)) c(8) = column('wall_force_contact', pc%wall_force)
   end function particle_contacts_columns

@@ -40,7 +40,7 @@ module mod_particle_lubrication
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates
   use mod_lees_edwards, only: lees_edwards_t, le_separation
   use mod_particle_system, only: particle_system_t, particle_system_add_diagonal, particle_system_add_pair
-  use mod_columns, only: column_t, column
+  use mod_columns, only: column_t, column, sphere_column
   implicit none
   private
   public :: particle_lubrication_t, particle_lubrication_create, particle_lubrication_links, &
@@ -624,16 +624,17 @@ contains
 
   ! The lubrication's columns of the series: links within the outer cut-off, the smallest gap among
   ! the candidates, and the correction's force and torque on each sphere (doc/INPUT.md "&lubrication").
-  function particle_lubrication_columns(pl) result(c)
+  function particle_lubrication_columns(pl, owned) result(c)
     type(particle_lubrication_t), intent(in) :: pl
+    integer, intent(in) :: owned(:)           ! the spheres whose rows this rank gives (mod_columns)
     type(column_t), allocatable :: c(:)
     ! element by element: an array constructor of column_t leaks their values (gfortran 12)
     allocate(c(merge(6, 5, pl%walls)))
     c(1) = column('lubrication_pairs', pl%npairs_total)
     c(2) = column('lubrication_walls', pl%nwalls_total)
     c(3) = column('min_gap', pl%min_gap)
-    c(4) = column('particles/force_lubrication', pl%force)
-    c(5) = column('particles/torque_lubrication', pl%torque)
+    c(4) = sphere_column('particles/force_lubrication', size(pl%force, 2), owned, pl%force(:, owned))
+    c(5) = sphere_column('particles/torque_lubrication', size(pl%torque, 2), owned, pl%torque(:, owned))
     ! between walls: the force of the lower and the upper wall on the spheres (3 x 2)
     if (pl%walls) c(6) = column('wall_force_lubrication', pl%wall_force)
   end function particle_lubrication_columns

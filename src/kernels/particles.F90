@@ -4,7 +4,7 @@
 module mod_particles
   use mod_kinds, only: dp
   use mod_neighbours, only: min_image
-  use mod_columns, only: column_t, column
+  use mod_columns, only: column_t, sphere_column
   implicit none
   private
   public :: particles_t, particles_init, advance_positions, displacements, configuration_fault, impose_motion, &
@@ -186,17 +186,18 @@ contains
 
   ! The spheres' columns of the series: their state after the step and the hydrodynamic force, torque
   ! and stresslet of the fluid on them (doc/INPUT.md "&particles").
-  function particles_columns(p) result(c)
+  function particles_columns(p, owned) result(c)
     type(particles_t), intent(in) :: p
+    integer, intent(in) :: owned(:)           ! the spheres whose rows this rank gives (mod_columns)
     type(column_t), allocatable :: c(:)
     ! element by element: an array constructor of column_t leaks their values (gfortran 12)
     allocate(c(6))
-    c(1) = column('particles/position', p%position)
-    c(2) = column('particles/velocity', p%velocity)
-    c(3) = column('particles/omega', p%omega)
-    c(4) = column('particles/force_hydro', p%force_hydro)
-    c(5) = column('particles/torque_hydro', p%torque_hydro)
-    c(6) = column('particles/stresslet_hydro', p%stresslet_hydro)
+    c(1) = sphere_column('particles/position', p%n, owned, p%position(:, owned))
+    c(2) = sphere_column('particles/velocity', p%n, owned, p%velocity(:, owned))
+    c(3) = sphere_column('particles/omega', p%n, owned, p%omega(:, owned))
+    c(4) = sphere_column('particles/force_hydro', p%n, owned, p%force_hydro(:, owned))
+    c(5) = sphere_column('particles/torque_hydro', p%n, owned, p%torque_hydro(:, owned))
+    c(6) = sphere_column('particles/stresslet_hydro', p%n, owned, p%stresslet_hydro(:, :, owned))
   end function particles_columns
 
 end module mod_particles

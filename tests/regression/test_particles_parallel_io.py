@@ -4,8 +4,9 @@ in its z-slab, mod_particles_io, mod_h5_parallel; doc/DESIGN.md "Files"), hold e
 state, in the layout one writer gave them, on any number of ranks:
  1. on 1, 2 and 3 ranks, each snapshot's position, velocity and omega and the checkpoint's
     position, velocity and omega are bitwise the series record of their step (series.h5 is written
-    by rank 0 alone from the replicated state, so a row written by the wrong rank, lost or
-    shifted shows here), and each snapshot's radius is the deck's;
+    by every rank too, but each rank writes a contiguous range of spheres after an all-to-all,
+    mod_series, not the rows of its slab: a row written by the wrong rank, lost or shifted in
+    either shows here), and each snapshot's radius is the deck's;
  2. the files have the same datasets, shapes, types, chunks, Fletcher-32 filters (h5py verifies
     the checksum on every read) and attributes on every rank count as on 1 rank; the attributes'
     values are equal;
@@ -21,13 +22,31 @@ state, in the layout one writer gave them, on any number of ranks:
  5. a collective write that fails (injected: a directory, not removable, where the .tmp must be
     created) stops every rank of a 3-rank run with status 3 and one message naming the file, and
     the last checkpoint stays whole: a snapshot (particles_00000010.h5.tmp), and a checkpoint of a
-    run continued from a step-10 checkpoint (checkpoint.h5.tmp), which keeps step 10.
+    run continued from a step-10 checkpoint (checkpoint.h5.tmp), which keeps step 10;
+ 6. series.h5, which every rank writes together since issue 45 (each rank buffers the per-sphere
+    columns of its own spheres only; mod_series), has on 2 and 3 ranks 1 rank's layout (datasets,
+    shapes, types, chunks, maximal shapes, filters, attributes), and its values agree with 1 rank's
+    within 1e-12 of each quantity's scale (wall_time excepted): the ranks' runs differ only in the
+    order of CG's reductions and of the links' sums (test_ld_rank_independence), whose round-off is
+    relative to the largest term of a balance, so the scale of a force, torque or stresslet is the
+    largest of its hydro, lubrication and contact parts (force_hydro, ~1e-10 here, is a sum of such
+    terms that nearly cancel), of another dataset its own largest value (measured: 2e-14 at most,
+    2026-11-29); in the DNS, whose spheres move as prescribed, their position, velocity and omega
+    are bitwise 1 rank's;
+ 7. a collective write of the series that fails on every rank (injected with strace: the opening of
+    series.parts/0000000021.h5.tmp fails with ENOSPC on each of 3 ranks, in the 3-rank run
+    continued from its step-20 checkpoint) stops every rank with status 3 and one message naming
+    the part, and the published series stays whole: series.h5 holds steps 1..20 once each, no part
+    is left.
     (tests/regression/test_full_disk.py covers the full disk, which the free-space check before
     every parallel write catches.)
 Decks: lubrication dynamics, 24 rough frictional spheres (phi 0.2) in a Lees-Edwards cube of 8 a,
 30 steps (the 3-rank run 20, then its restart to 30 on 1 rank), snapshots every 10 steps; DNS, a
-20 x 20 x 30-cell channel with walls, 10 steps, snapshots and checkpoints every 5. ~15 s on 2 cores."""
+20 x 20 x 30-cell channel with walls, 10 steps, snapshots and checkpoints every 5. ~17 s on 2 cores.
+Needs strace (scripts/install-deps) for 7."""
 import os
+import shutil
+import subprocess
 import h5py
 import numpy as np
 import fdsusp_testlib as T
@@ -113,12 +132,58 @@ def against_one_rank(ref, out, what, tol):
                 T.check(diff <= tol, '%s: %s /particles/%s within %.0e of 1 rank\'s (%.1e)' % (what, name, q, tol, diff))
 
 
+def series_layout(out):
+    """series.h5: {dataset: (shape, maxshape, dtype, chunks, compression, fletcher32, attributes)}
+    and the root's attributes, and {dataset: values}."""
+    shape, values = {}, {}
+    with h5py.File(os.path.join(out, 'series.h5'), 'r') as f:
+        shape['@'] = {k: np.array(v).tolist() for k, v in f.attrs.items()}
+
+        def visit(name, d):
+            if isinstance(d, h5py.Dataset):
+                shape[name] = (d.shape, d.maxshape, str(d.dtype), d.chunks, d.compression, d.fletcher32,
+                               {k: np.array(v).tolist() for k, v in d.attrs.items()})
+                values[name] = d[()]
+        f.visititems(visit)
+    return shape, values
+
+
+def series_scale(values, name):
+    """Check 6's scale of a dataset: of particles/force_hydro etc. the largest of its parts."""
+    family = name.rsplit('_', 1)[0] + '_' if name.startswith('particles/') and '_' in name else name
+    return max(max(np.abs(v).max(initial=0.0) for q, v in values.items() if q == name or q.startswith(family)),
+               1e-300)
+
+
+def series_against_one_rank(ref, out, what, tol=1e-12, exact=()):
+    """Check 6: out's series.h5 has ref's layout, values within tol of the scale (exact: bitwise)."""
+    shape1, v1 = series_layout(ref)
+    shape, v = series_layout(out)
+    T.check(shape == shape1, '%s: series.h5 has 1 rank\'s datasets, shapes, types, chunks, filters and attributes'
+            % what)
+    worst, where = 0.0, ''
+    for q in sorted(v1):
+        if q == 'wall_time' or q not in v or v[q].shape != v1[q].shape or v1[q].size == 0:
+            continue
+        if q in exact:
+            T.check(np.array_equal(v[q], v1[q]), '%s: series.h5 %s bitwise 1 rank\'s' % (what, q))
+            continue
+        diff = np.abs(np.asarray(v[q], float) - v1[q]).max() / series_scale(v1, q)
+        if diff >= worst:
+            worst, where = diff, q
+    if exact:
+        return
+    T.check(worst <= tol, '%s: series.h5 within %.0e of 1 rank\'s (largest: %.1e, %s)' % (what, tol, worst, where))
+
+
 # DNS, prescribed motion: bitwise on every rank count
 dns = {n: run('pio_dns_%d' % n, DNS, n) for n in (1, 2, 3)}
 for n in (1, 2, 3):
     against_series(dns[n], 'DNS %d rank(s)' % n, radii=np.ones(2))
 for n in (2, 3):
     against_one_rank(dns[1], dns[n], 'DNS %d ranks' % n, None)
+    series_against_one_rank(dns[1], dns[n], 'DNS %d ranks' % n,
+                            exact=['particles/' + q for q in STATE])
 
 # lubrication dynamics: 30 steps on 1 and 2 ranks, 20 on 3 and then 10 more on 1 from its checkpoint
 ld1 = run('pio_ld_1', LD.format(steps=30), 1)
@@ -129,9 +194,14 @@ for out, what in ((ld1, 'LD 1 rank'), (ld2, 'LD 2 ranks'), (ld3, 'LD 3 ranks')):
 against_one_rank(ld1, ld2, 'LD 2 ranks', TOL)
 ld1_20 = run('pio_ld_1_at_20', LD.format(steps=20), 1)
 against_one_rank(ld1_20, ld3, 'LD 3 ranks', TOL)
+series_against_one_rank(ld1, ld2, 'LD 2 ranks')
+series_against_one_rank(ld1_20, ld3, 'LD 3 ranks')
 
-# restart on 1 rank from the 3 ranks' checkpoint (step 20)
+# restart on 1 rank from the 3 ranks' checkpoint (step 20); check 7 continues a copy on 3 ranks
 d3 = os.path.dirname(ld3)
+d7 = T.scratch('pio_fail_series')
+shutil.rmtree(d7)
+shutil.copytree(d3, d7)
 T.check(int(T.h5_attr(os.path.join(ld3, 'checkpoint.h5'), 'step')[0]) == 20, 'LD 3 ranks: checkpoint at step 20')
 run('pio_ld_3', LD.format(steps=30), 1, args=['-restart', 'out/checkpoint.h5'], d=d3)
 s1, s = T.series(ld1), T.series(ld3)
@@ -170,4 +240,19 @@ T.check(status == 3 and 'fdsusp: fatal: out/checkpoint.h5.tmp cannot be created'
         'the file and keeps the last checkpoint' % status)
 T.check(int(T.h5_attr(os.path.join(out, 'checkpoint.h5'), 'step')[0]) == 10, 'checkpoint write fails: the last '
         'checkpoint (step 10) is whole')
+
+# 7. the series' part cannot be created on any of 3 ranks (strace fails its opening with ENOSPC), in
+# the 3-rank run continued from its step-20 checkpoint to 30 (a copy of it, made before the restart)
+part = 'out/series.parts/0000000021.h5.tmp'
+cmd = T.command(T.write_deck(d7, 'deck.nml', LD.format(steps=30)), 3, ['-restart', 'out/checkpoint.h5'])
+at = cmd.index(T.FDSUSP)
+cmd[at:at] = ['strace', '-f', '-o', '/dev/null', '-P', part, '-e', 'trace=openat', '-e', 'inject=openat:error=ENOSPC']
+p = subprocess.run(cmd, cwd=d7, env=T.ENV, capture_output=True, text=True, timeout=120)
+fatal = [l for l in p.stderr.splitlines() if l.startswith('fdsusp: fatal:')]
+T.check(p.returncode == 3 and len(fatal) == 1 and fatal[0].startswith('fdsusp: fatal: ' + part + ' cannot be created'),
+        'a series part cannot be created on 3 ranks: status %d, one message naming it: %s'
+        % (p.returncode, fatal or p.stderr[-300:]))
+steps = T.series(os.path.join(d7, 'out'))['step']
+T.check(np.array_equal(steps, np.arange(1, 21)) and not os.listdir(os.path.join(d7, 'out', 'series.parts')),
+        'a series part cannot be created: series.h5 keeps steps 1..20 once each, no part is left')
 T.finish()

@@ -4,11 +4,13 @@
 !     shape (0 where unused): scalars (integer and real), a vector, a 3 x N matrix, a 3 x 3 x N
 !     tensor; an integer is stored as the real of the same value;
 !  2. the spheres' columns are the six of doc/INPUT.md "&particles", in the file's order, each with
-!     shape (3, N) or (3, 3, N) and the particle data unchanged.
+!     shape (3, N) or (3, 3, N) and the particle data unchanged;
+!  3. a per-sphere column (sphere_column) of some spheres holds their rows only, with their global
+!     indices, and the shape of all N spheres; the spheres' columns are per-sphere columns.
 ! Exact comparisons: the values are copied, not computed.
 program test_columns
   use mod_kinds, only: dp
-  use mod_columns, only: column_t, column
+  use mod_columns, only: column_t, column, sphere_column
   use mod_particles, only: particles_t, particles_init, particles_columns, MOTION_FREE
   use mod_unit_checks, only: check, finish
   implicit none
@@ -37,7 +39,8 @@ program test_columns
   call particles_init(p, 4, 1.0_dp, MOTION_FREE)
   p%position = m
   p%velocity = 2 * m
-  cs = particles_columns(p)
+  allocate(cs(6))
+  cs = particles_columns(p, [1, 2, 3, 4])
   call check(size(cs) == 6, 'the spheres name six columns')
   call check(cs(1)%name == 'particles/position' .and. cs(2)%name == 'particles/velocity' .and. &
              cs(3)%name == 'particles/omega' .and. cs(4)%name == 'particles/force_hydro' .and. &
@@ -45,5 +48,13 @@ program test_columns
              'in the order of doc/INPUT.md: position, velocity, omega, force_hydro, torque_hydro, stresslet_hydro')
   call check(all(cs(1)%values == reshape(m, [12])) .and. all(cs(2)%values == reshape(2 * m, [12])) .and. &
              all(cs(6)%shape == [3, 3, 4]), 'their values are the particle data, the stresslet 3 x 3 x N')
+  call check(all([(allocated(cs(k)%rows), k = 1, 6)]), 'the spheres'' columns are per-sphere columns')
+  c = sphere_column('particles/velocity', 4, [4, 2], m(:, [4, 2]))
+  call check(all(c%shape == [3, 4, 0]) .and. all(c%rows == [4, 2]) .and. &
+             all(c%values == [10, 11, 12, 4, 5, 6]), 'a per-sphere column of spheres 4 and 2: their rows, '// &
+             'their indices, the shape of all 4')
+  cs = particles_columns(p, [3])
+  call check(all(cs(1)%shape == [3, 4, 0]) .and. all(cs(1)%values == m(:, 3)) .and. all(cs(6)%shape == [3, 3, 4]) &
+             .and. size(cs(6)%values) == 9, 'the spheres'' columns of sphere 3 only: its rows, the shapes of all 4')
   call finish('test_columns')
 end program test_columns

@@ -15,9 +15,12 @@
 !      uninterrupted run's;
 !   3. reopened with restart_step = 25 (between records): steps <= 24 are kept, 26 and 28 follow;
 !   4. reopened from the start (restart_step = -1): an empty series.h5 with the columns.
-! Exact comparisons (the values are stored as doubles, no tolerance). rank 0 writes the series
-! (is_root); on 3 ranks (tests/regression/test_unit_petsc_ranks.sh) the others must leave it alone
-! and learn every verdict from rank 0.
+! The two per-sphere columns (sphere_column) are given by every rank for its own spheres only,
+! and which spheres a rank owns changes from record to record (sphere i at step k belongs to rank
+! mod(i + k / 2, ranks)), as spheres change owner in a run: the file must not depend on it.
+! Exact comparisons (the values are stored as doubles, no tolerance). Every rank writes the series
+! together (parallel HDF5, mod_series); on 3 ranks (tests/regression/test_unit_petsc_ranks.sh) rank
+! 0 reads it back and every rank learns every verdict from rank 0.
 #include <petsc/finclude/petscsys.h>
 program test_series_append
   use, intrinsic :: iso_fortran_env, only: output_unit
@@ -25,8 +28,9 @@ program test_series_append
   use hdf5
   use mod_kinds, only: dp
   use mod_h5util, only: h5util_init, read_attribute
-  use mod_series, only: series_t, series_column, series_open, series_record, series_flush, series_close, &
-                        series_attributes
+  use mod_columns, only: sphere_column
+  use mod_series, only: series_t, series_column, series_add, series_open, series_record, series_flush, &
+                        series_close, series_attributes
   use mod_os_services, only: make_directory
   use mod_file_services, only: list_directory
   use mod_unit_checks, only: check, finish
@@ -37,7 +41,7 @@ program test_series_append
        'wall/force', 'particles/velocity', 'particles/stresslet']
   integer, parameter :: lengths(n_columns) = [1, 1, 1, 4, 3 * n_particles, 9 * n_particles]
   PetscErrorCode :: ierr
-  PetscMPIInt :: rank
+  PetscMPIInt :: rank, ranks
   character(len=512) :: dir, tmpdir
   type(series_t) :: s
   integer :: step, status, pid(1)
@@ -45,6 +49,7 @@ program test_series_append
 
   PetscCallA(PetscInitialize(ierr))
   call MPI_Comm_rank(PETSC_COMM_WORLD, rank, ierr)
+  call MPI_Comm_size(PETSC_COMM_WORLD, ranks, ierr)
   if (rank /= 0) open(unit=output_unit, file='/dev/null')
   call h5util_init()
   call get_environment_variable('TMPDIR', tmpdir, status=status)
@@ -121,12 +126,19 @@ contains
   subroutine columns(s, step)
     type(series_t), intent(inout) :: s
     integer, intent(in) :: step
+    real(dp) :: velocity(3, n_particles), stresslet(3, 3, n_particles)
+    integer, allocatable :: mine(:)
+    integer :: i
     call series_column(s, 'step', step)
     call series_column(s, 'time', value(step, 2, 1))
     call series_column(s, 'contacts', nint(value(step, 3, 1) * 1000))
     call series_column(s, 'wall/force', values(step, 4))
-    call series_column(s, 'particles/velocity', reshape(values(step, 5), [3, n_particles]))
-    call series_column(s, 'particles/stresslet', reshape(values(step, 6), [3, 3, n_particles]))
+    ! this rank's spheres at this step (another set at the next step but one)
+    mine = pack([(i, i = 1, n_particles)], [(mod(i + step / 2, ranks) == rank, i = 1, n_particles)])
+    velocity = reshape(values(step, 5), [3, n_particles])
+    stresslet = reshape(values(step, 6), [3, 3, n_particles])
+    call series_add(s, [sphere_column('particles/velocity', n_particles, mine, velocity(:, mine))])
+    call series_add(s, [sphere_column('particles/stresslet', n_particles, mine, stresslet(:, :, mine))])
   end subroutine columns
 
   subroutine declare(s)
