@@ -274,13 +274,7 @@ contains
           if (stress_control) then
             rate = ts%protocol%rate
             PetscCall(ld_motion_solve_stress(ts%ld, ts%ld_solver, parts, ts%protocol%stress, rate, reached, ierr, rheology=ts%rheology, lubrication=ts%lubrication, contacts=ts%contacts))
-            ! the strain and the offset advance with the spheres' Adams-Bashforth step (§7.4)
-            if (parts%have_prev) then
-              call shear_protocol_set_rate(ts%protocol, rate, reached, 1.5_dp * rate - 0.5_dp * ts%protocol%rate)
-            else
-              call shear_protocol_set_rate(ts%protocol, rate, reached, rate)
-            end if
-            call impose_rate(ts)
+            call take_stress_rate(ts, rate, reached)
           else
             PetscCall(ld_motion_solve(ts%ld, ts%ld_solver, parts, ierr, lubrication=ts%lubrication, contacts=ts%contacts))
           end if
@@ -368,12 +362,7 @@ contains
         ! the rate that sets the mean shear stress (doc/METHOD.md §7.4), as time_step_advance
         rate = ts%protocol%rate
         PetscCall(ld_motion_solve_stress(ts%ld, ts%ld_solver, set, ts%protocol%stress, rate, reached, ierr, rheology=ts%rheology, lubrication=ts%lubrication, contacts=ts%contacts, local=loc))
-        if (set%have_prev) then
-          call shear_protocol_set_rate(ts%protocol, rate, reached, 1.5_dp * rate - 0.5_dp * ts%protocol%rate)
-        else
-          call shear_protocol_set_rate(ts%protocol, rate, reached, rate)
-        end if
-        call impose_rate(ts)
+        call take_stress_rate(ts, rate, reached)
       else
         PetscCall(ld_motion_solve(ts%ld, ts%ld_solver, set, ierr, lubrication=ts%lubrication, contacts=ts%contacts, local=loc))
       end if
@@ -388,6 +377,20 @@ contains
       PetscCall(ld_local_end(loc, ts%parts, merge(RESULTS_NOW, RESULTS_LATER, ts%complete_view), ierr, ts%contacts, ts%lubrication))
     end associate
   end subroutine local_step
+
+  ! The rate a stress-controlled lubrication-dynamics step solved for (rate, giving the stress
+  ! reached) to the protocol and every piece: the strain and the offset advance with the spheres'
+  ! Adams-Bashforth step (doc/METHOD.md §7.4), forward Euler on a first step.
+  subroutine take_stress_rate(ts, rate, reached)
+    type(time_step_t), intent(inout) :: ts
+    real(dp), intent(in) :: rate, reached
+    if (ts%parts%have_prev) then
+      call shear_protocol_set_rate(ts%protocol, rate, reached, 1.5_dp * rate - 0.5_dp * ts%protocol%rate)
+    else
+      call shear_protocol_set_rate(ts%protocol, rate, reached, rate)
+    end if
+    call impose_rate(ts)
+  end subroutine take_stress_rate
 
   ! Every sphere's results of the last step in ts%parts, the contacts and the links, for output
   ! outside its cadence (a failure, the end of the run): those the local step kept on their owners

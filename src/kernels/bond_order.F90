@@ -26,25 +26,12 @@ contains
     real(dp), intent(in) :: r(:, :)              ! (3, nbonds)
     real(dp), intent(out) :: q6_global
     real(dp), intent(out) :: q6_local(np)
-    complex(dp) :: q(0:l, np), total(0:l), y(0:l)
-    integer :: bonds(np), k, i, e
-    q = (0.0_dp, 0.0_dp)
-    bonds = 0
-    do k = 1, nbonds
-      y = spherical_harmonics(r(:, k))
-      do e = 1, 2
-        i = ends(e, k)
-        q(:, i) = q(:, i) + y
-        bonds(i) = bonds(i) + 1
-      end do
-    end do
-    total = sum(q, dim=2)
-    q6_global = 0.0_dp
-    if (sum(bonds) > 0) q6_global = invariant(total / sum(bonds))
-    do i = 1, np
-      q6_local(i) = 0.0_dp
-      if (bonds(i) > 0) q6_local(i) = invariant(q(:, i) / bonds(i))
-    end do
+    complex(dp) :: total(0:l)
+    real(dp) :: bonds
+    integer :: k
+    ! one share: every sphere's
+    call bond_order_shares(np, nbonds, ends, r, [(.true., k = 1, np)], total, bonds, q6_local)
+    q6_global = bond_order_global(total, bonds)
   end subroutine bond_order_q6
 
   !> A share of the global sums over some of the spheres (owned, np): sum of their q_6m(i) N_b(i)
