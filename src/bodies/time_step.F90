@@ -20,7 +20,7 @@ module mod_time_step
   use mod_grid, only: grid_t
   use mod_fluid, only: fluid_t, fluid_step, fluid_mean_profile, fluid_add_response, fluid_set_sliding
   use mod_timers, only: stage_push, stage_pop, STAGE_FLUID, STAGE_PARTICLES, STAGE_CONTACTS, STAGE_LUBRICATION
-  use mod_particles, only: particles_t, advance_positions, displacements
+  use mod_particles, only: particles_t, advance_positions, displacements, MOTION_FREE, MOTION_FROZEN
   use mod_particle_contacts, only: particle_contacts_t, particle_contacts_step
   use mod_particle_lubrication, only: particle_lubrication_t
   use mod_rheology, only: rheology_t, rheo_sample, rheo_sample_flow, rheo_reach
@@ -38,7 +38,6 @@ module mod_time_step
   use mod_ld_local, only: ld_local_t, ld_local_create, ld_local_begin, ld_local_contacts_agree, ld_local_links, &
                           ld_local_statistics, ld_local_end, ld_local_complete_view, RESULTS_NOW, RESULTS_LATER, &
                           RESULTS_NONE
-  use mod_particles, only: MOTION_FREE, MOTION_FROZEN
   implicit none
   private
   public :: time_step_t, time_step_create, time_step_advance, time_step_guard, time_step_report, &
@@ -94,8 +93,8 @@ contains
   ! domain fd, or, without a fluid, their lubrication dynamics (ld, ld_solver); contacts,
   ! lubrication and rheology where the run has them; le: the Lees-Edwards boundaries (offset 0
   ! when inactive); protocol: the imposed shear in time (mod_shear_protocol). walls: walls in y.
-  ! Options: -fd_carry_lambda, -fault_nan_step, -ld_local_set. Collective (resolved: the geometry of X^n is built
-  ! here).
+  ! Options: -fd_carry_lambda, -fault_nan_step, -ld_local_set. Collective (resolved: the geometry
+  ! of X^n is built here).
   subroutine time_step_create(ts, dt, box, walls, le, protocol, ierr, grid, fluid, fd, parts, ld, ld_solver, &
                               contacts, lubrication, rheology, fluid_response)
     type(time_step_t), intent(out) :: ts
