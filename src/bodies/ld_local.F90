@@ -4,11 +4,12 @@
 ! (mod_sphere_halo), sets the block rows of its own spheres in the 6N system, and gets back the
 ! velocities of its own spheres only; the ghosts' velocities and link counts come from their owners
 ! through the halo. Nothing of the step's kernels is evaluated for every sphere on every rank, and
-! neither the links' sums nor the 6N solution is gathered in the step.
+! neither the links' sums nor the 6N solution is gathered in the step. The statistics sample the
+! local set too (ld_local_statistics: the ranks' shares summed in one reduction of O(bins)).
 !
 ! The particle state itself is still replicated between steps (the view: positions, velocities,
-! the hydrodynamic and contact results, the springs), because the statistics, the output and the
-! checkpoints read it: ld_local_begin takes each rank's local set from it, ld_local_end gathers the
+! the hydrodynamic and contact results, the springs), because the positions advance there and the
+! output and the checkpoints read it: ld_local_begin takes each rank's local set from it, ld_local_end gathers the
 ! own spheres' velocities (7 doubles a sphere) and springs (5 a spring) back into it every step, and
 ! their hydrodynamic, contact and link results (45 doubles) only when the output reads them
 ! (RESULTS_NOW, or ld_local_complete_view). Those gathers are the step's collectives of size N; they
