@@ -90,7 +90,6 @@ contains
     real(dp), allocatable :: radii(:)
     type(sphere_ownership_t) :: o
     integer :: i, n, np_hist, k, kept, info
-    logical, allocatable :: own_global(:)
 
     ierr = 0
     loc%total = parts%n
@@ -123,15 +122,12 @@ contains
       if (present(rheology)) call rheo_set_local(rheology, h%is_owned, radii)
       if (present(contacts)) then
         ! the springs of the pairs with an own sphere (the view holds every spring)
-        allocate(own_global(-2:parts%n))
-        own_global = .false.
-        own_global(pack(h%id, h%is_owned)) = .true.
         k = history_size(contacts%history)
         allocate(keys(2, k), springs(3, k))
         call history_pack(contacts%history, np_hist, keys, springs)
         kept = 0
         do i = 1, k
-          if (own_global(keys(1, i)) .or. own_global(keys(2, i))) then
+          if (owns(loc, keys(1, i)) .or. owns(loc, keys(2, i))) then
             kept = kept + 1
             keys(:, kept) = keys(:, i)
             springs(:, kept) = springs(:, i)
@@ -336,7 +332,7 @@ contains
         if (nsprings > 0) call history_pack(contacts%history, np_hist, keys, ups)
         k = 0
         do i = 1, nsprings
-          if (.not. owned_global(keys(1, i))) cycle
+          if (.not. owns(loc, keys(1, i))) cycle
           k = k + 1
           springs(:, k) = [real(keys(:, i), dp), ups(:, i)]
         end do
@@ -354,28 +350,6 @@ contains
       end if
     end associate
     if (results == RESULTS_NOW) call put_results(all, parts, contacts, lubrication)
-
-  contains
-
-    ! whether global sphere g is one of this rank's own
-    logical function owned_global(g)
-      integer, intent(in) :: g
-      integer :: lo, hi, mid
-      owned_global = .false.
-      lo = 1
-      hi = size(loc%halo%id)
-      do while (lo <= hi)
-        mid = (lo + hi) / 2
-        if (loc%halo%id(mid) == g) then
-          owned_global = loc%halo%is_owned(mid)
-          return
-        else if (loc%halo%id(mid) < g) then
-          lo = mid + 1
-        else
-          hi = mid - 1
-        end if
-      end do
-    end function owned_global
   end subroutine ld_local_end
 
   !> The results ld_local_end kept on their owners (RESULTS_LATER or RESULTS_NONE), gathered into
@@ -395,6 +369,28 @@ contains
     deallocate(loc%pending)
     call put_results(all, parts, contacts, lubrication)
   end subroutine ld_local_complete_view
+
+  ! Whether the sphere of global index g is one of this rank's own (a bisection of the local set's
+  ! ascending indices; false for a wall's id, < 0).
+  pure logical function owns(loc, g)
+    type(ld_local_t), intent(in) :: loc
+    integer, intent(in) :: g
+    integer :: lo, hi, mid
+    owns = .false.
+    lo = 1
+    hi = size(loc%halo%id)
+    do while (lo <= hi)
+      mid = (lo + hi) / 2
+      if (loc%halo%id(mid) == g) then
+        owns = loc%halo%is_owned(mid)
+        return
+      else if (loc%halo%id(mid) < g) then
+        lo = mid + 1
+      else
+        hi = mid - 1
+      end if
+    end do
+  end function owns
 
   ! The rows (k, m) of every rank, one after the other (rank order), on every rank. Collective.
   subroutine gather_rows(rows, all, ierr)
