@@ -36,15 +36,14 @@ so that one sphere always sees the other through it, or in the box (doc/VALIDATI
 Needs Debian's python3 with numpy, h5py and matplotlib (the shebang is /usr/bin/python3).
 """
 import argparse
-import math
 import os
 import sys
 
 import numpy as np
 import _fdsusp_path  # noqa: F401,E402  (this checkout's python/ on sys.path)
-from fdsusp.pair import (CASES, EXTEND, TRUNK_CASE, branch, check_trunk, deck_steps, load_case,  # noqa: E402
-                         load_dns, mobility, mobility_table, prepare, read_pairtraj, series_steps, start_dns,
-                         table, trunk_steps, upto)
+from fdsusp.pair import (CASES, TRUNK_CASE, branch, check_trunk, continuation, deck_steps, load_case,  # noqa: E402
+                         mobility, mobility_table, prepare, read_pairtraj, series_steps, start_dns, table,
+                         trunk_steps, upto)
 from fdsusp.run import run_all  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -165,9 +164,8 @@ def main():
                 steps = series_steps(dirs[c])
                 if status != 0 or len(steps) == 0 or steps[-1] < deck_steps(dirs[c]):
                     continue            # failed, or stopped by --hours: continued by the next call
-                if upto(load_dns(dirs[c], args.box), -args.start)[1] is None:
-                    transit = float(read_pairtraj(dirs[c])['t'][-1])
-                    more = deck_steps(dirs[c]) + int(math.ceil(EXTEND * transit / args.dt))
+                more = continuation(dirs[c], args.box, args.start, args.dt)
+                if more is not None:
                     print('%s: not across x = %g by step %d; continued to step %d' % (c, -args.start, steps[-1], more))
                     commands[c] = prepare_case(c, dirs[c], steps=more)
                     pending.append(c)

@@ -14,7 +14,7 @@ import numpy as np
 
 from . import deck as fdeck, series
 from .resistance import shear_functions
-from .run import ENV, MPIEXEC, checkout, copy_program, program
+from .run import ENV, MPIEXEC, checkout, copy_program, program, run_all
 
 # the checkout: the pairtraj decks of the cases (input/pair_*.nml) are the templates
 ROOT = checkout()
@@ -149,6 +149,26 @@ def continuation(d, box, start, dt):
         return None
     transit = float(read_pairtraj(d)['t'][-1])
     return deck_steps(d) + int(math.ceil(EXTEND * transit / dt))
+
+
+def run_to_crossing(cases, dirs, prepare_case, box, start, dt, jobs=2, rounds=2):
+    """Run each case's DNS on one rank, at most jobs at a time (prepare_case(c, steps=None) writes
+    its decks and returns its command, to `steps` when given), then continue, at most `rounds`
+    times, the cases that ran whole and whose pair has not crossed x = -start (continuation()).
+    Returns {case: (exit status, CPU seconds summed over its runs)}."""
+    commands = {c: prepare_case(c) for c in cases}
+    status = run_all(cases, lambda c: start_dns(dirs[c], commands[c], 1), jobs)
+    for _ in range(rounds):
+        more = {c: continuation(dirs[c], box, start, dt) for c in cases if status[c][0] == 0}
+        more = {c: steps for c, steps in more.items() if steps is not None}
+        if not more:
+            break
+        for c, steps in more.items():
+            print('%s: not across x = %g by step %d; continued to step %d' % (c, -start, deck_steps(dirs[c]), steps))
+            commands[c] = prepare_case(c, steps=steps)
+        for c, (code, cpu) in run_all(list(more), lambda c: start_dns(dirs[c], commands[c], 1), jobs).items():
+            status[c] = (code, status[c][1] + cpu)
+    return status
 
 
 def trunk_steps(refs, dt):

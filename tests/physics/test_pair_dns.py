@@ -36,7 +36,6 @@ import numpy as np
 import fdsusp_testlib as T  # noqa: E402
 
 from fdsusp import pair as P  # noqa: E402
-from fdsusp.run import run_all  # noqa: E402
 
 BOX, CELLS, DT, START, EPS_BAR = 10.0, 4, 2.5e-3, -2.5, 0.1
 # the DNS pairs here cross 0.3 % (rough) and 0.9 % (smooth) later than pairtraj's (transit 6.12 /
@@ -48,18 +47,9 @@ dirs = {c: os.path.join(work, c) for c in cases}
 # each DNS runs for STEPS_FACTOR times pairtraj's transit time and is compared up to where its pair
 # crosses x = -START (fdsusp.pair.compare): a case whose pair has not crossed by then is continued
 # from its final checkpoint (restarts are exact), as scripts/pair_dns.py does
-commands = {c: P.prepare(c, dirs[c], BOX, CELLS, DT, START, EPS_BAR, steps_factor=STEPS_FACTOR) for c in cases}
-status = run_all(cases, lambda c: P.start_dns(dirs[c], commands[c], 1), 2)
-for _ in range(2):
-    more = {c: P.continuation(dirs[c], BOX, START, DT) for c in cases if status[c][0] == 0}
-    more = {c: steps for c, steps in more.items() if steps is not None}
-    if not more:
-        break
-    for c, steps in more.items():
-        print('%s: not across x = %g by step %d; continued to step %d' % (c, -START, P.deck_steps(dirs[c]), steps))
-        commands[c] = P.prepare(c, dirs[c], BOX, CELLS, DT, START, EPS_BAR, steps=steps)
-    for c, (code, cpu) in run_all(list(more), lambda c: P.start_dns(dirs[c], commands[c], 1), 2).items():
-        status[c] = (code, status[c][1] + cpu)
+status = P.run_to_crossing(cases, dirs, lambda c, steps=None: P.prepare(c, dirs[c], BOX, CELLS, DT, START, EPS_BAR,
+                                                                       steps_factor=STEPS_FACTOR, steps=steps),
+                           BOX, START, DT)
 for c in cases:
     T.check(status[c][0] == 0, '%s: fdsusp exit status %d (%.0f CPU s)' % (c, status[c][0], status[c][1]))
 if T.failures:
