@@ -365,7 +365,9 @@ contains
   subroutine echo_deck(cfg)
     type(config_t), intent(in) :: cfg
     type(config_t) :: copy
-    character(len=8192) :: line
+    ! (a namelist write puts an array in one record: 64 inline spheres' values, ~25 characters each,
+    ! in each of &particles' arrays)
+    character(len=65536) :: line
     character(len=32) :: item
     character(len=64) :: group
     integer :: g, unit, ios, e, p
@@ -374,7 +376,7 @@ contains
                                                          'external_force', 'external_torque', 'species']
     if (.not. is_root()) return
     copy = cfg
-    open(newunit=unit, status='scratch', action='readwrite', recl=8192)
+    open(newunit=unit, status='scratch', action='readwrite', recl=len(line))
     do g = 1, ngroups
       call group_io(trim(known_groups(g)), copy, echo_unit=unit)
     end do
