@@ -891,6 +891,7 @@ contains
     integer, intent(out) :: ids(:,:)
     real(dp), intent(out) :: ups(:,:)
     np = h%np
+    if (h%n == 0) return              ! (an empty history has no arrays)
     ids(1, 1:h%n) = h%owner(1:h%n)
     ids(2, 1:h%n) = h%partner(1:h%n)
     ups(:, 1:h%n) = h%ups(:, 1:h%n)
