@@ -1,19 +1,20 @@
 ! The lubrication-dynamics step on a rank's local set (issue 45; doc/DESIGN.md "Spheres held by
-! their slab", doc/SCALING.md §3.1): each rank evaluates the contacts and the lubrication links of
-! the spheres whose centres are in its z-slab (its own) with the ghosts within reach of the slab
-! (mod_sphere_halo), sets the block rows of its own spheres in the 6N system, and gets back the
-! velocities of its own spheres only; the ghosts' velocities and link counts come from their owners
-! through the halo. Nothing of the step's kernels is evaluated for every sphere on every rank, and
-! neither the links' sums nor the 6N solution is gathered in the step. The statistics sample the
-! local set too (ld_local_statistics: the ranks' shares summed in one reduction of O(bins)).
+! their slab", doc/SCALING.md §3.1): each rank holds the spheres whose centres are in its z-slab (its
+! own) and the ghosts within reach of the slab (mod_sphere_halo), evaluates the contacts and the
+! lubrication links of its own spheres, sets their block rows in the 6N system and gets back their
+! velocities only; the ghosts' velocities and link counts come from their owners through the halo.
+! The statistics sample the local set too (ld_local_statistics: the ranks' shares summed in one
+! reduction of O(bins)).
 !
-! The particle state itself is still replicated between steps (the view: positions, velocities,
-! the hydrodynamic and contact results, the springs), because the positions advance there and the
-! output and the checkpoints read it: ld_local_begin takes each rank's local set from it, ld_local_end gathers the
-! own spheres' velocities (7 doubles a sphere) and springs (5 a spring) back into it every step, and
-! their hydrodynamic, contact and link results (45 doubles) only when the output reads them
-! (RESULTS_NOW, or ld_local_complete_view). Those gathers are the step's collectives of size N; they
-! go once the output reads the own spheres and the state migrates with them (doc/SCALING.md §3.1).
+! The local set is the state between steps: the positions advance on it (time_step), and at the
+! next step's start (ld_local_begin) the own spheres that left the slab go to their new owner with
+! what they carry (velocities, the Adams-Bashforth history, external loads, radius), the ghosts are
+! rebuilt, and the springs of the contacts go to the neighbours whose spheres they touch. No message
+! of a step grows with the total number of spheres. The replicated particle state (the view) is a
+! copy the output reads: it is brought up to date (ld_local_complete_view: positions, velocities,
+! springs and the last step's hydrodynamic, contact and link results gathered) only at the steps
+! whose output reads it (a series record, a snapshot, a checkpoint), after a failure and at the end
+! of the run; a restart and the first step take the local set from it.
 !
 ! With one rank, or without contacts and links (the block-diagonal one-body problem), the step keeps
 ! the replicated state (ld_local_t%active false). An owned sphere sees every contact and link in
@@ -25,8 +26,8 @@ module mod_ld_local
   use mod_kinds, only: dp
   use mod_particles, only: particles_t, particles_init
   use mod_sphere_halo, only: sphere_halo_t, sphere_halo_create, sphere_halo_migrate, sphere_halo_build, &
-                             sphere_halo_forward, sphere_halo_slab_of
-  use mod_sphere_ownership, only: sphere_ownership_t, sphere_ownership_by_slab
+                             sphere_halo_forward, sphere_halo_exchange, sphere_halo_slab_of
+  use mod_sorting, only: ascending_order
   use mod_contact, only: history_size, history_pack, history_unpack
   use mod_particle_contacts, only: particle_contacts_t, particle_contacts_set_local
   use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_set_local, &
@@ -37,24 +38,31 @@ module mod_ld_local
   implicit none
   private
   public :: ld_local_t, ld_local_create, ld_local_begin, ld_local_contacts_agree, ld_local_links, &
-            ld_local_forward_velocities, ld_local_statistics, ld_local_end, ld_local_complete_view
+            ld_local_forward_velocities, ld_local_statistics, ld_local_end, ld_local_complete_view, &
+            ld_local_own_slot
 
   type :: ld_local_t
     logical :: active = .false.           ! the step runs on the local set
+    logical :: live = .false.             ! the local set holds the state (from the first step on)
+    logical :: view_current = .true.      ! the view holds the local set's state and last results
     type(sphere_halo_t) :: halo           ! own spheres and ghosts (ascending global index)
-    type(particles_t) :: set              ! their state during the step
+    type(particles_t) :: set              ! their state
     integer :: total = 0                  ! spheres of the whole system
-    ! the own spheres' results of the last step not yet in the view (ld_local_end, RESULTS_LATER)
+    integer :: view_updates = 0           ! times the view was brought up to date (the run's account)
+    ! the own spheres' results of the last step not yet in the view (ld_local_end)
     real(dp), allocatable :: pending(:, :)
   end type ld_local_t
 
-  ! what ld_local_end does with the step's results (ld_local_end)
-  integer, parameter, public :: RESULTS_NOW = 1, RESULTS_LATER = 2, RESULTS_NONE = 3
+  ! ld_local_end: a step that reached its solve (its results kept), or one that failed before it
+  integer, parameter, public :: RESULTS_KEPT = 1, RESULTS_NONE = 2
 
-  ! the values per own sphere that ld_local_end gathers into the view (after its global index):
-  ! velocity, omega, hydrodynamic force, torque, stresslet; the contacts' force, torque,
-  ! stresslet; the links' force, torque, stresslet
-  integer, parameter :: GATHERED = 51
+  ! what a sphere carries to a new owner and its owner forwards to its ghosts (carried): velocity,
+  ! omega, the last step's velocity (Adams-Bashforth), external force and torque, radius
+  integer, parameter :: CARRIED = 16
+  ! the values per own sphere that the view takes (after its global index): the state, position,
+  ! velocity, omega, the last step's velocity (STATE_VALUES); the results, the hydrodynamic force, torque,
+  ! stresslet, the contacts' force, torque, stresslet, the links' force, torque, stresslet (RESULT_VALUES)
+  integer, parameter :: STATE_VALUES = 12, RESULT_VALUES = 45
 
 contains
 
@@ -71,11 +79,14 @@ contains
     if (loc%active) call sphere_halo_create(loc%halo, lz, reach)
   end subroutine ld_local_create
 
-  !> The local set of the configuration in parts (the view): own spheres by slab, ghosts within
-  !> reach through the halo, their state copied from the view; the contacts, the links, the
-  !> one-body model, the solver and the statistics told the local set (their set_local), the block
-  !> rows numbered by slab (mod_sphere_ownership), and the springs of the pairs with an own sphere
-  !> kept. Collective.
+  !> The local set of the step: on the first step (and after a restart) taken from the view parts,
+  !> then carried on from the last step's (carry_on: the own spheres that left the slab migrate with
+  !> what they carry, the ghosts rebuilt and given their owners' values, the springs sent to the
+  !> neighbours whose spheres they touch); the contacts, the links, the one-body model, the solver
+  !> and the statistics told the local set (their set_local), the block rows numbered by slab
+  !> (rank by rank, ascending global index within a rank, as mod_sphere_ownership), and the springs
+  !> of the pairs with an own sphere kept. parts%have_prev (a reversal or a branch clears it) is
+  !> the set's. Collective.
   subroutine ld_local_begin(loc, parts, ld, solver, ierr, contacts, lubrication, rheology)
     type(ld_local_t), intent(inout) :: loc
     type(particles_t), intent(in) :: parts
@@ -85,15 +96,45 @@ contains
     type(particle_contacts_t), intent(inout), optional :: contacts
     type(particle_lubrication_t), intent(inout), optional :: lubrication
     type(rheology_t), intent(inout), optional :: rheology
-    integer, allocatable :: id(:), keys(:, :)
-    real(dp), allocatable :: x(:, :), data(:, :), springs(:, :)
     real(dp), allocatable :: radii(:)
-    type(sphere_ownership_t) :: o
-    integer :: i, n, np_hist, k, kept, info
+    integer, allocatable :: rows(:)
 
     ierr = 0
     loc%total = parts%n
-    ! own spheres: those of this rank's slab (no sphere moves between ranks: the view is everywhere)
+    if (loc%live) then
+      call carry_on(loc, ierr)
+    else
+      call take_view(loc, parts, ierr)
+    end if
+    if (ierr /= 0) return
+    loc%live = .true.
+    loc%view_current = .false.
+    associate(h => loc%halo, s => loc%set)
+      s%have_prev = parts%have_prev
+      radii = s%radii / parts%radius
+      call own_rows(loc, rows, ierr)
+      if (ierr /= 0) return
+      call particle_solver_set_local(solver, rows, h%is_owned, loc%total)
+      call lubrication_dynamics_set_local(ld, radii)
+      if (present(lubrication)) call particle_lubrication_set_local(lubrication, h%is_owned, radii)
+      if (present(rheology)) call rheo_set_local(rheology, h%is_owned, radii)
+      if (present(contacts)) then
+        call keep_springs(loc, contacts, ierr)
+        if (ierr /= 0) return
+        call particle_contacts_set_local(contacts, h%id, h%is_owned, radii)
+      end if
+    end associate
+  end subroutine ld_local_begin
+
+  ! The local set taken from the view parts: own spheres by slab (no sphere moves between ranks:
+  ! the view is everywhere), the ghosts within reach, the state of each copied. Collective.
+  subroutine take_view(loc, parts, ierr)
+    type(ld_local_t), intent(inout) :: loc
+    type(particles_t), intent(in) :: parts
+    PetscErrorCode, intent(out) :: ierr
+    integer, allocatable :: id(:)
+    real(dp), allocatable :: x(:, :), data(:, :)
+    integer :: i
     id = pack([(i, i = 1, parts%n)], [(sphere_halo_slab_of(loc%halo, parts%position(3, i)) == loc%halo%rank, &
                                        i = 1, parts%n)])
     x = parts%position(:, id)
@@ -102,42 +143,176 @@ contains
     if (ierr /= 0) return
     call sphere_halo_build(loc%halo, x, ierr)
     if (ierr /= 0) return
+    call particles_init(loc%set, size(loc%halo%id), parts%radius, parts%motion)
+    loc%set%position = x
+    call put_cargo(loc%set, cargo(parts, loc%halo%id))
+  end subroutine take_view
+
+  ! The local set of the last step carried on to the positions it advanced to: the own spheres that
+  ! left the slab to the rank of their new slab (a neighbour's) with what they carry, the ghosts
+  ! rebuilt around the own spheres and given their owners' values. Collective.
+  subroutine carry_on(loc, ierr)
+    type(ld_local_t), intent(inout) :: loc
+    PetscErrorCode, intent(out) :: ierr
+    integer, allocatable :: own(:), id(:)
+    real(dp), allocatable :: x(:, :), data(:, :), values(:, :)
+    real(dp) :: radius
+    integer :: motion, q
     associate(h => loc%halo, s => loc%set)
-      n = h%owned + h%ghosts
-      call particles_init(s, n, parts%radius, parts%motion)
-      s%radii = parts%radii(h%id)
+      own = pack([(q, q = 1, s%n)], h%is_owned)
+      id = h%id(own)
+      x = s%position(:, own)
+      data = cargo(s, own)
+      radius = s%radius
+      motion = s%motion
+      call sphere_halo_migrate(h, id, x, data, ierr)
+      if (ierr /= 0) return
+      call sphere_halo_build(h, x, ierr)
+      if (ierr /= 0) return
+      ! the own spheres' values into their slots (ascending global index, as data), the ghosts' from
+      ! their owners
+      allocate(values(CARRIED, size(h%id)))
+      values = 0.0_dp
+      values(:, pack([(q, q = 1, size(h%id))], h%is_owned)) = data
+      call sphere_halo_forward(h, values, ierr)
+      if (ierr /= 0) return
+      call particles_init(s, size(h%id), radius, motion)
       s%position = x
-      s%velocity = parts%velocity(:, h%id)
-      s%omega = parts%omega(:, h%id)
-      s%velocity_prev = parts%velocity_prev(:, h%id)
-      s%have_prev = parts%have_prev
-      s%external_force = parts%external_force(:, h%id)
-      s%external_torque = parts%external_torque(:, h%id)
-      radii = s%radii / parts%radius
-      ! the rows of the 6N system: numbered by slab, in ascending global index within a slab
-      o = sphere_ownership_by_slab(parts%position, loc%halo%lz, h%ranks)
-      call particle_solver_set_local(solver, o%row(h%id), h%is_owned, parts%n)
-      call lubrication_dynamics_set_local(ld, radii)
-      if (present(lubrication)) call particle_lubrication_set_local(lubrication, h%is_owned, radii)
-      if (present(rheology)) call rheo_set_local(rheology, h%is_owned, radii)
-      if (present(contacts)) then
-        ! the springs of the pairs with an own sphere (the view holds every spring)
-        k = history_size(contacts%history)
-        allocate(keys(2, k), springs(3, k))
-        call history_pack(contacts%history, np_hist, keys, springs)
-        kept = 0
-        do i = 1, k
-          if (owns(loc, keys(1, i)) .or. owns(loc, keys(2, i))) then
-            kept = kept + 1
-            keys(:, kept) = keys(:, i)
-            springs(:, kept) = springs(:, i)
-          end if
-        end do
-        if (k > 0) call history_unpack(contacts%history, np_hist, kept, keys, springs, info)
-        call particle_contacts_set_local(contacts, h%id, h%is_owned, radii)
+      call put_cargo(s, values)
+    end associate
+  end subroutine carry_on
+
+  ! What the spheres idx of p carry (CARRIED values each).
+  function cargo(p, idx) result(data)
+    type(particles_t), intent(in) :: p
+    integer, intent(in) :: idx(:)
+    real(dp) :: data(CARRIED, size(idx))
+    data(1:3, :) = p%velocity(:, idx)
+    data(4:6, :) = p%omega(:, idx)
+    data(7:9, :) = p%velocity_prev(:, idx)
+    data(10:12, :) = p%external_force(:, idx)
+    data(13:15, :) = p%external_torque(:, idx)
+    data(16, :) = p%radii(idx)
+  end function cargo
+
+  ! The inverse of cargo, for every sphere of p.
+  subroutine put_cargo(p, data)
+    type(particles_t), intent(inout) :: p
+    real(dp), intent(in) :: data(:, :)
+    p%velocity = data(1:3, :)
+    p%omega = data(4:6, :)
+    p%velocity_prev = data(7:9, :)
+    p%external_force = data(10:12, :)
+    p%external_torque = data(13:15, :)
+    p%radii = data(16, :)
+  end subroutine put_cargo
+
+  ! The 0-based block rows of the local set: the own spheres' numbered after those of the ranks
+  ! before (an exclusive prefix sum of the own counts), the ghosts' from their owners. Collective.
+  subroutine own_rows(loc, rows, ierr)
+    type(ld_local_t), intent(inout) :: loc
+    integer, allocatable, intent(out) :: rows(:)
+    PetscErrorCode, intent(out) :: ierr
+    integer :: first, k, q
+    real(dp), allocatable :: values(:, :)
+    associate(h => loc%halo)
+      first = 0
+      call MPI_Exscan(h%owned, first, 1, MPI_INTEGER, MPI_SUM, PETSC_COMM_WORLD, ierr)
+      if (ierr /= 0) return
+      if (h%rank == 0) first = 0           ! (MPI_Exscan leaves rank 0's undefined)
+      allocate(values(1, size(h%id)))
+      values = 0.0_dp
+      k = 0
+      do q = 1, size(h%id)
+        if (.not. h%is_owned(q)) cycle
+        values(1, q) = real(first + k, dp)
+        k = k + 1
+      end do
+      call sphere_halo_forward(h, values, ierr)
+      if (ierr /= 0) return
+      rows = nint(values(1, :))
+    end associate
+  end subroutine own_rows
+
+  ! The contacts' springs after the local set changed: each rank sends a neighbour the springs it
+  ! holds of the pairs with a sphere that neighbour owns (a ghost received from it: a sphere that
+  ! moved to it is one, since it moved less than the reach), then keeps those of the pairs with an
+  ! own sphere, each pair once (a pair across a face comes from both of its ranks, with the same
+  ! spring: both evaluated it from the same values). Collective among neighbours.
+  subroutine keep_springs(loc, contacts, ierr)
+    type(ld_local_t), intent(inout) :: loc
+    type(particle_contacts_t), intent(inout) :: contacts
+    PetscErrorCode, intent(out) :: ierr
+    integer, allocatable :: keys(:, :), send_count(:), theirs(:), picked(:), order(:), new_keys(:, :)
+    real(dp), allocatable :: ups(:, :), send(:, :), received(:, :), new_ups(:, :)
+    integer :: k, np_hist, m, i, j, kept, info
+    associate(h => loc%halo)
+      k = history_size(contacts%history)
+      allocate(keys(2, k), ups(3, k))
+      np_hist = loc%total
+      if (k > 0) call history_pack(contacts%history, np_hist, keys, ups)
+      allocate(send_count(size(h%neighbour)), picked(0))
+      do m = 1, size(h%neighbour)
+        ! the global indices of the ghosts received from neighbour m, ascending
+        theirs = h%id(h%recv_local(h%recv_start(m):h%recv_start(m + 1) - 1))
+        picked = [picked, pack([(i, i = 1, k)], [(found(theirs, keys(1, i)) .or. found(theirs, keys(2, i)), i = 1, k)])]
+        send_count(m) = size(picked) - sum(send_count(1:m - 1))
+      end do
+      allocate(send(5, size(picked)))
+      do j = 1, size(picked)
+        send(:, j) = [real(keys(:, picked(j)), dp), ups(:, picked(j))]
+      end do
+      call sphere_halo_exchange(h, send_count, send, received, ierr)
+      if (ierr /= 0) return
+      keys = reshape([keys, nint(received(1:2, :))], [2, k + size(received, 2)])
+      ups = reshape([ups, received(3:5, :)], [3, k + size(received, 2)])
+      ! the pairs with an own sphere, ordered by (first, second) sphere, each once
+      kept = 0
+      do i = 1, size(keys, 2)
+        if (.not. (owns(loc, keys(1, i)) .or. owns(loc, keys(2, i)))) cycle
+        kept = kept + 1
+        keys(:, kept) = keys(:, i)
+        ups(:, kept) = ups(:, i)
+      end do
+      order = ascending_order(keys(2, 1:kept))
+      order = order(ascending_order(keys(1, order)))
+      allocate(new_keys(2, kept), new_ups(3, kept))
+      k = 0
+      do i = 1, kept
+        if (i > 1) then
+          if (all(keys(:, order(i)) == keys(:, order(i - 1)))) cycle
+        end if
+        k = k + 1
+        new_keys(:, k) = keys(:, order(i))
+        new_ups(:, k) = ups(:, order(i))
+      end do
+      call history_unpack(contacts%history, loc%total, k, new_keys, new_ups, info)
+      if (info /= 0) then
+        ierr = 1
+        SETERRQ(PETSC_COMM_SELF, ierr, 'the springs kept on a rank do not form a contact history')
       end if
     end associate
-  end subroutine ld_local_begin
+  contains
+    ! Whether g is in the ascending list ids (a bisection).
+    pure logical function found(ids, g)
+      integer, intent(in) :: ids(:), g
+      integer :: lo, hi, mid
+      found = .false.
+      lo = 1
+      hi = size(ids)
+      do while (lo <= hi)
+        mid = (lo + hi) / 2
+        if (ids(mid) == g) then
+          found = .true.
+          return
+        else if (ids(mid) < g) then
+          lo = mid + 1
+        else
+          hi = mid - 1
+        end if
+      end do
+    end function found
+  end subroutine keep_springs
 
   !> After the contacts of the step on the local set: their diagnostics made the whole system's
   !> (counts summed, each pair counted once; the largest overlap and its pair; the walls' forces
@@ -250,74 +425,80 @@ contains
     call rheo_sample_finish(rheology, shares, min_gap)
   end subroutine ld_local_statistics
 
-  !> The end of the step on the local set, into the view (Collective):
-  !>  - the own spheres' velocities and angular velocities gathered into parts (the next step and
-  !>    the guard read them; 56 B a sphere), and the springs of the pairs whose first sphere is own
-  !>    into the contacts' history (the next step's local sets and the checkpoints take them);
-  !>  - results: RESULTS_NOW, the own spheres' hydrodynamic force, torque, stresslet, and the
-  !>    contacts' and the links' per-sphere force, torque, stresslet gathered too (the output reads
-  !>    them: a series record, a snapshot, a checkpoint); RESULTS_LATER, kept on their owner until
-  !>    ld_local_complete_view gathers them (a step without output sends none of them);
-  !>    RESULTS_NONE, a step that failed before its solve: those of the last step stay pending.
-  !> The contacts and the links are left set for every sphere (set_local of the view), their
-  !> per-sphere arrays zero until gathered; the links' wall forces summed over the ranks.
-  subroutine ld_local_end(loc, parts, results, ierr, contacts, lubrication)
+  !> The end of the step's solve on the local set: results RESULTS_KEPT, the own spheres'
+  !> hydrodynamic force, torque and stresslet, and the contacts' and the links' per-sphere force,
+  !> torque and stresslet kept on their owner until the view takes them (ld_local_complete_view);
+  !> RESULTS_NONE, a step that failed before its solve: those of the last step stay kept.
+  !> Not collective.
+  subroutine ld_local_end(loc, results, contacts, lubrication)
+    type(ld_local_t), intent(inout) :: loc
+    integer, intent(in) :: results
+    type(particle_contacts_t), intent(in), optional :: contacts
+    type(particle_lubrication_t), intent(in), optional :: lubrication
+    integer :: q, k
+    if (results == RESULTS_NONE) return
+    associate(h => loc%halo, s => loc%set)
+      if (allocated(loc%pending)) deallocate(loc%pending)
+      allocate(loc%pending(RESULT_VALUES + 1, h%owned))
+      loc%pending = 0.0_dp
+      k = 0
+      do q = 1, s%n
+        if (.not. h%is_owned(q)) cycle
+        k = k + 1
+        loc%pending(1, k) = real(h%id(q), dp)
+        loc%pending(2:4, k) = s%force_hydro(:, q)
+        loc%pending(5:7, k) = s%torque_hydro(:, q)
+        loc%pending(8:16, k) = reshape(s%stresslet_hydro(:, :, q), [9])
+        if (present(contacts)) then
+          loc%pending(17:19, k) = contacts%force(:, q)
+          loc%pending(20:22, k) = contacts%torque(:, q)
+          loc%pending(23:31, k) = reshape(contacts%stresslet(:, :, q), [9])
+        end if
+        if (present(lubrication)) then
+          loc%pending(32:34, k) = lubrication%force(:, q)
+          loc%pending(35:37, k) = lubrication%torque(:, q)
+          loc%pending(38:46, k) = reshape(lubrication%stresslet(:, :, q), [9])
+        end if
+      end do
+    end associate
+  end subroutine ld_local_end
+
+  !> The view parts brought up to date from the local set, for the output (a series record, a
+  !> snapshot, a checkpoint, failed_state.h5): the own spheres' positions, velocities, omega and
+  !> last velocities gathered (STATE_VALUES), the springs of the pairs whose first sphere is own into the
+  !> contacts' history (every spring), the links' wall forces summed over the ranks, the contacts
+  !> and the links set for every sphere (their set_local of the view) with the kept results of the
+  !> last step (ld_local_end) in their per-sphere arrays and parts'. Nothing when the view is
+  !> current (the same on every rank). Collective.
+  subroutine ld_local_complete_view(loc, parts, ierr, contacts, lubrication)
     type(ld_local_t), intent(inout) :: loc
     type(particles_t), intent(inout) :: parts
-    integer, intent(in) :: results
     PetscErrorCode, intent(out) :: ierr
     type(particle_contacts_t), intent(inout), optional :: contacts
     type(particle_lubrication_t), intent(inout), optional :: lubrication
     real(dp), allocatable :: rows(:, :), all(:, :), springs(:, :), all_springs(:, :), ups(:, :)
-    integer, allocatable :: keys(:, :)
+    integer, allocatable :: keys(:, :), id(:)
     integer :: q, k, np_hist, nsprings, i, info
     logical, allocatable :: every(:)
 
     ierr = 0
+    if (loc%view_current) return
+    loc%view_current = .true.
+    loc%view_updates = loc%view_updates + 1
     associate(h => loc%halo, s => loc%set)
-      if (results /= RESULTS_NONE) then
-        ! this step's results of the own spheres, one row each (after the global index)
-        allocate(rows(GATHERED + 1, h%owned))
-        k = 0
-        do q = 1, s%n
-          if (.not. h%is_owned(q)) cycle
-          k = k + 1
-          rows(1, k) = real(h%id(q), dp)
-          rows(2:4, k) = s%velocity(:, q)
-          rows(5:7, k) = s%omega(:, q)
-          rows(8:10, k) = s%force_hydro(:, q)
-          rows(11:13, k) = s%torque_hydro(:, q)
-          rows(14:22, k) = reshape(s%stresslet_hydro(:, :, q), [9])
-          rows(23:52, k) = 0.0_dp
-          if (present(contacts)) then
-            rows(23:25, k) = contacts%force(:, q)
-            rows(26:28, k) = contacts%torque(:, q)
-            rows(29:37, k) = reshape(contacts%stresslet(:, :, q), [9])
-          end if
-          if (present(lubrication)) then
-            rows(38:40, k) = lubrication%force(:, q)
-            rows(41:43, k) = lubrication%torque(:, q)
-            rows(44:52, k) = reshape(lubrication%stresslet(:, :, q), [9])
-          end if
-        end do
-        call move_alloc(rows, loc%pending)
-      end if
-      if (results == RESULTS_NOW) then
-        PetscCall(gather_rows(loc%pending, all, ierr))
-        deallocate(loc%pending)
-      else
-        ! the velocities now (of this step, or unchanged after a failed one), the rest later
-        allocate(rows(7, h%owned))
-        k = 0
-        do q = 1, s%n
-          if (.not. h%is_owned(q)) cycle
-          k = k + 1
-          rows(:, k) = [real(h%id(q), dp), s%velocity(:, q), s%omega(:, q)]
-        end do
-        PetscCall(gather_rows(rows, all, ierr))
-      end if
-      parts%velocity(:, nint(all(1, :))) = all(2:4, :)
-      parts%omega(:, nint(all(1, :))) = all(5:7, :)
+      allocate(rows(STATE_VALUES + 1, h%owned))
+      k = 0
+      do q = 1, s%n
+        if (.not. h%is_owned(q)) cycle
+        k = k + 1
+        rows(:, k) = [real(h%id(q), dp), s%position(:, q), s%velocity(:, q), s%omega(:, q), s%velocity_prev(:, q)]
+      end do
+      PetscCall(gather_rows(rows, all, ierr))
+      id = nint(all(1, :))
+      parts%position(:, id) = all(2:4, :)
+      parts%velocity(:, id) = all(5:7, :)
+      parts%omega(:, id) = all(8:10, :)
+      parts%velocity_prev(:, id) = all(11:13, :)
       allocate(every(loc%total))
       every = .true.
       if (present(lubrication)) then
@@ -349,40 +530,25 @@ contains
         end if
       end if
     end associate
-    if (results == RESULTS_NOW) call put_results(all, parts, contacts, lubrication)
-  end subroutine ld_local_end
-
-  !> The results ld_local_end kept on their owners (RESULTS_LATER or RESULTS_NONE), gathered into
-  !> the view: parts' hydrodynamic force, torque, stresslet, the contacts' and the links' per-sphere
-  !> arrays. Nothing when none is pending (loc%pending is the same on every rank). Called before the
-  !> output reads them outside its cadence: a failure, the end of the run. Collective.
-  subroutine ld_local_complete_view(loc, parts, ierr, contacts, lubrication)
-    type(ld_local_t), intent(inout) :: loc
-    type(particles_t), intent(inout) :: parts
-    PetscErrorCode, intent(out) :: ierr
-    type(particle_contacts_t), intent(inout), optional :: contacts
-    type(particle_lubrication_t), intent(inout), optional :: lubrication
-    real(dp), allocatable :: all(:, :)
-    ierr = 0
-    if (.not. allocated(loc%pending)) return
-    PetscCall(gather_rows(loc%pending, all, ierr))
-    deallocate(loc%pending)
-    call put_results(all, parts, contacts, lubrication)
+    if (allocated(loc%pending)) then
+      PetscCall(gather_rows(loc%pending, all, ierr))
+      deallocate(loc%pending)
+      call put_results(all, parts, contacts, lubrication)
+    end if
   end subroutine ld_local_complete_view
 
-  ! Whether the sphere of global index g is one of this rank's own (a bisection of the local set's
-  ! ascending indices; false for a wall's id, < 0).
-  pure logical function owns(loc, g)
+  !> The slot in the local set of the own sphere of global index g; 0 when g is not an own sphere.
+  pure integer function ld_local_own_slot(loc, g) result(slot)
     type(ld_local_t), intent(in) :: loc
     integer, intent(in) :: g
     integer :: lo, hi, mid
-    owns = .false.
+    slot = 0
     lo = 1
     hi = size(loc%halo%id)
     do while (lo <= hi)
       mid = (lo + hi) / 2
       if (loc%halo%id(mid) == g) then
-        owns = loc%halo%is_owned(mid)
+        if (loc%halo%is_owned(mid)) slot = mid
         return
       else if (loc%halo%id(mid) < g) then
         lo = mid + 1
@@ -390,6 +556,13 @@ contains
         hi = mid - 1
       end if
     end do
+  end function ld_local_own_slot
+
+  ! Whether the sphere of global index g is one of this rank's own (false for a wall's id, < 0).
+  pure logical function owns(loc, g)
+    type(ld_local_t), intent(in) :: loc
+    integer, intent(in) :: g
+    owns = ld_local_own_slot(loc, g) > 0
   end function owns
 
   ! The rows (k, m) of every rank, one after the other (rank order), on every rank. Collective.
@@ -411,7 +584,7 @@ contains
     PetscCallMPI(MPI_Allgatherv(rows, size(rows), MPI_DOUBLE_PRECISION, all, counts, displs, MPI_DOUBLE_PRECISION, PETSC_COMM_WORLD, ierr))
   end subroutine gather_rows
 
-  ! The gathered rows of ld_local_end (every sphere's) into the view's per-sphere results.
+  ! The gathered results of ld_local_end (every sphere's) into the view's per-sphere arrays.
   subroutine put_results(all, parts, contacts, lubrication)
     real(dp), intent(in) :: all(:, :)
     type(particles_t), intent(inout) :: parts
@@ -421,18 +594,18 @@ contains
     integer :: n
     id = nint(all(1, :))
     n = size(id)
-    parts%force_hydro(:, id) = all(8:10, :)
-    parts%torque_hydro(:, id) = all(11:13, :)
-    parts%stresslet_hydro(:, :, id) = reshape(all(14:22, :), [3, 3, n])
+    parts%force_hydro(:, id) = all(2:4, :)
+    parts%torque_hydro(:, id) = all(5:7, :)
+    parts%stresslet_hydro(:, :, id) = reshape(all(8:16, :), [3, 3, n])
     if (present(contacts)) then
-      contacts%force(:, id) = all(23:25, :)
-      contacts%torque(:, id) = all(26:28, :)
-      contacts%stresslet(:, :, id) = reshape(all(29:37, :), [3, 3, n])
+      contacts%force(:, id) = all(17:19, :)
+      contacts%torque(:, id) = all(20:22, :)
+      contacts%stresslet(:, :, id) = reshape(all(23:31, :), [3, 3, n])
     end if
     if (present(lubrication)) then
-      lubrication%force(:, id) = all(38:40, :)
-      lubrication%torque(:, id) = all(41:43, :)
-      lubrication%stresslet(:, :, id) = reshape(all(44:52, :), [3, 3, n])
+      lubrication%force(:, id) = all(32:34, :)
+      lubrication%torque(:, id) = all(35:37, :)
+      lubrication%stresslet(:, :, id) = reshape(all(38:46, :), [3, 3, n])
     end if
   end subroutine put_results
 

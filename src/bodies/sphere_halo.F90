@@ -17,6 +17,8 @@
 !                          slots, and the lists of what goes to each neighbour
 !   sphere_halo_forward    owners' values -> their ghost copies (positions, velocities)
 !   sphere_halo_reverse    ghosts' partial sums -> added into their owners' values (forces)
+!   sphere_halo_exchange   records of any count to each neighbour (what goes with a sphere but is
+!                          not one value per sphere: the contacts' springs)
 ! A sphere is a ghost of rank q when the periodic distance along z from its centre to q's slab is
 ! below reach; a rank exchanges with every rank q /= itself whose slab lies within reach of its own.
 ! With one rank there are no ghosts and nothing is sent: periodic images are the kernels' minimum
@@ -29,7 +31,7 @@ module mod_sphere_halo
   implicit none
   private
   public :: sphere_halo_t, sphere_halo_create, sphere_halo_migrate, sphere_halo_build, sphere_halo_forward, &
-            sphere_halo_reverse, sphere_halo_slab_of, sphere_halo_distance
+            sphere_halo_reverse, sphere_halo_exchange, sphere_halo_slab_of, sphere_halo_distance
 
   type :: sphere_halo_t
     real(dp) :: lz = 0.0_dp                 ! the box's period along z [a]
@@ -328,6 +330,33 @@ contains
       values(:, h%send_local(g)) = values(:, h%send_local(g)) + recv_buf(:, g)
     end do
   end subroutine sphere_halo_reverse
+
+  !> Records of width w: send_count(m) of them to neighbour m (send_buf's columns grouped by
+  !> neighbour, in h%neighbour's order); on return recv_buf (w, received) holds the neighbours'
+  !> records, grouped in the same order. Collective among neighbours.
+  subroutine sphere_halo_exchange(h, send_count, send_buf, recv_buf, ierr)
+    type(sphere_halo_t), intent(inout) :: h
+    integer, intent(in) :: send_count(:)
+    real(dp), intent(in) :: send_buf(:, :)
+    real(dp), allocatable, intent(out) :: recv_buf(:, :)
+    PetscErrorCode, intent(out) :: ierr
+    integer :: recv_count(size(h%neighbour)), m, nb, w
+    integer :: offset(size(h%neighbour) + 1), roffset(size(h%neighbour) + 1)
+    nb = size(h%neighbour)
+    w = size(send_buf, 1)
+    call exchange_counts(h, send_count, recv_count, ierr)
+    if (ierr /= 0) return
+    offset(1) = 0
+    roffset(1) = 0
+    do m = 1, nb
+      offset(m + 1) = offset(m) + w * send_count(m)
+      roffset(m + 1) = roffset(m) + w * recv_count(m)
+    end do
+    allocate(recv_buf(w, roffset(nb + 1) / max(1, w)))
+    call swap(h, send_buf, offset, recv_buf, roffset, ierr)
+    if (ierr /= 0) return
+    h%bytes_sent = h%bytes_sent + 8_8 * offset(nb + 1)
+  end subroutine sphere_halo_exchange
 
   ! The columns from(from_start(m):...) of values go to neighbour m, which receives them into its
   ! columns to(to_start(m):...) (here: recv_buf in that order).

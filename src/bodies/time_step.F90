@@ -36,8 +36,8 @@ module mod_time_step
   use mod_ld_motion, only: ld_motion_solve, ld_motion_solve_stress
   use mod_particle_solver, only: particle_solver_t
   use mod_ld_local, only: ld_local_t, ld_local_create, ld_local_begin, ld_local_contacts_agree, ld_local_links, &
-                          ld_local_statistics, ld_local_end, ld_local_complete_view, RESULTS_NOW, RESULTS_LATER, &
-                          RESULTS_NONE
+                          ld_local_statistics, ld_local_end, ld_local_complete_view, ld_local_own_slot, &
+                          RESULTS_KEPT, RESULTS_NONE
   implicit none
   private
   public :: time_step_t, time_step_create, time_step_advance, time_step_guard, time_step_report, &
@@ -80,9 +80,10 @@ module mod_time_step
     type(shear_protocol_t), pointer :: protocol => null()   ! the imposed shear (&shear)
     real(dp), allocatable :: mean_flow(:)          ! x-z plane means of u per cell row (statistics)
     real(dp), allocatable :: position_before(:, :) ! X^n, then X^{n+1} - X^n
-    ! lubrication dynamics on more than one rank: each rank's own spheres and ghosts (mod_ld_local);
-    ! complete_view: the next step gathers every sphere's results into parts, the contacts and the
-    ! links (the caller's output reads them after it), else they wait for time_step_complete_view
+    ! lubrication dynamics on more than one rank: each rank's own spheres and ghosts (mod_ld_local),
+    ! the state between steps; complete_view: the next step brings parts, the contacts and the links
+    ! up to date at its end (the caller's output reads them after it), else they wait for a step
+    ! that does or for time_step_complete_view
     type(ld_local_t) :: local
     logical :: complete_view = .true.
   end type time_step_t
@@ -292,13 +293,28 @@ contains
           call rheo_sample_flow(ts%rheology, ts%mean_flow, ts%grid%h)
         end if
       end if
-      ts%position_before = parts%position
-      call advance_positions(parts, ts%dt, ts%box, [.true., .not. (ts%walls .or. le%active), .true.])
+      if (local) then
+        ! the local set is the state: its spheres advance (the view follows at the output's steps)
+        call advance_positions(ts%local%set, ts%dt, ts%box, [.true., .not. (ts%walls .or. le%active), .true.])
+        parts%have_prev = ts%local%set%have_prev
+      else
+        if (ts%variant == TIME_STEP_RESOLVED) ts%position_before = parts%position
+        call advance_positions(parts, ts%dt, ts%box, [.true., .not. (ts%walls .or. le%active), .true.])
+      end if
       call shear_protocol_end_step(ts%protocol)
       if (le%active) then
         ! the boundary slides on; spheres that left through y = 0 or Ly re-enter from the image
         call slide(le, ts%protocol, ts%dt)
-        call le_wrap(le, parts%position, parts%velocity, parts%velocity_prev)
+        if (local) then
+          associate(set => ts%local%set)
+            call le_wrap(le, set%position, set%velocity, set%velocity_prev)
+          end associate
+        else
+          call le_wrap(le, parts%position, parts%velocity, parts%velocity_prev)
+        end if
+      end if
+      if (local .and. ts%complete_view) then
+        PetscCall(ld_local_complete_view(ts%local, parts, ierr, ts%contacts, ts%lubrication))
       end if
       if (ts%variant == TIME_STEP_RESOLVED) then
         if (ts%carry_lambda) then
@@ -315,10 +331,12 @@ contains
   end subroutine time_step_advance
 
   ! The particle part of a lubrication-dynamics step on the ranks' local sets (mod_ld_local): the
-  ! local set of X^n, its contacts and links, the 6N solve of the own spheres' rows, and the own
-  ! spheres' results gathered back into ts%parts, which the statistics and the output read. A
-  ! failure (an overlap, a link) is described in ts%failure, the view left as at X^n (every stage
-  ! popped); otherwise the Particles stage is left pushed for the step's end. Collective.
+  ! local set of X^n (carried on from the last step's, or taken from ts%parts on the first), its
+  ! contacts and links, the 6N solve of the own spheres' rows, the statistics' sample, and the own
+  ! spheres' results kept for the view (time_step_advance then advances the local set, and brings
+  ! ts%parts up to date when the output reads it). A failure (an overlap, a link) is described in
+  ! ts%failure, the local set left at X^n (every stage popped); otherwise the Particles stage is
+  ! left pushed for the step's end. Collective.
   subroutine local_step(ts, ierr)
     type(time_step_t), intent(inout) :: ts
     PetscErrorCode, intent(out) :: ierr
@@ -336,7 +354,7 @@ contains
         PetscCall(stage_pop(ierr))
         if (info /= 0) then
           ts%failure = contact_failure(ts%contacts, info)
-          PetscCall(ld_local_end(loc, ts%parts, RESULTS_NONE, ierr, ts%contacts, ts%lubrication))
+          call ld_local_end(loc, RESULTS_NONE)
           return
         end if
       end if
@@ -351,7 +369,7 @@ contains
         PetscCall(stage_pop(ierr))
         if (ts%lubrication%failed_link(1) /= 0) then
           ts%failure = lubrication_failure(ts%lubrication%failed_link)
-          PetscCall(ld_local_end(loc, ts%parts, RESULTS_NONE, ierr, ts%contacts, ts%lubrication))
+          call ld_local_end(loc, RESULTS_NONE)
           return
         end if
       end if
@@ -373,7 +391,7 @@ contains
           PetscCall(ld_local_statistics(loc, ts%rheology, ierr, offset=le%offset))
         end if
       end if
-      PetscCall(ld_local_end(loc, ts%parts, merge(RESULTS_NOW, RESULTS_LATER, ts%complete_view), ierr, ts%contacts, ts%lubrication))
+      call ld_local_end(loc, RESULTS_KEPT, ts%contacts, ts%lubrication)
     end associate
   end subroutine local_step
 
@@ -391,9 +409,9 @@ contains
     call impose_rate(ts)
   end subroutine take_stress_rate
 
-  ! Every sphere's results of the last step in ts%parts, the contacts and the links, for output
-  ! outside its cadence (a failure, the end of the run): those the local step kept on their owners
-  ! (complete_view .false.) gathered. Collective.
+  ! ts%parts, the contacts and the links brought up to date from the ranks' local sets (positions,
+  ! velocities, springs, the last step's results), for output outside its cadence (a failure, the
+  ! end of the run); nothing when they are (or the step is replicated). Collective.
   subroutine time_step_complete_view(ts, ierr)
     type(time_step_t), intent(inout) :: ts
     PetscErrorCode, intent(out) :: ierr
@@ -567,19 +585,24 @@ contains
 
   ! The runtime guard after step (doc/DESIGN.md "Files, restart and signals"): a non-finite
   ! velocity, pressure or particle quantity, or a sphere half way through a wall, is described in
-  ! ts%failure. The norms are global reductions and particle data is replicated, so every rank
-  ! finds the same. At step -fault_nan_step the state is poisoned first (the guard's own test).
+  ! ts%failure. The norms are global reductions and the spheres are either replicated or looked at
+  ! by their owners (the local set: the first failing sphere found by one reduction, and the view
+  ! then brought up to date to name it), so every rank finds the same. At step -fault_nan_step the
+  ! state is poisoned first (the guard's own test).
   subroutine time_step_guard(ts, step, ierr)
     type(time_step_t), intent(inout) :: ts
     integer, intent(in) :: step
     PetscErrorCode, intent(out) :: ierr
     PetscReal :: norms(4)
-    integer :: c, q
+    integer :: c, q, first
     ierr = 0
     ts%failure = ''
     if (step == ts%fault_nan_step) then
       if (associated(ts%fluid)) then
         PetscCall(VecScale(ts%fluid%vel(1), ieee_value(1.0_dp, ieee_quiet_nan), ierr))
+      else if (ts%local%live) then
+        q = ld_local_own_slot(ts%local, 1)
+        if (q > 0) ts%local%set%velocity(1, q) = ieee_value(1.0_dp, ieee_quiet_nan)
       else
         ts%parts%velocity(1, 1) = ieee_value(1.0_dp, ieee_quiet_nan)
       end if
@@ -599,26 +622,51 @@ contains
       end if
     end do
     if (.not. associated(ts%parts)) return
+    if (ts%local%live) then
+      ! the own spheres of the local set; the smallest failing global index of all ranks
+      first = huge(1)
+      associate(set => ts%local%set, h => ts%local%halo)
+        do q = 1, set%n
+          if (.not. h%is_owned(q)) cycle
+          if (sphere_fault(ts, set, q)) then
+            first = h%id(q)
+            exit
+          end if
+        end do
+      end associate
+      PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, first, 1, MPI_INTEGER, MPI_MIN, PETSC_COMM_WORLD, ierr))
+      if (first == huge(1)) return
+      PetscCall(ld_local_complete_view(ts%local, ts%parts, ierr, ts%contacts, ts%lubrication))
+    end if
     associate(parts => ts%parts)
       do q = 1, parts%n
+        if (.not. sphere_fault(ts, parts, q)) cycle
         if (.not. (all(ieee_is_finite(parts%velocity(:, q))) .and. all(ieee_is_finite(parts%omega(:, q))) &
                    .and. all(ieee_is_finite(parts%position(:, q))))) then
           write(ts%failure, '(a,i0,a,3es10.3,a,3es10.3)') 'particle ', q, ' is not finite: velocity ', &
                parts%velocity(:, q), ' omega ', parts%omega(:, q)
-          return
-        end if
-        ! a sphere half way through a wall: nothing physical holds it back any more (no wall
-        ! contacts or lubrication, or a step far too large for them)
-        if (ts%walls .and. (parts%position(2, q) < 0.5_dp * parts%radii(q) .or. &
-                            parts%position(2, q) > ts%box(2) - 0.5_dp * parts%radii(q))) then
+        else
           write(ts%failure, '(a,i0,a,f10.5,a,f10.5,a)') 'particle ', q, ' is half way through a wall (centre y = ', &
                parts%position(2, q), ', walls at 0 and ', ts%box(2), &
                '): add &contact, keep &lubrication on, or lower &time dt'
-          return
         end if
+        return
       end do
     end associate
   end subroutine time_step_guard
+
+  ! Whether sphere q of p fails the runtime guard: a non-finite velocity, omega or position, or
+  ! half way through a wall (nothing physical holds it back any more: no wall contacts or
+  ! lubrication, or a step far too large for them).
+  pure logical function sphere_fault(ts, p, q)
+    type(time_step_t), intent(in) :: ts
+    type(particles_t), intent(in) :: p
+    integer, intent(in) :: q
+    sphere_fault = .not. (all(ieee_is_finite(p%velocity(:, q))) .and. all(ieee_is_finite(p%omega(:, q))) &
+                          .and. all(ieee_is_finite(p%position(:, q))))
+    if (ts%walls .and. .not. sphere_fault) sphere_fault = p%position(2, q) < 0.5_dp * p%radii(q) .or. &
+                                                        p%position(2, q) > ts%box(2) - 0.5_dp * p%radii(q)
+  end function sphere_fault
 
   ! The run's account of its steps, in the run log: wall time per step (seconds_per_step) and the
   ! fluid solvers' mean iterations, the largest contact overlap, the particle solves.
@@ -644,6 +692,12 @@ contains
              ts%largest_overlap / ts%contacts%params%h_r, ' h_r (step ', ts%largest_overlap_step, ')'
         call log_line(text)
       end if
+    end if
+    if (ts%local%live) then
+      ! the state between steps is the local sets; the replicated copy only for the output
+      write(text, '(a,i0,a,i0,a)') 'lubrication dynamics on the ranks'' local sets: the replicated view '// &
+           'brought up to date ', ts%local%view_updates, ' times in ', ts%steps_taken, ' steps (for the output)'
+      call log_line(text)
     end if
     if (associated(ts%lubrication)) then
       ! each rank holds the pair links of its own spheres (mod_lubrication_links)

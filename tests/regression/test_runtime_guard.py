@@ -19,7 +19,9 @@ Fifth guard: the default path, whose fluid solves are direct (nothing to fail to
 has one iterative solve, the particles' 6N system: a pair of spheres 0.1a apart couples it through
 lubrication, and with that solve capped at one iteration (-particles_ksp_max_it 1, a stand-in for a
 solve that fails) the run stops (status 4) with one message naming the solve and its KSP reason,
-and no checkpoint is written over the good one."""
+and no checkpoint is written over the good one.
+Sixth: the first guard in lubrication dynamics (a NaN velocity of particle 1 between two series
+records), where on several ranks each rank looks at its own spheres: 1 and 2 ranks stop alike."""
 import os
 import numpy as np
 import fdsusp_testlib as T
@@ -118,6 +120,33 @@ for ranks in sorted({1, max(2, T.RANKS)}):
     stops.append(messages[0] if len(messages) == 1 and status == 5 else 'status %d, %s' % (status, messages[:1]))
 T.check(len(set(stops)) == 1 and 'particle 1 and particle 2' in stops[0],
         'lubrication dynamics: the overlap across a slab face stops 1 and %d ranks alike: %s' % (max(2, T.RANKS), stops))
+
+# The runtime guard in lubrication dynamics on several ranks, where the local sets are the state
+# between steps (mod_ld_local) and each rank looks at its own spheres: particle 1 poisoned at step
+# 12, between two series records (every 5 steps), stops 1 and 2 ranks alike (status 5, one message
+# naming the particle), and failed_state.h5 holds the poisoned velocity (the view gathered for it).
+d = T.scratch('runtime_guard_nan_ld')
+deck = T.write_deck(d, 'n.nml', """&domain box = 6.4, 6.4, 6.4, y_boundary = 'walls', shear_rate = 1 /
+&fluid model = 'none' /
+&time dt = 1e-3, steps = 20 /
+&output directory = 'out', progress_every = 10, series_every = 5 /
+&lubrication model = 'none' /
+&particles number = 2, position(:,1) = 3.2, 3.2, 2.2, position(:,2) = 3.2, 3.2, 4.21 /
+&contact roughness = 0.01 /
+""")
+stops = []
+for ranks in sorted({1, max(2, T.RANKS)}):
+    status, out, err = T.run(deck, d, np_ranks=ranks, args=['-fault_nan_step', '12'], expect_ok=False)
+    messages = [l for l in err.splitlines() if l.startswith('fdsusp:')]
+    failed = os.path.join(d, 'out', 'failed_state.h5')
+    poisoned = os.path.exists(failed) and np.isnan(T.read_h5(failed, ['particles/velocity'])['particles/velocity'][0, 0])
+    stops.append(messages[0] if len(messages) == 1 and status == 5 and poisoned else
+                 'status %d, %s, failed_state.h5 poisoned: %s' % (status, messages[:1], poisoned))
+    if os.path.exists(failed):
+        os.remove(failed)
+T.check(len(set(stops)) == 1 and 'step 12' in stops[0] and 'particle 1 is not finite' in stops[0],
+        'lubrication dynamics: the guard stops 1 and %d ranks alike, failed_state.h5 poisoned: %s'
+        % (max(2, T.RANKS), stops))
 
 d = T.scratch('runtime_guard_particle_solve')
 PAIR = """&domain box = 6.4, 6.4, 6.4, cells_per_radius = 5, y_boundary = 'walls', shear_rate = 1 /
