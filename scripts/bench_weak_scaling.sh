@@ -10,6 +10,8 @@
 #   bash scripts/bench_weak_scaling.sh                              (ld and dns, 1 2 4 8 ranks)
 #   MODELS=ld RANKS="1 2" PER_RANK=500 bash scripts/bench_weak_scaling.sh
 #   OPTIONS="-ld_local_set 0" MODELS=ld bash scripts/bench_weak_scaling.sh   (options for every run)
+#   SERIES_EVERY=1 MODELS=ld bash scripts/bench_weak_scaling.sh   (a series record every step, the
+#        default cadence; otherwise none in the runs, so that only the step's traffic is counted)
 # Decks (z is the direction the grid is split in, so each rank's share is a slab of the same size):
 #   ld:  lubrication dynamics, the bench deck's physics (phi 0.4, mu_d 0.5, eps_r 5e-3, Lees-Edwards),
 #        PER_RANK spheres per rank (default 500) in a box L x L x (NP L);
@@ -24,6 +26,7 @@ MODELS=${MODELS:-"ld dns"}
 RANKS=${RANKS:-"1 2 4 8"}
 PER_RANK=${PER_RANK:-500}
 OPTIONS=${OPTIONS:-}
+SERIES_EVERY=${SERIES_EVERY:-100000}
 STEPS_SHORT=${STEPS_SHORT:-2}
 STEPS_LONG=${STEPS_LONG:-6}
 W=build/bench/weak_scaling
@@ -40,7 +43,7 @@ deck() {   # deck MODEL NP STEPS
 &domain box = $side, $side, $($PY -c "print('%.4f' % ($side * $np))"), y_boundary = 'lees-edwards', shear_rate = 1 /
 &fluid model = 'none' /
 &time dt = 2e-3, steps = $steps /
-&output directory = '$out', progress_every = 100000, series_every = 100000, checkpoint_every = 0 /
+&output directory = '$out', progress_every = 100000, series_every = $SERIES_EVERY, checkpoint_every = 0 /
 &particles solid_fraction = 0.4, seed = 1 /
 &contact roughness = 5e-3, friction = 0.5 /
 &run title = 'weak scaling, lubrication dynamics, $np ranks' /
@@ -50,7 +53,7 @@ EOF
 &domain box = 8, 20, $((8 * np)), cells_per_radius = 4, y_boundary = 'walls', shear_rate = 1 /
 &fluid reynolds = 0.01, initial_flow = 'shear' /
 &time dt = 1e-3, steps = $steps /
-&output directory = '$out', progress_every = 100000, series_every = 100000, checkpoint_every = 0 /
+&output directory = '$out', progress_every = 100000, series_every = $SERIES_EVERY, checkpoint_every = 0 /
 &particles solid_fraction = 0.3, seed = 1 /
 &contact roughness = 5e-3, friction = 0.5 /
 &lubrication model = 'full' /

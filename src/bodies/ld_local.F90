@@ -11,10 +11,11 @@
 ! what they carry (velocities, the Adams-Bashforth history, external loads, radius), the ghosts are
 ! rebuilt, and the springs of the contacts go to the neighbours whose spheres they touch. No message
 ! of a step grows with the total number of spheres. The replicated particle state (the view) is a
-! copy the output reads: it is brought up to date (ld_local_complete_view: positions, velocities,
-! springs and the last step's hydrodynamic, contact and link results gathered) only at the steps
-! whose output reads it (a series record, a snapshot, a checkpoint), after a failure and at the end
-! of the run; a restart and the first step take the local set from it.
+! copy for the output that reads every sphere: it is brought up to date (ld_local_complete_view:
+! positions, velocities, springs and the last step's hydrodynamic, contact and link results
+! gathered) only at the steps of a particle snapshot or a checkpoint, after a failure and at the
+! end of the run (a series record takes the own spheres of the local sets, mod_run_output); a
+! restart and the first step take the local set from it.
 !
 ! With one rank, or without contacts and links (the block-diagonal one-body problem), the step keeps
 ! the replicated state (ld_local_t%active false). An owned sphere sees every contact and link in
@@ -463,11 +464,11 @@ contains
     end associate
   end subroutine ld_local_end
 
-  !> The view parts brought up to date from the local set, for the output (a series record, a
-  !> snapshot, a checkpoint, failed_state.h5): the own spheres' positions, velocities, omega and
-  !> last velocities gathered (STATE_VALUES), the springs of the pairs whose first sphere is own into the
-  !> contacts' history (every spring), the links' wall forces summed over the ranks, the contacts
-  !> and the links set for every sphere (their set_local of the view) with the kept results of the
+  !> The view parts brought up to date from the local set, for the output that reads every sphere
+  !> (a particle snapshot, a checkpoint, failed_state.h5, the run's last output): the own spheres'
+  !> positions, velocities, omega and last velocities gathered (STATE_VALUES), the springs of the
+  !> pairs whose first sphere is own into the contacts' history (every spring), the contacts and
+  !> the links set for every sphere (their set_local of the view) with the kept results of the
   !> last step (ld_local_end) in their per-sphere arrays and parts'. Nothing when the view is
   !> current (the same on every rank). Collective.
   subroutine ld_local_complete_view(loc, parts, ierr, contacts, lubrication)
@@ -502,7 +503,6 @@ contains
       allocate(every(loc%total))
       every = .true.
       if (present(lubrication)) then
-        PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, lubrication%wall_force, 6, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr))
         call particle_lubrication_set_local(lubrication, every, parts%radii / parts%radius)
         deallocate(lubrication%owned)
       end if

@@ -41,7 +41,7 @@ module mod_time_step
   implicit none
   private
   public :: time_step_t, time_step_create, time_step_advance, time_step_guard, time_step_report, &
-            time_step_complete_view
+            time_step_complete_view, time_step_local_state
 
   ! the variants
   integer, parameter :: TIME_STEP_FLUID = 1       ! the fluid alone (no spheres)
@@ -391,6 +391,10 @@ contains
           PetscCall(ld_local_statistics(loc, ts%rheology, ierr, offset=le%offset))
         end if
       end if
+      ! the links' wall forces of the own spheres summed over the ranks (a series column)
+      if (associated(ts%lubrication)) then
+        PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, ts%lubrication%wall_force, 6, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr))
+      end if
       call ld_local_end(loc, RESULTS_KEPT, ts%contacts, ts%lubrication)
     end associate
   end subroutine local_step
@@ -408,6 +412,14 @@ contains
     end if
     call impose_rate(ts)
   end subroutine take_stress_rate
+
+  ! Whether the state of the run is the ranks' local sets (ts%local: lubrication dynamics on several
+  ! ranks) and ts%parts, the contacts and the links are not up to date with it: the output of this
+  ! step then takes the own spheres of the local sets (the contacts and the links are set for them).
+  pure logical function time_step_local_state(ts)
+    type(time_step_t), intent(in) :: ts
+    time_step_local_state = ts%local%live .and. .not. ts%local%view_current
+  end function time_step_local_state
 
   ! ts%parts, the contacts and the links brought up to date from the ranks' local sets (positions,
   ! velocities, springs, the last step's results), for output outside its cadence (a failure, the

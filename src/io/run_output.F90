@@ -31,7 +31,7 @@ module mod_run_output
   implicit none
   private
   public :: run_output_t, run_output_open, run_output_step, run_output_checkpoint, run_output_fail, run_output_close, &
-            run_output_reads_spheres
+            run_output_reads_view
 
   type :: run_output_t
     type(config_t) :: cfg
@@ -145,31 +145,38 @@ contains
     write(s, '(a,i0)') name, k
   end function species_attribute
 
-  !> Whether the output of step reads the spheres' per-sphere results (a series record, a particle
-  !> snapshot, a checkpoint), so that a step on the ranks' local sets gathers them
-  !> (mod_time_step complete_view).
-  pure logical function run_output_reads_spheres(out, step) result(reads)
+  !> Whether the output of step reads every sphere from the replicated particle state (a particle
+  !> snapshot, a checkpoint), so that a step on the ranks' local sets brings it up to date
+  !> (mod_time_step complete_view); a series record takes the own spheres of the local sets.
+  pure logical function run_output_reads_view(out, step) result(reads)
     type(run_output_t), intent(in) :: out
     integer, intent(in) :: step
+    reads = .false.
     associate(schedule => out%cfg%output)
-      reads = mod(step, schedule%series_every) == 0
       if (schedule%particles_every > 0) reads = reads .or. mod(step, schedule%particles_every) == 0
       if (schedule%checkpoint_every > 0) reads = reads .or. mod(step, schedule%checkpoint_every) == 0
     end associate
-  end function run_output_reads_spheres
+  end function run_output_reads_view
 
-  ! The output of step (time), on the deck's &output cadences.
-  subroutine run_output_step(out, step, time, ierr)
+  ! The output of step (time), on the deck's &output cadences. local: this rank's local set of
+  ! lubrication dynamics (mod_ld_local: its spheres' global indices id, which are its own, and
+  ! the number of all spheres total), which a series record reads while the replicated particle
+  ! state is not up to date (the snapshots and checkpoints read that one, run_output_reads_view);
+  ! the run's contacts and links are then set for the local set.
+  subroutine run_output_step(out, step, time, ierr, local, id, own, total)
     type(run_output_t), intent(inout) :: out
     integer, intent(in) :: step
     real(dp), intent(in) :: time
     PetscErrorCode, intent(out) :: ierr
+    type(particles_t), intent(in), optional :: local
+    integer, intent(in), optional :: id(:), total
+    logical, intent(in), optional :: own(:)
     real(dp) :: wall_now, wall_per_step
     ierr = 0
     associate(schedule => out%cfg%output)
       PetscCall(stage_push(STAGE_OUTPUT, ierr))
       wall_now = MPI_Wtime() - out%wall_start
-      if (mod(step, schedule%series_every) == 0) call record(out, step, time)
+      if (mod(step, schedule%series_every) == 0) call record(out, step, time, local, id, own, total)
       if (mod(step, schedule%progress_every) == 0) then
         wall_per_step = wall_now / (step - out%first_step)
         if (associated(out%fluid)) then
@@ -258,11 +265,14 @@ contains
 
   ! One record of series.h5, and the statistics' share of it: only the records on the series_every
   ! grid enter the statistics (a restart then adds exactly the records an uninterrupted run would).
-  subroutine record(out, step, time)
+  subroutine record(out, step, time, local, id, own, total)
     type(run_output_t), intent(inout) :: out
     integer, intent(in) :: step
     real(dp), intent(in) :: time
-    call series_columns(out, step, time)
+    type(particles_t), intent(in), optional :: local
+    integer, intent(in), optional :: id(:), total
+    logical, intent(in), optional :: own(:)
+    call series_columns(out, step, time, local, id, own, total)
     call series_record(out%series)
     if (associated(out%parts) .and. associated(out%rheology)) then
       if (mod(step, out%cfg%output%series_every) == 0) call rheo_accumulate(out%rheology, step)
@@ -272,12 +282,16 @@ contains
   ! The columns of series.h5 in the file's order: the name and the value of each (the value's shape
   ! is the column's). Called once before series_open, which makes these calls the declaration of
   ! the columns, then for every record, so the header and the records cannot differ.
-  subroutine series_columns(out, step, time)
+  subroutine series_columns(out, step, time, local, id, own, total)
     type(run_output_t), intent(inout) :: out
     integer, intent(in) :: step
     real(dp), intent(in) :: time
+    type(particles_t), intent(in), optional :: local
+    integer, intent(in), optional :: id(:), total
+    logical, intent(in), optional :: own(:)
     real(dp) :: err_vel, err_p_max, err_p_rms
-    integer, allocatable :: owned(:)
+    integer, allocatable :: owned(:), rows(:)
+    integer :: q
     PetscErrorCode :: ierr
     call series_column(out%series, 'step', step)
     call series_column(out%series, 'time', time)
@@ -297,11 +311,21 @@ contains
     end if
     if (.not. associated(out%parts)) return
     ! the per-sphere columns: each rank gives the rows of the spheres it owns (as for the particle
-    ! files), the series writes them collectively (mod_series)
-    owned = owned_spheres(out%state%owned_spheres, out%parts, out%cfg%domain%box)
-    call series_add(out%series, particles_columns(out%parts, owned))
-    if (associated(out%lubrication)) call series_add(out%series, particle_lubrication_columns(out%lubrication, owned))
-    if (associated(out%contacts)) call series_add(out%series, particle_contacts_columns(out%contacts, owned))
+    ! files), the series writes them collectively (mod_series); from a local set, its own spheres
+    ! with their global indices
+    if (present(local)) then
+      owned = pack([(q, q = 1, local%n)], own)
+      rows = id(owned)
+      call series_add(out%series, particles_columns(local, owned, rows, total))
+      if (associated(out%lubrication)) call series_add(out%series, &
+        particle_lubrication_columns(out%lubrication, owned, rows, total))
+      if (associated(out%contacts)) call series_add(out%series, particle_contacts_columns(out%contacts, owned, rows, total))
+    else
+      owned = owned_spheres(out%state%owned_spheres, out%parts, out%cfg%domain%box)
+      call series_add(out%series, particles_columns(out%parts, owned))
+      if (associated(out%lubrication)) call series_add(out%series, particle_lubrication_columns(out%lubrication, owned))
+      if (associated(out%contacts)) call series_add(out%series, particle_contacts_columns(out%contacts, owned))
+    end if
     if (associated(out%rheology)) then
       call series_add(out%series, rheo_columns(out%rheology))
       if (associated(out%contacts)) call series_column(out%series, 'contact_overlap_over_roughness', &

@@ -343,19 +343,28 @@ contains
 
   !> The contacts' columns of the series: open and sliding contacts, the largest overlap, and the
   !> contact force, torque and stresslet on each sphere (doc/INPUT.md "&contact").
-  function particle_contacts_columns(pc, owned) result(c)
+  function particle_contacts_columns(pc, owned, rows, total) result(c)
     type(particle_contacts_t), intent(in) :: pc
     integer, intent(in) :: owned(:)           ! the spheres whose rows this rank gives (mod_columns)
+    ! (a rank's local set: the global indices of owned and the number of all spheres; absent, the
+    ! contacts are set for every sphere and owned are global indices)
+    integer, intent(in), optional :: rows(:), total
     type(column_t), allocatable :: c(:)
+    integer, allocatable :: r(:)
+    integer :: n
+    r = owned
+    n = size(pc%force, 2)
+    if (present(rows)) r = rows
+    if (present(total)) n = total
     ! element by element: an array constructor of column_t leaks their values (gfortran 12)
     allocate(c(merge(8, 7, .not. pc%periodic(2))))
     c(1) = column('contacts_pair', pc%stats%pair_contacts)
     c(2) = column('contacts_wall', pc%stats%wall_contacts)
     c(3) = column('contacts_sliding', pc%stats%sliding)
     c(4) = column('contact_max_overlap', pc%max_overlap)
-    c(5) = sphere_column('particles/force_contact', size(pc%force, 2), owned, pc%force(:, owned))
-    c(6) = sphere_column('particles/torque_contact', size(pc%torque, 2), owned, pc%torque(:, owned))
-    c(7) = sphere_column('particles/stresslet_contact', size(pc%stresslet, 3), owned, pc%stresslet(:, :, owned))
+    c(5) = sphere_column('particles/force_contact', n, r, pc%force(:, owned))
+    c(6) = sphere_column('particles/torque_contact', n, r, pc%torque(:, owned))
+    c(7) = sphere_column('particles/stresslet_contact', n, r, pc%stresslet(:, :, owned))
     ! between walls: the force of the lower and the upper wall on the spheres (3 x 2)
     if (.not. pc%periodic(2)) c(8) = column('wall_force_contact', pc%wall_force)
   end function particle_contacts_columns

@@ -624,17 +624,26 @@ contains
 
   ! The lubrication's columns of the series: links within the outer cut-off, the smallest gap among
   ! the candidates, and the correction's force and torque on each sphere (doc/INPUT.md "&lubrication").
-  function particle_lubrication_columns(pl, owned) result(c)
+  function particle_lubrication_columns(pl, owned, rows, total) result(c)
     type(particle_lubrication_t), intent(in) :: pl
     integer, intent(in) :: owned(:)           ! the spheres whose rows this rank gives (mod_columns)
+    ! (a rank's local set: the global indices of owned and the number of all spheres; absent, the
+    ! links are set for every sphere and owned are global indices)
+    integer, intent(in), optional :: rows(:), total
     type(column_t), allocatable :: c(:)
+    integer, allocatable :: r(:)
+    integer :: n
+    r = owned
+    n = size(pl%force, 2)
+    if (present(rows)) r = rows
+    if (present(total)) n = total
     ! element by element: an array constructor of column_t leaks their values (gfortran 12)
     allocate(c(merge(6, 5, pl%walls)))
     c(1) = column('lubrication_pairs', pl%npairs_total)
     c(2) = column('lubrication_walls', pl%nwalls_total)
     c(3) = column('min_gap', pl%min_gap)
-    c(4) = sphere_column('particles/force_lubrication', size(pl%force, 2), owned, pl%force(:, owned))
-    c(5) = sphere_column('particles/torque_lubrication', size(pl%torque, 2), owned, pl%torque(:, owned))
+    c(4) = sphere_column('particles/force_lubrication', n, r, pl%force(:, owned))
+    c(5) = sphere_column('particles/torque_lubrication', n, r, pl%torque(:, owned))
     ! between walls: the force of the lower and the upper wall on the spheres (3 x 2)
     if (pl%walls) c(6) = column('wall_force_lubrication', pl%wall_force)
   end function particle_lubrication_columns

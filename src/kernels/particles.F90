@@ -186,18 +186,27 @@ contains
 
   ! The spheres' columns of the series: their state after the step and the hydrodynamic force, torque
   ! and stresslet of the fluid on them (doc/INPUT.md "&particles").
-  function particles_columns(p, owned) result(c)
+  function particles_columns(p, owned, rows, total) result(c)
     type(particles_t), intent(in) :: p
-    integer, intent(in) :: owned(:)           ! the spheres whose rows this rank gives (mod_columns)
+    integer, intent(in) :: owned(:)           ! the spheres of p whose rows this rank gives (mod_columns)
+    ! (a rank's local set, mod_ld_local: the global indices of owned and the number of all spheres;
+    ! absent, p holds every sphere and owned are global indices)
+    integer, intent(in), optional :: rows(:), total
     type(column_t), allocatable :: c(:)
+    integer, allocatable :: r(:)
+    integer :: n
+    r = owned
+    n = p%n
+    if (present(rows)) r = rows
+    if (present(total)) n = total
     ! element by element: an array constructor of column_t leaks their values (gfortran 12)
     allocate(c(6))
-    c(1) = sphere_column('particles/position', p%n, owned, p%position(:, owned))
-    c(2) = sphere_column('particles/velocity', p%n, owned, p%velocity(:, owned))
-    c(3) = sphere_column('particles/omega', p%n, owned, p%omega(:, owned))
-    c(4) = sphere_column('particles/force_hydro', p%n, owned, p%force_hydro(:, owned))
-    c(5) = sphere_column('particles/torque_hydro', p%n, owned, p%torque_hydro(:, owned))
-    c(6) = sphere_column('particles/stresslet_hydro', p%n, owned, p%stresslet_hydro(:, :, owned))
+    c(1) = sphere_column('particles/position', n, r, p%position(:, owned))
+    c(2) = sphere_column('particles/velocity', n, r, p%velocity(:, owned))
+    c(3) = sphere_column('particles/omega', n, r, p%omega(:, owned))
+    c(4) = sphere_column('particles/force_hydro', n, r, p%force_hydro(:, owned))
+    c(5) = sphere_column('particles/torque_hydro', n, r, p%torque_hydro(:, owned))
+    c(6) = sphere_column('particles/stresslet_hydro', n, r, p%stresslet_hydro(:, :, owned))
   end function particles_columns
 
 end module mod_particles

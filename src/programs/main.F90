@@ -43,9 +43,9 @@ program fdsusp
   use mod_sphere_ownership, only: sphere_ownership_mine
   use mod_checkpoint, only: checkpoint_state_t, checkpoint_check, checkpoint_read
   use mod_time_step, only: time_step_t, time_step_create, time_step_advance, time_step_guard, time_step_report, &
-                           time_step_complete_view
+                           time_step_complete_view, time_step_local_state
   use mod_run_output, only: run_output_t, run_output_open, run_output_step, run_output_checkpoint, &
-                            run_output_fail, run_output_close, run_output_reads_spheres
+                            run_output_fail, run_output_close, run_output_reads_view
   implicit none
 
   PetscErrorCode :: ierr
@@ -212,8 +212,9 @@ program fdsusp
   stop_reason = RUN_GOES_ON
   if (step >= cfg%time%steps) stop_reason = RUN_DONE
   do while (stop_reason == RUN_GOES_ON)
-    ! (a step on the ranks' local sets gathers the spheres' results only when the output reads them)
-    ts%complete_view = run_output_reads_spheres(out, step + 1)
+    ! (a step on the ranks' local sets brings the replicated particle state up to date only for the
+    ! output that reads it; a series record takes the local sets)
+    ts%complete_view = run_output_reads_view(out, step + 1)
     PetscCallA(time_step_advance(ts, step, ierr))
     if (len_trim(ts%failure) > 0) then
       PetscCallA(time_step_complete_view(ts, ierr))
@@ -221,7 +222,14 @@ program fdsusp
     end if
     step = step + 1
     time = time + cfg%time%dt
-    PetscCallA(run_output_step(out, step, time, ierr))
+    if (time_step_local_state(ts)) then
+      ! (the series takes the own spheres of the ranks' local sets, the state of the step)
+      associate(local => ts%local)
+        PetscCallA(run_output_step(out, step, time, ierr, local%set, local%halo%id, local%halo%is_owned, local%total))
+      end associate
+    else
+      PetscCallA(run_output_step(out, step, time, ierr))
+    end if
     ! the runtime guard: a non-finite or escaped state stops the run with a diagnostic
     PetscCallA(time_step_guard(ts, step, ierr))
     if (len_trim(ts%failure) > 0) then
