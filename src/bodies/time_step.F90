@@ -20,7 +20,7 @@ module mod_time_step
   use mod_grid, only: grid_t
   use mod_fluid, only: fluid_t, fluid_step, fluid_mean_profile, fluid_add_response, fluid_set_sliding
   use mod_timers, only: stage_push, stage_pop, STAGE_FLUID, STAGE_PARTICLES, STAGE_CONTACTS, STAGE_LUBRICATION
-  use mod_particles, only: particles_t, advance_positions, displacements, MOTION_FREE, MOTION_FROZEN
+  use mod_particles, only: particles_t, sphere_share_t, advance_positions, displacements, MOTION_FREE, MOTION_FROZEN
   use mod_particle_contacts, only: particle_contacts_t, particle_contacts_step
   use mod_particle_lubrication, only: particle_lubrication_t
   use mod_rheology, only: rheology_t, rheo_sample, rheo_sample_flow, rheo_reach
@@ -41,7 +41,7 @@ module mod_time_step
   implicit none
   private
   public :: time_step_t, time_step_create, time_step_advance, time_step_guard, time_step_report, &
-            time_step_complete_view, time_step_local_state
+            time_step_complete_view, time_step_share
 
   ! the variants
   integer, parameter :: TIME_STEP_FLUID = 1       ! the fluid alone (no spheres)
@@ -81,11 +81,9 @@ module mod_time_step
     real(dp), allocatable :: mean_flow(:)          ! x-z plane means of u per cell row (statistics)
     real(dp), allocatable :: position_before(:, :) ! X^n, then X^{n+1} - X^n
     ! lubrication dynamics on more than one rank: each rank's own spheres and ghosts (mod_ld_local),
-    ! the state between steps; complete_view: the next step brings parts, the contacts and the links
-    ! up to date at its end (the caller's output reads them after it), else they wait for a step
-    ! that does or for time_step_complete_view
+    ! the state between steps, which the output takes (time_step_share); parts, the contacts and
+    ! the links are brought up to date with it only for a failure (time_step_complete_view)
     type(ld_local_t) :: local
-    logical :: complete_view = .true.
   end type time_step_t
 
 contains
@@ -313,9 +311,6 @@ contains
           call le_wrap(le, parts%position, parts%velocity, parts%velocity_prev)
         end if
       end if
-      if (local .and. ts%complete_view) then
-        PetscCall(ld_local_complete_view(ts%local, parts, ierr, ts%contacts, ts%lubrication))
-      end if
       if (ts%variant == TIME_STEP_RESOLVED) then
         if (ts%carry_lambda) then
           ! (with Lees-Edwards the carry finds the displacement of each sphere and image itself)
@@ -413,17 +408,25 @@ contains
     call impose_rate(ts)
   end subroutine take_stress_rate
 
-  ! Whether the state of the run is the ranks' local sets (ts%local: lubrication dynamics on several
-  ! ranks) and ts%parts, the contacts and the links are not up to date with it: the output of this
-  ! step then takes the own spheres of the local sets (the contacts and the links are set for them).
-  pure logical function time_step_local_state(ts)
-    type(time_step_t), intent(in) :: ts
-    time_step_local_state = ts%local%live .and. .not. ts%local%view_current
-  end function time_step_local_state
+  ! This rank's share of the spheres when the state of the run is the ranks' local sets
+  ! (lubrication dynamics on several ranks) and ts%parts, the contacts and the links are not up to
+  ! date with it (shared): the output then takes the share, and the contacts and the links as they
+  ! are, set for it. share%set points into ts (a target).
+  subroutine time_step_share(ts, share, shared)
+    type(time_step_t), target, intent(in) :: ts
+    type(sphere_share_t), intent(out) :: share
+    logical, intent(out) :: shared
+    shared = ts%local%live .and. .not. ts%local%view_current
+    if (.not. shared) return
+    share%set => ts%local%set
+    share%id = ts%local%halo%id
+    share%own = ts%local%halo%is_owned
+    share%total = ts%local%total
+  end subroutine time_step_share
 
   ! ts%parts, the contacts and the links brought up to date from the ranks' local sets (positions,
-  ! velocities, springs, the last step's results), for output outside its cadence (a failure, the
-  ! end of the run); nothing when they are (or the step is replicated). Collective.
+  ! velocities, springs, the last step's results), for the state a failure writes; nothing when
+  ! they are (or the step is replicated). Collective.
   subroutine time_step_complete_view(ts, ierr)
     type(time_step_t), intent(inout) :: ts
     PetscErrorCode, intent(out) :: ierr

@@ -54,11 +54,11 @@ module mod_checkpoint
   use mod_file_services, only: require_free_space, write_failure_cause, errno_text, remove_file, directory_of
   use mod_errors, only: is_root, abort_run, abort_if_any, file_error_from_root, input_error, log_line
   use mod_restart_deck, only: deck_record, deck_compare
-  use mod_particles, only: particles_t
+  use mod_particles, only: particles_t, sphere_share_t
   use mod_particles_io, only: particles_write, particles_read_state, owned_spheres, owned_spheres_rule
   use mod_h5_parallel, only: h5_parallel_create, h5_parallel_open, h5_parallel_close
   use mod_contact, only: contact_history_t
-  use mod_contacts_io, only: contacts_write, contacts_read
+  use mod_contacts_io, only: contacts_write, contacts_read, contacts_gather
   use mod_rheology, only: rheology_t, rheo_state, rheo_restore
   use mod_shear_protocol, only: shear_protocol_t, shear_protocol_state, shear_protocol_restore, shear_protocol_varies, &
                                 PROTOCOL_STATE_SIZE
@@ -87,14 +87,19 @@ module mod_checkpoint
 
 contains
 
-  ! The checkpoint of STATE at step and time, published as PATH once whole.
-  subroutine checkpoint_write(path, cfg, state, step, time, ierr)
+  ! The checkpoint of STATE at step and time, published as PATH once whole. share (lubrication
+  ! dynamics on several ranks, mod_ld_local): the spheres are each rank's local set, not
+  ! state%parts, and state%history holds the springs of its own spheres' pairs; the file is the
+  ! same.
+  subroutine checkpoint_write(path, cfg, state, step, time, ierr, share)
     character(len=*), intent(in) :: path
     type(config_t), intent(in) :: cfg
     type(checkpoint_state_t), intent(in) :: state
     integer, intent(in) :: step
     real(dp), intent(in) :: time
     PetscErrorCode, intent(out) :: ierr
+    type(sphere_share_t), intent(in), optional :: share
+    type(contact_history_t) :: every_spring
     PetscViewer :: viewer
     integer(HID_T) :: file, group
     integer :: err, k, stars, unsigned
@@ -150,9 +155,16 @@ contains
       if (err /= 0) call write_failed_everywhere('cannot be created')
     end if
     if (associated(state%parts)) then
-      call particles_write(file, state%parts, cfg%domain%box, .true., &
-                           owned_spheres(state%owned_spheres, state%parts, cfg%domain%box), message)
+      if (present(share)) then
+        call particles_write(file, state%parts, cfg%domain%box, .true., [integer ::], message, share)
+      else
+        call particles_write(file, state%parts, cfg%domain%box, .true., &
+                             owned_spheres(state%owned_spheres, state%parts, cfg%domain%box), message)
+      end if
       if (len_trim(message) > 0) call write_failed_everywhere(trim(message))
+      ! (rank 0 writes the springs below: from a share, every rank's gathered to it first)
+      if (associated(state%history) .and. present(share)) &
+        call contacts_gather(state%history, share%id, share%own, share%total, every_spring)
     end if
     ! the fields' checksums, each rank reading a share of their rows (no rank holds a field)
     unsigned = 0
@@ -198,7 +210,13 @@ contains
       end if
       failed = failed .or. err /= 0
       if (associated(state%parts)) then
-        if (associated(state%history)) call contacts_write(file, state%history, state%parts%n)
+        if (associated(state%history)) then
+          if (present(share)) then
+            call contacts_write(file, every_spring, state%parts%n)
+          else
+            call contacts_write(file, state%history, state%parts%n)
+          end if
+        end if
       end if
       if (associated(state%rh)) then
         call put_int('rheology_window', [state%rh%discard_step, state%rh%block_steps])

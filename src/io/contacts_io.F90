@@ -2,8 +2,9 @@
 ! with attributes np (particle count) and count (open contacts with a spring), and, when
 ! count > 0, the datasets ids (count x 2 integers as seen from C/Python: owner, partner; partner
 ! -1 / -2 is the lower / upper wall) and spring (count x 3 doubles: Upsilon in units of a), in
-! the canonical order of history_pack. Written by rank 0 into the open checkpoint; read by rank 0
-! and broadcast, every rank then unpacks the same history.
+! the canonical order of history_pack. Written by rank 0 into the open checkpoint (when each rank
+! holds the springs of its own spheres' pairs, contacts_gather first collects them on rank 0); read
+! by rank 0 and broadcast, every rank then unpacks the same history.
 #include <petsc/finclude/petscsys.h>
 module mod_contacts_io
   use hdf5
@@ -14,7 +15,7 @@ module mod_contacts_io
   use mod_errors, only: is_root, file_error, file_error_from_root, abort_run, warn_line
   implicit none
   private
-  public :: contacts_write, contacts_read
+  public :: contacts_write, contacts_read, contacts_gather
 
 contains
 
@@ -44,6 +45,66 @@ contains
     end if
     call h5gclose_f(group, err)
   end subroutine contacts_write
+
+  ! The history of every pair on rank 0 (all), from h on each rank holding the springs of the pairs
+  ! with one of its own spheres (a rank's local set, mod_ld_local: the global indices id of its
+  ! spheres, ascending, which of them are its own, total spheres): each pair from the owner of its
+  ! first sphere, so each once. Other ranks' all is empty. Collective (one gather to rank 0, 5
+  ! values a spring).
+  subroutine contacts_gather(h, id, own, total, all)
+    type(contact_history_t), intent(in) :: h
+    integer, intent(in) :: id(:), total
+    logical, intent(in) :: own(:)
+    type(contact_history_t), intent(inout) :: all
+    integer, allocatable :: keys(:, :), counts(:), displs(:)
+    real(dp), allocatable :: ups(:, :), mine(:, :), every(:, :)
+    integer :: n, np, k, i, r, ranks, rank, info, ierr
+    n = history_size(h)
+    allocate(keys(2, n), ups(3, n), mine(5, n))
+    if (n > 0) call history_pack(h, np, keys, ups)
+    k = 0
+    do i = 1, n
+      if (.not. owned(keys(1, i))) cycle
+      k = k + 1
+      mine(:, k) = [real(keys(:, i), dp), ups(:, i)]
+    end do
+    call MPI_Comm_size(PETSC_COMM_WORLD, ranks, ierr)
+    call MPI_Comm_rank(PETSC_COMM_WORLD, rank, ierr)
+    allocate(counts(ranks), displs(ranks))
+    call MPI_Gather(5 * k, 1, MPI_INTEGER, counts, 1, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
+    displs(1) = 0
+    do r = 2, ranks
+      displs(r) = displs(r - 1) + counts(r - 1)
+    end do
+    allocate(every(5, merge(sum(counts) / 5, 0, rank == 0)))
+    call MPI_Gatherv(mine, 5 * k, MPI_DOUBLE_PRECISION, every, counts, displs, MPI_DOUBLE_PRECISION, 0, &
+                     PETSC_COMM_WORLD, ierr)
+    call history_clear(all)
+    if (rank /= 0) return
+    call history_unpack(all, total, size(every, 2), nint(every(1:2, :)), every(3:5, :), info)
+    if (info /= 0) call abort_run('internal error: the springs gathered from the ranks do not form a '// &
+                                  'contact history (mod_contacts_io)')
+  contains
+    ! Whether the sphere of global index g is one of this rank's own (a bisection of id).
+    pure logical function owned(g)
+      integer, intent(in) :: g
+      integer :: lo, hi, mid
+      owned = .false.
+      lo = 1
+      hi = size(id)
+      do while (lo <= hi)
+        mid = (lo + hi) / 2
+        if (id(mid) == g) then
+          owned = own(mid)
+          return
+        else if (id(mid) < g) then
+          lo = mid + 1
+        else
+          hi = mid - 1
+        end if
+      end do
+    end function owned
+  end subroutine contacts_gather
 
   ! Restart: the history from the checkpoint PATH (collective). np: the particle count of the
   ! run. A checkpoint without /contacts (written by a run without contacts) gives an empty

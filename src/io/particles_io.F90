@@ -11,7 +11,7 @@ module mod_particles_io
   use petscsys
   use mod_kinds, only: dp
   use mod_params, only: config_t
-  use mod_particles, only: particles_t, particles_init, motion_code, configuration_fault
+  use mod_particles, only: particles_t, sphere_share_t, particles_init, motion_code, configuration_fault
   use mod_h5util, only: read_values, write_attribute, read_attribute, has_object, read_dataset, dataset_dims
   use mod_h5_parallel, only: h5_parallel_create, h5_parallel_close, h5_parallel_write_columns, h5_parallel_agree
   use mod_errors, only: is_root, input_error, file_error, file_error_from_root, abort_run, abort_if_any
@@ -190,57 +190,77 @@ contains
   ! needs. Collective: every rank makes the same metadata calls (the group, the datasets and
   ! their attributes, with the replicated values), and each writes the columns of the spheres
   ! OWNED (global indices, unique over the ranks: owned_spheres) in one collective transfer per
-  ! dataset. message: '' or what failed, the same on every rank.
-  subroutine particles_write(file, parts, box, state, owned, message)
+  ! dataset; share (a rank's local set): its own spheres instead, under their global indices.
+  ! message: '' or what failed, the same on every rank.
+  subroutine particles_write(file, parts, box, state, owned, message, share)
     integer(HID_T), intent(in) :: file
     type(particles_t), intent(in) :: parts
     real(dp), intent(in) :: box(3)
     logical, intent(in) :: state
     integer, intent(in) :: owned(:)
     character(len=*), intent(out) :: message
-    integer(HID_T) :: group, dset
-    integer :: err, e, attributes
-    message = ''
-    call check_partition(owned, parts%n)
-    call h5gcreate_f(file, 'particles', group, err)
-    call h5_parallel_agree(err)
-    if (err /= 0) then
-      message = 'cannot take the group /particles'
-      return
+    type(sphere_share_t), intent(in), optional :: share
+    integer, allocatable :: slots(:)
+    integer :: i
+    if (present(share)) then
+      slots = pack([(i, i = 1, share%set%n)], share%own)
+      call write_group(share%set, slots, share%id(slots), share%total)
+    else
+      call write_group(parts, owned, owned, parts%n)
     end if
-    ! the attributes' failures, agreed once at the end (they are metadata, which every rank
-    ! writes alike in its cache and rank 0 writes to the file)
-    attributes = 0
-    call particle_columns(group, 'position', parts%position(:, owned), parts%n, owned, message)
-    if (len_trim(message) == 0) then
-      call h5dopen_f(group, 'position', dset, err)
-      attributes = max(attributes, abs(err))
-      if (err == 0) then
-        call write_attribute(dset, 'box', box, e)
-        attributes = max(attributes, abs(e))
-        call h5dclose_f(dset, e)
+  contains
+    ! The group from the spheres slots of p, rows (global indices) of n.
+    subroutine write_group(p, slots, rows, n)
+      type(particles_t), intent(in) :: p
+      integer, intent(in) :: slots(:), rows(:), n
+      integer(HID_T) :: group, dset
+      integer :: err, e, attributes, mixture
+      PetscErrorCode :: ierr
+      message = ''
+      call check_partition(rows, n)
+      call h5gcreate_f(file, 'particles', group, err)
+      call h5_parallel_agree(err)
+      if (err /= 0) then
+        message = 'cannot take the group /particles'
+        return
       end if
-      call write_attribute(group, 'box', box, e)
-      attributes = max(attributes, abs(e))
-      call write_attribute(group, 'radius', [parts%radius], e)
-      attributes = max(attributes, abs(e))
-    end if
-    if (state .and. len_trim(message) == 0) then
-      call particle_columns(group, 'velocity', parts%velocity(:, owned), parts%n, owned, message)
-      call particle_columns(group, 'omega', parts%omega(:, owned), parts%n, owned, message)
-      call particle_columns(group, 'velocity_prev', parts%velocity_prev(:, owned), parts%n, owned, message)
-      call write_attribute(group, 'have_prev', [merge(1, 0, parts%have_prev)], e)
-      attributes = max(attributes, abs(e))
-      call write_attribute(group, 'motion', [parts%motion], e)
-      attributes = max(attributes, abs(e))
-      ! a mixture's radii, which a restart checks against its deck's (equal spheres: the attribute)
-      if (any(parts%radii /= parts%radius)) &
-        call particle_columns(group, 'radius', reshape(parts%radii(owned), [1, size(owned)]), parts%n, owned, message)
-    end if
-    call h5gclose_f(group, err)
-    attributes = max(attributes, abs(err))
-    call h5_parallel_agree(attributes)
-    if (attributes /= 0 .and. len_trim(message) == 0) message = 'cannot take the attributes of /particles'
+      ! the attributes' failures, agreed once at the end (they are metadata, which every rank
+      ! writes alike in its cache and rank 0 writes to the file)
+      attributes = 0
+      call particle_columns(group, 'position', p%position(:, slots), n, rows, message)
+      if (len_trim(message) == 0) then
+        call h5dopen_f(group, 'position', dset, err)
+        attributes = max(attributes, abs(err))
+        if (err == 0) then
+          call write_attribute(dset, 'box', box, e)
+          attributes = max(attributes, abs(e))
+          call h5dclose_f(dset, e)
+        end if
+        call write_attribute(group, 'box', box, e)
+        attributes = max(attributes, abs(e))
+        call write_attribute(group, 'radius', [p%radius], e)
+        attributes = max(attributes, abs(e))
+      end if
+      if (state .and. len_trim(message) == 0) then
+        call particle_columns(group, 'velocity', p%velocity(:, slots), n, rows, message)
+        call particle_columns(group, 'omega', p%omega(:, slots), n, rows, message)
+        call particle_columns(group, 'velocity_prev', p%velocity_prev(:, slots), n, rows, message)
+        call write_attribute(group, 'have_prev', [merge(1, 0, p%have_prev)], e)
+        attributes = max(attributes, abs(e))
+        call write_attribute(group, 'motion', [p%motion], e)
+        attributes = max(attributes, abs(e))
+        ! a mixture's radii, which a restart checks against its deck's (equal spheres: the
+        ! attribute); every rank must take the same branch (a share may hold one species only)
+        mixture = merge(1, 0, any(p%radii(slots) /= p%radius))
+        call MPI_Allreduce(MPI_IN_PLACE, mixture, 1, MPI_INTEGER, MPI_MAX, PETSC_COMM_WORLD, ierr)
+        if (mixture > 0) &
+          call particle_columns(group, 'radius', reshape(p%radii(slots), [1, size(slots)]), n, rows, message)
+      end if
+      call h5gclose_f(group, err)
+      attributes = max(attributes, abs(err))
+      call h5_parallel_agree(attributes)
+      if (attributes /= 0 .and. len_trim(message) == 0) message = 'cannot take the attributes of /particles'
+    end subroutine write_group
   end subroutine particles_write
 
   ! The dataset /particles/NAME (k, n) from this rank's columns VALUES of the spheres OWNED, unless
@@ -299,21 +319,23 @@ contains
 
   ! A particle snapshot for viewing: OUTDIR/particles_NNNNNNNN.h5 (/particles: position,
   ! velocity, omega, and radius per sphere for glyph scaling), written by every rank, each the
-  ! spheres OWNED (owned_spheres), and OUTDIR/particles.xmf, the XDMF time series of the snapshots
-  ! written so far by this run (ParaView: open it, apply Glyph Sphere scaled by radius), written by
-  ! rank 0. Collective.
-  subroutine particles_snapshot(outdir, parts, box, step, time, owned)
+  ! spheres OWNED (owned_spheres; share, a rank's local set: its own spheres instead), and
+  ! OUTDIR/particles.xmf, the XDMF time series of the snapshots written so far by this run
+  ! (ParaView: open it, apply Glyph Sphere scaled by radius), written by rank 0. Collective.
+  subroutine particles_snapshot(outdir, parts, box, step, time, owned, share)
     character(len=*), intent(in) :: outdir
     type(particles_t), intent(in) :: parts
     real(dp), intent(in) :: box(3)
     integer, intent(in) :: step
     real(dp), intent(in) :: time
     integer, intent(in) :: owned(:)
+    type(sphere_share_t), intent(in), optional :: share
     integer, save :: nsnap = 0
     integer, allocatable, save :: steps(:)
     real(dp), allocatable, save :: times(:)
     integer(HID_T) :: file, group
     integer :: err, unit, k
+    integer, allocatable :: slots(:)
     character(len=32) :: h5
     character(len=64) :: dims
     character(len=1100) :: path
@@ -332,15 +354,13 @@ contains
     call require_free_space(outdir, 8.0_dp * 10 * parts%n, trim(path)//'.tmp')
     call h5_parallel_create(trim(path)//'.tmp', file, err)
     if (err /= 0) call write_failed_everywhere(path, 'cannot be created')
-    call particles_write(file, parts, box, .false., owned, message)
-    if (len_trim(message) == 0) then
-      call h5gopen_f(file, 'particles', group, err)
-      call h5_parallel_agree(err)
-      if (err /= 0) message = 'cannot take /particles'
-      call particle_columns(group, 'velocity', parts%velocity(:, owned), parts%n, owned, message)
-      call particle_columns(group, 'omega', parts%omega(:, owned), parts%n, owned, message)
-      call particle_columns(group, 'radius', reshape(parts%radii(owned), [1, size(owned)]), parts%n, owned, message)
-      if (err == 0) call h5gclose_f(group, err)
+    if (present(share)) then
+      slots = pack([(k, k = 1, share%set%n)], share%own)
+      call particles_write(file, parts, box, .false., owned, message, share)
+      if (len_trim(message) == 0) call more_columns(share%set, slots, share%id(slots))
+    else
+      call particles_write(file, parts, box, .false., owned, message)
+      if (len_trim(message) == 0) call more_columns(parts, owned, owned)
     end if
     if (len_trim(message) > 0) call write_failed_everywhere(path, trim(message))
     call h5_parallel_close(file, err)
@@ -391,6 +411,19 @@ contains
             '     <DataItem Dimensions="'//trim(shape)//'" NumberType="Float" Precision="8" Format="HDF">'// &
             trim(h5)//':/particles/'//name//'</DataItem>'//nl//'    </Attribute>'//nl
     end subroutine attribute
+
+    ! velocity, omega and radius of the spheres slots of p, rows (global indices) of parts%n
+    subroutine more_columns(p, slots, rows)
+      type(particles_t), intent(in) :: p
+      integer, intent(in) :: slots(:), rows(:)
+      call h5gopen_f(file, 'particles', group, err)
+      call h5_parallel_agree(err)
+      if (err /= 0) message = 'cannot take /particles'
+      call particle_columns(group, 'velocity', p%velocity(:, slots), parts%n, rows, message)
+      call particle_columns(group, 'omega', p%omega(:, slots), parts%n, rows, message)
+      call particle_columns(group, 'radius', reshape(p%radii(slots), [1, size(slots)]), parts%n, rows, message)
+      if (err == 0) call h5gclose_f(group, err)
+    end subroutine more_columns
   end subroutine particles_snapshot
 
   ! A write of a particle file failed: stop the run naming the file and the cause.

@@ -19,7 +19,7 @@ module mod_run_output
                         series_close, series_attributes
   use mod_output, only: write_fields, progress_line
   use mod_checkpoint, only: checkpoint_state_t, checkpoint_write
-  use mod_particles, only: particles_t, particles_columns
+  use mod_particles, only: particles_t, sphere_share_t, particles_columns
   use mod_particles_io, only: particles_snapshot, owned_spheres
   use mod_particle_contacts, only: particle_contacts_t, particle_contacts_columns
   use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_columns
@@ -30,8 +30,7 @@ module mod_run_output
   use mod_shear_protocol, only: shear_protocol_columns, shear_protocol_varies
   implicit none
   private
-  public :: run_output_t, run_output_open, run_output_step, run_output_checkpoint, run_output_fail, run_output_close, &
-            run_output_reads_view
+  public :: run_output_t, run_output_open, run_output_step, run_output_checkpoint, run_output_fail, run_output_close
 
   type :: run_output_t
     type(config_t) :: cfg
@@ -145,38 +144,22 @@ contains
     write(s, '(a,i0)') name, k
   end function species_attribute
 
-  !> Whether the output of step reads every sphere from the replicated particle state (a particle
-  !> snapshot, a checkpoint), so that a step on the ranks' local sets brings it up to date
-  !> (mod_time_step complete_view); a series record takes the own spheres of the local sets.
-  pure logical function run_output_reads_view(out, step) result(reads)
-    type(run_output_t), intent(in) :: out
-    integer, intent(in) :: step
-    reads = .false.
-    associate(schedule => out%cfg%output)
-      if (schedule%particles_every > 0) reads = reads .or. mod(step, schedule%particles_every) == 0
-      if (schedule%checkpoint_every > 0) reads = reads .or. mod(step, schedule%checkpoint_every) == 0
-    end associate
-  end function run_output_reads_view
-
-  ! The output of step (time), on the deck's &output cadences. local: this rank's local set of
-  ! lubrication dynamics (mod_ld_local: its spheres' global indices id, which are its own, and
-  ! the number of all spheres total), which a series record reads while the replicated particle
-  ! state is not up to date (the snapshots and checkpoints read that one, run_output_reads_view);
-  ! the run's contacts and links are then set for the local set.
-  subroutine run_output_step(out, step, time, ierr, local, id, own, total)
+  ! The output of step (time), on the deck's &output cadences. share: this rank's share of the
+  ! spheres (the local set of lubrication dynamics on several ranks, mod_ld_local), the state of the
+  ! step, which the series record, the snapshot and the checkpoint then take instead of the
+  ! replicated particles (and the contacts and the links are set for it).
+  subroutine run_output_step(out, step, time, ierr, share)
     type(run_output_t), intent(inout) :: out
     integer, intent(in) :: step
     real(dp), intent(in) :: time
     PetscErrorCode, intent(out) :: ierr
-    type(particles_t), intent(in), optional :: local
-    integer, intent(in), optional :: id(:), total
-    logical, intent(in), optional :: own(:)
+    type(sphere_share_t), intent(in), optional :: share
     real(dp) :: wall_now, wall_per_step
     ierr = 0
     associate(schedule => out%cfg%output)
       PetscCall(stage_push(STAGE_OUTPUT, ierr))
       wall_now = MPI_Wtime() - out%wall_start
-      if (mod(step, schedule%series_every) == 0) call record(out, step, time, local, id, own, total)
+      if (mod(step, schedule%series_every) == 0) call record(out, step, time, share)
       if (mod(step, schedule%progress_every) == 0) then
         wall_per_step = wall_now / (step - out%first_step)
         if (associated(out%fluid)) then
@@ -192,27 +175,40 @@ contains
         end if
       end if
       if (schedule%particles_every > 0 .and. associated(out%parts)) then
-        if (mod(step, schedule%particles_every) == 0) &
-          call particles_snapshot(schedule%directory, out%parts, out%cfg%domain%box, step, time, &
-                                  owned_spheres(out%state%owned_spheres, out%parts, out%cfg%domain%box))
+        if (mod(step, schedule%particles_every) == 0) call snapshot(out, step, time, share)
       end if
       if (schedule%checkpoint_every > 0) then
         if (mod(step, schedule%checkpoint_every) == 0) then
-          PetscCall(run_output_checkpoint(out, step, time, ierr))
+          PetscCall(run_output_checkpoint(out, step, time, ierr, share))
         end if
       end if
       PetscCall(stage_pop(ierr))
     end associate
   end subroutine run_output_step
 
+  ! A particle snapshot of step (time): of the replicated particles, or of the ranks' shares.
+  subroutine snapshot(out, step, time, share)
+    type(run_output_t), intent(inout) :: out
+    integer, intent(in) :: step
+    real(dp), intent(in) :: time
+    type(sphere_share_t), intent(in), optional :: share
+    if (present(share)) then
+      call particles_snapshot(out%cfg%output%directory, out%parts, out%cfg%domain%box, step, time, [integer ::], share)
+    else
+      call particles_snapshot(out%cfg%output%directory, out%parts, out%cfg%domain%box, step, time, &
+                              owned_spheres(out%state%owned_spheres, out%parts, out%cfg%domain%box))
+    end if
+  end subroutine snapshot
+
   ! checkpoint.h5 at step (time), the series flushed first so that it holds every record up to it.
-  subroutine run_output_checkpoint(out, step, time, ierr)
+  subroutine run_output_checkpoint(out, step, time, ierr, share)
     type(run_output_t), intent(inout) :: out
     integer, intent(in) :: step
     real(dp), intent(in) :: time
     PetscErrorCode, intent(out) :: ierr
+    type(sphere_share_t), intent(in), optional :: share
     call series_flush(out%series)
-    PetscCall(checkpoint_write(out%checkpoint_path, out%cfg, out%state, step, time, ierr))
+    PetscCall(checkpoint_write(out%checkpoint_path, out%cfg, out%state, step, time, ierr, share))
   end subroutine run_output_checkpoint
 
   ! The end of a run at step (time): the last record, the series closed, and when steps were taken
@@ -220,25 +216,24 @@ contains
   ! A run restarted at its last step (a batch chain's job after a kill between the last checkpoint
   ! and the end of the last outputs) writes the last fields and particles again: the killed run may
   ! not have published them (the checkpoint it restarts from already is the last one).
-  subroutine run_output_close(out, step, time, ierr)
+  subroutine run_output_close(out, step, time, ierr, share)
     type(run_output_t), intent(inout) :: out
     integer, intent(in) :: step
     real(dp), intent(in) :: time
     PetscErrorCode, intent(out) :: ierr
+    type(sphere_share_t), intent(in), optional :: share
     ierr = 0
     PetscCall(stage_push(STAGE_OUTPUT, ierr))
-    if (step > out%first_step .and. mod(step, out%cfg%output%series_every) /= 0) call record(out, step, time)
+    if (step > out%first_step .and. mod(step, out%cfg%output%series_every) /= 0) call record(out, step, time, share)
     call series_close(out%series)
     if (step > out%first_step .or. out%restarted) then
       if (associated(out%fluid)) then
         PetscCall(write_fields(out%cfg%output%directory, out%grid, out%fluid, step, time, ierr))
       end if
-      if (associated(out%parts)) call particles_snapshot(out%cfg%output%directory, out%parts, out%cfg%domain%box, &
-                                                         step, time, owned_spheres(out%state%owned_spheres, &
-                                                         out%parts, out%cfg%domain%box))
+      if (associated(out%parts)) call snapshot(out, step, time, share)
     end if
     if (step > out%first_step) then
-      PetscCall(run_output_checkpoint(out, step, time, ierr))
+      PetscCall(run_output_checkpoint(out, step, time, ierr, share))
     end if
     if (associated(out%rheology)) call summary(out, step)
     PetscCall(stage_pop(ierr))
@@ -265,14 +260,12 @@ contains
 
   ! One record of series.h5, and the statistics' share of it: only the records on the series_every
   ! grid enter the statistics (a restart then adds exactly the records an uninterrupted run would).
-  subroutine record(out, step, time, local, id, own, total)
+  subroutine record(out, step, time, share)
     type(run_output_t), intent(inout) :: out
     integer, intent(in) :: step
     real(dp), intent(in) :: time
-    type(particles_t), intent(in), optional :: local
-    integer, intent(in), optional :: id(:), total
-    logical, intent(in), optional :: own(:)
-    call series_columns(out, step, time, local, id, own, total)
+    type(sphere_share_t), intent(in), optional :: share
+    call series_columns(out, step, time, share)
     call series_record(out%series)
     if (associated(out%parts) .and. associated(out%rheology)) then
       if (mod(step, out%cfg%output%series_every) == 0) call rheo_accumulate(out%rheology, step)
@@ -282,13 +275,11 @@ contains
   ! The columns of series.h5 in the file's order: the name and the value of each (the value's shape
   ! is the column's). Called once before series_open, which makes these calls the declaration of
   ! the columns, then for every record, so the header and the records cannot differ.
-  subroutine series_columns(out, step, time, local, id, own, total)
+  subroutine series_columns(out, step, time, share)
     type(run_output_t), intent(inout) :: out
     integer, intent(in) :: step
     real(dp), intent(in) :: time
-    type(particles_t), intent(in), optional :: local
-    integer, intent(in), optional :: id(:), total
-    logical, intent(in), optional :: own(:)
+    type(sphere_share_t), intent(in), optional :: share
     real(dp) :: err_vel, err_p_max, err_p_rms
     integer, allocatable :: owned(:), rows(:)
     integer :: q
@@ -313,13 +304,14 @@ contains
     ! the per-sphere columns: each rank gives the rows of the spheres it owns (as for the particle
     ! files), the series writes them collectively (mod_series); from a local set, its own spheres
     ! with their global indices
-    if (present(local)) then
-      owned = pack([(q, q = 1, local%n)], own)
-      rows = id(owned)
-      call series_add(out%series, particles_columns(local, owned, rows, total))
+    if (present(share)) then
+      owned = pack([(q, q = 1, share%set%n)], share%own)
+      rows = share%id(owned)
+      call series_add(out%series, particles_columns(share%set, owned, rows, share%total))
       if (associated(out%lubrication)) call series_add(out%series, &
-        particle_lubrication_columns(out%lubrication, owned, rows, total))
-      if (associated(out%contacts)) call series_add(out%series, particle_contacts_columns(out%contacts, owned, rows, total))
+        particle_lubrication_columns(out%lubrication, owned, rows, share%total))
+      if (associated(out%contacts)) call series_add(out%series, &
+        particle_contacts_columns(out%contacts, owned, rows, share%total))
     else
       owned = owned_spheres(out%state%owned_spheres, out%parts, out%cfg%domain%box)
       call series_add(out%series, particles_columns(out%parts, owned))

@@ -7,7 +7,7 @@ module mod_particles
   use mod_columns, only: column_t, sphere_column
   implicit none
   private
-  public :: particles_t, particles_init, advance_positions, displacements, configuration_fault, impose_motion, &
+  public :: particles_t, sphere_share_t, particles_init, advance_positions, displacements, configuration_fault, impose_motion, &
             particles_columns
   public :: MOTION_FREE, MOTION_PRESCRIBED, MOTION_FROZEN, MOTION_RESISTANCE, MOTION_FIXED, motion_code
 
@@ -36,6 +36,16 @@ module mod_particles
     real(dp), allocatable :: torque_hydro(:, :)    ! (3, n) [eta gamma_dot a^3]
     real(dp), allocatable :: stresslet_hydro(:, :, :)   ! (3, 3, n) [eta gamma_dot a^3]
   end type particles_t
+
+  ! A rank's share of the spheres when each rank holds its own spheres and their ghosts (the local
+  ! set of lubrication dynamics, mod_ld_local) rather than every sphere: the output writes the own
+  ! spheres' rows of the set under their global indices (mod_run_output, mod_checkpoint).
+  type :: sphere_share_t
+    type(particles_t), pointer :: set => null()    ! own spheres and ghosts
+    integer, allocatable :: id(:)                  ! (set%n) each one's global index, ascending
+    logical, allocatable :: own(:)                 ! (set%n) this rank's own
+    integer :: total = 0                           ! spheres of the whole system
+  end type sphere_share_t
 
 contains
 

@@ -23,7 +23,7 @@ program fdsusp
   use mod_fluid, only: fluid_t, fluid_create, fluid_destroy, fluid_options_check, fluid_bench_cold_poisson, &
                        fluid_unit_response
   use mod_fluid_verification, only: fluid_errors_vs_manufactured
-  use mod_particles, only: particles_t, MOTION_FREE
+  use mod_particles, only: particles_t, sphere_share_t, MOTION_FREE
   use mod_particles_io, only: particles_load
   use mod_initial_packing, only: initial_packing_make
   use mod_particle_contacts, only: particle_contacts_t, particle_contacts_create, particle_contacts_description
@@ -43,9 +43,9 @@ program fdsusp
   use mod_sphere_ownership, only: sphere_ownership_mine
   use mod_checkpoint, only: checkpoint_state_t, checkpoint_check, checkpoint_read
   use mod_time_step, only: time_step_t, time_step_create, time_step_advance, time_step_guard, time_step_report, &
-                           time_step_complete_view, time_step_local_state
+                           time_step_complete_view, time_step_share
   use mod_run_output, only: run_output_t, run_output_open, run_output_step, run_output_checkpoint, &
-                            run_output_fail, run_output_close, run_output_reads_view
+                            run_output_fail, run_output_close
   implicit none
 
   PetscErrorCode :: ierr
@@ -72,7 +72,9 @@ program fdsusp
   type(particle_lubrication_t), pointer :: lubrication_p => null()
   type(rheology_t), pointer :: rheology_p => null()
   type(lees_edwards_t), pointer :: le_p => null()
-  type(time_step_t) :: ts                           ! the step of this run
+  type(time_step_t), target :: ts                   ! the step of this run
+  type(sphere_share_t) :: share                     ! this rank's share of the spheres (time_step_share)
+  logical :: shared
   type(run_output_t) :: out                         ! what it writes, and when
   character(len=max_line) :: deck, restart
   character(len=400) :: text
@@ -212,9 +214,6 @@ program fdsusp
   stop_reason = RUN_GOES_ON
   if (step >= cfg%time%steps) stop_reason = RUN_DONE
   do while (stop_reason == RUN_GOES_ON)
-    ! (a step on the ranks' local sets brings the replicated particle state up to date only for the
-    ! output that reads it; a series record takes the local sets)
-    ts%complete_view = run_output_reads_view(out, step + 1)
     PetscCallA(time_step_advance(ts, step, ierr))
     if (len_trim(ts%failure) > 0) then
       PetscCallA(time_step_complete_view(ts, ierr))
@@ -222,11 +221,10 @@ program fdsusp
     end if
     step = step + 1
     time = time + cfg%time%dt
-    if (time_step_local_state(ts)) then
-      ! (the series takes the own spheres of the ranks' local sets, the state of the step)
-      associate(local => ts%local)
-        PetscCallA(run_output_step(out, step, time, ierr, local%set, local%halo%id, local%halo%is_owned, local%total))
-      end associate
+    ! (lubrication dynamics on several ranks: the output takes each rank's share of the spheres)
+    call time_step_share(ts, share, shared)
+    if (shared) then
+      PetscCallA(run_output_step(out, step, time, ierr, share))
     else
       PetscCallA(run_output_step(out, step, time, ierr))
     end if
@@ -241,8 +239,12 @@ program fdsusp
 
   ! ---- end of run: the series, the last fields and a checkpoint to continue from ----
   if (step > first_step) call time_step_report(ts, (MPI_Wtime() - wall_loop) / (step - first_step))
-  PetscCallA(time_step_complete_view(ts, ierr))
-  PetscCallA(run_output_close(out, step, time, ierr))
+  call time_step_share(ts, share, shared)
+  if (shared) then
+    PetscCallA(run_output_close(out, step, time, ierr, share))
+  else
+    PetscCallA(run_output_close(out, step, time, ierr))
+  end if
   call log_line(run_stop_line(cfg, stop_reason, step, merge(fl%max_rate, 0.0_dp, cfg%resolved)))
   if (cfg%verification%manufactured_solution .and. cfg%resolved) then
     PetscCallA(fluid_errors_vs_manufactured(grid, fl, cfg%domain%shear_rate, err_vel, err_p_max, err_p_rms, ierr))

@@ -19,13 +19,15 @@ the sparse solve runs at every step.
     2026-11-29: contacts, links, the 6N rows and the velocities of a rank's local set, its run log
     says so), which the agreement in 2. and 3. then checks: an own sphere that missed a contact,
     a link or a ghost's velocity would move at O(1) differently.
- 6. the local sets are the state between steps and the series records take their own spheres:
-    with a particle snapshot every 8 steps, 3 ranks bring the replicated view up to date only for
-    the snapshots (5 times in 40 steps, the run log says), agree with 1 rank at every step of the
-    series, and the snapshots hold 1 rank's spheres of their steps. In between, the spheres that
-    cross a slab face migrate with their velocities and Adams-Bashforth history, and the contacts'
-    springs go to the ranks of the spheres they touch (each rank holds only its pairs'; more in
-    test_ld_migration).
+ 6. the local sets are the state between steps, and the output takes each rank's own spheres of
+    them (the series, the particle snapshots, the checkpoints with the springs gathered on rank
+    0): with a snapshot every 8 steps, 3 ranks never gather the replicated state (0 times in 40
+    steps, the run log says), their series agrees with 1 rank's at every step, the snapshots hold
+    1 rank's spheres of their steps, and the final checkpoint 1 rank's (positions, velocities,
+    omega, the Adams-Bashforth velocities, the springs' pairs and values); the restart in 3.
+    starts from such a checkpoint. In between, the spheres that cross a slab face migrate with
+    their velocities and Adams-Bashforth history, and the contacts' springs go to the ranks of the
+    spheres they touch (more in test_ld_migration).
 Tolerance: the CG iterations run to a relative residual of 1e-12; on more ranks their inner
 products sum in another order, which changes the iterates at round-off and the converged solution
 within the solver's tolerance. Measured (2026-11-28): at most 4.2e-13 (omega, the smallest
@@ -122,8 +124,8 @@ compare(ref, results(d), '20 steps on 2 ranks + restart + 20 on 3 vs 40 on 1')
 # the state carried on the local sets between the snapshots
 d3, out3 = run('ld_ranks_every8_3', 3, every=8)
 m = re.search(r'replicated view brought up to date (\d+) times in (\d+) steps', out3)
-T.check(m is not None and (int(m.group(1)), int(m.group(2))) == (5, 40),
-        '3 ranks, a snapshot every 8 steps: the view brought up to date for the snapshots only (%s)'
+T.check(m is not None and (int(m.group(1)), int(m.group(2))) == (0, 40),
+        '3 ranks, a snapshot every 8 steps: the replicated state never gathered (%s)'
         % (m.group(0) if m else 'no such log line'))
 compare(ref, results(d3), '3 ranks vs 1, a snapshot every 8 steps')
 worst = 0.0
@@ -131,4 +133,13 @@ for step in (8, 16, 24, 32, 40):
     snap = T.read_h5(os.path.join(d3, 'out', 'particles_%08d.h5' % step), ['particles/position'])['particles/position']
     worst = max(worst, np.abs(snap - ref['particles/position'][step - 1]).max() / np.abs(ref['particles/position']).max())
 T.check(worst <= TOL, '3 ranks: the snapshots of steps 8-40 hold 1 rank\'s positions (%.1e of the largest)' % worst)
+CHECKPOINT = ['particles/position', 'particles/velocity', 'particles/omega', 'particles/velocity_prev',
+              'contacts/spring']
+c1 = T.read_h5(os.path.join(d1, 'out', 'checkpoint.h5'), CHECKPOINT + ['contacts/ids'])
+c3 = T.read_h5(os.path.join(d3, 'out', 'checkpoint.h5'), CHECKPOINT + ['contacts/ids'])
+T.check(np.array_equal(c1['contacts/ids'], c3['contacts/ids']),
+        '3 ranks: the final checkpoint holds 1 rank\'s %d springs\' pairs' % len(c1['contacts/ids']))
+for k in CHECKPOINT:
+    e = np.abs(c3[k] - c1[k]).max() / (np.abs(c1[k]).max() or 1.0) if c3[k].shape == c1[k].shape else np.inf
+    T.check(e <= TOL, '3 ranks: the final checkpoint\'s %s is 1 rank\'s (%.1e of its largest)' % (k, e))
 T.finish()
