@@ -9,6 +9,10 @@
 ! one rank is seen by every rank, so that no rank waits in the next collective call for ever.
 ! In parallel HDF5 every rank must make the same metadata calls (groups, datasets, attributes)
 ! with the same values: the callers make them on every rank with the replicated values.
+! serial_alone (create, open): on a run of one rank the file goes through HDF5's default (sec2)
+! driver instead: the same file for a reader, without MPI-IO's cost per call (series.h5's flushes,
+! doc/BENCHMARKS.md §20). Only for a caller whose transfers do not ask for MPI-IO (mod_series;
+! h5_parallel_write_columns always does).
 #include <petsc/finclude/petscsys.h>
 module mod_h5_parallel
   use hdf5
@@ -27,32 +31,34 @@ module mod_h5_parallel
 
 contains
 
-  !> Create (truncate) the file PATH for every rank through MPI-IO on PETSC_COMM_WORLD. Collective.
-  subroutine h5_parallel_create(path, file, err)
+  !> Create (truncate) the file PATH for every rank through MPI-IO on PETSC_COMM_WORLD (see
+  !> serial_alone above). Collective.
+  subroutine h5_parallel_create(path, file, err, serial_alone)
     character(len=*), intent(in) :: path
     integer(HID_T), intent(out) :: file
     integer, intent(out) :: err
+    logical, intent(in), optional :: serial_alone
     integer(HID_T) :: fapl
-    call mpio_access(fapl, err)
+    call mpio_access(fapl, err, serial_alone)
     if (err == 0) call h5fcreate_f(path, H5F_ACC_TRUNC_F, file, err, access_prp=fapl)
     call close_plist(fapl)
     call h5_parallel_agree(err)
   end subroutine h5_parallel_create
 
-  !> Open the existing file PATH read-write (read_only: read only) for every rank through MPI-IO.
-  !> Collective.
-  subroutine h5_parallel_open(path, file, err, read_only)
+  !> Open the existing file PATH read-write (read_only: read only) for every rank through MPI-IO
+  !> (see serial_alone above). Collective.
+  subroutine h5_parallel_open(path, file, err, read_only, serial_alone)
     character(len=*), intent(in) :: path
     integer(HID_T), intent(out) :: file
     integer, intent(out) :: err
-    logical, intent(in), optional :: read_only
+    logical, intent(in), optional :: read_only, serial_alone
     integer(HID_T) :: fapl
     integer :: mode
     mode = H5F_ACC_RDWR_F
     if (present(read_only)) then
       if (read_only) mode = H5F_ACC_RDONLY_F
     end if
-    call mpio_access(fapl, err)
+    call mpio_access(fapl, err, serial_alone)
     if (err == 0) call h5fopen_f(path, mode, file, err, access_prp=fapl)
     call close_plist(fapl)
     call h5_parallel_agree(err)
@@ -184,12 +190,27 @@ contains
     if (ierr /= 0) err = max(1, mine)
   end subroutine h5_parallel_agree
 
-  ! A file access list for MPI-IO on PETSC_COMM_WORLD.
-  subroutine mpio_access(fapl, err)
+  ! A file access list for MPI-IO on PETSC_COMM_WORLD; with serial_alone on one rank, HDF5's
+  ! default driver.
+  subroutine mpio_access(fapl, err, serial_alone)
     integer(HID_T), intent(out) :: fapl
     integer, intent(out) :: err
+    logical, intent(in), optional :: serial_alone
+    integer :: ranks
+    PetscErrorCode :: ierr
     call h5pcreate_f(H5P_FILE_ACCESS_F, fapl, err)
-    if (err == 0) call h5pset_fapl_mpio_f(fapl, PETSC_COMM_WORLD, MPI_INFO_NULL, err)
+    if (err /= 0) return
+    if (present(serial_alone)) then
+      if (serial_alone) then
+        call MPI_Comm_size(PETSC_COMM_WORLD, ranks, ierr)
+        if (ierr /= 0) then
+          err = 1
+          return
+        end if
+        if (ranks == 1) return
+      end if
+    end if
+    call h5pset_fapl_mpio_f(fapl, PETSC_COMM_WORLD, MPI_INFO_NULL, err)
   end subroutine mpio_access
 
   subroutine close_plist(plist)

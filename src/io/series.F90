@@ -16,9 +16,12 @@
 ! values. At a flush the buffered rows go, in one all-to-all, to the rank that writes their sphere
 ! in the file (rank r writes the contiguous range of spheres r N / P + 1 .. (r + 1) N / P), so that
 ! each rank writes one box (its spheres x the records) of each per-sphere dataset in one
-! collective transfer; consolidation moves the records the same way, each rank its range (reading
-! the parts, which are only read, through its own serial open, so without collective calls). The
-! layout is one writer's: the same datasets, shapes, types and chunks on any number of ranks.
+! collective transfer, filled column by column from the rows (no dense copy of them); consolidation
+! moves the records the same way, each rank its range (reading the parts, which are only read,
+! through its own serial open, so without collective calls; the part a flush has just published
+! from memory). One rank exchanges nothing and opens the files with HDF5's serial driver
+! (doc/BENCHMARKS.md §20). The layout is one writer's: the same datasets, shapes, types and chunks
+! on any number of ranks.
 ! Every decision that leads to a collective call is the same on every rank: the wall-clock interval
 ! of progress flushes is rank 0's, broadcast; the parts, the steps and the files' problems are
 ! rank 0's, broadcast; every HDF5 failure is agreed by all ranks.
@@ -65,6 +68,8 @@ module mod_series
     integer :: sphere_values = 0             ! a sphere's values of the per-sphere columns
     integer :: spheres = 0                   ! N, the per-sphere columns' last dimension
     integer :: sphere_lo = 1, sphere_hi = 0  ! the spheres this rank writes into a file
+    logical :: alone = .false.               ! one rank: its buffer written as it is, through HDF5's
+                                             ! serial driver (mod_h5_parallel serial_alone)
     integer :: record_length = 0             ! the values of one record over all ranks
     real(dp), allocatable :: buffer(:, :)    ! (value of the other columns, record), every rank
     integer :: nbuf = 0
@@ -253,6 +258,7 @@ contains
     PetscCallMPIA(MPI_Comm_rank(PETSC_COMM_WORLD, rank, ierr))
     s%sphere_lo = int(int(rank, 8) * s%spheres / ranks) + 1
     s%sphere_hi = int(int(rank + 1, 8) * s%spheres / ranks)
+    s%alone = ranks == 1
     ! -series_flush_seconds: how often at most progress lines publish the records (checkpoints, a
     ! full buffer and the end always do): a part and, while series.h5 is small, its copy per flush
     ! would cost more than the step itself in a run with a progress line every step
@@ -349,10 +355,10 @@ contains
     type(series_t), intent(inout) :: s
     logical, intent(in), optional :: progress
     character(len=1100) :: part
-    integer(HID_T) :: file
     integer(kind=8) :: now, rate
     logical :: due
-    real(dp), allocatable :: dense(:, :, :)
+    real(dp), allocatable :: rows(:, :)
+    integer, allocatable :: place(:, :)
     PetscErrorCode :: ierr
     if (.not. s%open .or. s%nbuf == 0) return
     call system_clock(now, rate)
@@ -364,20 +370,38 @@ contains
     if (.not. due) return
     s%last_flush = now
     write(part, '(a,i10.10,a)') trim(s%parts_dir)//'/', nint(s%buffer(1, 1)), '.h5'
-    call spheres_by_range(s, dense)
     ! a full disk must stop every rank before the collective write, not inside it
     call require_free_space(directory_of(s%path), 8.0_dp * s%record_length * s%nbuf, trim(part))
-    call create_file(s, trim(part)//'.tmp', file)
-    call append_records(s, file, trim(part)//'.tmp', s%buffer(:, 1:s%nbuf), dense)
-    call close_file(s, file, trim(part)//'.tmp')
-    call publish(s, trim(part)//'.tmp', part)
+    if (s%alone) then
+      ! one rank writes every sphere: its rows as they are, not a copy (doc/BENCHMARKS.md §20)
+      call check_places(s, s%sphere_place(:, 1:s%nrows))
+      call publish_records(s, part, s%sphere_buffer(:, 1:s%nrows), s%sphere_place(:, 1:s%nrows))
+    else
+      call spheres_by_range(s, rows, place)
+      call publish_records(s, part, rows, place)
+    end if
     s%nbuf = 0
     s%nrows = 0
+  end subroutine series_flush
+
+  ! The buffered records as the part `part` (its per-sphere columns: rows(:, j) the values of the
+  ! sphere and record place(:, j), every sphere of this rank's range and record once), and
+  ! series.h5 consolidated when that is due, these records appended from memory. Collective.
+  subroutine publish_records(s, part, rows, place)
+    type(series_t), intent(inout) :: s
+    character(len=*), intent(in) :: part
+    real(dp), intent(in) :: rows(:, :)
+    integer, intent(in) :: place(:, :)
+    integer(HID_T) :: file
+    call create_file(s, trim(part)//'.tmp', file)
+    call append_records(s, file, trim(part)//'.tmp', s%buffer(:, 1:s%nbuf), rows=rows, place=place, record0=0)
+    call close_file(s, file, trim(part)//'.tmp')
+    call publish(s, trim(part)//'.tmp', part)
     s%parts = s%parts + 1
     s%parts_bytes = s%parts_bytes + file_bytes(part)
     if (s%consolidated_bytes + s%parts_bytes <= small_series_bytes .or. s%parts >= max_parts .or. &
-        s%parts_bytes >= 0.5_dp * s%consolidated_bytes) call consolidate(s, no_limit)
-  end subroutine series_flush
+        s%parts_bytes >= 0.5_dp * s%consolidated_bytes) call consolidate(s, no_limit, part, rows, place)
+  end subroutine publish_records
 
   ! The end of a run: the buffered records and the parts, all in series.h5. Collective.
   subroutine series_close(s)
@@ -388,27 +412,27 @@ contains
   end subroutine series_close
 
   ! The buffered rows of every rank, each sent to the rank that writes its sphere into the files
-  ! (one all-to-all): dense(value, sphere - sphere_lo + 1, record) of the spheres sphere_lo ..
-  ! sphere_hi of every buffered record. Every (sphere, record) must come from exactly one rank.
-  ! Collective.
-  subroutine spheres_by_range(s, dense)
+  ! (one all-to-all): rows(:, j) the values of the sphere and buffered record place(:, j), for
+  ! every sphere of sphere_lo .. sphere_hi and every buffered record exactly once (checked). The
+  ! rows are not put in order: append_records places each where it belongs, so that no dense copy
+  ! of them is held beside the buffer and the exchanged rows (doc/BENCHMARKS.md §20). Collective.
+  subroutine spheres_by_range(s, rows, place)
     type(series_t), intent(in) :: s
-    real(dp), allocatable, intent(out) :: dense(:, :, :)
-    integer :: ranks, width, j, k, r, i, record
+    real(dp), allocatable, intent(out) :: rows(:, :)
+    integer, allocatable, intent(out) :: place(:, :)
+    integer :: ranks, j, k, r, n
     integer, allocatable :: owner(:), order(:), send_count(:), send_displs(:), recv_count(:), recv_displs(:), &
-                            times(:, :)
-    real(dp), allocatable :: send(:, :), recv(:, :)
+                            send_place(:, :)
+    real(dp), allocatable :: send(:, :)
     PetscErrorCode :: ierr
-    allocate(dense(s%sphere_values, s%sphere_hi - s%sphere_lo + 1, s%nbuf))
-    dense = 0.0_dp
+    allocate(rows(s%sphere_values, 0), place(2, 0))
     if (s%sphere_values == 0) return
     call abort_if_any(any(s%sphere_place(1, 1:s%nrows) < 1 .or. s%sphere_place(1, 1:s%nrows) > s%spheres), &
                       'internal error: series.h5: a per-sphere row names no sphere of the run')
     PetscCallMPIA(MPI_Comm_size(PETSC_COMM_WORLD, ranks, ierr))
-    ! a row: its sphere, its record, its values; sorted by the rank that writes the sphere
-    width = s%sphere_values + 2
-    allocate(owner(s%nrows), send(width, s%nrows), send_count(0:ranks - 1), send_displs(0:ranks - 1), &
-             recv_count(0:ranks - 1), recv_displs(0:ranks - 1))
+    ! the rows sorted by the rank that writes their sphere
+    allocate(owner(s%nrows), send(s%sphere_values, s%nrows), send_place(2, s%nrows), send_count(0:ranks - 1), &
+             send_displs(0:ranks - 1), recv_count(0:ranks - 1), recv_displs(0:ranks - 1))
     do j = 1, s%nrows
       ! the largest r whose range starts at or before the sphere: r N / P <= sphere - 1
       owner(j) = int((int(s%sphere_place(1, j) - 1, 8) * ranks + ranks - 1) / s%spheres)
@@ -417,9 +441,9 @@ contains
     send_count = 0
     do k = 1, s%nrows
       j = order(k)
-      send(1:2, k) = real(s%sphere_place(:, j), dp)
-      send(3:, k) = s%sphere_buffer(:, j)
-      send_count(owner(j)) = send_count(owner(j)) + width
+      send_place(:, k) = s%sphere_place(:, j)
+      send(:, k) = s%sphere_buffer(:, j)
+      send_count(owner(j)) = send_count(owner(j)) + 1
     end do
     PetscCallMPIA(MPI_Alltoall(send_count, 1, MPI_INTEGER, recv_count, 1, MPI_INTEGER, PETSC_COMM_WORLD, ierr))
     send_displs(0) = 0
@@ -428,19 +452,37 @@ contains
       send_displs(r) = send_displs(r - 1) + send_count(r - 1)
       recv_displs(r) = recv_displs(r - 1) + recv_count(r - 1)
     end do
-    allocate(recv(width, sum(recv_count) / width))
-    PetscCallMPIA(MPI_Alltoallv(send, send_count, send_displs, MPI_DOUBLE_PRECISION, recv, recv_count, recv_displs, MPI_DOUBLE_PRECISION, PETSC_COMM_WORLD, ierr))
-    allocate(times(size(dense, 2), s%nbuf))
-    times = 0
-    do k = 1, size(recv, 2)
-      i = nint(recv(1, k)) - s%sphere_lo + 1
-      record = nint(recv(2, k))
-      dense(:, i, record) = recv(3:, k)
-      times(i, record) = times(i, record) + 1
-    end do
-    call abort_if_any(any(times /= 1), 'internal error: series.h5: a sphere''s values of a record were given '// &
-                      'by no rank or by more than one')
+    n = sum(recv_count)
+    deallocate(rows, place)
+    allocate(rows(s%sphere_values, n), place(2, n))
+    PetscCallMPIA(MPI_Alltoallv(send_place, 2 * send_count, 2 * send_displs, MPI_INTEGER, place, 2 * recv_count, 2 * recv_displs, MPI_INTEGER, PETSC_COMM_WORLD, ierr))
+    PetscCallMPIA(MPI_Alltoallv(send, s%sphere_values * send_count, s%sphere_values * send_displs, MPI_DOUBLE_PRECISION, rows, s%sphere_values * recv_count, s%sphere_values * recv_displs, MPI_DOUBLE_PRECISION, PETSC_COMM_WORLD, ierr))
+    deallocate(send)
+    call check_places(s, place)
   end subroutine spheres_by_range
+
+  ! Whether place(:, j) (sphere, buffered record) of the rows gives every sphere of this rank's
+  ! range and every buffered record exactly once; else a programming error, stopped on every
+  ! rank. Collective.
+  subroutine check_places(s, place)
+    type(series_t), intent(in) :: s
+    integer, intent(in) :: place(:, :)
+    integer, allocatable :: times(:, :)
+    integer :: j
+    logical :: wrong
+    if (s%sphere_values == 0) return
+    wrong = any(place(1, :) < s%sphere_lo .or. place(1, :) > s%sphere_hi .or. place(2, :) < 1 .or. place(2, :) > s%nbuf)
+    if (.not. wrong) then
+      allocate(times(s%sphere_lo:s%sphere_hi, s%nbuf))
+      times = 0
+      do j = 1, size(place, 2)
+        times(place(1, j), place(2, j)) = times(place(1, j), place(2, j)) + 1
+      end do
+      wrong = any(times /= 1)
+    end if
+    call abort_if_any(wrong, 'internal error: series.h5: a sphere''s values of a record were given '// &
+                      'by no rank or by more than one')
+  end subroutine check_places
 
   ! A new, empty series.h5 (the columns and attributes), published whole. Collective.
   subroutine start_empty(s)
@@ -494,10 +536,16 @@ contains
   ! removed: the records of series.h5 (its longest sound prefix: every column that long, steps
   ! increasing), then each part's records after the last step so far, up to step `limit`. Rank 0
   ! lists the parts, copies series.h5 and renames and removes files; every rank moves the records
-  ! of its range of spheres (and rank 0 those of the other columns). Collective.
-  subroutine consolidate(s, limit)
+  ! of its range of spheres (and rank 0 those of the other columns). fresh, optional: the part a
+  ! flush has just published from the buffered records, whose per-sphere rows it gives as rows and
+  ! place (publish_records): they are appended from memory, not read back from the part (the same
+  ! values; the read was a fifth of a flush's cost, doc/BENCHMARKS.md §20). Collective.
+  subroutine consolidate(s, limit, fresh, rows, place)
     type(series_t), intent(inout) :: s
     integer, intent(in) :: limit
+    character(len=*), intent(in), optional :: fresh
+    real(dp), intent(in), optional :: rows(:, :)
+    integer, intent(in), optional :: place(:, :)
     character(len=256), allocatable :: parts(:)
     character(len=1100) :: tmp, part
     character(len=400) :: problem
@@ -522,7 +570,7 @@ contains
       if (is_root()) err = copy_file(s%path, tmp)
       call from_root(err)
       if (err /= 0) call write_failed(s, tmp, 'cannot be written as a copy of series.h5 ('//errno_text(err)//')')
-      call h5_parallel_open(trim(tmp), file, err)
+      call h5_parallel_open(trim(tmp), file, err, serial_alone=.true.)
       if (err /= 0) then
         problem = 'it cannot be read as HDF5'
       else
@@ -545,6 +593,19 @@ contains
     slice = min(256, s%max_records)
     do k = 1, size(parts)
       part = trim(s%parts_dir)//'/'//trim(parts(k))
+      if (present(fresh)) then
+        if (part == fresh) then
+          ! its records after the last step so far, up to the limit, from the buffer
+          steps = nint(s%buffer(1, 1:s%nbuf))
+          i0 = findloc(steps > last, .true., 1)
+          i1 = count(steps <= limit)
+          if (i0 > 0 .and. i1 >= i0) then
+            call append_records(s, file, tmp, s%buffer(:, i0:i1), rows=rows, place=place, record0=i0 - 1)
+            last = steps(i1)
+          end if
+          cycle
+        end if
+      end if
       ! a part is only read: each rank opens it by itself (no collective call), and reads its share
       call h5fopen_f(trim(part), H5F_ACC_RDONLY_F, source, err)
       call h5_parallel_agree(err)
@@ -760,18 +821,23 @@ contains
   end subroutine read_records
 
   ! Append records to every column of a file open on every rank: scalars(value, record) of the
-  ! other columns from rank 0, dense(value, sphere, record) of the per-sphere ones from every rank
-  ! for its range of spheres. Collective.
-  subroutine append_records(s, file, filename, scalars, dense)
+  ! other columns from rank 0; the per-sphere ones from every rank for its range of spheres, either
+  ! dense(value, sphere, record), or rows(:, j) the values of the sphere and record place(:, j)
+  ! (records record0 + 1 .. record0 + size(scalars, 2) taken, the others not). Collective.
+  subroutine append_records(s, file, filename, scalars, dense, rows, place, record0)
     type(series_t), intent(in) :: s
     integer(HID_T), intent(in) :: file
     character(len=*), intent(in) :: filename
-    real(dp), intent(in) :: scalars(:, :), dense(:, :, :)
+    real(dp), intent(in) :: scalars(:, :)
+    real(dp), intent(in), optional :: dense(:, :, :), rows(:, :)
+    integer, intent(in), optional :: place(:, :), record0
     integer(HID_T) :: dset, fspace
     integer(HSIZE_T) :: dims(4), maxdims(4), offset(4), count(4)
-    integer :: err, e, c, rank, w
+    integer :: err, e, c, rank, w, n, m, j, i, r
     logical :: selected
     real(dp), allocatable :: values(:)
+    n = size(scalars, 2)
+    m = s%sphere_hi - s%sphere_lo + 1
     do c = 1, size(s%names)
       rank = column_rank(s%shapes(:, c))
       call h5dopen_f(file, trim(s%names(c)), dset, err)
@@ -779,18 +845,29 @@ contains
       err = max(err, abs(e))
       call h5sget_simple_extent_dims_f(fspace, dims(1:rank), maxdims(1:rank), e)
       call h5sclose_f(fspace, e)
-      call box(s, c, int(dims(rank)), size(scalars, 2), rank, offset, count, selected)
-      dims(rank) = dims(rank) + size(scalars, 2)
+      call box(s, c, int(dims(rank)), n, rank, offset, count, selected)
+      dims(rank) = dims(rank) + n
       call h5dset_extent_f(dset, dims(1:rank), e)
       err = max(err, abs(e))
       w = s%width(c)
-      if (s%per_sphere(c)) then
+      if (s%per_sphere(c) .and. present(dense)) then
         values = reshape(dense(s%first(c):s%first(c) + w - 1, :, :), [w * size(dense, 2) * size(dense, 3)])
+      else if (s%per_sphere(c)) then
+        ! in the box's order (value, sphere, record)
+        if (allocated(values)) deallocate(values)
+        allocate(values(w * m * n))
+        do j = 1, size(place, 2)
+          r = place(2, j) - record0
+          if (r < 1 .or. r > n) cycle
+          i = (int(r - 1) * m + place(1, j) - s%sphere_lo) * w
+          values(i + 1:i + w) = rows(s%first(c):s%first(c) + w - 1, j)
+        end do
       else
-        values = reshape(scalars(s%first(c):s%first(c) + w - 1, :), [w * size(scalars, 2)])
+        values = reshape(scalars(s%first(c):s%first(c) + w - 1, :), [w * n])
       end if
       if (size(values) == 0) values = [0.0_dp]
-      call transfer(dset, .true., s%per_sphere(c), selected, offset(1:rank), count(1:rank), values, e)
+      ! one rank alone moves every value by itself; several move the per-sphere boxes together
+      call transfer(dset, .true., s%per_sphere(c) .and. .not. s%alone, selected, offset(1:rank), count(1:rank), values, e)
       err = max(err, abs(e))
       ! closing writes the dataset's cached chunks: a full disk may show only here
       call h5dclose_f(dset, e)
@@ -880,7 +957,7 @@ contains
     character(len=*), intent(in) :: name
     integer(HID_T), intent(out) :: file
     integer :: err, c
-    call h5_parallel_create(trim(name), file, err)
+    call h5_parallel_create(trim(name), file, err, serial_alone=.true.)
     if (err /= 0) call write_failed(s, name, 'cannot be created')
     do c = 1, size(s%names)
       call create_column(s, file, name, trim(s%names(c)), c == 1, s%shapes(:, c))

@@ -15,6 +15,12 @@
 !      uninterrupted run's;
 !   3. reopened with restart_step = 25 (between records): steps <= 24 are kept, 26 and 28 follow;
 !   4. reopened from the start (restart_step = -1): an empty series.h5 with the columns.
+!   5. memory of a flush: a series of 1000 spheres (velocity, omega, stresslet: 15 values a sphere)
+!      whose 128 buffered records (15 MiB) are flushed as a part and consolidated: on one rank the
+!      flush raises the peak resident size (VmHWM) by less than the buffered rows' size (each
+!      column's box is made from the buffer as it is written, 9 of 15 values at most; before
+!      2026-11-29 the rows were copied three times, +45 MiB; doc/BENCHMARKS.md §20). On several
+!      ranks the figure is printed, not checked (the exchange holds a copy of the rank's rows).
 ! The two per-sphere columns (sphere_column) are given by every rank for its own spheres only,
 ! and which spheres a rank owns changes from record to record (sphere i at step k belongs to rank
 ! mod(i + k / 2, ranks)), as spheres change owner in a run: the file must not depend on it.
@@ -31,7 +37,7 @@ program test_series_append
   use mod_columns, only: sphere_column
   use mod_series, only: series_t, series_column, series_add, series_open, series_record, series_flush, &
                         series_close, series_attributes
-  use mod_os_services, only: make_directory
+  use mod_os_services, only: make_directory, peak_resident_kb
   use mod_file_services, only: list_directory
   use mod_unit_checks, only: check, finish
   implicit none
@@ -103,6 +109,9 @@ program test_series_append
   expected = [integer ::]
   call verify('a new run from the start (restart_step -1)', expected)
 
+  ! 5. the memory of a flush
+  call flush_memory()
+
   if (rank == 0) call execute_command_line('rm -rf '''//trim(dir)//'''')
   call finish('test_series_append')
   PetscCallA(PetscFinalize(ierr))
@@ -155,6 +164,46 @@ contains
     call declare(s)
     call series_open(s, dir, restart_step, 10)
   end subroutine reopen
+
+  ! Section 5: 128 records of 1000 spheres buffered, then flushed (a part and its consolidation);
+  ! the rise of this rank's peak resident size during the flush against the size of its rows.
+  subroutine flush_memory()
+    integer, parameter :: spheres = 1000, records = 128
+    type(series_t) :: big
+    real(dp) :: velocity(3, spheres), omega(3, spheres), stresslet(3, 3, spheres), rows_mib, rise_mib
+    integer, allocatable :: mine(:)
+    integer :: i, k, before(1), after(1)
+    character(len=200) :: text
+    mine = pack([(i, i = 1, spheres)], [(mod(i, ranks) == rank, i = 1, spheres)])
+    do k = 0, records
+      velocity = real(k, dp)
+      omega = -real(k, dp)
+      stresslet = 0.5_dp * k
+      call series_column(big, 'step', k)
+      call series_add(big, [sphere_column('particles/velocity', spheres, mine, velocity(:, mine))])
+      call series_add(big, [sphere_column('particles/omega', spheres, mine, omega(:, mine))])
+      call series_add(big, [sphere_column('particles/stresslet', spheres, mine, stresslet(:, :, mine))])
+      if (k == 0) then
+        ! the columns declared (record 0 is not recorded), the files made before the measure
+        if (rank == 0) status = make_directory(trim(dir)//'/big')
+        call MPI_Barrier(PETSC_COMM_WORLD, ierr)
+        call series_open(big, trim(dir)//'/big', -1, records)
+      else
+        call series_record(big)
+      end if
+    end do
+    rows_mib = 15.0_dp * 8.0_dp * size(mine) * records / 1048576.0_dp
+    before = peak_resident_kb()
+    call series_close(big)
+    after = peak_resident_kb()
+    rise_mib = (after(1) - before(1)) / 1024.0_dp
+    write(text, '(a,f0.1,a,f0.1,a)') 'a flush of ', rows_mib, ' MiB of buffered rows raises the peak by ', rise_mib, ' MiB'
+    if (ranks == 1) then
+      call check(before(1) > 0 .and. rise_mib < rows_mib, trim(text)//' (less than the rows, one rank)')
+    else
+      write(output_unit, '(a)') '  '//trim(text)//' on rank 0 (not checked on several ranks)'
+    end if
+  end subroutine flush_memory
 
   ! series.h5 holds the records of `steps`, each equal to what columns() gives for its step; no
   ! part and no partial write is left.
