@@ -10,12 +10,12 @@
 ! next step's start (ld_local_begin) the own spheres that left the slab go to their new owner with
 ! what they carry (velocities, the Adams-Bashforth history, external loads, radius), the ghosts are
 ! rebuilt, and the springs of the contacts go to the neighbours whose spheres they touch. No message
-! of a step grows with the total number of spheres. The replicated particle state (the view) is a
-! copy for the output that reads every sphere: it is brought up to date (ld_local_complete_view:
-! positions, velocities, springs and the last step's hydrodynamic, contact and link results
-! gathered) only at the steps of a particle snapshot or a checkpoint, after a failure and at the
-! end of the run (a series record takes the own spheres of the local sets, mod_run_output); a
-! restart and the first step take the local set from it.
+! of a step grows with the total number of spheres. The output takes each rank's share of the
+! local sets (mod_time_step time_step_share: the series, the snapshots, the checkpoints). The
+! replicated particle state (the view) is brought up to date (ld_local_complete_view: positions,
+! velocities, springs and the last step's hydrodynamic, contact and link results gathered) only
+! for a failure, whose state and message it gives; a restart and the first step take the local
+! set from it.
 !
 ! With one rank, or without contacts and links (the block-diagonal one-body problem), the step keeps
 ! the replicated state (ld_local_t%active false). An owned sphere sees every contact and link in
@@ -464,8 +464,8 @@ contains
     end associate
   end subroutine ld_local_end
 
-  !> The view parts brought up to date from the local set, for the output that reads every sphere
-  !> (a particle snapshot, a checkpoint, failed_state.h5, the run's last output): the own spheres'
+  !> The view parts brought up to date from the local set, for a failure (failed_state.h5 and the
+  !> runtime guard's message, which read every sphere): the own spheres'
   !> positions, velocities, omega and last velocities gathered (STATE_VALUES), the springs of the
   !> pairs whose first sphere is own into the contacts' history (every spring), the contacts and
   !> the links set for every sphere (their set_local of the view) with the kept results of the

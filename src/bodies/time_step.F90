@@ -709,9 +709,9 @@ contains
       end if
     end if
     if (ts%local%live) then
-      ! the state between steps is the local sets; the replicated copy only for the output
+      ! the state between steps is the local sets; the replicated copy only for a failure
       write(text, '(a,i0,a,i0,a)') 'lubrication dynamics on the ranks'' local sets: the replicated view '// &
-           'brought up to date ', ts%local%view_updates, ' times in ', ts%steps_taken, ' steps (for the output)'
+           'brought up to date ', ts%local%view_updates, ' times in ', ts%steps_taken, ' steps (a failure needs it)'
       call log_line(text)
     end if
     if (associated(ts%lubrication)) then
