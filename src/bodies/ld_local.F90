@@ -50,6 +50,12 @@ module mod_ld_local
     type(particles_t) :: set              ! their state
     integer :: total = 0                  ! spheres of the whole system
     integer :: view_updates = 0           ! times the view was brought up to date (the run's account)
+    ! the sets are kept from step to step while no sphere has moved half the skin along z since
+    ! they were made (ld_local_begin): skin, the smallest of the kernels' neighbour lists' [a]
+    real(dp) :: skin = 0.0_dp
+    real(dp), allocatable :: z_made(:)    ! the local set's centres' z when the sets were made
+    logical :: kernels_told = .false.     ! the kernels hold the local set (their set_local)
+    integer :: sets_made = 0              ! times the sets were made (the run's account)
     ! the own spheres' results of the last step not yet in the view (ld_local_end)
     real(dp), allocatable :: pending(:, :)
   end type ld_local_t
@@ -68,26 +74,30 @@ module mod_ld_local
 contains
 
   !> Active on more than one rank when the run has contacts or lubrication links: reach, the
-  !> largest of their neighbour lists' cut-offs (skin included) [a], and lz the box's period along z.
-  !> Collective in name only.
-  subroutine ld_local_create(loc, lz, reach)
+  !> largest of their neighbour lists' cut-offs (skin included) [a], skin the smallest of their
+  !> skins [a], and lz the box's period along z. Collective in name only.
+  subroutine ld_local_create(loc, lz, reach, skin)
     type(ld_local_t), intent(out) :: loc
-    real(dp), intent(in) :: lz, reach
+    real(dp), intent(in) :: lz, reach, skin
     PetscMPIInt :: ranks
     PetscErrorCode :: ierr
     call MPI_Comm_size(PETSC_COMM_WORLD, ranks, ierr)
     loc%active = ranks > 1 .and. reach > 0.0_dp
+    loc%skin = skin
     if (loc%active) call sphere_halo_create(loc%halo, lz, reach)
   end subroutine ld_local_create
 
   !> The local set of the step: on the first step (and after a restart) taken from the view parts,
-  !> then carried on from the last step's (carry_on: the own spheres that left the slab migrate with
-  !> what they carry, the ghosts rebuilt and given their owners' values, the springs sent to the
-  !> neighbours whose spheres they touch); the contacts, the links, the one-body model, the solver
-  !> and the statistics told the local set (their set_local), the block rows numbered by slab
-  !> (rank by rank, ascending global index within a rank, as mod_sphere_ownership), and the springs
-  !> of the pairs with an own sphere kept. parts%have_prev (a reversal or a branch clears it) is
-  !> the set's. Collective.
+  !> then kept from step to step while no sphere has moved half the skin along z since the sets
+  !> were made (every sphere a rank's own spheres reach within a kernel's range is then still among
+  !> its ghosts, and the ghosts, advanced like their owners from the same forwarded values, are
+  !> their owners' copies: nothing to send), else made again from the last step's (carry_on: the own
+  !> spheres that left the slab migrate with what they carry, the ghosts rebuilt and given their
+  !> owners' values, the springs sent to the neighbours whose spheres they touch). When the sets
+  !> are made, the contacts, the links, the one-body model, the solver and the statistics are told
+  !> them (their set_local), the block rows numbered by slab (rank by rank, ascending global index
+  !> within a rank, as mod_sphere_ownership), and the springs of the pairs with an own sphere kept.
+  !> parts%have_prev (a reversal or a branch clears it) is the set's. Collective.
   subroutine ld_local_begin(loc, parts, ld, solver, ierr, contacts, lubrication, rheology)
     type(ld_local_t), intent(inout) :: loc
     type(particles_t), intent(in) :: parts
@@ -99,19 +109,26 @@ contains
     type(rheology_t), intent(inout), optional :: rheology
     real(dp), allocatable :: radii(:)
     integer, allocatable :: rows(:)
+    logical :: keep
 
     ierr = 0
     loc%total = parts%n
+    loc%view_current = .false.
     if (loc%live) then
+      call sets_hold(loc, keep, ierr)
+      if (ierr /= 0) return
+      loc%set%have_prev = parts%have_prev
+      if (keep) return
       call carry_on(loc, ierr)
     else
       call take_view(loc, parts, ierr)
     end if
     if (ierr /= 0) return
     loc%live = .true.
-    loc%view_current = .false.
+    loc%sets_made = loc%sets_made + 1
     associate(h => loc%halo, s => loc%set)
       s%have_prev = parts%have_prev
+      loc%z_made = s%position(3, :)
       radii = s%radii / parts%radius
       call own_rows(loc, rows, ierr)
       if (ierr /= 0) return
@@ -124,8 +141,31 @@ contains
         if (ierr /= 0) return
         call particle_contacts_set_local(contacts, h%id, h%is_owned, radii)
       end if
+      loc%kernels_told = .true.
     end associate
   end subroutine ld_local_begin
+
+  ! Whether the sets made last can serve this step (keep): the kernels still hold them and no own
+  ! sphere of any rank has moved half the skin along z since (the largest such move, one
+  ! reduction). Collective.
+  subroutine sets_hold(loc, keep, ierr)
+    type(ld_local_t), intent(inout) :: loc
+    logical, intent(out) :: keep
+    PetscErrorCode, intent(out) :: ierr
+    real(dp) :: moved, dz
+    integer :: q
+    moved = 0.0_dp
+    associate(h => loc%halo, s => loc%set)
+      do q = 1, s%n
+        if (.not. h%is_owned(q)) cycle
+        dz = s%position(3, q) - loc%z_made(q)
+        moved = max(moved, abs(dz - h%lz * anint(dz / h%lz)))
+      end do
+    end associate
+    if (.not. loc%kernels_told) moved = huge(1.0_dp)
+    call MPI_Allreduce(MPI_IN_PLACE, moved, 1, MPI_DOUBLE_PRECISION, MPI_MAX, PETSC_COMM_WORLD, ierr)
+    keep = moved < 0.5_dp * loc%skin
+  end subroutine sets_hold
 
   ! The local set taken from the view parts: own spheres by slab (no sphere moves between ranks:
   ! the view is everywhere), the ghosts within reach, the state of each copied. Collective.
@@ -486,6 +526,8 @@ contains
     if (loc%view_current) return
     loc%view_current = .true.
     loc%view_updates = loc%view_updates + 1
+    ! (the contacts and the links are set for every sphere below: the next step makes the sets)
+    loc%kernels_told = .false.
     associate(h => loc%halo, s => loc%set)
       allocate(rows(STATE_VALUES + 1, h%owned))
       k = 0

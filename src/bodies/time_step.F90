@@ -23,7 +23,7 @@ module mod_time_step
   use mod_particles, only: particles_t, sphere_share_t, advance_positions, displacements, MOTION_FREE, MOTION_FROZEN
   use mod_particle_contacts, only: particle_contacts_t, particle_contacts_step
   use mod_particle_lubrication, only: particle_lubrication_t
-  use mod_rheology, only: rheology_t, rheo_sample, rheo_sample_flow, rheo_reach
+  use mod_rheology, only: rheology_t, rheo_sample, rheo_sample_flow, rheo_reach, rheo_skin
   use mod_lees_edwards, only: lees_edwards_t, le_wrap, le_advance, le_set_strain
   use mod_shear_protocol, only: shear_protocol_t, shear_protocol_begin_step, shear_protocol_end_step, &
                                 shear_protocol_varies, shear_protocol_set_rate, PROTOCOL_OSCILLATORY, CONTROL_STRESS
@@ -114,7 +114,7 @@ contains
     type(rheology_t), target, intent(in), optional :: rheology
     PetscBool :: set, use_local
     PetscInt :: fault_step
-    real(dp) :: reach
+    real(dp) :: reach, skin
     character(len=200) :: text
     ierr = 0
     ts%dt = dt
@@ -146,17 +146,29 @@ contains
     if (associated(ts%rheology) .and. associated(ts%fluid)) allocate(ts%mean_flow(0:ts%grid%n(2) - 1))
     if (ts%variant == TIME_STEP_FLUID_FREE) then
       ! the reach of the local set: the largest neighbour-list cut-off of the contacts and links
+      ! and the smallest skin of those lists: the local sets are kept while no sphere has moved
+      ! half of it (mod_ld_local)
       reach = 0.0_dp
-      if (associated(ts%contacts)) reach = ts%contacts%nlist%cutoff
-      if (associated(ts%lubrication)) reach = max(reach, ts%lubrication%nlist%cutoff)
+      skin = huge(1.0_dp)
+      if (associated(ts%contacts)) then
+        reach = ts%contacts%nlist%cutoff
+        skin = ts%contacts%nlist%skin
+      end if
+      if (associated(ts%lubrication)) then
+        reach = max(reach, ts%lubrication%nlist%cutoff)
+        skin = min(skin, ts%lubrication%nlist%skin)
+      end if
       ! (the statistics' shells too, which the local step samples: ghosts within their reach)
-      if (associated(ts%rheology) .and. reach > 0.0_dp) reach = max(reach, rheo_reach(ts%rheology))
+      if (associated(ts%rheology) .and. reach > 0.0_dp) then
+        reach = max(reach, rheo_reach(ts%rheology))
+        skin = min(skin, rheo_skin(ts%rheology))
+      end if
       ! -ld_local_set 0: every rank evaluates the step for every sphere (the replicated state, as
       ! before 2026-11-29; for comparisons)
       use_local = PETSC_TRUE
       PetscCall(PetscOptionsGetBool(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-ld_local_set', use_local, set, ierr))
       if (.not. use_local) reach = 0.0_dp
-      call ld_local_create(ts%local, box(3), reach)
+      call ld_local_create(ts%local, box(3), reach, skin)
       if (ts%local%active) then
         write(text, '(a,f7.3,a)') 'lubrication dynamics on the ranks'' local sets: each rank steps the spheres of '// &
              'its z-slab and their ghosts within ', reach, ' a (free or frozen spheres)'
@@ -712,6 +724,10 @@ contains
       ! the state between steps is the local sets; the replicated copy only for a failure
       write(text, '(a,i0,a,i0,a)') 'lubrication dynamics on the ranks'' local sets: the replicated view '// &
            'brought up to date ', ts%local%view_updates, ' times in ', ts%steps_taken, ' steps (a failure needs it)'
+      call log_line(text)
+      write(text, '(a,i0,a,i0,a,f6.3,a)') 'lubrication dynamics on the ranks'' local sets: the sets made ', &
+           ts%local%sets_made, ' times in ', ts%steps_taken, ' steps (kept while no sphere has moved half the skin, ', &
+           0.5_dp * ts%local%skin, ' a, along z)'
       call log_line(text)
     end if
     if (associated(ts%lubrication)) then

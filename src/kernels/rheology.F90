@@ -71,7 +71,7 @@ module mod_rheology
   public :: species_summary_t, rheo_summarise_species, rheo_species_quantities, NSPECIES_Q, NQS, species_names
   public :: rheology_settings_t, rheology_t, rheo_create, rheo_sample, rheo_sample_flow, rheo_accumulate, rheo_quantities, rheo_block_of, &
             rheo_state, rheo_restore, rheo_summarise, rheo_columns, NQ, NSUMMARY, summary_names, slab_volume, &
-            rheo_particle_shear_stress, rheo_set_local, rheo_sample_shares, rheo_sample_finish, rheo_reach
+            rheo_particle_shear_stress, rheo_set_local, rheo_sample_shares, rheo_sample_finish, rheo_reach, rheo_skin
 
   ! per-record values that are block-averaged: stress_hydro(5), stress_contact(5), phi_core,
   ! particle fit(5), suspension fit(5)
@@ -291,6 +291,15 @@ contains
     if (r%order) reach = max(reach, r%bond_list%cutoff)
     if (r%nradial > 0) reach = max(reach, r%radial_list%cutoff)
   end function rheo_reach
+
+  !> The smallest skin of the statistics' neighbour lists: their partners stay listed while no
+  !> sphere has moved half of it since their build.
+  pure real(dp) function rheo_skin(r) result(skin)
+    type(rheology_t), intent(in) :: r
+    skin = r%nl%skin
+    if (r%order) skin = min(skin, r%bond_list%skin)
+    if (r%nradial > 0) skin = min(skin, r%radial_list%skin)
+  end function rheo_skin
 
   ! The species of a mixture (distinct radii, smallest first), each sphere's species, and the
   ! per-species arrays and accumulators; the range of the partial g(r) (doc/RHEOLOGY.md "Per

@@ -6,10 +6,12 @@ velocities, its Adams-Bashforth history and its external load, and the contacts'
 ranks of the spheres they touch; the replicated view is brought up to date only when the output
 reads it. In the sheared box the spheres hardly move along z (the vorticity direction: in
 test_ld_rank_independence few cross a face), so this scene pushes them across: every sphere
-carries the same external force F along z, a drift of about F/(4 pi eta a) (72 a gamma_dot: the
-one-body drag, less the pairs' shared drag within the lubrication cut-off).
+carries the same external force F along z, a drift of about F/(4 pi eta a) (36 a gamma_dot: the
+one-body drag, less the pairs' shared drag within the lubrication cut-off), 0.07a a step: the
+local sets, kept while no sphere has moved half the skin (0.1a) along z, are made again about
+every other step, so that both paths alternate.
 Scene: 55 rough frictional spheres (phi 0.45, mu 0.5) in a Lees-Edwards cube of 8 a, 40 steps, the
-series recorded every 8 steps; a drift of 5.8 a over the run, 2.2 slab widths on 3 ranks.
+series recorded every 10 steps; a drift of 4.3a over the run, 1.6 slab widths on 3 ranks.
  1. the spheres do cross: between consecutive records every sphere changes slab on 3 ranks at least
     once, while frictional contacts hold springs;
  2. 2 and 3 ranks against 1 at every record: positions, velocities, omega, hydrodynamic and contact
@@ -19,13 +21,14 @@ most 2.4e-12, the contact stresslets); the sparse solve converges to a relative 
 and sums in another order on more ranks. A sphere that arrived without its Adams-Bashforth history
 or a spring lost in a migration changes a velocity or a contact force at O(1)."""
 import os
+import re
 import numpy as np
 import h5py
 import fdsusp_testlib as T
 
 L = 8.0
-STEPS, EVERY, DT = 40, 8, 2e-3
-F = 900.0
+STEPS, EVERY, DT = 60, 10, 2e-3
+F = 450.0
 PACK = """&domain box = {L}, {L}, {L}, y_boundary = 'lees-edwards', shear_rate = 1 /
 &fluid model = 'none' /
 &time dt = 2e-3, steps = 1 /
@@ -62,8 +65,8 @@ def deck(force):
 
 runs = {'drift_1': (F, 1), 'drift_2': (F, 2), 'drift_3': (F, 3)}
 dirs = {name: T.scratch('ld_migration_' + name) for name in runs}
-T.run_many([dict(deck=T.write_deck(dirs[name], 'd.nml', deck(force)), cwd=dirs[name], np_ranks=ranks)
-            for name, (force, ranks) in runs.items()])
+logs = dict(zip(runs, T.run_many([dict(deck=T.write_deck(dirs[name], 'd.nml', deck(force)), cwd=dirs[name],
+                                         np_ranks=ranks) for name, (force, ranks) in runs.items()])))
 S = {name: T.series(os.path.join(dirs[name], 'out')) for name in runs}
 T.check(len(S['drift_1']['time']) == STEPS // EVERY, '%d records (%d)' % (STEPS // EVERY, len(S['drift_1']['time'])))
 
@@ -83,6 +86,14 @@ with h5py.File(os.path.join(dirs['drift_1'], 'out', 'checkpoint.h5'), 'r') as f:
     keys1 = f['contacts/ids'][...] if springs1 else None
     ups1 = f['contacts/spring'][...] if springs1 else None
 T.check(springs1 > 0, 'frictional contacts hold springs at the end (%d)' % springs1)
+
+# the sets are kept while no sphere has moved half the skin (0.1a) along z, and made again after:
+# at ~0.07a a step, about every other step, so the run mixes both
+for ranks in (2, 3):
+    m = re.search(r'the sets made (\d+) times in (\d+) steps', logs['drift_%d' % ranks][1])
+    made = int(m.group(1)) if m else -1
+    T.check(STEPS // 4 <= made <= 3 * STEPS // 4, '%d ranks: the local sets made %d times in %d steps (kept in '
+            'between)' % (ranks, made, STEPS))
 
 # 2. 2 and 3 ranks against 1
 for ranks in (2, 3):
