@@ -6,11 +6,13 @@
 ! The statistics sample the local set too (ld_local_statistics: the ranks' shares summed in one
 ! reduction of O(bins)).
 !
-! The local set is the state between steps: the positions advance on it (time_step), and at the
-! next step's start (ld_local_begin) the own spheres that left the slab go to their new owner with
-! what they carry (velocities, the Adams-Bashforth history, external loads, radius), the ghosts are
-! rebuilt, and the springs of the contacts go to the neighbours whose spheres they touch. No message
-! of a step grows with the total number of spheres. The output takes each rank's share of the
+! The local set is the state between steps: the positions advance on it (time_step), the ghosts'
+! like their owners' from the same forwarded values. The sets are kept while no sphere has moved
+! half the kernels' smallest skin along z since they were made; then, at the next step's start
+! (ld_local_begin), the own spheres that left the slab go to their new owner with what they carry
+! (velocities, the Adams-Bashforth history, external loads, radius), the ghosts are rebuilt, and the
+! springs of the contacts go to the neighbours whose spheres they touch. No message of a step grows
+! with the total number of spheres. The output takes each rank's share of the
 ! local sets (mod_time_step time_step_share: the series, the snapshots, the checkpoints). The
 ! replicated particle state (the view) is brought up to date (ld_local_complete_view: positions,
 ! velocities, springs and the last step's hydrodynamic, contact and link results gathered) only
