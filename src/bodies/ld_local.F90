@@ -15,9 +15,8 @@
 ! with the total number of spheres. The output takes each rank's share of the
 ! local sets (mod_time_step time_step_share: the series, the snapshots, the checkpoints). The
 ! replicated particle state (the view) is brought up to date (ld_local_complete_view: positions,
-! velocities, springs and the last step's hydrodynamic, contact and link results gathered) only
-! for a failure, whose state and message it gives; a restart and the first step take the local
-! set from it.
+! velocities and springs gathered) only for a failure, whose state and message it gives; a
+! restart and the first step take the local set from it.
 !
 ! With one rank, or without contacts and links (the block-diagonal one-body problem), the step keeps
 ! the replicated state (ld_local_t%active false). An owned sphere sees every contact and link in
@@ -30,7 +29,7 @@ module mod_ld_local
   use mod_particles, only: particles_t, particles_init
   use mod_sphere_halo, only: sphere_halo_t, sphere_halo_create, sphere_halo_migrate, sphere_halo_build, &
                              sphere_halo_forward, sphere_halo_exchange, sphere_halo_slab_of
-  use mod_sorting, only: ascending_order
+  use mod_sorting, only: ascending_order, sorted_position
   use mod_contact, only: history_size, history_pack, history_unpack
   use mod_particle_contacts, only: particle_contacts_t, particle_contacts_set_local
   use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_set_local, &
@@ -41,13 +40,13 @@ module mod_ld_local
   implicit none
   private
   public :: ld_local_t, ld_local_create, ld_local_begin, ld_local_contacts_agree, ld_local_links, &
-            ld_local_forward_velocities, ld_local_statistics, ld_local_end, ld_local_complete_view, &
+            ld_local_forward_velocities, ld_local_statistics, ld_local_complete_view, &
             ld_local_own_slot
 
   type :: ld_local_t
     logical :: active = .false.           ! the step runs on the local set
     logical :: live = .false.             ! the local set holds the state (from the first step on)
-    logical :: view_current = .true.      ! the view holds the local set's state and last results
+    logical :: view_current = .true.      ! the view holds the local set's state
     type(sphere_halo_t) :: halo           ! own spheres and ghosts (ascending global index)
     type(particles_t) :: set              ! their state
     integer :: total = 0                  ! spheres of the whole system
@@ -58,20 +57,14 @@ module mod_ld_local
     real(dp), allocatable :: z_made(:)    ! the local set's centres' z when the sets were made
     logical :: kernels_told = .false.     ! the kernels hold the local set (their set_local)
     integer :: sets_made = 0              ! times the sets were made (the run's account)
-    ! the own spheres' results of the last step not yet in the view (ld_local_end)
-    real(dp), allocatable :: pending(:, :)
   end type ld_local_t
-
-  ! ld_local_end: a step that reached its solve (its results kept), or one that failed before it
-  integer, parameter, public :: RESULTS_KEPT = 1, RESULTS_NONE = 2
 
   ! what a sphere carries to a new owner and its owner forwards to its ghosts (carried): velocity,
   ! omega, the last step's velocity (Adams-Bashforth), external force and torque, radius
   integer, parameter :: CARRIED = 16
-  ! the values per own sphere that the view takes (after its global index): the state, position,
-  ! velocity, omega, the last step's velocity (STATE_VALUES); the results, the hydrodynamic force, torque,
-  ! stresslet, the contacts' force, torque, stresslet, the links' force, torque, stresslet (RESULT_VALUES)
-  integer, parameter :: STATE_VALUES = 12, RESULT_VALUES = 45
+  ! the values per own sphere that the view takes (after its global index): position, velocity,
+  ! omega, the last step's velocity
+  integer, parameter :: STATE_VALUES = 12
 
 contains
 
@@ -116,20 +109,20 @@ contains
     ierr = 0
     loc%total = parts%n
     loc%view_current = .false.
+    keep = .false.
     if (loc%live) then
       call sets_hold(loc, keep, ierr)
       if (ierr /= 0) return
-      loc%set%have_prev = parts%have_prev
-      if (keep) return
-      call carry_on(loc, ierr)
+      if (.not. keep) call carry_on(loc, ierr)
     else
       call take_view(loc, parts, ierr)
     end if
     if (ierr /= 0) return
+    loc%set%have_prev = parts%have_prev
+    if (keep) return
     loc%live = .true.
     loc%sets_made = loc%sets_made + 1
     associate(h => loc%halo, s => loc%set)
-      s%have_prev = parts%have_prev
       loc%z_made = s%position(3, :)
       radii = s%radii / parts%radius
       call own_rows(loc, rows, ierr)
@@ -298,7 +291,8 @@ contains
       do m = 1, size(h%neighbour)
         ! the global indices of the ghosts received from neighbour m, ascending
         theirs = h%id(h%recv_local(h%recv_start(m):h%recv_start(m + 1) - 1))
-        picked = [picked, pack([(i, i = 1, k)], [(found(theirs, keys(1, i)) .or. found(theirs, keys(2, i)), i = 1, k)])]
+        picked = [picked, pack([(i, i = 1, k)], [(sorted_position(theirs, keys(1, i)) > 0 .or. &
+                                                 sorted_position(theirs, keys(2, i)) > 0, i = 1, k)])]
         send_count(m) = size(picked) - sum(send_count(1:m - 1))
       end do
       allocate(send(5, size(picked)))
@@ -335,26 +329,6 @@ contains
         SETERRQ(PETSC_COMM_SELF, ierr, 'the springs kept on a rank do not form a contact history')
       end if
     end associate
-  contains
-    ! Whether g is in the ascending list ids (a bisection).
-    pure logical function found(ids, g)
-      integer, intent(in) :: ids(:), g
-      integer :: lo, hi, mid
-      found = .false.
-      lo = 1
-      hi = size(ids)
-      do while (lo <= hi)
-        mid = (lo + hi) / 2
-        if (ids(mid) == g) then
-          found = .true.
-          return
-        else if (ids(mid) < g) then
-          lo = mid + 1
-        else
-          hi = mid - 1
-        end if
-      end do
-    end function found
   end subroutine keep_springs
 
   !> After the contacts of the step on the local set: their diagnostics made the whole system's
@@ -468,51 +442,12 @@ contains
     call rheo_sample_finish(rheology, shares, min_gap)
   end subroutine ld_local_statistics
 
-  !> The end of the step's solve on the local set: results RESULTS_KEPT, the own spheres'
-  !> hydrodynamic force, torque and stresslet, and the contacts' and the links' per-sphere force,
-  !> torque and stresslet kept on their owner until the view takes them (ld_local_complete_view);
-  !> RESULTS_NONE, a step that failed before its solve: those of the last step stay kept.
-  !> Not collective.
-  subroutine ld_local_end(loc, results, contacts, lubrication)
-    type(ld_local_t), intent(inout) :: loc
-    integer, intent(in) :: results
-    type(particle_contacts_t), intent(in), optional :: contacts
-    type(particle_lubrication_t), intent(in), optional :: lubrication
-    integer :: q, k
-    if (results == RESULTS_NONE) return
-    associate(h => loc%halo, s => loc%set)
-      if (allocated(loc%pending)) deallocate(loc%pending)
-      allocate(loc%pending(RESULT_VALUES + 1, h%owned))
-      loc%pending = 0.0_dp
-      k = 0
-      do q = 1, s%n
-        if (.not. h%is_owned(q)) cycle
-        k = k + 1
-        loc%pending(1, k) = real(h%id(q), dp)
-        loc%pending(2:4, k) = s%force_hydro(:, q)
-        loc%pending(5:7, k) = s%torque_hydro(:, q)
-        loc%pending(8:16, k) = reshape(s%stresslet_hydro(:, :, q), [9])
-        if (present(contacts)) then
-          loc%pending(17:19, k) = contacts%force(:, q)
-          loc%pending(20:22, k) = contacts%torque(:, q)
-          loc%pending(23:31, k) = reshape(contacts%stresslet(:, :, q), [9])
-        end if
-        if (present(lubrication)) then
-          loc%pending(32:34, k) = lubrication%force(:, q)
-          loc%pending(35:37, k) = lubrication%torque(:, q)
-          loc%pending(38:46, k) = reshape(lubrication%stresslet(:, :, q), [9])
-        end if
-      end do
-    end associate
-  end subroutine ld_local_end
-
   !> The view parts brought up to date from the local set, for a failure (failed_state.h5 and the
-  !> runtime guard's message, which read every sphere): the own spheres'
-  !> positions, velocities, omega and last velocities gathered (STATE_VALUES), the springs of the
-  !> pairs whose first sphere is own into the contacts' history (every spring), the contacts and
-  !> the links set for every sphere (their set_local of the view) with the kept results of the
-  !> last step (ld_local_end) in their per-sphere arrays and parts'. Nothing when the view is
-  !> current (the same on every rank). Collective.
+  !> runtime guard's message, which read every sphere's state, not the step's forces): the own
+  !> spheres' positions, velocities, omega and last velocities gathered (STATE_VALUES), the springs
+  !> of the pairs whose first sphere is own into the contacts' history (every spring), the
+  !> contacts and the links set for every sphere (their set_local of the view). Nothing when the
+  !> view is current (the same on every rank). Collective.
   subroutine ld_local_complete_view(loc, parts, ierr, contacts, lubrication)
     type(ld_local_t), intent(inout) :: loc
     type(particles_t), intent(inout) :: parts
@@ -574,32 +509,16 @@ contains
         end if
       end if
     end associate
-    if (allocated(loc%pending)) then
-      PetscCall(gather_rows(loc%pending, all, ierr))
-      deallocate(loc%pending)
-      call put_results(all, parts, contacts, lubrication)
-    end if
   end subroutine ld_local_complete_view
 
   !> The slot in the local set of the own sphere of global index g; 0 when g is not an own sphere.
   pure integer function ld_local_own_slot(loc, g) result(slot)
     type(ld_local_t), intent(in) :: loc
     integer, intent(in) :: g
-    integer :: lo, hi, mid
-    slot = 0
-    lo = 1
-    hi = size(loc%halo%id)
-    do while (lo <= hi)
-      mid = (lo + hi) / 2
-      if (loc%halo%id(mid) == g) then
-        if (loc%halo%is_owned(mid)) slot = mid
-        return
-      else if (loc%halo%id(mid) < g) then
-        lo = mid + 1
-      else
-        hi = mid - 1
-      end if
-    end do
+    slot = sorted_position(loc%halo%id, g)
+    if (slot > 0) then
+      if (.not. loc%halo%is_owned(slot)) slot = 0
+    end if
   end function ld_local_own_slot
 
   ! Whether the sphere of global index g is one of this rank's own (false for a wall's id, < 0).
@@ -627,30 +546,5 @@ contains
     allocate(all(size(rows, 1), sum(counts) / max(1, size(rows, 1))))
     PetscCallMPI(MPI_Allgatherv(rows, size(rows), MPI_DOUBLE_PRECISION, all, counts, displs, MPI_DOUBLE_PRECISION, PETSC_COMM_WORLD, ierr))
   end subroutine gather_rows
-
-  ! The gathered results of ld_local_end (every sphere's) into the view's per-sphere arrays.
-  subroutine put_results(all, parts, contacts, lubrication)
-    real(dp), intent(in) :: all(:, :)
-    type(particles_t), intent(inout) :: parts
-    type(particle_contacts_t), intent(inout), optional :: contacts
-    type(particle_lubrication_t), intent(inout), optional :: lubrication
-    integer, allocatable :: id(:)
-    integer :: n
-    id = nint(all(1, :))
-    n = size(id)
-    parts%force_hydro(:, id) = all(2:4, :)
-    parts%torque_hydro(:, id) = all(5:7, :)
-    parts%stresslet_hydro(:, :, id) = reshape(all(8:16, :), [3, 3, n])
-    if (present(contacts)) then
-      contacts%force(:, id) = all(17:19, :)
-      contacts%torque(:, id) = all(20:22, :)
-      contacts%stresslet(:, :, id) = reshape(all(23:31, :), [3, 3, n])
-    end if
-    if (present(lubrication)) then
-      lubrication%force(:, id) = all(32:34, :)
-      lubrication%torque(:, id) = all(35:37, :)
-      lubrication%stresslet(:, :, id) = reshape(all(38:46, :), [3, 3, n])
-    end if
-  end subroutine put_results
 
 end module mod_ld_local

@@ -36,8 +36,7 @@ module mod_time_step
   use mod_ld_motion, only: ld_motion_solve, ld_motion_solve_stress
   use mod_particle_solver, only: particle_solver_t
   use mod_ld_local, only: ld_local_t, ld_local_create, ld_local_begin, ld_local_contacts_agree, ld_local_links, &
-                          ld_local_statistics, ld_local_end, ld_local_complete_view, ld_local_own_slot, &
-                          RESULTS_KEPT, RESULTS_NONE
+                          ld_local_statistics, ld_local_complete_view, ld_local_own_slot
   implicit none
   private
   public :: time_step_t, time_step_create, time_step_advance, time_step_guard, time_step_report, &
@@ -338,10 +337,10 @@ contains
   end subroutine time_step_advance
 
   ! The particle part of a lubrication-dynamics step on the ranks' local sets (mod_ld_local): the
-  ! local set of X^n (carried on from the last step's, or taken from ts%parts on the first), its
-  ! contacts and links, the 6N solve of the own spheres' rows, the statistics' sample, and the own
-  ! spheres' results kept for the view (time_step_advance then advances the local set, and brings
-  ! ts%parts up to date when the output reads it). A failure (an overlap, a link) is described in
+  ! local set of X^n (kept or carried on from the last step's, or taken from ts%parts on the
+  ! first), its contacts and links, the 6N solve of the own spheres' rows, the statistics' sample
+  ! (time_step_advance then advances the local set, which the output takes: time_step_share). A
+  ! failure (an overlap, a link) is described in
   ! ts%failure, the local set left at X^n (every stage popped); otherwise the Particles stage is
   ! left pushed for the step's end. Collective.
   subroutine local_step(ts, ierr)
@@ -361,7 +360,6 @@ contains
         PetscCall(stage_pop(ierr))
         if (info /= 0) then
           ts%failure = contact_failure(ts%contacts, info)
-          call ld_local_end(loc, RESULTS_NONE)
           return
         end if
       end if
@@ -376,7 +374,6 @@ contains
         PetscCall(stage_pop(ierr))
         if (ts%lubrication%failed_link(1) /= 0) then
           ts%failure = lubrication_failure(ts%lubrication%failed_link)
-          call ld_local_end(loc, RESULTS_NONE)
           return
         end if
       end if
@@ -402,7 +399,6 @@ contains
       if (associated(ts%lubrication)) then
         PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, ts%lubrication%wall_force, 6, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr))
       end if
-      call ld_local_end(loc, RESULTS_KEPT, ts%contacts, ts%lubrication)
     end associate
   end subroutine local_step
 
@@ -436,9 +432,9 @@ contains
     share%total = ts%local%total
   end subroutine time_step_share
 
-  ! ts%parts, the contacts and the links brought up to date from the ranks' local sets (positions,
-  ! velocities, springs, the last step's results), for the state a failure writes; nothing when
-  ! they are (or the step is replicated). Collective.
+  ! ts%parts and the contacts' springs brought up to date from the ranks' local sets (positions,
+  ! velocities, springs), for the state a failure writes; nothing when they are (or the step is
+  ! replicated). Collective.
   subroutine time_step_complete_view(ts, ierr)
     type(time_step_t), intent(inout) :: ts
     PetscErrorCode, intent(out) :: ierr

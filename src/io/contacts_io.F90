@@ -11,6 +11,7 @@ module mod_contacts_io
   use petscsys
   use mod_kinds, only: dp
   use mod_contact, only: contact_history_t, history_size, history_pack, history_unpack, history_clear
+  use mod_sorting, only: sorted_position
   use mod_h5util, only: write_attribute, read_attribute, has_object, write_dataset, read_dataset
   use mod_errors, only: is_root, file_error, file_error_from_root, abort_run, warn_line
   implicit none
@@ -58,13 +59,16 @@ contains
     type(contact_history_t), intent(inout) :: all
     integer, allocatable :: keys(:, :), counts(:), displs(:)
     real(dp), allocatable :: ups(:, :), mine(:, :), every(:, :)
-    integer :: n, np, k, i, r, ranks, rank, info, ierr
+    integer :: n, np, k, i, p, r, ranks, rank, info, ierr
     n = history_size(h)
     allocate(keys(2, n), ups(3, n), mine(5, n))
     if (n > 0) call history_pack(h, np, keys, ups)
     k = 0
     do i = 1, n
-      if (.not. owned(keys(1, i))) cycle
+      ! each pair from the owner of its first sphere (a sphere, never a wall)
+      p = sorted_position(id, keys(1, i))
+      if (p == 0) cycle
+      if (.not. own(p)) cycle
       k = k + 1
       mine(:, k) = [real(keys(:, i), dp), ups(:, i)]
     end do
@@ -84,26 +88,6 @@ contains
     call history_unpack(all, total, size(every, 2), nint(every(1:2, :)), every(3:5, :), info)
     if (info /= 0) call abort_run('internal error: the springs gathered from the ranks do not form a '// &
                                   'contact history (mod_contacts_io)')
-  contains
-    ! Whether the sphere of global index g is one of this rank's own (a bisection of id).
-    pure logical function owned(g)
-      integer, intent(in) :: g
-      integer :: lo, hi, mid
-      owned = .false.
-      lo = 1
-      hi = size(id)
-      do while (lo <= hi)
-        mid = (lo + hi) / 2
-        if (id(mid) == g) then
-          owned = own(mid)
-          return
-        else if (id(mid) < g) then
-          lo = mid + 1
-        else
-          hi = mid - 1
-        end if
-      end do
-    end function owned
   end subroutine contacts_gather
 
   ! Restart: the history from the checkpoint PATH (collective). np: the particle count of the

@@ -10,7 +10,7 @@ module mod_columns
   use mod_kinds, only: dp
   implicit none
   private
-  public :: column_t, column, sphere_column
+  public :: column_t, column, sphere_column, sphere_rows
 
   type :: column_t
     character(len=64) :: name = ''
@@ -98,5 +98,22 @@ contains
     c%values = reshape(value, [size(value)])
     c%rows = rows
   end function sphere_column_tensor
+
+  !> The global indices and the number of all spheres of a per-sphere column given for the spheres
+  !> owned of a set of whole spheres: owned itself and whole when the set is every sphere; rows and
+  !> total, when given, for a rank's local set (mod_ld_local), whose indices are not global.
+  pure subroutine sphere_rows(owned, whole, r, n, rows, total)
+    integer, intent(in) :: owned(:), whole
+    integer, allocatable, intent(out) :: r(:)
+    integer, intent(out) :: n
+    integer, intent(in), optional :: rows(:), total
+    if (present(rows)) then
+      r = rows
+    else
+      r = owned
+    end if
+    n = whole
+    if (present(total)) n = total
+  end subroutine sphere_rows
 
 end module mod_columns

@@ -28,7 +28,7 @@ module mod_particle_contacts
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates
   use mod_lees_edwards, only: lees_edwards_t
   use mod_particle_system, only: particle_system_t, particle_system_add_diagonal, particle_system_add_pair
-  use mod_columns, only: column_t, column, sphere_column
+  use mod_columns, only: column_t, column, sphere_column, sphere_rows
   implicit none
   private
   public :: particle_contacts_settings_t, particle_contacts_t, particle_contacts_create, particle_contacts_step, &
@@ -352,10 +352,7 @@ contains
     type(column_t), allocatable :: c(:)
     integer, allocatable :: r(:)
     integer :: n
-    r = owned
-    n = size(pc%force, 2)
-    if (present(rows)) r = rows
-    if (present(total)) n = total
+    call sphere_rows(owned, size(pc%force, 2), r, n, rows, total)
     ! element by element: an array constructor of column_t leaks their values (gfortran 12)
     allocate(c(merge(8, 7, .not. pc%periodic(2))))
     c(1) = column('contacts_pair', pc%stats%pair_contacts)

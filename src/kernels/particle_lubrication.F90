@@ -40,7 +40,7 @@ module mod_particle_lubrication
   use mod_neighbours, only: nlist_t, nlist_init, nlist_candidates
   use mod_lees_edwards, only: lees_edwards_t, le_separation
   use mod_particle_system, only: particle_system_t, particle_system_add_diagonal, particle_system_add_pair
-  use mod_columns, only: column_t, column, sphere_column
+  use mod_columns, only: column_t, column, sphere_column, sphere_rows
   implicit none
   private
   public :: particle_lubrication_t, particle_lubrication_create, particle_lubrication_links, &
@@ -633,10 +633,7 @@ contains
     type(column_t), allocatable :: c(:)
     integer, allocatable :: r(:)
     integer :: n
-    r = owned
-    n = size(pl%force, 2)
-    if (present(rows)) r = rows
-    if (present(total)) n = total
+    call sphere_rows(owned, size(pl%force, 2), r, n, rows, total)
     ! element by element: an array constructor of column_t leaks their values (gfortran 12)
     allocate(c(merge(6, 5, pl%walls)))
     c(1) = column('lubrication_pairs', pl%npairs_total)

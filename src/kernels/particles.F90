@@ -4,7 +4,7 @@
 module mod_particles
   use mod_kinds, only: dp
   use mod_neighbours, only: min_image
-  use mod_columns, only: column_t, sphere_column
+  use mod_columns, only: column_t, sphere_column, sphere_rows
   implicit none
   private
   public :: particles_t, sphere_share_t, particles_init, advance_positions, displacements, configuration_fault, impose_motion, &
@@ -205,10 +205,7 @@ contains
     type(column_t), allocatable :: c(:)
     integer, allocatable :: r(:)
     integer :: n
-    r = owned
-    n = p%n
-    if (present(rows)) r = rows
-    if (present(total)) n = total
+    call sphere_rows(owned, p%n, r, n, rows, total)
     ! element by element: an array constructor of column_t leaks their values (gfortran 12)
     allocate(c(6))
     c(1) = sphere_column('particles/position', n, r, p%position(:, owned))

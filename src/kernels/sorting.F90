@@ -2,7 +2,7 @@
 module mod_sorting
   implicit none
   private
-  public :: ascending_order
+  public :: ascending_order, sorted_position
 
 contains
 
@@ -43,5 +43,26 @@ contains
       width = 2 * width
     end do
   end function ascending_order
+
+
+  !> The position of g in the ascending list ids (a bisection); 0 when g is not in it.
+  pure integer function sorted_position(ids, g) result(position)
+    integer, intent(in) :: ids(:), g
+    integer :: lo, hi, mid
+    position = 0
+    lo = 1
+    hi = size(ids)
+    do while (lo <= hi)
+      mid = (lo + hi) / 2
+      if (ids(mid) == g) then
+        position = mid
+        return
+      else if (ids(mid) < g) then
+        lo = mid + 1
+      else
+        hi = mid - 1
+      end if
+    end do
+  end function sorted_position
 
 end module mod_sorting

@@ -73,8 +73,7 @@ program fdsusp
   type(rheology_t), pointer :: rheology_p => null()
   type(lees_edwards_t), pointer :: le_p => null()
   type(time_step_t), target :: ts                   ! the step of this run
-  type(sphere_share_t) :: share                     ! this rank's share of the spheres (time_step_share)
-  logical :: shared
+  type(sphere_share_t), target :: share             ! this rank's share of the spheres (output_share)
   type(run_output_t) :: out                         ! what it writes, and when
   character(len=max_line) :: deck, restart
   character(len=400) :: text
@@ -221,13 +220,7 @@ program fdsusp
     end if
     step = step + 1
     time = time + cfg%time%dt
-    ! (lubrication dynamics on several ranks: the output takes each rank's share of the spheres)
-    call time_step_share(ts, share, shared)
-    if (shared) then
-      PetscCallA(run_output_step(out, step, time, ierr, share))
-    else
-      PetscCallA(run_output_step(out, step, time, ierr))
-    end if
+    PetscCallA(run_output_step(out, step, time, ierr, output_share()))
     ! the runtime guard: a non-finite or escaped state stops the run with a diagnostic
     PetscCallA(time_step_guard(ts, step, ierr))
     if (len_trim(ts%failure) > 0) then
@@ -239,12 +232,7 @@ program fdsusp
 
   ! ---- end of run: the series, the last fields and a checkpoint to continue from ----
   if (step > first_step) call time_step_report(ts, (MPI_Wtime() - wall_loop) / (step - first_step))
-  call time_step_share(ts, share, shared)
-  if (shared) then
-    PetscCallA(run_output_close(out, step, time, ierr, share))
-  else
-    PetscCallA(run_output_close(out, step, time, ierr))
-  end if
+  PetscCallA(run_output_close(out, step, time, ierr, output_share()))
   call log_line(run_stop_line(cfg, stop_reason, step, merge(fl%max_rate, 0.0_dp, cfg%resolved)))
   if (cfg%verification%manufactured_solution .and. cfg%resolved) then
     PetscCallA(fluid_errors_vs_manufactured(grid, fl, cfg%domain%shear_rate, err_vel, err_p_max, err_p_rms, ierr))
@@ -272,6 +260,17 @@ program fdsusp
   PetscCallA(PetscFinalize(ierr))
 
 contains
+
+  ! What the output takes of the spheres: this rank's share when the state is the ranks' local sets
+  ! (lubrication dynamics on several ranks, time_step_share), else nothing (a disassociated pointer,
+  ! an absent argument: the replicated particles).
+  function output_share() result(p)
+    type(sphere_share_t), pointer :: p
+    logical :: shared
+    call time_step_share(ts, share, shared)
+    p => null()
+    if (shared) p => share
+  end function output_share
 
   ! The peak resident memory of the run (VmHWM), summed over the ranks and per grid cell: gross,
   ! the libraries' fixed cost included. scripts/bench_memory.sh takes the difference of two grids

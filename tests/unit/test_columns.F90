@@ -6,7 +6,9 @@
 !  2. the spheres' columns are the six of doc/INPUT.md "&particles", in the file's order, each with
 !     shape (3, N) or (3, 3, N) and the particle data unchanged;
 !  3. a per-sphere column (sphere_column) of some spheres holds their rows only, with their global
-!     indices, and the shape of all N spheres; the spheres' columns are per-sphere columns.
+!     indices, and the shape of all N spheres; the spheres' columns are per-sphere columns;
+!  4. of a rank's local set (mod_ld_local: its spheres' own indices are not global), the spheres'
+!     columns of the own spheres carry the global indices given and the shape of all the spheres.
 ! Exact comparisons: the values are copied, not computed.
 program test_columns
   use mod_kinds, only: dp
@@ -56,5 +58,10 @@ program test_columns
   cs = particles_columns(p, [3])
   call check(all(cs(1)%shape == [3, 4, 0]) .and. all(cs(1)%values == m(:, 3)) .and. all(cs(6)%shape == [3, 3, 4]) &
              .and. size(cs(6)%values) == 9, 'the spheres'' columns of sphere 3 only: its rows, the shapes of all 4')
+  ! the 4 spheres as a local set whose slots 2 and 4 are own, global spheres 7 and 9 of 10
+  cs = particles_columns(p, [2, 4], [7, 9], 10)
+  call check(all(cs(1)%shape == [3, 10, 0]) .and. all(cs(1)%rows == [7, 9]) .and. &
+             all(cs(2)%values == reshape(2 * m(:, [2, 4]), [6])) .and. all(cs(6)%shape == [3, 3, 10]), &
+             'a local set''s own spheres 2 and 4: their values under global indices 7 and 9, the shapes of all 10')
   call finish('test_columns')
 end program test_columns
