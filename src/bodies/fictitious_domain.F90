@@ -23,8 +23,12 @@
 !   moments    F = -sum Lambda e_c dV, T = -sum r x Lambda e_c dV,
 !              S = -1/2 sum Lambda (r e_c + e_c r) dV - (sum_cells alpha p dV) I   (§3.7: the
 !              trace of the traction moment needs the interior pressure).
-! Particle data is replicated; each rank works on the faces it owns and the moments are summed
-! over ranks, so spheres cross processor boundaries freely and the result does not depend on the
+! Each rank works on the faces it owns. The spheres are replicated and the moments summed over
+! the ranks, or (halo, optional in each routine: the resolved step on the ranks' local sets,
+! mod_ld_local) the spheres are a rank's own spheres and their ghosts, whose faces may lie on its
+! grid, and each sphere's partial moments are added into its owner's (mod_sphere_halo's reverse
+! exchange; nothing of size N is sent), which alone sets its block row and solves for its motion.
+! Either way spheres cross processor boundaries freely and the result does not depend on the
 ! decomposition beyond round-off.
 ! Lees-Edwards (doc/METHOD.md §3.9): the grid is not wrapped in y; a sphere that reaches across
 ! y = 0 or Ly is visited once more as its image in the box, at x -+ delta, y -+ Ly, moving faster
@@ -42,7 +46,8 @@ module mod_fictitious_domain
   use mod_particles, only: particles_t, MOTION_FREE, MOTION_FROZEN, impose_motion
   use mod_particle_system, only: particle_system_reset, particle_system_add_diagonal
   use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_add_to_system, &
-                                      particle_lubrication_add_corrections
+                                      particle_lubrication_add_corrections, particle_lubrication_corrections
+  use mod_sphere_halo, only: sphere_halo_t, sphere_halo_reverse, sphere_halo_forward
   use mod_lubrication_links, only: lubrication_links_corrections
   use mod_particle_contacts, only: particle_contacts_t, particle_contacts_add_stiffness, &
                                    particle_contacts_implicit_update, particle_contacts_set_rate
@@ -174,17 +179,26 @@ contains
   ! the paper scene), the sphere computes their alphas there itself, so every sphere takes the same
   ! decision without grid-sized ownership arrays or a second pass (before 2026-11-26 the geometry
   ! was half of the paper scene's step).
-  ! le, optional: a Lees-Edwards boundary (le%active), its offset now.
-  subroutine fictitious_domain_geometry(grid, fd, parts, le)
+  ! le, optional: a Lees-Edwards boundary (le%active), its offset now. halo, optional: parts is a
+  ! rank's local set, M_p summed on each sphere's owner (see the top); set_made, optional: the
+  ! local set was made anew since the last geometry (its indices are other spheres').
+  subroutine fictitious_domain_geometry(grid, fd, parts, le, halo, set_made)
     type(grid_t), intent(in) :: grid
     type(fictitious_domain_t), intent(inout) :: fd
     type(particles_t), intent(in) :: parts
     type(lees_edwards_t), intent(in), optional :: le
+    type(sphere_halo_t), intent(inout), optional :: halo
+    logical, intent(in), optional :: set_made
     integer :: ierr, e
+    logical :: new_set
     real(dp) :: h
     type(mac_block_t) :: block
 
     PetscCallA(event_begin(EVENT_GEOMETRY, ierr))
+    ! the spheres are another set than the last geometry's (a local set made anew: the rivals'
+    ! neighbour list starts afresh)
+    new_set = .false.
+    if (present(set_made)) new_set = set_made
     ! each sphere inflated by the same offset in cells (§3.3): the offset is the grid's, not the sphere's
     if (allocated(fd%inflated_radius)) then
       if (size(fd%inflated_radius) /= parts%n) deallocate(fd%inflated_radius)
@@ -204,30 +218,55 @@ contains
       ! the spheres and their images in the box (see the top)
       fd%le = le
       call make_entries(grid, fd, parts)
-      call find_rivals(grid, fd, fd%entry_position, fd%entry_radius)
+      call find_rivals(grid, fd, fd%entry_position, fd%entry_radius, .true.)
       if (allocated(fd%rigid_entries)) deallocate(fd%rigid_entries)
       allocate(fd%rigid_entries(6, 6, fd%entries))
       fd%rigid_entries = 0.0_dp
       block = mac_block_t(h=h, box=grid%box, n=grid%n, walls=.false., sliding=.true., lo=grid%lo, hi=grid%hi)
       call faces_build(block, fd%entry_position, fd%entry_radius, fd%kappa * fd%beta * h**2 / fd%eta, &
                        fd%rival_start, fd%rival_part, fd%rival_offset, fd%faces, fd%rigid_entries)
-      call MPI_Allreduce(MPI_IN_PLACE, fd%rigid_entries, 36 * fd%entries, MPI_DOUBLE_PRECISION, MPI_SUM, &
-                         PETSC_COMM_WORLD, ierr)
-      do e = 1, fd%entries
-        fd%rigid_matrix(:, :, fd%owner(e)) = fd%rigid_matrix(:, :, fd%owner(e)) + fd%rigid_entries(:, :, e)
-      end do
+      if (present(halo)) then
+        ! (the entries' matrices stay this rank's parts: the moments use them linearly)
+        do e = 1, fd%entries
+          fd%rigid_matrix(:, :, fd%owner(e)) = fd%rigid_matrix(:, :, fd%owner(e)) + fd%rigid_entries(:, :, e)
+        end do
+        call owners_sum_matrices(fd%rigid_matrix, halo, ierr)
+      else
+        call MPI_Allreduce(MPI_IN_PLACE, fd%rigid_entries, 36 * fd%entries, MPI_DOUBLE_PRECISION, MPI_SUM, &
+                           PETSC_COMM_WORLD, ierr)
+        do e = 1, fd%entries
+          fd%rigid_matrix(:, :, fd%owner(e)) = fd%rigid_matrix(:, :, fd%owner(e)) + fd%rigid_entries(:, :, e)
+        end do
+      end if
       fd%previous_position = parts%position
       fd%previous_offset = le%offset
     else
-      call find_rivals(grid, fd, parts%position, fd%inflated_radius)
+      call find_rivals(grid, fd, parts%position, fd%inflated_radius, new_set)
       block = mac_block_t(h=h, box=grid%box, n=grid%n, walls=grid%walls, lo=grid%lo, hi=grid%hi)
       call faces_build(block, parts%position, fd%inflated_radius, fd%kappa * fd%beta * h**2 / fd%eta, fd%rival_start, &
                        fd%rival_part, fd%rival_offset, fd%faces, fd%rigid_matrix)
-      call MPI_Allreduce(MPI_IN_PLACE, fd%rigid_matrix, 36 * parts%n, MPI_DOUBLE_PRECISION, MPI_SUM, &
-                         PETSC_COMM_WORLD, ierr)
+      if (present(halo)) then
+        call owners_sum_matrices(fd%rigid_matrix, halo, ierr)
+      else
+        call MPI_Allreduce(MPI_IN_PLACE, fd%rigid_matrix, 36 * parts%n, MPI_DOUBLE_PRECISION, MPI_SUM, &
+                           PETSC_COMM_WORLD, ierr)
+      end if
     end if
     PetscCallA(event_end(EVENT_GEOMETRY, ierr))
   end subroutine fictitious_domain_geometry
+
+  ! The rigid-body matrices (6, 6, n) of a local set: each ghost's part, made from this rank's
+  ! faces, added into its owner's (mod_sphere_halo); a ghost keeps its part. Collective among
+  ! neighbours.
+  subroutine owners_sum_matrices(matrices, halo, ierr)
+    real(dp), intent(inout) :: matrices(:, :, :)
+    type(sphere_halo_t), intent(inout) :: halo
+    PetscErrorCode, intent(out) :: ierr
+    real(dp), allocatable :: flat(:, :)
+    flat = reshape(matrices, [36, size(matrices, 3)])
+    call sphere_halo_reverse(halo, flat, ierr)
+    matrices = reshape(flat, shape(matrices))
+  end subroutine owners_sum_matrices
 
   ! The entries of a Lees-Edwards geometry (see the top): every sphere (entries 1..n), then the
   ! image above of each sphere whose visit may reach below y = 0 (its centre within its inflated
@@ -294,10 +333,11 @@ contains
   ! reach would let a sphere reach its own image: refused.
   ! Lees-Edwards: among the entries (spheres and images, positions (3, :)), with y not wrapped; the
   ! entries change with every geometry, so the list is made afresh each time.
-  subroutine find_rivals(grid, fd, positions, radii)
+  subroutine find_rivals(grid, fd, positions, radii, new_set)
     type(grid_t), intent(in) :: grid
     type(fictitious_domain_t), intent(inout) :: fd
     real(dp), intent(in) :: positions(:, :), radii(:)
+    logical, intent(in) :: new_set
     real(dp) :: reach
     integer :: info, l, i, j, n, pass
     logical :: periodic(3)
@@ -305,12 +345,14 @@ contains
     character(len=200) :: text
 
     n = size(positions, 2)
-    reach = maxval(radii) + 0.5_dp * sqrt(3.0_dp) * grid%h
+    reach = 0.5_dp * sqrt(3.0_dp) * grid%h
+    if (n > 0) reach = reach + maxval(radii)
     periodic = [.true., .not. (grid%walls .or. fd%sliding), .true.]
-    if (fd%sliding .and. allocated(fd%rival_start)) then
+    if ((fd%sliding .or. new_set) .and. allocated(fd%rival_start)) then
       if (size(fd%rival_start) /= n + 1) deallocate(fd%rival_start)
       if (allocated(fd%reach_pairs)) deallocate(fd%reach_pairs)
     end if
+    if (new_set) fd%reach_list%np = 0
     if (.not. allocated(fd%rival_start)) then
       if (any(periodic .and. grid%box < 2.0_dp * reach)) then
         write(text, '(a,f8.4,a)') 'fdsusp: error: &domain box: every periodic length must be at least ', &
@@ -393,13 +435,14 @@ contains
   ! to it at the last offset (an image moves by -+ the offset's change besides its sphere), which
   ! the carry works out itself (displacement unused), and the old Lambda across y = 0, Ly is read
   ! at the last offset (the ghost rows of the carry layout, mod_sliding_boundary). Collective.
-  subroutine fictitious_domain_follow(grid, fd, parts, displacement, ierr, le)
+  subroutine fictitious_domain_follow(grid, fd, parts, displacement, ierr, le, halo)
     type(grid_t), intent(in) :: grid
     type(fictitious_domain_t), intent(inout) :: fd
     type(particles_t), intent(in) :: parts
     real(dp), intent(in) :: displacement(:, :)
     PetscErrorCode, intent(out) :: ierr
     type(lees_edwards_t), intent(in), optional :: le
+    type(sphere_halo_t), intent(inout), optional :: halo
     Vec :: old(3)
     type(field_view_t) :: lam_old(3), lam(3)
     type(lees_edwards_t) :: before
@@ -413,7 +456,7 @@ contains
       before%offset = fd%previous_offset
       last_position = fd%previous_position
     end if
-    call fictitious_domain_geometry(grid, fd, parts, le)
+    call fictitious_domain_geometry(grid, fd, parts, le, halo)
     if (fd%sliding) then
       allocate(entry_displacement(3, fd%entries))
       do e = 1, fd%entries
@@ -500,12 +543,13 @@ contains
 
   ! b = sum_f w u~_c g dV and m = sum_f Lambda^n_f/(1+gamma) g dV per sphere (rows 1-6, 7-12 of
   ! fd%moments). vel: the projected velocity u~. Collective.
-  subroutine fictitious_domain_moments(grid, fd, vel, n, ierr)
+  subroutine fictitious_domain_moments(grid, fd, vel, n, ierr, halo)
     type(grid_t), intent(in) :: grid
     type(fictitious_domain_t), intent(inout) :: fd
     Vec, intent(in) :: vel(3)
     integer, intent(in) :: n
     PetscErrorCode, intent(out) :: ierr
+    type(sphere_halo_t), intent(inout), optional :: halo
     type(field_view_t) :: u(3), lam(3)
     real(dp) :: dv
     real(dp), allocatable :: entry_moments(:, :)
@@ -534,8 +578,10 @@ contains
       PetscCall(DMDAVecRestoreArrayReadF90(grid%da(c), vel(c), u(c)%v, ierr))
     end do
     if (fd%sliding) then
-      call MPI_Allreduce(MPI_IN_PLACE, entry_moments, 12 * fd%entries, MPI_DOUBLE_PRECISION, MPI_SUM, &
-                         PETSC_COMM_WORLD, ierr)
+      if (.not. present(halo)) then
+        call MPI_Allreduce(MPI_IN_PLACE, entry_moments, 12 * fd%entries, MPI_DOUBLE_PRECISION, MPI_SUM, &
+                           PETSC_COMM_WORLD, ierr)
+      end if
       ! an image's faces move faster by copy gamma_dot Ly e_x: b - copy gamma_dot Ly M_p e_1 (see the top)
       do e = 1, fd%entries
         q = fd%owner(e)
@@ -543,9 +589,12 @@ contains
         if (fd%copy(e) /= 0) fd%moments(1:6, q) = fd%moments(1:6, q) &
                                                   - fd%copy(e) * fd%image_speed * fd%rigid_entries(1:6, 1, e)
       end do
-    else
+    else if (.not. present(halo)) then
       call MPI_Allreduce(MPI_IN_PLACE, fd%moments, 12 * n, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
     end if
+    ! a local set: each sphere's parts (with an image's, and its correction from this rank's part of
+    ! the image's M_p: the sum is linear) added into its owner's
+    if (present(halo)) call sphere_halo_reverse(halo, fd%moments, ierr)
     PetscCall(event_end(EVENT_MOMENTS, ierr))
   end subroutine fictitious_domain_moments
 
@@ -558,24 +607,40 @@ contains
   ! the contacts of this step (particle_contacts_step at X^n): their forces and torques join the
   ! right-hand side (free and frozen motion) and, for free motion with implicit contacts, their
   ! linearised stiffness the 6N system; after the solve their force, torque and stresslet are
-  ! those the balance used (mod_particle_contacts). Identical on every rank (replicated data).
-  subroutine fictitious_domain_solve_motion(fd, parts, ierr, extra_force, extra_torque, lubrication, contacts)
+  ! those the balance used (mod_particle_contacts). Identical on every rank (replicated data), or
+  ! (halo, optional) parts is a rank's local set: the own spheres' rows are solved (fd%solver told
+  ! the set, mod_ld_local), a ghost's row is a placeholder (the identity), and the own velocities
+  ! are then forwarded to their ghosts, before the contacts' update.
+  subroutine fictitious_domain_solve_motion(fd, parts, ierr, extra_force, extra_torque, lubrication, contacts, halo)
     type(fictitious_domain_t), intent(inout) :: fd
     type(particles_t), intent(inout) :: parts
     PetscErrorCode, intent(out) :: ierr
     real(dp), intent(in), optional :: extra_force(:, :), extra_torque(:, :)
     type(particle_lubrication_t), intent(in), optional :: lubrication
     type(particle_contacts_t), intent(inout), optional :: contacts
-    real(dp), allocatable :: rhs(:, :)
+    type(sphere_halo_t), intent(inout), optional :: halo
+    real(dp), allocatable :: rhs(:, :), v(:, :)
+    real(dp) :: identity(6, 6)
     integer :: q, n
 
     PetscCall(event_begin(EVENT_MOTION, ierr))
     n = parts%n
+    identity = 0.0_dp
+    do q = 1, 6
+      identity(q, q) = 1.0_dp
+    end do
     select case (parts%motion)
     case (MOTION_FREE, MOTION_FROZEN)
       allocate(rhs(6, n))
       call particle_system_reset(fd%solver%system, n)
       do q = 1, n
+        if (present(halo)) then
+          if (.not. halo%is_owned(q)) then
+            call particle_system_add_diagonal(fd%solver%system, q, identity)
+            rhs(:, q) = 0.0_dp
+            cycle
+          end if
+        end if
         call particle_system_add_diagonal(fd%solver%system, q, fd%beta * fd%rigid_matrix(:, :, q))
         rhs(:, q) = fd%beta * fd%moments(1:6, q) - fd%moments(7:12, q) &
              + [parts%external_force(:, q), parts%external_torque(:, q)]
@@ -588,6 +653,15 @@ contains
         call particle_contacts_add_stiffness(contacts, fd%solver%system, rhs, parts%velocity, parts%omega, parts%have_prev)
       call particle_solver_solve(fd%solver, rhs, parts, ierr, ': a particle covers no grid face?')
       CHKERRQ(ierr)
+      if (present(halo)) then
+        allocate(v(6, n))
+        v(1:3, :) = parts%velocity
+        v(4:6, :) = parts%omega
+        call sphere_halo_forward(halo, v, ierr)
+        CHKERRQ(ierr)
+        parts%velocity = v(1:3, :)
+        parts%omega = v(4:6, :)
+      end if
       if (present(contacts)) call particle_contacts_implicit_update(contacts, parts%velocity, parts%omega)
     case default                    ! prescribed, resistance, fixed
       call impose_motion(parts)
@@ -879,7 +953,7 @@ contains
   ! T = -sum r x Lambda e_c dV, S = -1/2 sum Lambda (r e_c + e_c r) dV - (sum_cells alpha p dV) I
   ! (doc/METHOD.md §3.7). vel: u~ on entry, u^{n+1} on exit. lubrication, optional: its corrections are added to
   ! the resolved force, torque and stresslet, which then hold the total hydrodynamics. Collective.
-  subroutine fictitious_domain_update(grid, fd, vel, pressure, parts, ierr, lubrication)
+  subroutine fictitious_domain_update(grid, fd, vel, pressure, parts, ierr, lubrication, halo)
     type(grid_t), intent(in) :: grid
     type(fictitious_domain_t), intent(inout) :: fd
     Vec, intent(inout) :: vel(3)
@@ -887,6 +961,7 @@ contains
     type(particles_t), intent(inout) :: parts
     PetscErrorCode, intent(out) :: ierr
     type(particle_lubrication_t), intent(inout), optional :: lubrication
+    type(sphere_halo_t), intent(inout), optional :: halo
     real(dp), allocatable :: sums(:, :), velocity(:, :), omega(:, :), entry_sums(:, :)
     type(field_view_t) :: u(3), lam(3), p
     real(dp) :: dv, integral
@@ -958,14 +1033,23 @@ contains
     end do
     if (fd%sliding) then
       ! an image's force, torque and stresslet (about its own centre) are its sphere's
-      call MPI_Allreduce(MPI_IN_PLACE, entry_sums, 16 * fd%entries, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
+      if (.not. present(halo)) then
+        call MPI_Allreduce(MPI_IN_PLACE, entry_sums, 16 * fd%entries, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
+      end if
       do e = 1, fd%entries
         sums(:, fd%owner(e)) = sums(:, fd%owner(e)) + entry_sums(:, e)
       end do
-    else
+    else if (.not. present(halo)) then
       call MPI_Allreduce(MPI_IN_PLACE, sums, 16 * n, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
     end if
-    if (present(lubrication)) then
+    ! a local set: each sphere's parts added into its owner's, whose sums are then complete (a
+    ! ghost's are its part; nothing reads them), and its links' corrections (every link of an own
+    ! sphere is this rank's)
+    if (present(halo)) then
+      call sphere_halo_reverse(halo, sums, ierr)
+      CHKERRQ(ierr)
+      if (present(lubrication)) call particle_lubrication_corrections(lubrication, parts%velocity, parts%omega)
+    else if (present(lubrication)) then
       PetscCall(lubrication_links_corrections(lubrication, parts%velocity, parts%omega, ierr))
     end if
     do q = 1, n

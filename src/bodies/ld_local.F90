@@ -1,5 +1,8 @@
-! The lubrication-dynamics step on a rank's local set (issue 45; doc/DESIGN.md "Spheres held by
-! their slab", doc/SCALING.md §3.1): each rank holds the spheres whose centres are in its z-slab (its
+! The particle step on a rank's local set (issue 45; doc/DESIGN.md "Spheres held by their slab",
+! doc/SCALING.md §3.1): lubrication dynamics, and since 2026-11-29 (evening) the resolved step too
+! (mod_time_step: the slabs the grid's z-ranges, the fictitious domain's geometry, moments and
+! update on the local set, each sphere's parts summed on its owner; ld_local_begin without a
+! one-body model). Each rank holds the spheres whose centres are in its z-slab (its
 ! own) and the ghosts within reach of the slab (mod_sphere_halo), evaluates the contacts and the
 ! lubrication links of its own spheres, sets their block rows in the 6N system and gets back their
 ! velocities only; the ghosts' velocities and link counts come from their owners through the halo.
@@ -57,6 +60,7 @@ module mod_ld_local
     real(dp), allocatable :: z_made(:)    ! the local set's centres' z when the sets were made
     logical :: kernels_told = .false.     ! the kernels hold the local set (their set_local)
     integer :: sets_made = 0              ! times the sets were made (the run's account)
+    logical :: made = .false.             ! the last ld_local_begin made them (the caller's geometry follows)
   end type ld_local_t
 
   ! what a sphere carries to a new owner and its owner forwards to its ghosts (carried): velocity,
@@ -68,18 +72,22 @@ module mod_ld_local
 
 contains
 
-  !> Active on more than one rank when the run has contacts or lubrication links: reach, the
-  !> largest of their neighbour lists' cut-offs (skin included) [a], skin the smallest of their
-  !> skins [a], and lz the box's period along z. Collective in name only.
-  subroutine ld_local_create(loc, lz, reach, skin)
+  !> Active on more than one rank when reach > 0: reach, the largest distance at which a sphere
+  !> acts on another or on a grid face (the contacts' and the links' neighbour-list cut-offs, skin
+  !> included; the fictitious domain's support plus half the skin) [a], skin the smallest of the
+  !> neighbour lists' skins [a], and lz the box's period along z. edges (0:P), optional: the
+  !> slabs' z-edges (the grid's z-ranges in the resolved step; default P equal slabs). Collective in
+  !> name only.
+  subroutine ld_local_create(loc, lz, reach, skin, edges)
     type(ld_local_t), intent(out) :: loc
     real(dp), intent(in) :: lz, reach, skin
+    real(dp), intent(in), optional :: edges(0:)
     PetscMPIInt :: ranks
     PetscErrorCode :: ierr
     call MPI_Comm_size(PETSC_COMM_WORLD, ranks, ierr)
     loc%active = ranks > 1 .and. reach > 0.0_dp
     loc%skin = skin
-    if (loc%active) call sphere_halo_create(loc%halo, lz, reach)
+    if (loc%active) call sphere_halo_create(loc%halo, lz, reach, edges)
   end subroutine ld_local_create
 
   !> The local set of the step: on the first step (and after a restart) taken from the view parts,
@@ -93,12 +101,12 @@ contains
   !> them (their set_local), the block rows numbered by slab (rank by rank, ascending global index
   !> within a rank, as mod_sphere_ownership), and the springs of the pairs with an own sphere kept.
   !> parts%have_prev (a reversal or a branch clears it) is the set's. Collective.
-  subroutine ld_local_begin(loc, parts, ld, solver, ierr, contacts, lubrication, rheology)
+  subroutine ld_local_begin(loc, parts, solver, ierr, ld, contacts, lubrication, rheology)
     type(ld_local_t), intent(inout) :: loc
     type(particles_t), intent(in) :: parts
-    type(lubrication_dynamics_t), intent(inout) :: ld
     type(particle_solver_t), intent(inout) :: solver
     PetscErrorCode, intent(out) :: ierr
+    type(lubrication_dynamics_t), intent(inout), optional :: ld
     type(particle_contacts_t), intent(inout), optional :: contacts
     type(particle_lubrication_t), intent(inout), optional :: lubrication
     type(rheology_t), intent(inout), optional :: rheology
@@ -109,6 +117,7 @@ contains
     ierr = 0
     loc%total = parts%n
     loc%view_current = .false.
+    loc%made = .false.
     keep = .false.
     if (loc%live) then
       call sets_hold(loc, keep, ierr)
@@ -121,6 +130,7 @@ contains
     loc%set%have_prev = parts%have_prev
     if (keep) return
     loc%live = .true.
+    loc%made = .true.
     loc%sets_made = loc%sets_made + 1
     associate(h => loc%halo, s => loc%set)
       loc%z_made = s%position(3, :)
@@ -128,7 +138,7 @@ contains
       call own_rows(loc, rows, ierr)
       if (ierr /= 0) return
       call particle_solver_set_local(solver, rows, h%is_owned, loc%total)
-      call lubrication_dynamics_set_local(ld, radii)
+      if (present(ld)) call lubrication_dynamics_set_local(ld, radii)
       if (present(lubrication)) call particle_lubrication_set_local(lubrication, h%is_owned, radii)
       if (present(rheology)) call rheo_set_local(rheology, h%is_owned, radii)
       if (present(contacts)) then

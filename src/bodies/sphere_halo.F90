@@ -9,7 +9,8 @@
 ! A rank's spheres ("the local set") are its own and its ghosts, held in ascending order of their
 ! global index (the index of one rank's run): a loop over the local set visits the spheres in the
 ! order one rank would, so sums over the pairs of local spheres can follow one rank's order.
-!   sphere_halo_create     the slabs (P equal slabs of Lz, those of mod_sphere_ownership) and reach
+!   sphere_halo_create     the slabs (P equal slabs of Lz, those of mod_sphere_ownership, or given
+!                          edges: the grid's z-ranges in the resolved step) and reach
 !   sphere_halo_migrate    after the spheres moved: each sphere with its data to the rank of its
 !                          slab (among neighbours; one all-to-all when a sphere went farther, as
 !                          at the first distribution; one integer reduction decides which)
@@ -35,6 +36,10 @@ module mod_sphere_halo
 
   type :: sphere_halo_t
     real(dp) :: lz = 0.0_dp                 ! the box's period along z [a]
+    ! the slabs: rank q's is [edge(q), edge(q + 1)); equal: edge(q) = q lz / P (then slab_of is
+    ! mod_sphere_ownership's floor(P z/lz) exactly)
+    real(dp), allocatable :: edge(:)        ! (0:P)
+    logical :: equal = .true.
     real(dp) :: reach = 0.0_dp              ! the interaction range plus skin [a]
     integer :: rank = 0, ranks = 1
     integer :: owned = 0                    ! own spheres of the local set
@@ -53,11 +58,13 @@ module mod_sphere_halo
 
 contains
 
-  !> The slabs of the ranks of PETSC_COMM_WORLD (P equal slabs of lz, mod_sphere_ownership's) and
-  !> the ranks within reach of this one. Collective in name only (no messages).
-  subroutine sphere_halo_create(h, lz, reach)
+  !> The slabs of the ranks of PETSC_COMM_WORLD (P equal slabs of lz, mod_sphere_ownership's, or
+  !> edges (0:P), ascending from 0 to lz: rank q's slab is [edges(q), edges(q + 1))) and the ranks
+  !> within reach of this one. Collective in name only (no messages).
+  subroutine sphere_halo_create(h, lz, reach, edges)
     type(sphere_halo_t), intent(out) :: h
     real(dp), intent(in) :: lz, reach
+    real(dp), intent(in), optional :: edges(0:)
     PetscMPIInt :: rank, ranks
     PetscErrorCode :: ierr
     integer :: q
@@ -67,6 +74,13 @@ contains
     h%ranks = ranks
     h%lz = lz
     h%reach = reach
+    h%equal = .not. present(edges)
+    allocate(h%edge(0:ranks))
+    if (present(edges)) then
+      h%edge(0:ranks) = edges(0:ranks)
+    else
+      h%edge(0:ranks) = [(lz * q / ranks, q = 0, ranks)]
+    end if
     allocate(h%neighbour(0))
     do q = 0, ranks - 1
       if (q /= rank .and. slab_gap(h, q, rank) < reach) h%neighbour = [h%neighbour, q]
@@ -77,11 +91,24 @@ contains
     h%recv_start = 1
   end subroutine sphere_halo_create
 
-  !> The rank whose slab holds z (wrapped into [0, lz)): floor(P z/lz), as mod_sphere_ownership.
+  !> The rank whose slab holds z (wrapped into [0, lz)): equal slabs floor(P z/lz), as
+  !> mod_sphere_ownership; given edges, the last q with edge(q) <= z.
   pure integer function sphere_halo_slab_of(h, z)
     type(sphere_halo_t), intent(in) :: h
     real(dp), intent(in) :: z
-    sphere_halo_slab_of = min(h%ranks - 1, max(0, int(modulo(z, h%lz) / h%lz * h%ranks)))
+    real(dp) :: zw
+    integer :: q
+    zw = modulo(z, h%lz)
+    if (h%equal) then
+      sphere_halo_slab_of = min(h%ranks - 1, max(0, int(zw / h%lz * h%ranks)))
+    else
+      q = 0
+      do while (q < h%ranks - 1)
+        if (h%edge(q + 1) > zw) exit
+        q = q + 1
+      end do
+      sphere_halo_slab_of = q
+    end if
   end function sphere_halo_slab_of
 
   !> The periodic distance along z from z to the slab of rank q (0 inside it).
@@ -95,8 +122,8 @@ contains
       return
     end if
     zw = modulo(z, h%lz)
-    lo = h%lz * q / h%ranks
-    hi = h%lz * (q + 1) / h%ranks
+    lo = h%edge(q)
+    hi = h%edge(q + 1)
     sphere_halo_distance = min(modulo(lo - zw, h%lz), modulo(zw - hi, h%lz))
   end function sphere_halo_distance
 
@@ -105,10 +132,10 @@ contains
     type(sphere_halo_t), intent(in) :: h
     integer, intent(in) :: q, r
     real(dp) :: lo_q, hi_q, lo_r, hi_r
-    lo_q = h%lz * q / h%ranks
-    hi_q = h%lz * (q + 1) / h%ranks
-    lo_r = h%lz * r / h%ranks
-    hi_r = h%lz * (r + 1) / h%ranks
+    lo_q = h%edge(q)
+    hi_q = h%edge(q + 1)
+    lo_r = h%edge(r)
+    hi_r = h%edge(r + 1)
     slab_gap = min(modulo(lo_q - hi_r, h%lz), modulo(lo_r - hi_q, h%lz))
   end function slab_gap
 

@@ -113,7 +113,10 @@ contains
     type(rheology_t), target, intent(in), optional :: rheology
     PetscBool :: set, use_local
     PetscInt :: fault_step
-    real(dp) :: reach, skin
+    PetscMPIInt :: ranks
+    real(dp) :: reach, skin, support
+    real(dp), allocatable :: edges(:)
+    integer :: q
     character(len=200) :: text
     ierr = 0
     ts%dt = dt
@@ -143,7 +146,7 @@ contains
       ts%variant = TIME_STEP_FLUID_FREE
     end if
     if (associated(ts%rheology) .and. associated(ts%fluid)) allocate(ts%mean_flow(0:ts%grid%n(2) - 1))
-    if (ts%variant == TIME_STEP_FLUID_FREE) then
+    if (associated(ts%parts)) then
       ! the reach of the local set: the largest neighbour-list cut-off of the contacts and links
       ! and the smallest skin of those lists: the local sets are kept while no sphere has moved
       ! half of it (mod_ld_local)
@@ -157,19 +160,49 @@ contains
         reach = max(reach, ts%lubrication%nlist%cutoff)
         skin = min(skin, ts%lubrication%nlist%skin)
       end if
+      ! -ld_local_set 0, -fd_local_set 0: every rank evaluates the step for every sphere (the
+      ! replicated state, as before 2026-11-29; for comparisons)
+      use_local = PETSC_TRUE
+      PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, ranks, ierr))
+      if (ts%variant == TIME_STEP_FLUID_FREE) then
+        PetscCall(PetscOptionsGetBool(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-ld_local_set', use_local, set, ierr))
+      else
+        PetscCall(PetscOptionsGetBool(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-fd_local_set', use_local, set, ierr))
+        ! the resolved step on local sets: the slabs are the grid's z-ranges (a grid split in z
+        ! only), a sphere is a ghost of every rank whose faces it may visit before the sets are
+        ! made again: its inflated radius and a cell and a half (as the Lees-Edwards entries), plus
+        ! half the skin, plus one cell, the most a sphere moves in the step between the check of
+        ! the sets (ld_local_begin) and the geometry at the step's end (fictitious_domain_follow);
+        ! the motion is solved (free or frozen) and the rate imposed (stress control couples every
+        ! sphere to the walls' speed: the replicated step)
+        use_local = use_local .and. size(ts%grid%rank_cells_z) == ranks .and. ts%protocol%control /= CONTROL_STRESS &
+                    .and. (ts%parts%motion == MOTION_FREE .or. ts%parts%motion == MOTION_FROZEN)
+        if (skin == huge(1.0_dp)) skin = 0.5_dp * ts%parts%radius
+        support = maxval(ts%parts%radii) + ts%fd%radius_offset * ts%grid%h + 1.5_dp * ts%grid%h
+        reach = max(reach, support + 0.5_dp * skin + ts%grid%h)
+        allocate(edges(0:ranks))
+        edges(0) = 0.0_dp
+        if (use_local) then
+          do q = 1, ranks
+            edges(q) = edges(q - 1) + ts%grid%rank_cells_z(q) * ts%grid%h
+          end do
+        end if
+        edges(ranks) = box(3)
+      end if
       ! (the statistics' shells too, which the local step samples: ghosts within their reach)
       if (associated(ts%rheology) .and. reach > 0.0_dp) then
         reach = max(reach, rheo_reach(ts%rheology))
         skin = min(skin, rheo_skin(ts%rheology))
       end if
-      ! -ld_local_set 0: every rank evaluates the step for every sphere (the replicated state, as
-      ! before 2026-11-29; for comparisons)
-      use_local = PETSC_TRUE
-      PetscCall(PetscOptionsGetBool(PETSC_NULL_OPTIONS, PETSC_NULL_CHARACTER, '-ld_local_set', use_local, set, ierr))
-      if (.not. use_local) reach = 0.0_dp
-      call ld_local_create(ts%local, box(3), reach, skin)
+      ! (one sphere: nothing to share out; its kernels keep their one-sphere set-up)
+      if (.not. use_local .or. ts%parts%n < 2) reach = 0.0_dp
+      if (allocated(edges)) then
+        call ld_local_create(ts%local, box(3), reach, skin, edges)
+      else
+        call ld_local_create(ts%local, box(3), reach, skin)
+      end if
       if (ts%local%active) then
-        write(text, '(a,f7.3,a)') 'lubrication dynamics on the ranks'' local sets: each rank steps the spheres of '// &
+        write(text, '(a,f7.3,a)') 'spheres on the ranks'' local sets: each rank steps the spheres of '// &
              'its z-slab and their ghosts within ', reach, ' a (free or frozen spheres)'
         call log_line(text)
       end if
@@ -224,10 +257,9 @@ contains
       ! (Euler, as the first step does), and so does the implicit contacts' prediction of the
       ! motion (particle_contacts_add_stiffness), set from the same flag
       if (ts%protocol%reversed) parts%have_prev = .false.
-      local = ts%variant == TIME_STEP_FLUID_FREE .and. ts%local%active .and. &
-              (parts%motion == MOTION_FREE .or. parts%motion == MOTION_FROZEN)
+      local = ts%local%active .and. (parts%motion == MOTION_FREE .or. parts%motion == MOTION_FROZEN)
       if (local) then
-        ! lubrication dynamics on the ranks' local sets (mod_ld_local)
+        ! the spheres on the ranks' local sets (mod_ld_local)
         PetscCall(local_step(ts, ierr))
         if (len_trim(ts%failure) > 0) return
       else
@@ -304,6 +336,7 @@ contains
       end if
       if (local) then
         ! the local set is the state: its spheres advance (the view follows at the output's steps)
+        if (ts%variant == TIME_STEP_RESOLVED) ts%position_before = ts%local%set%position
         call advance_positions(ts%local%set, ts%dt, ts%box, [.true., .not. (ts%walls .or. le%active), .true.])
         parts%have_prev = ts%local%set%have_prev
       else
@@ -322,7 +355,17 @@ contains
           call le_wrap(le, parts%position, parts%velocity, parts%velocity_prev)
         end if
       end if
-      if (ts%variant == TIME_STEP_RESOLVED) then
+      if (ts%variant == TIME_STEP_RESOLVED .and. local) then
+        ! the geometry of the local set (each sphere's parts summed on its owner)
+        associate(set => ts%local%set)
+          if (ts%carry_lambda) then
+            ts%position_before = displacements(set%position, ts%position_before, ts%box, [.true., .not. ts%walls, .true.])
+            PetscCall(fictitious_domain_follow(ts%grid, ts%fd, set, ts%position_before, ierr, le, ts%local%halo))
+          else
+            call fictitious_domain_geometry(ts%grid, ts%fd, set, le, ts%local%halo)
+          end if
+        end associate
+      else if (ts%variant == TIME_STEP_RESOLVED) then
         if (ts%carry_lambda) then
           ! (with Lees-Edwards the carry finds the displacement of each sphere and image itself)
           ts%position_before = displacements(parts%position, ts%position_before, ts%box, [.true., .not. ts%walls, .true.])
@@ -351,7 +394,14 @@ contains
     ierr = 0
     associate(loc => ts%local, set => ts%local%set, le => ts%le)
       PetscCall(stage_push(STAGE_PARTICLES, ierr))
-      PetscCall(ld_local_begin(loc, ts%parts, ts%ld, ts%ld_solver, ierr, ts%contacts, ts%lubrication, ts%rheology))
+      if (ts%variant == TIME_STEP_RESOLVED) then
+        PetscCall(ld_local_begin(loc, ts%parts, ts%fd%solver, ierr, contacts=ts%contacts, lubrication=ts%lubrication, rheology=ts%rheology))
+        ! sets made anew (the first step, or spheres moved half the skin): the geometry of X^n
+        ! again on them, for their indices (the same faces: Lambda^n stays where it was carried)
+        if (loc%made) call regeometry(ts)
+      else
+        PetscCall(ld_local_begin(loc, ts%parts, ts%ld_solver, ierr, ld=ts%ld, contacts=ts%contacts, lubrication=ts%lubrication, rheology=ts%rheology))
+      end if
       PetscCall(stage_pop(ierr))
       if (associated(ts%contacts)) then
         PetscCall(stage_push(STAGE_CONTACTS, ierr))
@@ -377,6 +427,32 @@ contains
           return
         end if
       end if
+      if (ts%variant == TIME_STEP_RESOLVED) then
+        ! the fluid step with Lambda^n, then the particle sub-problem of the own spheres (their
+        ! moments summed on them, their rows solved, their velocities forwarded to the ghosts),
+        ! Lambda^{n+1}, u^{n+1} and each own sphere's force, torque and stresslet (time_step_advance)
+        PetscCall(stage_push(STAGE_FLUID, ierr))
+        PetscCall(fluid_step(ts%grid, ts%fluid, ierr, ts%fd%lambda))
+        PetscCall(stage_pop(ierr))
+        PetscCall(stage_push(STAGE_PARTICLES, ierr))
+        if (le%active) call fictitious_domain_set_image_speed(ts%fd, ts%protocol%rate * ts%box(2))
+        PetscCall(fictitious_domain_moments(ts%grid, ts%fd, ts%fluid%vel, set%n, ierr, loc%halo))
+        PetscCall(fictitious_domain_solve_motion(ts%fd, set, ierr, lubrication=ts%lubrication, contacts=ts%contacts, halo=loc%halo))
+        PetscCall(fictitious_domain_update(ts%grid, ts%fd, ts%fluid%vel, ts%fluid%pressure, set, ierr, ts%lubrication, loc%halo))
+        if (associated(ts%rheology)) then
+          if (associated(ts%contacts)) then
+            PetscCall(ld_local_statistics(loc, ts%rheology, ierr, ts%contacts%stresslet, le%offset))
+          else
+            PetscCall(ld_local_statistics(loc, ts%rheology, ierr, offset=le%offset))
+          end if
+          PetscCall(fluid_mean_profile(ts%grid, ts%fluid, ts%mean_flow, ierr))
+          call rheo_sample_flow(ts%rheology, ts%mean_flow, ts%grid%h)
+        end if
+        if (associated(ts%lubrication)) then
+          PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, ts%lubrication%wall_force, 6, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr))
+        end if
+        return
+      end if
       ! (the stage stays pushed for the rest of the step, as in time_step_advance)
       PetscCall(stage_push(STAGE_PARTICLES, ierr))
       if (ts%protocol%control == CONTROL_STRESS) then
@@ -401,6 +477,16 @@ contains
       end if
     end associate
   end subroutine local_step
+
+  ! The geometry of X^n on the local set just made (the same faces as the last geometry's, which the
+  ! old set's ghosts covered: Lambda^n, carried onto them, stays listed). Collective.
+  subroutine regeometry(ts)
+    type(time_step_t), intent(inout) :: ts
+    logical :: listed
+    listed = ts%fd%lambda_listed
+    call fictitious_domain_geometry(ts%grid, ts%fd, ts%local%set, ts%le, ts%local%halo, set_made=.true.)
+    ts%fd%lambda_listed = listed
+  end subroutine regeometry
 
   ! The rate a stress-controlled lubrication-dynamics step solved for (rate, giving the stress
   ! reached) to the protocol and every piece: the strain and the offset advance with the spheres'
@@ -718,10 +804,10 @@ contains
     end if
     if (ts%local%live) then
       ! the state between steps is the local sets; the replicated copy only for a failure
-      write(text, '(a,i0,a,i0,a)') 'lubrication dynamics on the ranks'' local sets: the replicated view '// &
+      write(text, '(a,i0,a,i0,a)') 'spheres on the ranks'' local sets: the replicated view '// &
            'brought up to date ', ts%local%view_updates, ' times in ', ts%steps_taken, ' steps (a failure needs it)'
       call log_line(text)
-      write(text, '(a,i0,a,i0,a,f6.3,a)') 'lubrication dynamics on the ranks'' local sets: the sets made ', &
+      write(text, '(a,i0,a,i0,a,f6.3,a)') 'spheres on the ranks'' local sets: the sets made ', &
            ts%local%sets_made, ' times in ', ts%steps_taken, ' steps (kept while no sphere has moved half the skin, ', &
            0.5_dp * ts%local%skin, ' a, along z)'
       call log_line(text)
