@@ -56,8 +56,7 @@ module mod_ld_local
     integer :: view_updates = 0           ! times the view was brought up to date (the run's account)
     ! the sets are kept from step to step while no sphere has moved half the skin along z since
     ! they were made (ld_local_begin): skin, the smallest of the kernels' neighbour lists' [a]
-    real(dp) :: skin = 0.0_dp
-    real(dp), allocatable :: z_made(:)    ! the local set's centres' z when the sets were made
+    real(dp) :: skin = 0.0_dp             ! (the set's sets_made_z: its centres' z when the sets were made)
     logical :: kernels_told = .false.     ! the kernels hold the local set (their set_local)
     integer :: sets_made = 0              ! times the sets were made (the run's account)
     logical :: made = .false.             ! the last ld_local_begin made them (the caller's geometry follows)
@@ -122,9 +121,17 @@ contains
     if (loc%live) then
       call sets_hold(loc, keep, ierr)
       if (ierr /= 0) return
+      if (.not. loc%kernels_told) keep = .false.
       if (.not. keep) call carry_on(loc, ierr)
     else
+      ! the sets the view's checkpoint was written from (if made for as many ranks), or new ones;
+      ! then as on any step: made again if a sphere has moved half the skin since
       call take_view(loc, parts, ierr)
+      if (ierr /= 0) return
+      call sets_hold(loc, keep, ierr)
+      if (ierr /= 0) return
+      if (.not. keep) call carry_on(loc, ierr)
+      keep = .false.                       ! (the kernels are told the sets)
     end if
     if (ierr /= 0) return
     loc%set%have_prev = parts%have_prev
@@ -133,7 +140,6 @@ contains
     loc%made = .true.
     loc%sets_made = loc%sets_made + 1
     associate(h => loc%halo, s => loc%set)
-      loc%z_made = s%position(3, :)
       radii = s%radii / parts%radius
       call own_rows(loc, rows, ierr)
       if (ierr /= 0) return
@@ -150,9 +156,8 @@ contains
     end associate
   end subroutine ld_local_begin
 
-  ! Whether the sets made last can serve this step (keep): the kernels still hold them and no own
-  ! sphere of any rank has moved half the skin along z since (the largest such move, one
-  ! reduction). Collective.
+  ! Whether the sets made last can serve this step (keep): no own sphere of any rank has moved half
+  ! the skin along z since (the largest such move, one reduction). Collective.
   subroutine sets_hold(loc, keep, ierr)
     type(ld_local_t), intent(inout) :: loc
     logical, intent(out) :: keep
@@ -163,34 +168,40 @@ contains
     associate(h => loc%halo, s => loc%set)
       do q = 1, s%n
         if (.not. h%is_owned(q)) cycle
-        dz = s%position(3, q) - loc%z_made(q)
+        dz = s%position(3, q) - s%sets_made_z(q)
         moved = max(moved, abs(dz - h%lz * anint(dz / h%lz)))
       end do
     end associate
-    if (.not. loc%kernels_told) moved = huge(1.0_dp)
     call MPI_Allreduce(MPI_IN_PLACE, moved, 1, MPI_DOUBLE_PRECISION, MPI_MAX, PETSC_COMM_WORLD, ierr)
     keep = moved < 0.5_dp * loc%skin
   end subroutine sets_hold
 
   ! The local set taken from the view parts: own spheres by slab (no sphere moves between ranks:
-  ! the view is everywhere), the ghosts within reach, the state of each copied. Collective.
+  ! the view is everywhere), the ghosts within reach, the state of each copied. The slabs are
+  ! those of each sphere's z when the sets were made (parts%sets_made_z, from a checkpoint of a run
+  ! on as many ranks: the same owners and ghosts as that run held), else of its position.
+  ! Collective.
   subroutine take_view(loc, parts, ierr)
     type(ld_local_t), intent(inout) :: loc
     type(particles_t), intent(in) :: parts
     PetscErrorCode, intent(out) :: ierr
     integer, allocatable :: id(:)
-    real(dp), allocatable :: x(:, :), data(:, :)
+    real(dp), allocatable :: x(:, :), data(:, :), z_made(:)
     integer :: i
-    id = pack([(i, i = 1, parts%n)], [(sphere_halo_slab_of(loc%halo, parts%position(3, i)) == loc%halo%rank, &
-                                       i = 1, parts%n)])
+    z_made = parts%position(3, :)
+    if (allocated(parts%sets_made_z) .and. parts%sets_made_ranks == loc%halo%ranks) z_made = parts%sets_made_z
+    id = pack([(i, i = 1, parts%n)], [(sphere_halo_slab_of(loc%halo, z_made(i)) == loc%halo%rank, i = 1, parts%n)])
     x = parts%position(:, id)
+    x(3, :) = z_made(id)
     allocate(data(0, size(id)))
     call sphere_halo_migrate(loc%halo, id, x, data, ierr)
     if (ierr /= 0) return
     call sphere_halo_build(loc%halo, x, ierr)
     if (ierr /= 0) return
     call particles_init(loc%set, size(loc%halo%id), parts%radius, parts%motion)
-    loc%set%position = x
+    loc%set%position = parts%position(:, loc%halo%id)
+    loc%set%sets_made_z = z_made(loc%halo%id)
+    loc%set%sets_made_ranks = loc%halo%ranks
     call put_cargo(loc%set, cargo(parts, loc%halo%id))
   end subroutine take_view
 
@@ -224,6 +235,8 @@ contains
       if (ierr /= 0) return
       call particles_init(s, size(h%id), radius, motion)
       s%position = x
+      s%sets_made_z = x(3, :)
+      s%sets_made_ranks = h%ranks
       call put_cargo(s, values)
     end associate
   end subroutine carry_on

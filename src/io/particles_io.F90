@@ -255,6 +255,14 @@ contains
         call MPI_Allreduce(MPI_IN_PLACE, mixture, 1, MPI_INTEGER, MPI_MAX, PETSC_COMM_WORLD, ierr)
         if (mixture > 0) &
           call particle_columns(group, 'radius', reshape(p%radii(slots), [1, size(slots)]), n, rows, message)
+        ! the ranks' local sets (a share: every rank's set holds them), for an exact restart on as
+        ! many ranks (mod_particles)
+        if (present(share) .and. p%sets_made_ranks > 0) then
+          call particle_columns(group, 'sets_made_z', reshape(p%sets_made_z(slots), [1, size(slots)]), n, rows, &
+                                message)
+          call write_attribute(group, 'sets_made_ranks', [p%sets_made_ranks], e)
+          attributes = max(attributes, abs(e))
+        end if
       end if
       call h5gclose_f(group, err)
       attributes = max(attributes, abs(err))
@@ -446,13 +454,15 @@ contains
     type(particles_t), intent(inout) :: parts
     integer(HID_T) :: file, group
     integer(HSIZE_T) :: fdims(2)
-    real(dp) :: buffer(3, parts%n, 4)
-    integer :: err, e, flag(1), ierr, rank
+    real(dp) :: buffer(3, parts%n, 4), sets_z(1, parts%n)
+    integer :: err, e, flag(1), ierr, rank, sets_ranks(1)
     character(len=200) :: message
     character(len=16), parameter :: names(4) = [character(len=16) :: 'position', 'velocity', 'omega', &
          'velocity_prev']
     message = ''
     flag = 0
+    sets_ranks = 0
+    sets_z = 0.0_dp
     if (is_root()) then
       call h5fopen_f(path, H5F_ACC_RDONLY_F, file, err)
       if (.not. has_object(file, 'particles')) then
@@ -474,6 +484,15 @@ contains
         end do
         call read_attribute(group, 'have_prev', flag, err)
         if (len_trim(message) == 0) message = radii_change(group, parts)
+        ! the ranks' local sets of the run that wrote it (absent: none, or an older checkpoint)
+        if (len_trim(message) == 0) then
+          call dataset_dims(group, 'sets_made_z', rank, fdims)
+          if (rank == 2 .and. all(fdims == [1_HSIZE_T, int(parts%n, HSIZE_T)])) then
+            call read_dataset(group, 'sets_made_z', sets_z, err)
+            if (err == 0) call read_attribute(group, 'sets_made_ranks', sets_ranks, err)
+            if (err /= 0) message = 'cannot read /particles/sets_made_z'
+          end if
+        end if
         call h5gclose_f(group, err)
       end if
       call h5fclose_f(file, err)
@@ -481,6 +500,13 @@ contains
     call file_error_from_root(path, 'particles', message)
     call MPI_Bcast(buffer, size(buffer), MPI_DOUBLE_PRECISION, 0, PETSC_COMM_WORLD, ierr)
     call MPI_Bcast(flag, 1, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
+    call MPI_Bcast(sets_ranks, 1, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
+    parts%sets_made_ranks = sets_ranks(1)
+    if (allocated(parts%sets_made_z)) deallocate(parts%sets_made_z)
+    if (sets_ranks(1) > 0) then
+      call MPI_Bcast(sets_z, size(sets_z), MPI_DOUBLE_PRECISION, 0, PETSC_COMM_WORLD, ierr)
+      parts%sets_made_z = sets_z(1, :)
+    end if
     parts%position = buffer(:, :, 1)
     parts%velocity = buffer(:, :, 2)
     parts%omega = buffer(:, :, 3)

@@ -35,6 +35,13 @@ module mod_particles
     real(dp), allocatable :: force_hydro(:, :)     ! (3, n) [eta gamma_dot a^2]
     real(dp), allocatable :: torque_hydro(:, :)    ! (3, n) [eta gamma_dot a^3]
     real(dp), allocatable :: stresslet_hydro(:, :, :)   ! (3, 3, n) [eta gamma_dot a^3]
+    ! the ranks' local sets (mod_ld_local): each sphere's z when they were last made, and the rank
+    ! count they were made for (0: none). A checkpoint keeps them, so that a restart on as many
+    ! ranks makes the very sets the run held: which rank owns a sphere (and so the order of its
+    ! sums and of the solver's rows) depends on when the sets were made, not only on where the
+    ! sphere is, and the restart then repeats the run's arithmetic bitwise
+    real(dp), allocatable :: sets_made_z(:)
+    integer :: sets_made_ranks = 0
   end type particles_t
 
   ! A rank's share of the spheres when each rank holds its own spheres and their ghosts (the local

@@ -12,11 +12,7 @@ opposite external forces (the shear slides them past each other: a tangential sp
 pressed onto the lower wall, which moves at -3.2 along x (a wall spring). The test checks that
 these contacts exist at every step of both runs and that the checkpoint at step 10 holds non-zero
 springs, so the history really is exercised; and that the checkpoint's springs at step 20 agree
-too. 2 ranks: the contact state is replicated and must be identical on both. On several ranks the
-runs take the replicated step (-fd_local_set 0): on the ranks' local sets (the default since
-2026-11-29) a restart makes the sets anew, and with contacts that changes the last bits (8e-16 in
-the velocities over the 10 steps after the restart, 5e-14 in the forces); test_fd_local_set checks
-that restart across rank counts, to 1e-10."""
+too. 2 ranks: the contact state is replicated and must be identical on both."""
 import os
 import h5py
 import numpy as np
@@ -47,10 +43,9 @@ def springs(d):
 
 
 a = T.scratch('contact_restart_straight')
-REPLICATED = ['-fd_local_set', '0']
-T.run(T.write_deck(a, 'd.nml', DECK.format(steps=20)), a, np_ranks=T.RANKS, args=REPLICATED)
+T.run(T.write_deck(a, 'd.nml', DECK.format(steps=20)), a, np_ranks=T.RANKS)
 b = T.scratch('contact_restart_split')
-T.run(T.write_deck(b, 'd10.nml', DECK.format(steps=10)), b, np_ranks=T.RANKS, args=REPLICATED)
+T.run(T.write_deck(b, 'd10.nml', DECK.format(steps=10)), b, np_ranks=T.RANKS)
 ids, ups = springs(b)
 T.check(len(ids) == 2 and [1, 2] in ids.tolist() and [3, -1] in ids.tolist(),
         'checkpoint at step 10 holds the springs of contacts (1,2) and (3, lower wall): %s' % ids.tolist())
@@ -58,7 +53,7 @@ norms = np.linalg.norm(ups, axis=1) if len(ups) else np.zeros(0)
 T.check(len(norms) == 2 and norms.min() > 1e-4,
         'the springs are not zero: |Upsilon| = %s a' % ', '.join('%.2e' % v for v in norms))
 _, out, _ = T.run(T.write_deck(b, 'd.nml', DECK.format(steps=20)), b, np_ranks=T.RANKS,
-                  args=['-restart', os.path.join(b, 'out', 'checkpoint.h5')] + REPLICATED)
+                  args=['-restart', os.path.join(b, 'out', 'checkpoint.h5')])
 T.check('friction on' in out, "the run log's models line says contacts and friction are on")
 
 sa, sb = T.series(os.path.join(a, 'out')), T.series(os.path.join(b, 'out'))

@@ -10,7 +10,8 @@ the sparse solve runs at every step.
     angular velocities, hydrodynamic and contact stresslets, and the statistics' samples (core
     stresses, the particle velocity fit, pair counts, Q6, the smallest gap) within 1e-10 of each
     quantity's largest magnitude;
- 3. 20 steps on 2 ranks, a checkpoint, 20 more on 3 agree with the 40 on 1 rank, likewise;
+ 3. 20 steps on 2 ranks, a checkpoint, 20 more on 3 agree with the 40 on 1 rank, likewise; 20 more
+    on 2 ranks equal the 40 on 2 bitwise (the checkpoint keeps the ranks' local sets);
  4. the lubrication links stay on the ranks that evaluated them (mod_lubrication_links, issue 45):
     one rank holds all the pair links of the last step (the run log's count), on 2 and 3 ranks
     none does, each holding at least its share; the series' count of pair links (the whole
@@ -102,8 +103,10 @@ ref = results(d1)
 total1, most1 = links(out1)
 T.check(total1 > 0 and most1 == total1, '1 rank holds all %d pair links (%d)' % (total1, most1))
 pairs1 = T.series(os.path.join(d1, 'out'))['lubrication_pairs']
+dirs = {}
 for n in (2, 3):
     d, out = run('ld_ranks_%d' % n, n)
+    dirs[n] = d
     T.check(matrix_type(out) == 'mpibaij', '%d ranks: distributed matrix (%s)' % (n, matrix_type(out)))
     T.check("on the ranks' local sets" in out and "on the ranks' local sets" not in out1,
             '%d ranks: each rank steps its own spheres and ghosts (1 rank: every sphere)' % n)
@@ -120,6 +123,13 @@ d, _ = run('ld_ranks_restart', 2, steps=20)
 T.check(int(T.h5_attr(os.path.join(d, 'out', 'checkpoint.h5'), 'step')[0]) == 20, 'checkpoint at step 20 (2 ranks)')
 run('ld_ranks_restart', 3, steps=40, args=['-restart', 'out/checkpoint.h5'], d=d)
 compare(ref, results(d), '20 steps on 2 ranks + restart + 20 on 3 vs 40 on 1')
+# restart on as many ranks: the checkpoint keeps the sets the run held (particles/sets_made_z), so
+# the restart has the same owners, ghosts and rows, and repeats the run's arithmetic bitwise
+d, _ = run('ld_ranks_restart_same', 2, steps=20)
+run('ld_ranks_restart_same', 2, steps=40, args=['-restart', 'out/checkpoint.h5'], d=d)
+same, two = results(d), results(dirs[2])
+worst = max(np.abs(same[k] - two[k]).max() for k in QUANTITIES)
+T.check(worst == 0.0, '20 steps on 2 ranks + restart + 20 on 2 = 40 on 2 bitwise (largest difference %.1e)' % worst)
 
 # the state carried on the local sets between the snapshots
 d3, out3 = run('ld_ranks_every8_3', 3, every=8)
