@@ -89,8 +89,9 @@ contains
     if (loc%active) call sphere_halo_create(loc%halo, lz, reach, edges)
   end subroutine ld_local_create
 
-  !> The local set of the step: on the first step (and after a restart) taken from the view parts,
-  !> then kept from step to step while no sphere has moved half the skin along z since the sets
+  !> The local set of the step: on the first step (and after a restart) taken from the view parts
+  !> (after a restart on as many ranks, the sets the checkpoint's run held: parts%sets_made_z, so
+  !> that the restart repeats its arithmetic bitwise), then kept from step to step while no sphere has moved half the skin along z since the sets
   !> were made (every sphere a rank's own spheres reach within a kernel's range is then still among
   !> its ghosts, and the ghosts, advanced like their owners from the same forwarded values, are
   !> their owners' copies: nothing to send), else made again from the last step's (carry_on: the own

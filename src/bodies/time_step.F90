@@ -180,14 +180,14 @@ contains
         if (skin == huge(1.0_dp)) skin = 0.5_dp * ts%parts%radius
         support = maxval(ts%parts%radii) + ts%fd%radius_offset * ts%grid%h + 1.5_dp * ts%grid%h
         reach = max(reach, support + 0.5_dp * skin + ts%grid%h)
-        allocate(edges(0:ranks))
-        edges(0) = 0.0_dp
         if (use_local) then
+          allocate(edges(0:ranks))
+          edges(0) = 0.0_dp
           do q = 1, ranks
             edges(q) = edges(q - 1) + ts%grid%rank_cells_z(q) * ts%grid%h
           end do
+          edges(ranks) = box(3)
         end if
-        edges(ranks) = box(3)
       end if
       ! (the statistics' shells too, which the local step samples: ghosts within their reach)
       if (associated(ts%rheology) .and. reach > 0.0_dp) then
