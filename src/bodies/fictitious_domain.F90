@@ -48,6 +48,7 @@ module mod_fictitious_domain
   use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_add_to_system, &
                                       particle_lubrication_add_corrections, particle_lubrication_corrections
   use mod_sphere_halo, only: sphere_halo_t, sphere_halo_reverse, sphere_halo_forward
+  use mod_ld_local, only: ld_local_contacts_update
   use mod_lubrication_links, only: lubrication_links_corrections
   use mod_particle_contacts, only: particle_contacts_t, particle_contacts_add_stiffness, &
                                    particle_contacts_implicit_update, particle_contacts_set_rate
@@ -662,7 +663,14 @@ contains
         parts%velocity = v(1:3, :)
         parts%omega = v(4:6, :)
       end if
-      if (present(contacts)) call particle_contacts_implicit_update(contacts, parts%velocity, parts%omega)
+      if (present(contacts)) then
+        if (present(halo)) then
+          ! (the walls' forces summed over the ranks)
+          PetscCall(ld_local_contacts_update(contacts, parts%velocity, parts%omega, ierr))
+        else
+          call particle_contacts_implicit_update(contacts, parts%velocity, parts%omega)
+        end if
+      end if
     case default                    ! prescribed, resistance, fixed
       call impose_motion(parts)
     end select
@@ -672,12 +680,13 @@ contains
   ! Stress control (doc/METHOD.md §7.4): b = sum_f w u_c g dV of vel, the fluid step's response to a
   ! unit wall speed (the same field every step; the geometry of X^n weighs it), into
   ! fd%response_moments (6, n), summed over ranks. Collective.
-  subroutine fictitious_domain_response_moments(grid, fd, vel, n, ierr)
+  subroutine fictitious_domain_response_moments(grid, fd, vel, n, ierr, halo)
     type(grid_t), intent(in) :: grid
     type(fictitious_domain_t), intent(inout) :: fd
     Vec, intent(in) :: vel(3)
     integer, intent(in) :: n
     PetscErrorCode, intent(out) :: ierr
+    type(sphere_halo_t), intent(inout), optional :: halo
     type(field_view_t) :: u(3), lam(3)
     real(dp), allocatable :: both(:, :)
     integer :: c, e, q
@@ -697,8 +706,11 @@ contains
     end do
     if (fd%sliding) then
       ! per entry, then each image's to its sphere, less what its extra speed (gamma_dot Ly per
-      ! unit rate: Ly) takes off (Lees-Edwards, see the top)
-      call MPI_Allreduce(MPI_IN_PLACE, both, 12 * fd%entries, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
+      ! unit rate: Ly) takes off (Lees-Edwards, see the top; a local set: this rank's parts, summed
+      ! on the owners below)
+      if (.not. present(halo)) then
+        call MPI_Allreduce(MPI_IN_PLACE, both, 12 * fd%entries, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
+      end if
       if (allocated(fd%response_moments)) deallocate(fd%response_moments)
       allocate(fd%response_moments(6, n))
       fd%response_moments = 0.0_dp
@@ -708,9 +720,12 @@ contains
                                     - fd%copy(e) * fd%le%box(2) * fd%rigid_entries(1:6, 1, e)
       end do
     else
-      call MPI_Allreduce(MPI_IN_PLACE, both, 12 * n, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
+      if (.not. present(halo)) then
+        call MPI_Allreduce(MPI_IN_PLACE, both, 12 * n, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr)
+      end if
       fd%response_moments = both(1:6, 1:n)
     end if
+    if (present(halo)) call sphere_halo_reverse(halo, fd%response_moments, ierr)
     PetscCall(event_end(EVENT_MOMENTS, ierr))
   end subroutine fictitious_domain_response_moments
 
@@ -745,9 +760,12 @@ contains
   ! (r e_c + e_c r) dV of §3.7, affine in the rate through u~ and U: at r0 from u~ (grid, vel)
   ! with Lambda^n, per unit rate from the fluid's unit response (response_vel) without it
   ! (shear_stresslet); the links' and contacts' from their corrections at each rate. volume: the box's.
+  ! halo (optional): parts is a rank's local set (see fictitious_domain_solve_motion): each solve
+  ! gives the own spheres' velocities, forwarded to the ghosts; the walls' forces and the spheres'
+  ! stresslets are summed over the own spheres of every rank.
   subroutine fictitious_domain_solve_stress(fd, parts, stress, fluid_stress, fluid_slope, response_scale, area, &
                                             rate, particle_stress, ierr, lubrication, contacts, grid, vel, &
-                                            response_vel, volume)
+                                            response_vel, volume, halo)
     type(fictitious_domain_t), intent(inout) :: fd
     type(particles_t), intent(inout) :: parts
     real(dp), intent(in) :: stress, fluid_stress, fluid_slope, response_scale, area
@@ -759,6 +777,7 @@ contains
     type(grid_t), intent(in), optional :: grid
     Vec, intent(in), optional :: vel(3), response_vel(3)
     real(dp), intent(in), optional :: volume
+    type(sphere_halo_t), intent(inout), optional :: halo
     real(dp), allocatable :: rhs(:, :), u_before(:, :), w_before(:, :), u0(:, :), w0(:, :), u1(:, :), w1(:, :)
     real(dp), allocatable :: drive(:, :), uinf(:, :), wall_drive(:, :)
     real(dp), allocatable :: c_force(:, :), c_torque(:, :), c_stresslet(:, :, :)
@@ -791,6 +810,7 @@ contains
       call particle_system_add_diagonal(fd%solver%system, q, fd%beta * fd%rigid_matrix(:, :, q))
       rhs(:, q) = (fd%beta * response_scale) * fd%response_moments(:, q)
     end do
+    call placeholders()
     call set_rate(1.0_dp)
     if (present(lubrication)) call particle_lubrication_add_to_system(lubrication, fd%solver%system, rhs)
     if (stiffness) call particle_contacts_add_stiffness(contacts, fd%solver%system, rhs, 0.0_dp * u_before, &
@@ -800,6 +820,7 @@ contains
     call particle_solver_solve(fd%solver, rhs, parts, ierr, ': a particle covers no grid face? (stress control: '// &
                                'the part per unit rate)')
     CHKERRQ(ierr)
+    call forward_velocities()
     u1 = parts%velocity
     w1 = parts%omega
     ! the step at r0 (assembled last: the contacts keep its U^{n-1} for their implicit update), from U^{n-1}
@@ -810,6 +831,7 @@ contains
            + [parts%external_force(:, q), parts%external_torque(:, q)]
       if (present(contacts)) rhs(:, q) = rhs(:, q) + [contacts%force(:, q), contacts%torque(:, q)]
     end do
+    call placeholders()
     call set_rate(rate_before)
     if (present(lubrication)) call particle_lubrication_add_to_system(lubrication, fd%solver%system, rhs)
     if (stiffness) call particle_contacts_add_stiffness(contacts, fd%solver%system, rhs, u_before, w_before, &
@@ -818,6 +840,7 @@ contains
     parts%omega = w_before
     call particle_solver_solve(fd%solver, rhs, parts, ierr, ': a particle covers no grid face?')
     CHKERRQ(ierr)
+    call forward_velocities()
     u0 = parts%velocity
     w0 = parts%omega
     ! Lees-Edwards: the fictitious domain's stresslet at r0 and per unit rate (affine; see above)
@@ -849,6 +872,33 @@ contains
 
   contains
 
+    ! a local set: a ghost's row of the system a placeholder (the identity, nothing on the right;
+    ! its owner solves for it), as fictitious_domain_solve_motion
+    subroutine placeholders()
+      integer :: g, c
+      if (.not. present(halo)) return
+      do g = 1, n
+        if (halo%is_owned(g)) cycle
+        fd%solver%system%diag(:, :, g) = 0.0_dp
+        do c = 1, 6
+          fd%solver%system%diag(c, c, g) = 1.0_dp
+        end do
+        rhs(:, g) = 0.0_dp
+      end do
+    end subroutine placeholders
+
+    ! a local set: the own spheres' velocities to their ghosts (the host's ierr)
+    subroutine forward_velocities()
+      real(dp), allocatable :: v(:, :)
+      if (.not. present(halo)) return
+      allocate(v(6, n))
+      v(1:3, :) = parts%velocity
+      v(4:6, :) = parts%omega
+      call sphere_halo_forward(halo, v, ierr)
+      parts%velocity = v(1:3, :)
+      parts%omega = v(4:6, :)
+    end subroutine forward_velocities
+
     ! every rate-dependent datum of the particle problem at rate r: the links' drives, undisturbed
     ! velocities and E_inf, the walls' velocity in the contacts
     subroutine set_rate(r)
@@ -871,32 +921,61 @@ contains
     subroutine at_rate(r, u, w, walls_share)
       real(dp), intent(in) :: r, u(:, :), w(:, :)
       real(dp), intent(out) :: walls_share
-      real(dp) :: force(3, 2)
+      real(dp) :: force(3, 2), lubrication_force(3, 2), spheres(2)
       call set_rate(r)
       parts%velocity = u
       parts%omega = w
       force = 0.0_dp
+      spheres = 0.0_dp
       if (present(contacts)) then
         contacts%force = c_force
         contacts%torque = c_torque
         contacts%stresslet = c_stresslet
         contacts%wall_force = c_wall_force
         contacts%stiffness_added = c_added
-        call particle_contacts_implicit_update(contacts, u, w)
+        if (present(halo)) then
+          PetscCall(ld_local_contacts_update(contacts, u, w, ierr))
+        else
+          call particle_contacts_implicit_update(contacts, u, w)
+        end if
         force = force + contacts%wall_force
+        spheres(1) = own_sum(contacts%stresslet(1, 2, :))
       end if
       if (present(lubrication)) then
-        PetscCall(lubrication_links_corrections(lubrication, u, w, ierr))
-        force = force + lubrication%wall_force
+        if (present(halo)) then
+          ! (the own spheres' links: their walls' forces summed over the ranks here, the
+          ! lubrication's own left for the step's end)
+          call particle_lubrication_corrections(lubrication, u, w)
+          lubrication_force = lubrication%wall_force
+          PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, lubrication_force, 6, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr))
+        else
+          PetscCall(lubrication_links_corrections(lubrication, u, w, ierr))
+          lubrication_force = lubrication%wall_force
+        end if
+        force = force + lubrication_force
+        spheres(2) = own_sum(lubrication%stresslet(1, 2, :))
       end if
       walls_share = (force(1, 2) - force(1, 1)) / (2.0_dp * area)
       if (fd%sliding) then
+        if (present(halo)) then
+          PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, spheres, 2, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr))
+        end if
         walls_share = fd_stress0 + (r - rate_before) * fd_stress1
-        if (present(contacts)) walls_share = walls_share + sum(contacts%stresslet(1, 2, :))
-        if (present(lubrication)) walls_share = walls_share + sum(lubrication%stresslet(1, 2, :))
+        if (present(contacts)) walls_share = walls_share + spheres(1)
+        if (present(lubrication)) walls_share = walls_share + spheres(2)
         walls_share = walls_share / volume
       end if
     end subroutine at_rate
+
+    ! the sum of values (n) over the spheres, a local set's own only
+    real(dp) function own_sum(values)
+      real(dp), intent(in) :: values(:)
+      if (present(halo)) then
+        own_sum = sum(values, halo%is_owned)
+      else
+        own_sum = sum(values)
+      end if
+    end function own_sum
   end subroutine fictitious_domain_solve_stress
 
   ! Lees-Edwards stress control: the xy stresslet the fictitious domain would give all spheres,

@@ -34,7 +34,7 @@ module mod_ld_local
                              sphere_halo_forward, sphere_halo_exchange, sphere_halo_slab_of
   use mod_sorting, only: ascending_order, sorted_position
   use mod_contact, only: history_size, history_pack, history_unpack
-  use mod_particle_contacts, only: particle_contacts_t, particle_contacts_set_local
+  use mod_particle_contacts, only: particle_contacts_t, particle_contacts_set_local, particle_contacts_implicit_update
   use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_set_local, &
                                       particle_lubrication_links, LINKS_COUNT, LINKS_EVALUATE
   use mod_lubrication_dynamics, only: lubrication_dynamics_t, lubrication_dynamics_set_local
@@ -42,7 +42,8 @@ module mod_ld_local
   use mod_rheology, only: rheology_t, rheo_set_local, rheo_sample, rheo_sample_shares, rheo_sample_finish
   implicit none
   private
-  public :: ld_local_t, ld_local_create, ld_local_begin, ld_local_contacts_agree, ld_local_links, &
+  public :: ld_local_t, ld_local_create, ld_local_begin, ld_local_contacts_agree, ld_local_contacts_update, &
+            ld_local_links, &
             ld_local_forward_velocities, ld_local_statistics, ld_local_complete_view, &
             ld_local_own_slot
 
@@ -425,6 +426,22 @@ contains
     pl%failed_link = most(1:2)
     pl%npairs_most = most(3)
   end subroutine ld_local_links
+
+  !> The contacts' implicit update (particle_contacts_implicit_update) on a local set: the walls'
+  !> forces on the spheres made the whole system's again. Before it they are (ld_local_contacts_agree
+  !> summed the explicit forces), and the update adds the implicit part of the own spheres' wall
+  !> contacts only: those parts are summed over the ranks (6 doubles). Collective.
+  subroutine ld_local_contacts_update(contacts, velocity, omega, ierr)
+    type(particle_contacts_t), intent(inout) :: contacts
+    real(dp), intent(in) :: velocity(:, :), omega(:, :)
+    PetscErrorCode, intent(out) :: ierr
+    real(dp) :: before(3, 2), part(3, 2)
+    before = contacts%wall_force
+    call particle_contacts_implicit_update(contacts, velocity, omega)
+    part = contacts%wall_force - before
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, part, 6, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr))
+    contacts%wall_force = before + part
+  end subroutine ld_local_contacts_update
 
   !> After the solve: the own spheres' velocities and angular velocities sent to their ghosts.
   !> Collective among neighbours.

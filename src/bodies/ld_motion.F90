@@ -16,7 +16,7 @@ module mod_ld_motion
   use mod_particles, only: particles_t, MOTION_FREE, MOTION_FROZEN, impose_motion
   use mod_particle_solver, only: particle_solver_t, particle_solver_solve
   use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_corrections
-  use mod_ld_local, only: ld_local_t, ld_local_forward_velocities
+  use mod_ld_local, only: ld_local_t, ld_local_forward_velocities, ld_local_contacts_update
   use mod_lubrication_links, only: lubrication_links_corrections
   use mod_particle_contacts, only: particle_contacts_t, particle_contacts_implicit_update, particle_contacts_set_rate
   use mod_lubrication_dynamics, only: lubrication_dynamics_t, lubrication_dynamics_assemble, &
@@ -53,8 +53,12 @@ contains
       PetscCall(particle_solver_solve(solver, rhs, parts, ierr, ''))
       if (present(local)) then
         PetscCall(ld_local_forward_velocities(local, ierr))
+        if (present(contacts)) then
+          PetscCall(ld_local_contacts_update(contacts, parts%velocity, parts%omega, ierr))
+        end if
+      else if (present(contacts)) then
+        call particle_contacts_implicit_update(contacts, parts%velocity, parts%omega)
       end if
-      if (present(contacts)) call particle_contacts_implicit_update(contacts, parts%velocity, parts%omega)
     case default                    ! prescribed, resistance, fixed
       call impose_motion(parts)
     end select
@@ -203,7 +207,11 @@ contains
         contacts%stresslet = c_stresslet
         contacts%wall_force = c_wall_force
         contacts%stiffness_added = c_added
-        call particle_contacts_implicit_update(contacts, u, w)
+        if (present(local)) then
+          PetscCall(ld_local_contacts_update(contacts, u, w, ierr))
+        else
+          call particle_contacts_implicit_update(contacts, u, w)
+        end if
       end if
       if (present(lubrication)) then
         if (present(local)) then

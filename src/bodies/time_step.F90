@@ -35,6 +35,7 @@ module mod_time_step
   use mod_lubrication_links, only: lubrication_links_evaluate
   use mod_ld_motion, only: ld_motion_solve, ld_motion_solve_stress
   use mod_particle_solver, only: particle_solver_t
+  use mod_sphere_halo, only: sphere_halo_t
   use mod_ld_local, only: ld_local_t, ld_local_create, ld_local_begin, ld_local_contacts_agree, ld_local_links, &
                           ld_local_statistics, ld_local_complete_view, ld_local_own_slot
   implicit none
@@ -173,9 +174,8 @@ contains
         ! made again: its inflated radius and a cell and a half (as the Lees-Edwards entries), plus
         ! half the skin, plus one cell, the most a sphere moves in the step between the check of
         ! the sets (ld_local_begin) and the geometry at the step's end (fictitious_domain_follow);
-        ! the motion is solved (free or frozen) and the rate imposed (stress control couples every
-        ! sphere to the walls' speed: the replicated step)
-        use_local = use_local .and. size(ts%grid%rank_cells_z) == ranks .and. ts%protocol%control /= CONTROL_STRESS &
+        ! the motion is solved (free or frozen), the rate imposed or set by the stress
+        use_local = use_local .and. size(ts%grid%rank_cells_z) == ranks &
                     .and. (ts%parts%motion == MOTION_FREE .or. ts%parts%motion == MOTION_FROZEN)
         if (skin == huge(1.0_dp)) skin = 0.5_dp * ts%parts%radius
         support = maxval(ts%parts%radii) + ts%fd%radius_offset * ts%grid%h + 1.5_dp * ts%grid%h
@@ -437,7 +437,11 @@ contains
         PetscCall(stage_push(STAGE_PARTICLES, ierr))
         if (le%active) call fictitious_domain_set_image_speed(ts%fd, ts%protocol%rate * ts%box(2))
         PetscCall(fictitious_domain_moments(ts%grid, ts%fd, ts%fluid%vel, set%n, ierr, loc%halo))
-        PetscCall(fictitious_domain_solve_motion(ts%fd, set, ierr, lubrication=ts%lubrication, contacts=ts%contacts, halo=loc%halo))
+        if (ts%protocol%control == CONTROL_STRESS) then
+          PetscCall(resolved_stress_control(ts, ierr))
+        else
+          PetscCall(fictitious_domain_solve_motion(ts%fd, set, ierr, lubrication=ts%lubrication, contacts=ts%contacts, halo=loc%halo))
+        end if
         PetscCall(fictitious_domain_update(ts%grid, ts%fd, ts%fluid%vel, ts%fluid%pressure, set, ierr, ts%lubrication, loc%halo))
         if (associated(ts%rheology)) then
           if (associated(ts%contacts)) then
@@ -538,19 +542,30 @@ contains
   ! the stress reached and the walls' strain rate (the walls move at gamma_dot^n over the step).
   ! The update that follows (Lambda^{n+1}, u^{n+1}) is affine in u~ and U and is made once, with
   ! both at gamma_dot^n. Collective.
+  ! On the ranks' local sets (ts%local live) the spheres are a rank's own and ghosts, their sums
+  ! made on their owners (halo).
   subroutine resolved_stress_control(ts, ierr)
-    type(time_step_t), intent(inout) :: ts
+    type(time_step_t), target, intent(inout) :: ts
     PetscErrorCode, intent(out) :: ierr
     real(dp) :: rate, rate_before, per_rate, walls_share, fluid_stress, fluid_slope
+    type(particles_t), pointer :: spheres
+    type(sphere_halo_t), pointer :: halo
+    ! (a disassociated halo is an absent argument: the replicated spheres)
+    spheres => ts%parts
+    halo => null()
+    if (ts%local%live) then
+      spheres => ts%local%set
+      halo => ts%local%halo
+    end if
     associate(fl => ts%fluid, unit => ts%fluid_response)
-      PetscCall(fictitious_domain_response_moments(ts%grid, ts%fd, unit%vel, ts%parts%n, ierr))
+      PetscCall(fictitious_domain_response_moments(ts%grid, ts%fd, unit%vel, spheres%n, ierr, halo))
       rate_before = ts%protocol%rate
       rate = rate_before
       if (ts%le%active) then
         ! Lees-Edwards (doc/METHOD.md §7.4): the mean shear stress of the box, eta gamma_dot plus
         ! the spheres' stresslets over its volume; the unit response is per unit rate
         per_rate = 1.0_dp
-        PetscCall(fictitious_domain_solve_stress(ts%fd, ts%parts, ts%protocol%stress, rate_before, 1.0_dp, per_rate, 0.0_dp, rate, walls_share, ierr, lubrication=ts%lubrication, contacts=ts%contacts, grid=ts%grid, vel=fl%vel, response_vel=unit%vel, volume=product(ts%box)))
+        PetscCall(fictitious_domain_solve_stress(ts%fd, spheres, ts%protocol%stress, rate_before, 1.0_dp, per_rate, 0.0_dp, rate, walls_share, ierr, lubrication=ts%lubrication, contacts=ts%contacts, grid=ts%grid, vel=fl%vel, response_vel=unit%vel, volume=product(ts%box), halo=halo))
         ! the images and the boundary's jump at the rate found; the offset after the step stays the
         ! one the fluid's step took (the strain advances at the last step's rate, slide_fluid)
         call fictitious_domain_set_image_speed(ts%fd, rate * ts%box(2))
@@ -564,7 +579,7 @@ contains
         per_rate = 0.5_dp * ts%box(2)
         fluid_stress = 0.5_dp * (fl%tau_bottom + fl%tau_top)
         fluid_slope = per_rate * 0.5_dp * (unit%tau_bottom + unit%tau_top)
-        PetscCall(fictitious_domain_solve_stress(ts%fd, ts%parts, ts%protocol%stress, fluid_stress, fluid_slope, per_rate, ts%box(1) * ts%box(3), rate, walls_share, ierr, lubrication=ts%lubrication, contacts=ts%contacts))
+        PetscCall(fictitious_domain_solve_stress(ts%fd, spheres, ts%protocol%stress, fluid_stress, fluid_slope, per_rate, ts%box(1) * ts%box(3), rate, walls_share, ierr, lubrication=ts%lubrication, contacts=ts%contacts, halo=halo))
         PetscCall(stage_push(STAGE_FLUID, ierr))
         PetscCall(fluid_add_response(ts%grid, fl, unit, (rate - rate_before) * per_rate, ierr))
         PetscCall(stage_pop(ierr))

@@ -19,7 +19,9 @@ are visited too.
     before 2026-11-29);
  4. 20 steps on 2 ranks, a checkpoint, 20 more on 3 agree with 40 on 1 rank; 20 more on 2 ranks
     equal 40 on 2 bitwise (the checkpoint keeps the sets the run held: particles/sets_made_z);
- 5. the Lees-Edwards cube: 2 and 3 ranks agree with 1 rank at every step (2.'s quantities).
+ 5. the Lees-Edwards cube: 2 and 3 ranks agree with 1 rank at every step (2.'s quantities);
+ 6. stress control (the mean shear stress 3, 20 steps), between walls and in the Lees-Edwards
+    cube: 2 and 3 ranks give 1 rank's rate and spheres at every step.
 Tolerance: the moments of a sphere whose faces lie on two ranks are summed in another order, and
 the particle solve (CG to a relative residual of 1e-12 when lubrication couples the spheres) sums
 its inner products in another order; the spheres carry such differences on through contacts and
@@ -35,7 +37,7 @@ import numpy as np
 import fdsusp_testlib as T
 
 DECK = """&domain box = 8, 8, 8, cells_per_radius = 4, y_boundary = '{boundary}', shear_rate = 1 /
-&fluid reynolds = 0.01, initial_flow = 'shear', body_force = 0, 0, {force} /
+&fluid reynolds = 0.01, initial_flow = 'shear', body_force = 0, 0, {force}{fluid} /
 &time dt = 2e-3, steps = {steps} /
 &output directory = 'out', progress_every = 10 /
 &particles solid_fraction = 0.3, seed = 3 /
@@ -52,9 +54,10 @@ CHECKPOINT = ['checkpoint:' + k for k in FIELDS]
 TOL = 1e-10
 
 
-def run(name, ranks, steps=40, args=(), d=None, boundary='walls', force=1.5):
+def run(name, ranks, steps=40, args=(), d=None, boundary='walls', force=1.5, shear='', fluid=''):
     d = d or T.scratch(name)
-    deck = T.write_deck(d, 'd%d.nml' % steps, DECK.format(steps=steps, boundary=boundary, force=force))
+    deck = T.write_deck(d, 'd%d.nml' % steps, DECK.format(steps=steps, boundary=boundary, force=force, fluid=fluid)
+                        + shear)
     status, out, err = T.run(deck, d, np_ranks=ranks, args=list(args))
     return d, out
 
@@ -150,4 +153,20 @@ for n in (2, 3):
     d, out = run('fd_local_le_%d' % n, n, boundary='lees-edwards', steps=30)
     T.check("spheres on the ranks' local sets" in out, '%d ranks, Lees-Edwards: local sets' % n)
     compare(le_ref, results(d, fields=False), 'Lees-Edwards, %d ranks vs 1' % n, QUANTITIES)
+# stress control (doc/METHOD.md §7.4): both solves on the local sets, the walls' forces and the
+# spheres' stresslets summed over the own spheres of every rank, the rate the same
+for boundary in ('walls', 'lees-edwards'):
+    refs = None
+    for n in (1, 2, 3):
+        d, out = run('fd_local_stress_%s_%d' % (boundary, n), n, boundary=boundary, steps=20,
+                     shear="&shear control = 'stress', stress = 3.0 /", fluid=', viscous_theta = 1')
+        r = results(d, fields=False)
+        r['shear/rate'] = T.series(os.path.join(d, 'out'))['shear/rate']
+        if refs is None:
+            refs = r
+            T.check(np.abs(r['shear/rate'] - 1.0).max() > 1e-3, 'stress control, %s: the rate is set by the stress '
+                    '(%.3f-%.3f)' % (boundary, r['shear/rate'].min(), r['shear/rate'].max()))
+            continue
+        T.check("spheres on the ranks' local sets" in out, 'stress control, %s, %d ranks: local sets' % (boundary, n))
+        compare(refs, r, 'stress control, %s, %d ranks vs 1' % (boundary, n), QUANTITIES + ['shear/rate'])
 T.finish()
