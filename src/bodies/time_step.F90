@@ -207,8 +207,9 @@ contains
         call log_line(text)
       end if
     end if
-    if (ts%variant == TIME_STEP_RESOLVED) then
-      ! the geometry at X^n; each step then moves it, and Lambda with it, to X^{n+1}
+    if (ts%variant == TIME_STEP_RESOLVED .and. .not. ts%local%active) then
+      ! the geometry at X^n; each step then moves it, and Lambda with it, to X^{n+1} (on local sets
+      ! the first step makes it, on its rank's spheres: local_step)
       PetscCall(stage_push(STAGE_PARTICLES, ierr))
       call fictitious_domain_geometry(ts%grid, ts%fd, ts%parts, ts%le)
       PetscCall(stage_pop(ierr))
