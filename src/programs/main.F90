@@ -15,7 +15,7 @@ program fdsusp
   use mod_params, only: config_t, read_deck, echo_deck, max_line
   use mod_errors, only: log_line, warn_line, input_error, report_limits, fatal_error
   use mod_run_control, only: command_line, prepare_output_directory, continue_from_directory, run_stop_reason, &
-                             run_stop_line, RUN_GOES_ON, RUN_DONE
+                             run_stop_line, run_signal_line, RUN_GOES_ON, RUN_DONE
   use mod_os_services, only: install_signal_handlers, release_directory, peak_resident_kb
   use mod_timers, only: timers_register, stage_push, stage_pop, STAGE_SETUP
   use mod_h5util, only: h5util_init
@@ -232,6 +232,7 @@ program fdsusp
 
   ! ---- end of run: the series, the last fields and a checkpoint to continue from ----
   if (step > first_step) call time_step_report(ts, (MPI_Wtime() - wall_loop) / (step - first_step))
+  if (len_trim(run_signal_line(stop_reason, step)) > 0) call log_line(run_signal_line(stop_reason, step))
   PetscCallA(run_output_close(out, step, time, ierr, output_share()))
   call log_line(run_stop_line(cfg, stop_reason, step, merge(fl%max_rate, 0.0_dp, cfg%resolved)))
   if (cfg%verification%manufactured_solution .and. cfg%resolved) then

@@ -12,7 +12,8 @@ module mod_run_control
   use mod_os_services, only: stop_signal, make_directory, probe_directory, lock_directory
   implicit none
   private
-  public :: command_line, prepare_output_directory, continue_from_directory, run_stop_reason, run_stop_line
+  public :: command_line, prepare_output_directory, continue_from_directory, run_stop_reason, run_stop_line, &
+            run_signal_line
   integer, parameter, public :: RUN_GOES_ON = 0, RUN_DONE = 1, RUN_SIGNALLED = 2, RUN_WALL_LIMIT = 3, RUN_STEADY = 4
 
 contains
@@ -154,6 +155,17 @@ contains
     if (all_flags(2) == 1) reason = RUN_WALL_LIMIT
     if (all_flags(1) == 1) reason = RUN_SIGNALLED
   end function run_stop_reason
+
+  ! What the run does on a signal, said before it writes the checkpoint (a SIGKILL that follows the
+  ! signal may end the run before its last word; the log then still tells where the checkpoint
+  ! came from); '' for any other reason to stop.
+  function run_signal_line(reason, step) result(text)
+    integer, intent(in) :: reason, step
+    character(len=200) :: text
+    text = ''
+    if (reason == RUN_SIGNALLED) write(text, '(a,i0,a,i0,a)') 'signal ', stop_signal(), ' at step ', step, &
+                                                              ': writing the checkpoint'
+  end function run_signal_line
 
   ! The run log's last word on why the run stopped at step (max_rate: the flow's max|du/dt| when
   ! it stopped steady).
