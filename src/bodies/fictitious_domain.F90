@@ -44,11 +44,11 @@ module mod_fictitious_domain
   use mod_kinds, only: dp
   use mod_grid, only: grid_t, grid_create_box_layout, FIELD_P
   use mod_particles, only: particles_t, MOTION_FREE, MOTION_FROZEN, impose_motion
-  use mod_particle_system, only: particle_system_reset, particle_system_add_diagonal
+  use mod_particle_system, only: particle_system_t, particle_system_reset, particle_system_add_diagonal
   use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_add_to_system, &
                                       particle_lubrication_add_corrections, particle_lubrication_corrections
-  use mod_sphere_halo, only: sphere_halo_t, sphere_halo_reverse, sphere_halo_forward
-  use mod_ld_local, only: ld_local_contacts_update
+  use mod_sphere_halo, only: sphere_halo_t, sphere_halo_reverse
+  use mod_ld_local, only: ld_local_contacts_update, ld_local_forward_motion
   use mod_lubrication_links, only: lubrication_links_corrections
   use mod_particle_contacts, only: particle_contacts_t, particle_contacts_add_stiffness, &
                                    particle_contacts_implicit_update, particle_contacts_set_rate
@@ -255,6 +255,24 @@ contains
     end if
     PetscCallA(event_end(EVENT_GEOMETRY, ierr))
   end subroutine fictitious_domain_geometry
+
+  ! A local set's ghost rows of the particle system: a placeholder (the identity, nothing on the
+  ! right), since their owners solve for them (the distributed solve takes the own rows only; the
+  ! block solve, without pairs, solves every row).
+  subroutine ghost_rows(system, rhs, halo)
+    type(particle_system_t), intent(inout) :: system
+    real(dp), intent(inout) :: rhs(:, :)
+    type(sphere_halo_t), intent(in) :: halo
+    integer :: q, c
+    do q = 1, size(rhs, 2)
+      if (halo%is_owned(q)) cycle
+      system%diag(:, :, q) = 0.0_dp
+      do c = 1, 6
+        system%diag(c, c, q) = 1.0_dp
+      end do
+      rhs(:, q) = 0.0_dp
+    end do
+  end subroutine ghost_rows
 
   ! The rigid-body matrices (6, 6, n) of a local set: each ghost's part, made from this rank's
   ! faces, added into its owner's (mod_sphere_halo); a ghost keeps its part. Collective among
@@ -620,28 +638,16 @@ contains
     type(particle_lubrication_t), intent(in), optional :: lubrication
     type(particle_contacts_t), intent(inout), optional :: contacts
     type(sphere_halo_t), intent(inout), optional :: halo
-    real(dp), allocatable :: rhs(:, :), v(:, :)
-    real(dp) :: identity(6, 6)
+    real(dp), allocatable :: rhs(:, :)
     integer :: q, n
 
     PetscCall(event_begin(EVENT_MOTION, ierr))
     n = parts%n
-    identity = 0.0_dp
-    do q = 1, 6
-      identity(q, q) = 1.0_dp
-    end do
     select case (parts%motion)
     case (MOTION_FREE, MOTION_FROZEN)
       allocate(rhs(6, n))
       call particle_system_reset(fd%solver%system, n)
       do q = 1, n
-        if (present(halo)) then
-          if (.not. halo%is_owned(q)) then
-            call particle_system_add_diagonal(fd%solver%system, q, identity)
-            rhs(:, q) = 0.0_dp
-            cycle
-          end if
-        end if
         call particle_system_add_diagonal(fd%solver%system, q, fd%beta * fd%rigid_matrix(:, :, q))
         rhs(:, q) = fd%beta * fd%moments(1:6, q) - fd%moments(7:12, q) &
              + [parts%external_force(:, q), parts%external_torque(:, q)]
@@ -649,19 +655,14 @@ contains
         if (present(extra_torque)) rhs(4:6, q) = rhs(4:6, q) + extra_torque(:, q)
         if (present(contacts)) rhs(:, q) = rhs(:, q) + [contacts%force(:, q), contacts%torque(:, q)]
       end do
+      if (present(halo)) call ghost_rows(fd%solver%system, rhs, halo)
       if (present(lubrication)) call particle_lubrication_add_to_system(lubrication, fd%solver%system, rhs)
       if (present(contacts) .and. parts%motion == MOTION_FREE) &
         call particle_contacts_add_stiffness(contacts, fd%solver%system, rhs, parts%velocity, parts%omega, parts%have_prev)
       call particle_solver_solve(fd%solver, rhs, parts, ierr, ': a particle covers no grid face?')
       CHKERRQ(ierr)
       if (present(halo)) then
-        allocate(v(6, n))
-        v(1:3, :) = parts%velocity
-        v(4:6, :) = parts%omega
-        call sphere_halo_forward(halo, v, ierr)
-        CHKERRQ(ierr)
-        parts%velocity = v(1:3, :)
-        parts%omega = v(4:6, :)
+        PetscCall(ld_local_forward_motion(halo, parts, ierr))
       end if
       if (present(contacts)) then
         if (present(halo)) then
@@ -810,7 +811,7 @@ contains
       call particle_system_add_diagonal(fd%solver%system, q, fd%beta * fd%rigid_matrix(:, :, q))
       rhs(:, q) = (fd%beta * response_scale) * fd%response_moments(:, q)
     end do
-    call placeholders()
+    if (present(halo)) call ghost_rows(fd%solver%system, rhs, halo)
     call set_rate(1.0_dp)
     if (present(lubrication)) call particle_lubrication_add_to_system(lubrication, fd%solver%system, rhs)
     if (stiffness) call particle_contacts_add_stiffness(contacts, fd%solver%system, rhs, 0.0_dp * u_before, &
@@ -820,7 +821,9 @@ contains
     call particle_solver_solve(fd%solver, rhs, parts, ierr, ': a particle covers no grid face? (stress control: '// &
                                'the part per unit rate)')
     CHKERRQ(ierr)
-    call forward_velocities()
+    if (present(halo)) then
+      PetscCall(ld_local_forward_motion(halo, parts, ierr))
+    end if
     u1 = parts%velocity
     w1 = parts%omega
     ! the step at r0 (assembled last: the contacts keep its U^{n-1} for their implicit update), from U^{n-1}
@@ -831,7 +834,7 @@ contains
            + [parts%external_force(:, q), parts%external_torque(:, q)]
       if (present(contacts)) rhs(:, q) = rhs(:, q) + [contacts%force(:, q), contacts%torque(:, q)]
     end do
-    call placeholders()
+    if (present(halo)) call ghost_rows(fd%solver%system, rhs, halo)
     call set_rate(rate_before)
     if (present(lubrication)) call particle_lubrication_add_to_system(lubrication, fd%solver%system, rhs)
     if (stiffness) call particle_contacts_add_stiffness(contacts, fd%solver%system, rhs, u_before, w_before, &
@@ -840,7 +843,9 @@ contains
     parts%omega = w_before
     call particle_solver_solve(fd%solver, rhs, parts, ierr, ': a particle covers no grid face?')
     CHKERRQ(ierr)
-    call forward_velocities()
+    if (present(halo)) then
+      PetscCall(ld_local_forward_motion(halo, parts, ierr))
+    end if
     u0 = parts%velocity
     w0 = parts%omega
     ! Lees-Edwards: the fictitious domain's stresslet at r0 and per unit rate (affine; see above)
@@ -871,33 +876,6 @@ contains
     PetscCall(event_end(EVENT_MOTION, ierr))
 
   contains
-
-    ! a local set: a ghost's row of the system a placeholder (the identity, nothing on the right;
-    ! its owner solves for it), as fictitious_domain_solve_motion
-    subroutine placeholders()
-      integer :: g, c
-      if (.not. present(halo)) return
-      do g = 1, n
-        if (halo%is_owned(g)) cycle
-        fd%solver%system%diag(:, :, g) = 0.0_dp
-        do c = 1, 6
-          fd%solver%system%diag(c, c, g) = 1.0_dp
-        end do
-        rhs(:, g) = 0.0_dp
-      end do
-    end subroutine placeholders
-
-    ! a local set: the own spheres' velocities to their ghosts (the host's ierr)
-    subroutine forward_velocities()
-      real(dp), allocatable :: v(:, :)
-      if (.not. present(halo)) return
-      allocate(v(6, n))
-      v(1:3, :) = parts%velocity
-      v(4:6, :) = parts%omega
-      call sphere_halo_forward(halo, v, ierr)
-      parts%velocity = v(1:3, :)
-      parts%omega = v(4:6, :)
-    end subroutine forward_velocities
 
     ! every rate-dependent datum of the particle problem at rate r: the links' drives, undisturbed
     ! velocities and E_inf, the walls' velocity in the contacts

@@ -43,7 +43,7 @@ module mod_ld_local
   implicit none
   private
   public :: ld_local_t, ld_local_create, ld_local_begin, ld_local_contacts_agree, ld_local_contacts_update, &
-            ld_local_links, &
+            ld_local_forward_motion, ld_local_links, &
             ld_local_forward_velocities, ld_local_statistics, ld_local_complete_view, &
             ld_local_own_slot
 
@@ -448,15 +448,24 @@ contains
   subroutine ld_local_forward_velocities(loc, ierr)
     type(ld_local_t), intent(inout) :: loc
     PetscErrorCode, intent(out) :: ierr
-    real(dp), allocatable :: v(:, :)
-    allocate(v(6, loc%set%n))
-    v(1:3, :) = loc%set%velocity
-    v(4:6, :) = loc%set%omega
-    call sphere_halo_forward(loc%halo, v, ierr)
-    if (ierr /= 0) return
-    loc%set%velocity = v(1:3, :)
-    loc%set%omega = v(4:6, :)
+    call ld_local_forward_motion(loc%halo, loc%set, ierr)
   end subroutine ld_local_forward_velocities
+
+  !> The own spheres' velocities and angular velocities of the local set p (held by halo) sent to
+  !> their ghosts. Collective among neighbours.
+  subroutine ld_local_forward_motion(halo, p, ierr)
+    type(sphere_halo_t), intent(inout) :: halo
+    type(particles_t), intent(inout) :: p
+    PetscErrorCode, intent(out) :: ierr
+    real(dp), allocatable :: v(:, :)
+    allocate(v(6, p%n))
+    v(1:3, :) = p%velocity
+    v(4:6, :) = p%omega
+    call sphere_halo_forward(halo, v, ierr)
+    if (ierr /= 0) return
+    p%velocity = v(1:3, :)
+    p%omega = v(4:6, :)
+  end subroutine ld_local_forward_motion
 
   !> The statistics' sample of the configuration on the local set (mod_rheology's local set: sums
   !> over the own spheres, each pair by the owner of its reference, the ghosts within reach of the

@@ -428,6 +428,7 @@ contains
           return
         end if
       end if
+      ! (the stage stays pushed for the rest of the step, as in time_step_advance)
       if (ts%variant == TIME_STEP_RESOLVED) then
         ! the fluid step with Lambda^n, then the particle sub-problem of the own spheres (their
         ! moments summed on them, their rows solved, their velocities forwarded to the ghosts),
@@ -444,36 +445,28 @@ contains
           PetscCall(fictitious_domain_solve_motion(ts%fd, set, ierr, lubrication=ts%lubrication, contacts=ts%contacts, halo=loc%halo))
         end if
         PetscCall(fictitious_domain_update(ts%grid, ts%fd, ts%fluid%vel, ts%fluid%pressure, set, ierr, ts%lubrication, loc%halo))
-        if (associated(ts%rheology)) then
-          if (associated(ts%contacts)) then
-            PetscCall(ld_local_statistics(loc, ts%rheology, ierr, ts%contacts%stresslet, le%offset))
-          else
-            PetscCall(ld_local_statistics(loc, ts%rheology, ierr, offset=le%offset))
-          end if
-          PetscCall(fluid_mean_profile(ts%grid, ts%fluid, ts%mean_flow, ierr))
-          call rheo_sample_flow(ts%rheology, ts%mean_flow, ts%grid%h)
-        end if
-        if (associated(ts%lubrication)) then
-          PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, ts%lubrication%wall_force, 6, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr))
-        end if
-        return
-      end if
-      ! (the stage stays pushed for the rest of the step, as in time_step_advance)
-      PetscCall(stage_push(STAGE_PARTICLES, ierr))
-      if (ts%protocol%control == CONTROL_STRESS) then
-        ! the rate that sets the mean shear stress (doc/METHOD.md §7.4), as time_step_advance
-        rate = ts%protocol%rate
-        PetscCall(ld_motion_solve_stress(ts%ld, ts%ld_solver, set, ts%protocol%stress, rate, reached, ierr, rheology=ts%rheology, lubrication=ts%lubrication, contacts=ts%contacts, local=loc))
-        call take_stress_rate(ts, rate, reached)
       else
-        PetscCall(ld_motion_solve(ts%ld, ts%ld_solver, set, ierr, lubrication=ts%lubrication, contacts=ts%contacts, local=loc))
+        PetscCall(stage_push(STAGE_PARTICLES, ierr))
+        if (ts%protocol%control == CONTROL_STRESS) then
+          ! the rate that sets the mean shear stress (doc/METHOD.md §7.4), as time_step_advance
+          rate = ts%protocol%rate
+          PetscCall(ld_motion_solve_stress(ts%ld, ts%ld_solver, set, ts%protocol%stress, rate, reached, ierr, rheology=ts%rheology, lubrication=ts%lubrication, contacts=ts%contacts, local=loc))
+          call take_stress_rate(ts, rate, reached)
+        else
+          PetscCall(ld_motion_solve(ts%ld, ts%ld_solver, set, ierr, lubrication=ts%lubrication, contacts=ts%contacts, local=loc))
+        end if
       end if
-      ! the core statistics of this configuration, before it moves on: the own spheres' shares
+      ! the core statistics of this configuration, before it moves on: the own spheres' shares (and
+      ! the resolved flow's profile)
       if (associated(ts%rheology)) then
         if (associated(ts%contacts)) then
           PetscCall(ld_local_statistics(loc, ts%rheology, ierr, ts%contacts%stresslet, le%offset))
         else
           PetscCall(ld_local_statistics(loc, ts%rheology, ierr, offset=le%offset))
+        end if
+        if (ts%variant == TIME_STEP_RESOLVED) then
+          PetscCall(fluid_mean_profile(ts%grid, ts%fluid, ts%mean_flow, ierr))
+          call rheo_sample_flow(ts%rheology, ts%mean_flow, ts%grid%h)
         end if
       end if
       ! the links' wall forces of the own spheres summed over the ranks (a series column)
