@@ -92,8 +92,8 @@ contains
 
   !> The local set of the step: on the first step (and after a restart) taken from the view parts
   !> (after a restart on as many ranks, the sets the checkpoint's run held: parts%sets_made_z, so
-  !> that the restart repeats its arithmetic bitwise), then kept from step to step while no sphere has moved half the skin along z since the sets
-  !> were made (every sphere a rank's own spheres reach within a kernel's range is then still among
+  !> that the restart repeats its arithmetic bitwise), then kept from step to step while no sphere
+  !> has moved half the skin along z since the sets were made (every sphere a rank's own spheres reach within a kernel's range is then still among
   !> its ghosts, and the ghosts, advanced like their owners from the same forwarded values, are
   !> their owners' copies: nothing to send), else made again from the last step's (carry_on: the own
   !> spheres that left the slab migrate with what they carry, the ghosts rebuilt and given their

@@ -220,12 +220,14 @@ contains
   ! sample the configuration X^n with its velocities before it moves on. A failure ends it early,
   ! described in ts%failure. Collective.
   subroutine time_step_advance(ts, step, ierr)
-    type(time_step_t), intent(inout) :: ts
+    type(time_step_t), target, intent(inout) :: ts
     integer, intent(in) :: step
     PetscErrorCode, intent(out) :: ierr
     integer :: info
     real(dp) :: rate, reached
     logical :: stress_control, local
+    type(particles_t), pointer :: spheres
+    type(sphere_halo_t), pointer :: halo
     ierr = 0
     ts%failure = ''
     ! the imposed rate of this step, gamma_dot(t_n), in every piece that uses it (stress control:
@@ -291,22 +293,7 @@ contains
         end if
         ! (a disassociated pointer passed to an optional argument is absent: contacts, lubrication)
         if (ts%variant == TIME_STEP_RESOLVED) then
-          ! (stress control: the fluid at the last step's wall speed, impose_rate)
-          PetscCall(stage_push(STAGE_FLUID, ierr))
-          PetscCall(fluid_step(ts%grid, ts%fluid, ierr, ts%fd%lambda))
-          PetscCall(stage_pop(ierr))
-          PetscCall(stage_push(STAGE_PARTICLES, ierr))
-          ! the particle sub-problem (doc/METHOD.md §3.2 eq. (1)): moments of u~ and Lambda^n, the
-          ! 6N system for U, Omega, then Lambda^{n+1}, u^{n+1} and the hydrodynamic force, torque,
-          ! stresslet
-          if (le%active) call fictitious_domain_set_image_speed(ts%fd, ts%protocol%rate * ts%box(2))
-          PetscCall(fictitious_domain_moments(ts%grid, ts%fd, ts%fluid%vel, parts%n, ierr))
-          if (stress_control) then
-            PetscCall(resolved_stress_control(ts, ierr))
-          else
-            PetscCall(fictitious_domain_solve_motion(ts%fd, parts, ierr, lubrication=ts%lubrication, contacts=ts%contacts))
-          end if
-          PetscCall(fictitious_domain_update(ts%grid, ts%fd, ts%fluid%vel, ts%fluid%pressure, parts, ierr, ts%lubrication))
+          PetscCall(resolved_particles(ts, ierr))
         else
           PetscCall(stage_push(STAGE_PARTICLES, ierr))
           ! lubrication dynamics: the 6N Stokes balance of the spheres alone (one-body drag in the
@@ -335,44 +322,26 @@ contains
           call rheo_sample_flow(ts%rheology, ts%mean_flow, ts%grid%h)
         end if
       end if
-      if (local) then
-        ! the local set is the state: its spheres advance (the view follows at the output's steps)
-        if (ts%variant == TIME_STEP_RESOLVED) ts%position_before = ts%local%set%position
-        call advance_positions(ts%local%set, ts%dt, ts%box, [.true., .not. (ts%walls .or. le%active), .true.])
-        parts%have_prev = ts%local%set%have_prev
-      else
-        if (ts%variant == TIME_STEP_RESOLVED) ts%position_before = parts%position
-        call advance_positions(parts, ts%dt, ts%box, [.true., .not. (ts%walls .or. le%active), .true.])
-      end if
+      ! the spheres advance: every sphere, or each rank's local set, which is then the state (the
+      ! view follows only for a failure)
+      call stepped_spheres(ts, spheres, halo)
+      if (ts%variant == TIME_STEP_RESOLVED) ts%position_before = spheres%position
+      call advance_positions(spheres, ts%dt, ts%box, [.true., .not. (ts%walls .or. le%active), .true.])
+      parts%have_prev = spheres%have_prev
       call shear_protocol_end_step(ts%protocol)
       if (le%active) then
         ! the boundary slides on; spheres that left through y = 0 or Ly re-enter from the image
         call slide(le, ts%protocol, ts%dt)
-        if (local) then
-          associate(set => ts%local%set)
-            call le_wrap(le, set%position, set%velocity, set%velocity_prev)
-          end associate
-        else
-          call le_wrap(le, parts%position, parts%velocity, parts%velocity_prev)
-        end if
+        call le_wrap(le, spheres%position, spheres%velocity, spheres%velocity_prev)
       end if
-      if (ts%variant == TIME_STEP_RESOLVED .and. local) then
-        ! the geometry of the local set (each sphere's parts summed on its owner)
-        associate(set => ts%local%set)
-          if (ts%carry_lambda) then
-            ts%position_before = displacements(set%position, ts%position_before, ts%box, [.true., .not. ts%walls, .true.])
-            PetscCall(fictitious_domain_follow(ts%grid, ts%fd, set, ts%position_before, ierr, le, ts%local%halo))
-          else
-            call fictitious_domain_geometry(ts%grid, ts%fd, set, le, ts%local%halo)
-          end if
-        end associate
-      else if (ts%variant == TIME_STEP_RESOLVED) then
+      if (ts%variant == TIME_STEP_RESOLVED) then
+        ! the geometry at X^{n+1} (of a local set: each sphere's parts summed on its owner)
         if (ts%carry_lambda) then
           ! (with Lees-Edwards the carry finds the displacement of each sphere and image itself)
-          ts%position_before = displacements(parts%position, ts%position_before, ts%box, [.true., .not. ts%walls, .true.])
-          PetscCall(fictitious_domain_follow(ts%grid, ts%fd, parts, ts%position_before, ierr, le))
+          ts%position_before = displacements(spheres%position, ts%position_before, ts%box, [.true., .not. ts%walls, .true.])
+          PetscCall(fictitious_domain_follow(ts%grid, ts%fd, spheres, ts%position_before, ierr, le, halo))
         else
-          call fictitious_domain_geometry(ts%grid, ts%fd, parts, le)
+          call fictitious_domain_geometry(ts%grid, ts%fd, spheres, le, halo)
         end if
       end if
       PetscCall(stage_pop(ierr))
@@ -430,21 +399,8 @@ contains
       end if
       ! (the stage stays pushed for the rest of the step, as in time_step_advance)
       if (ts%variant == TIME_STEP_RESOLVED) then
-        ! the fluid step with Lambda^n, then the particle sub-problem of the own spheres (their
-        ! moments summed on them, their rows solved, their velocities forwarded to the ghosts),
-        ! Lambda^{n+1}, u^{n+1} and each own sphere's force, torque and stresslet (time_step_advance)
-        PetscCall(stage_push(STAGE_FLUID, ierr))
-        PetscCall(fluid_step(ts%grid, ts%fluid, ierr, ts%fd%lambda))
-        PetscCall(stage_pop(ierr))
-        PetscCall(stage_push(STAGE_PARTICLES, ierr))
-        if (le%active) call fictitious_domain_set_image_speed(ts%fd, ts%protocol%rate * ts%box(2))
-        PetscCall(fictitious_domain_moments(ts%grid, ts%fd, ts%fluid%vel, set%n, ierr, loc%halo))
-        if (ts%protocol%control == CONTROL_STRESS) then
-          PetscCall(resolved_stress_control(ts, ierr))
-        else
-          PetscCall(fictitious_domain_solve_motion(ts%fd, set, ierr, lubrication=ts%lubrication, contacts=ts%contacts, halo=loc%halo))
-        end if
-        PetscCall(fictitious_domain_update(ts%grid, ts%fd, ts%fluid%vel, ts%fluid%pressure, set, ierr, ts%lubrication, loc%halo))
+        ! the own spheres' moments summed on them, their rows solved, their velocities forwarded
+        PetscCall(resolved_particles(ts, ierr))
       else
         PetscCall(stage_push(STAGE_PARTICLES, ierr))
         if (ts%protocol%control == CONTROL_STRESS) then
@@ -475,6 +431,46 @@ contains
       end if
     end associate
   end subroutine local_step
+
+  ! The spheres the step takes: every sphere (halo disassociated, an absent argument), or, once the
+  ! ranks' local sets hold the state, this rank's set and its halo. Points into ts.
+  subroutine stepped_spheres(ts, spheres, halo)
+    type(time_step_t), target, intent(inout) :: ts
+    type(particles_t), pointer, intent(out) :: spheres
+    type(sphere_halo_t), pointer, intent(out) :: halo
+    spheres => ts%parts
+    halo => null()
+    if (ts%local%live) then
+      spheres => ts%local%set
+      halo => ts%local%halo
+    end if
+  end subroutine stepped_spheres
+
+  ! The resolved step after the spheres' contacts and links (doc/METHOD.md §3.2 eq. (1)): the fluid
+  ! with Lambda^n (stress control: at the last step's wall speed, impose_rate), the moments of u~
+  ! and Lambda^n, the 6N system for U, Omega (or the rate that sets the stress and U at it), then
+  ! Lambda^{n+1}, u^{n+1} and the hydrodynamic force, torque and stresslet; on a local set each
+  ! sphere's moments and sums on its owner (stepped_spheres). The Particles stage is left pushed
+  ! for the rest of the step. Collective.
+  subroutine resolved_particles(ts, ierr)
+    type(time_step_t), target, intent(inout) :: ts
+    PetscErrorCode, intent(out) :: ierr
+    type(particles_t), pointer :: spheres
+    type(sphere_halo_t), pointer :: halo
+    call stepped_spheres(ts, spheres, halo)
+    PetscCall(stage_push(STAGE_FLUID, ierr))
+    PetscCall(fluid_step(ts%grid, ts%fluid, ierr, ts%fd%lambda))
+    PetscCall(stage_pop(ierr))
+    PetscCall(stage_push(STAGE_PARTICLES, ierr))
+    if (ts%le%active) call fictitious_domain_set_image_speed(ts%fd, ts%protocol%rate * ts%box(2))
+    PetscCall(fictitious_domain_moments(ts%grid, ts%fd, ts%fluid%vel, spheres%n, ierr, halo))
+    if (ts%protocol%control == CONTROL_STRESS) then
+      PetscCall(resolved_stress_control(ts, ierr))
+    else
+      PetscCall(fictitious_domain_solve_motion(ts%fd, spheres, ierr, lubrication=ts%lubrication, contacts=ts%contacts, halo=halo))
+    end if
+    PetscCall(fictitious_domain_update(ts%grid, ts%fd, ts%fluid%vel, ts%fluid%pressure, spheres, ierr, ts%lubrication, halo))
+  end subroutine resolved_particles
 
   ! The geometry of X^n on the local set just made (the same faces as the last geometry's, which the
   ! old set's ghosts covered: Lambda^n, carried onto them, stays listed). Collective.
@@ -544,13 +540,7 @@ contains
     real(dp) :: rate, rate_before, per_rate, walls_share, fluid_stress, fluid_slope
     type(particles_t), pointer :: spheres
     type(sphere_halo_t), pointer :: halo
-    ! (a disassociated halo is an absent argument: the replicated spheres)
-    spheres => ts%parts
-    halo => null()
-    if (ts%local%live) then
-      spheres => ts%local%set
-      halo => ts%local%halo
-    end if
+    call stepped_spheres(ts, spheres, halo)
     associate(fl => ts%fluid, unit => ts%fluid_response)
       PetscCall(fictitious_domain_response_moments(ts%grid, ts%fd, unit%vel, spheres%n, ierr, halo))
       rate_before = ts%protocol%rate
