@@ -15,11 +15,10 @@
 ! (ld_local_begin), the own spheres that left the slab go to their new owner with what they carry
 ! (velocities, the Adams-Bashforth history, external loads, radius), the ghosts are rebuilt, and the
 ! springs of the contacts go to the neighbours whose spheres they touch. No message of a step grows
-! with the total number of spheres. The output takes each rank's share of the
-! local sets (mod_time_step time_step_share: the series, the snapshots, the checkpoints). The
-! replicated particle state (the view) is brought up to date (ld_local_complete_view: positions,
-! velocities and springs gathered) only for a failure, whose state and message it gives; a
-! restart and the first step take the local set from it.
+! with the total number of spheres. The output takes each rank's share of the local sets
+! (mod_time_step time_step_share: the series, the snapshots, the checkpoints, a failure's state).
+! The first step takes the local set from the replicated particle state of the start (the deck,
+! the packing or the checkpoint), which is then released: from then on no rank holds every sphere.
 !
 ! With one rank, or without contacts and links (the block-diagonal one-body problem), the step keeps
 ! the replicated state (ld_local_t%active false). An owned sphere sees every contact and link in
@@ -29,7 +28,7 @@
 module mod_ld_local
   use petscsys
   use mod_kinds, only: dp
-  use mod_particles, only: particles_t, particles_init
+  use mod_particles, only: particles_t, particles_init, particles_release
   use mod_sphere_halo, only: sphere_halo_t, sphere_halo_create, sphere_halo_migrate, sphere_halo_build, &
                              sphere_halo_forward, sphere_halo_exchange, sphere_halo_slab_of
   use mod_sorting, only: ascending_order, sorted_position
@@ -44,17 +43,15 @@ module mod_ld_local
   private
   public :: ld_local_t, ld_local_create, ld_local_begin, ld_local_contacts_agree, ld_local_contacts_update, &
             ld_local_forward_motion, ld_local_links, &
-            ld_local_forward_velocities, ld_local_statistics, ld_local_complete_view, &
-            ld_local_own_slot
+            ld_local_forward_velocities, ld_local_statistics, ld_local_own_slot
 
   type :: ld_local_t
     logical :: active = .false.           ! the step runs on the local set
     logical :: live = .false.             ! the local set holds the state (from the first step on)
-    logical :: view_current = .true.      ! the view holds the local set's state
     type(sphere_halo_t) :: halo           ! own spheres and ghosts (ascending global index)
     type(particles_t) :: set              ! their state
     integer :: total = 0                  ! spheres of the whole system
-    integer :: view_updates = 0           ! times the view was brought up to date (the run's account)
+    integer(kind=8) :: released = 0       ! bytes of the replicated particles released (the run's account)
     ! the sets are kept from step to step while no sphere has moved half the skin along z since
     ! they were made (ld_local_begin): skin, the smallest of the kernels' neighbour lists' [a]
     real(dp) :: skin = 0.0_dp             ! (the set's sets_made_z: its centres' z when the sets were made)
@@ -66,9 +63,6 @@ module mod_ld_local
   ! what a sphere carries to a new owner and its owner forwards to its ghosts (carried): velocity,
   ! omega, the last step's velocity (Adams-Bashforth), external force and torque, radius
   integer, parameter :: CARRIED = 16
-  ! the values per own sphere that the view takes (after its global index): position, velocity,
-  ! omega, the last step's velocity
-  integer, parameter :: STATE_VALUES = 12
 
 contains
 
@@ -90,9 +84,10 @@ contains
     if (loc%active) call sphere_halo_create(loc%halo, lz, reach, edges)
   end subroutine ld_local_create
 
-  !> The local set of the step: on the first step (and after a restart) taken from the view parts
-  !> (after a restart on as many ranks, the sets the checkpoint's run held: parts%sets_made_z, so
-  !> that the restart repeats its arithmetic bitwise), then kept from step to step while no sphere
+  !> The local set of the step: on the first step (and after a restart) taken from the replicated
+  !> parts of the start, which are then released (particles_release: n, the radius, the motion and
+  !> have_prev stay; after a restart on as many ranks the sets are the checkpoint's run's:
+  !> parts%sets_made_z, so that the restart repeats its arithmetic bitwise), then kept from step to step while no sphere
   !> has moved half the skin along z since the sets were made (every sphere a rank's own spheres reach within a kernel's range is then still among
   !> its ghosts, and the ghosts, advanced like their owners from the same forwarded values, are
   !> their owners' copies: nothing to send), else made again from the last step's (carry_on: the own
@@ -104,7 +99,7 @@ contains
   !> parts%have_prev (a reversal or a branch clears it) is the set's. Collective.
   subroutine ld_local_begin(loc, parts, solver, ierr, ld, contacts, lubrication, rheology)
     type(ld_local_t), intent(inout) :: loc
-    type(particles_t), intent(in) :: parts
+    type(particles_t), intent(inout) :: parts
     type(particle_solver_t), intent(inout) :: solver
     PetscErrorCode, intent(out) :: ierr
     type(lubrication_dynamics_t), intent(inout), optional :: ld
@@ -117,7 +112,6 @@ contains
 
     ierr = 0
     loc%total = parts%n
-    loc%view_current = .false.
     loc%made = .false.
     keep = .false.
     if (loc%live) then
@@ -126,10 +120,11 @@ contains
       if (.not. loc%kernels_told) keep = .false.
       if (.not. keep) call carry_on(loc, ierr)
     else
-      ! the sets the view's checkpoint was written from (if made for as many ranks), or new ones;
-      ! then as on any step: made again if a sphere has moved half the skin since
-      call take_view(loc, parts, ierr)
+      ! the sets the checkpoint's run held (if made for as many ranks), or new ones; then as on any
+      ! step: made again if a sphere has moved half the skin since
+      call take_replicated(loc, parts, ierr)
       if (ierr /= 0) return
+      call particles_release(parts, loc%released)
       call sets_hold(loc, keep, ierr)
       if (ierr /= 0) return
       if (.not. keep) call carry_on(loc, ierr)
@@ -178,12 +173,12 @@ contains
     keep = moved < 0.5_dp * loc%skin
   end subroutine sets_hold
 
-  ! The local set taken from the view parts: own spheres by slab (no sphere moves between ranks:
-  ! the view is everywhere), the ghosts within reach, the state of each copied. The slabs are
+  ! The local set taken from the replicated parts: own spheres by slab (no sphere moves between
+  ! ranks: every rank holds every sphere), the ghosts within reach, the state of each copied. The slabs are
   ! those of each sphere's z when the sets were made (parts%sets_made_z, from a checkpoint of a run
   ! on as many ranks: the same owners and ghosts as that run held), else of its position.
   ! Collective.
-  subroutine take_view(loc, parts, ierr)
+  subroutine take_replicated(loc, parts, ierr)
     type(ld_local_t), intent(inout) :: loc
     type(particles_t), intent(in) :: parts
     PetscErrorCode, intent(out) :: ierr
@@ -205,7 +200,7 @@ contains
     loc%set%sets_made_z = z_made(loc%halo%id)
     loc%set%sets_made_ranks = loc%halo%ranks
     call put_cargo(loc%set, cargo(parts, loc%halo%id))
-  end subroutine take_view
+  end subroutine take_replicated
 
   ! The local set of the last step carried on to the positions it advanced to: the own spheres that
   ! left the slab to the rank of their new slab (a neighbour's) with what they carry, the ghosts
@@ -492,75 +487,6 @@ contains
     call rheo_sample_finish(rheology, shares, min_gap)
   end subroutine ld_local_statistics
 
-  !> The view parts brought up to date from the local set, for a failure (failed_state.h5 and the
-  !> runtime guard's message, which read every sphere's state, not the step's forces): the own
-  !> spheres' positions, velocities, omega and last velocities gathered (STATE_VALUES), the springs
-  !> of the pairs whose first sphere is own into the contacts' history (every spring), the
-  !> contacts and the links set for every sphere (their set_local of the view). Nothing when the
-  !> view is current (the same on every rank). Collective.
-  subroutine ld_local_complete_view(loc, parts, ierr, contacts, lubrication)
-    type(ld_local_t), intent(inout) :: loc
-    type(particles_t), intent(inout) :: parts
-    PetscErrorCode, intent(out) :: ierr
-    type(particle_contacts_t), intent(inout), optional :: contacts
-    type(particle_lubrication_t), intent(inout), optional :: lubrication
-    real(dp), allocatable :: rows(:, :), all(:, :), springs(:, :), all_springs(:, :), ups(:, :)
-    integer, allocatable :: keys(:, :), id(:)
-    integer :: q, k, np_hist, nsprings, i, info
-    logical, allocatable :: every(:)
-
-    ierr = 0
-    if (loc%view_current) return
-    loc%view_current = .true.
-    loc%view_updates = loc%view_updates + 1
-    ! (the contacts and the links are set for every sphere below: the next step makes the sets)
-    loc%kernels_told = .false.
-    associate(h => loc%halo, s => loc%set)
-      allocate(rows(STATE_VALUES + 1, h%owned))
-      k = 0
-      do q = 1, s%n
-        if (.not. h%is_owned(q)) cycle
-        k = k + 1
-        rows(:, k) = [real(h%id(q), dp), s%position(:, q), s%velocity(:, q), s%omega(:, q), s%velocity_prev(:, q)]
-      end do
-      PetscCall(gather_rows(rows, all, ierr))
-      id = nint(all(1, :))
-      parts%position(:, id) = all(2:4, :)
-      parts%velocity(:, id) = all(5:7, :)
-      parts%omega(:, id) = all(8:10, :)
-      parts%velocity_prev(:, id) = all(11:13, :)
-      allocate(every(loc%total))
-      every = .true.
-      if (present(lubrication)) then
-        call particle_lubrication_set_local(lubrication, every, parts%radii / parts%radius)
-        deallocate(lubrication%owned)
-      end if
-      if (present(contacts)) then
-        ! the springs of the pairs whose first sphere is own (5 values each: the pair, the spring)
-        nsprings = history_size(contacts%history)
-        allocate(keys(2, nsprings), ups(3, nsprings), springs(5, nsprings))
-        if (nsprings > 0) call history_pack(contacts%history, np_hist, keys, ups)
-        k = 0
-        do i = 1, nsprings
-          if (.not. owns(loc, keys(1, i))) cycle
-          k = k + 1
-          springs(:, k) = [real(keys(:, i), dp), ups(:, i)]
-        end do
-        PetscCall(gather_rows(springs(:, 1:k), all_springs, ierr))
-        nsprings = size(all_springs, 2)
-        call particle_contacts_set_local(contacts, [(i, i = 1, loc%total)], every, parts%radii / parts%radius)
-        deallocate(contacts%ids, contacts%owned)
-        if (contacts%params%mu_d > 0) then
-          call history_unpack(contacts%history, loc%total, nsprings, nint(all_springs(1:2, :)), all_springs(3:5, :), info)
-          if (info /= 0) then
-            ierr = 1
-            SETERRQ(PETSC_COMM_SELF, ierr, 'the springs gathered from the ranks do not form a history')
-          end if
-        end if
-      end if
-    end associate
-  end subroutine ld_local_complete_view
-
   !> The slot in the local set of the own sphere of global index g; 0 when g is not an own sphere.
   pure integer function ld_local_own_slot(loc, g) result(slot)
     type(ld_local_t), intent(in) :: loc
@@ -577,24 +503,5 @@ contains
     integer, intent(in) :: g
     owns = ld_local_own_slot(loc, g) > 0
   end function owns
-
-  ! The rows (k, m) of every rank, one after the other (rank order), on every rank. Collective.
-  subroutine gather_rows(rows, all, ierr)
-    real(dp), intent(in) :: rows(:, :)
-    real(dp), allocatable, intent(out) :: all(:, :)
-    PetscErrorCode, intent(out) :: ierr
-    integer, allocatable :: counts(:), displs(:)
-    integer :: r
-    PetscMPIInt :: ranks
-    PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, ranks, ierr))
-    allocate(counts(ranks), displs(ranks))
-    PetscCallMPI(MPI_Allgather(size(rows), 1, MPI_INTEGER, counts, 1, MPI_INTEGER, PETSC_COMM_WORLD, ierr))
-    displs(1) = 0
-    do r = 2, ranks
-      displs(r) = displs(r - 1) + counts(r - 1)
-    end do
-    allocate(all(size(rows, 1), sum(counts) / max(1, size(rows, 1))))
-    PetscCallMPI(MPI_Allgatherv(rows, size(rows), MPI_DOUBLE_PRECISION, all, counts, displs, MPI_DOUBLE_PRECISION, PETSC_COMM_WORLD, ierr))
-  end subroutine gather_rows
 
 end module mod_ld_local

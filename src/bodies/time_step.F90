@@ -37,11 +37,10 @@ module mod_time_step
   use mod_particle_solver, only: particle_solver_t
   use mod_sphere_halo, only: sphere_halo_t
   use mod_ld_local, only: ld_local_t, ld_local_create, ld_local_begin, ld_local_contacts_agree, ld_local_links, &
-                          ld_local_statistics, ld_local_complete_view, ld_local_own_slot
+                          ld_local_statistics, ld_local_own_slot
   implicit none
   private
-  public :: time_step_t, time_step_create, time_step_advance, time_step_guard, time_step_report, &
-            time_step_complete_view, time_step_share
+  public :: time_step_t, time_step_create, time_step_advance, time_step_guard, time_step_report, time_step_share
 
   ! the variants
   integer, parameter :: TIME_STEP_FLUID = 1       ! the fluid alone (no spheres)
@@ -80,9 +79,9 @@ module mod_time_step
     type(shear_protocol_t), pointer :: protocol => null()   ! the imposed shear (&shear)
     real(dp), allocatable :: mean_flow(:)          ! x-z plane means of u per cell row (statistics)
     real(dp), allocatable :: position_before(:, :) ! X^n, then X^{n+1} - X^n
-    ! lubrication dynamics on more than one rank: each rank's own spheres and ghosts (mod_ld_local),
-    ! the state between steps, which the output takes (time_step_share); parts, the contacts and
-    ! the links are brought up to date with it only for a failure (time_step_complete_view)
+    ! spheres on more than one rank: each rank's own spheres and ghosts (mod_ld_local), the state
+    ! between steps from the first step on, which the output takes (time_step_share); parts, the
+    ! replicated state of the start, is then released (it keeps n, the radius, the motion, have_prev)
     type(ld_local_t) :: local
   end type time_step_t
 
@@ -322,8 +321,7 @@ contains
           call rheo_sample_flow(ts%rheology, ts%mean_flow, ts%grid%h)
         end if
       end if
-      ! the spheres advance: every sphere, or each rank's local set, which is then the state (the
-      ! view follows only for a failure)
+      ! the spheres advance: every sphere, or each rank's local set, which is the state
       call stepped_spheres(ts, spheres, halo)
       if (ts%variant == TIME_STEP_RESOLVED) ts%position_before = spheres%position
       call advance_positions(spheres, ts%dt, ts%box, [.true., .not. (ts%walls .or. le%active), .true.])
@@ -496,32 +494,20 @@ contains
     call impose_rate(ts)
   end subroutine take_stress_rate
 
-  ! This rank's share of the spheres when the state of the run is the ranks' local sets
-  ! (lubrication dynamics on several ranks) and ts%parts, the contacts and the links are not up to
-  ! date with it (shared): the output then takes the share, and the contacts and the links as they
-  ! are, set for it. share%set points into ts (a target).
+  ! This rank's share of the spheres when the state of the run is the ranks' local sets (shared):
+  ! the output then takes the share, and the contacts and the links as they are, set for it.
+  ! share%set points into ts (a target).
   subroutine time_step_share(ts, share, shared)
     type(time_step_t), target, intent(in) :: ts
     type(sphere_share_t), intent(out) :: share
     logical, intent(out) :: shared
-    shared = ts%local%live .and. .not. ts%local%view_current
+    shared = ts%local%live
     if (.not. shared) return
     share%set => ts%local%set
     share%id = ts%local%halo%id
     share%own = ts%local%halo%is_owned
     share%total = ts%local%total
   end subroutine time_step_share
-
-  ! ts%parts and the contacts' springs brought up to date from the ranks' local sets (positions,
-  ! velocities, springs), for the state a failure writes; nothing when they are (or the step is
-  ! replicated). Collective.
-  subroutine time_step_complete_view(ts, ierr)
-    type(time_step_t), intent(inout) :: ts
-    PetscErrorCode, intent(out) :: ierr
-    ierr = 0
-    if (.not. ts%local%active) return
-    PetscCall(ld_local_complete_view(ts%local, ts%parts, ierr, ts%contacts, ts%lubrication))
-  end subroutine time_step_complete_view
 
   ! Stress control of the DNS with spheres between walls (doc/METHOD.md §7.4): after the fluid step
   ! at the last step's wall speed and its moments, the rate gamma_dot^n whose mean wall shear stress
@@ -694,15 +680,15 @@ contains
   ! The runtime guard after step (doc/DESIGN.md "Files, restart and signals"): a non-finite
   ! velocity, pressure or particle quantity, or a sphere half way through a wall, is described in
   ! ts%failure. The norms are global reductions and the spheres are either replicated or looked at
-  ! by their owners (the local set: the first failing sphere found by one reduction, and the view
-  ! then brought up to date to name it), so every rank finds the same. At step -fault_nan_step the
-  ! state is poisoned first (the guard's own test).
+  ! by their owners (the local set: the first failing sphere found by one reduction, described by
+  ! its owner, whose text every rank receives), so every rank finds the same. At step
+  ! -fault_nan_step the state is poisoned first (the guard's own test).
   subroutine time_step_guard(ts, step, ierr)
     type(time_step_t), intent(inout) :: ts
     integer, intent(in) :: step
     PetscErrorCode, intent(out) :: ierr
     PetscReal :: norms(4)
-    integer :: c, q, first
+    integer :: c, q, first, teller
     ierr = 0
     ts%failure = ''
     if (step == ts%fault_nan_step) then
@@ -731,7 +717,8 @@ contains
     end do
     if (.not. associated(ts%parts)) return
     if (ts%local%live) then
-      ! the own spheres of the local set; the smallest failing global index of all ranks
+      ! the own spheres of the local set; the smallest failing global index of all ranks, described
+      ! by its owner
       first = huge(1)
       associate(set => ts%local%set, h => ts%local%halo)
         do q = 1, set%n
@@ -741,27 +728,41 @@ contains
             exit
           end if
         end do
-      end associate
-      PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, first, 1, MPI_INTEGER, MPI_MIN, PETSC_COMM_WORLD, ierr))
-      if (first == huge(1)) return
-      PetscCall(ld_local_complete_view(ts%local, ts%parts, ierr, ts%contacts, ts%lubrication))
-    end if
-    associate(parts => ts%parts)
-      do q = 1, parts%n
-        if (.not. sphere_fault(ts, parts, q)) cycle
-        if (.not. (all(ieee_is_finite(parts%velocity(:, q))) .and. all(ieee_is_finite(parts%omega(:, q))) &
-                   .and. all(ieee_is_finite(parts%position(:, q))))) then
-          write(ts%failure, '(a,i0,a,3es10.3,a,3es10.3)') 'particle ', q, ' is not finite: velocity ', &
-               parts%velocity(:, q), ' omega ', parts%omega(:, q)
-        else
-          write(ts%failure, '(a,i0,a,f10.5,a,f10.5,a)') 'particle ', q, ' is half way through a wall (centre y = ', &
-               parts%position(2, q), ', walls at 0 and ', ts%box(2), &
-               '): add &contact, keep &lubrication on, or lower &time dt'
+        PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, first, 1, MPI_INTEGER, MPI_MIN, PETSC_COMM_WORLD, ierr))
+        if (first == huge(1)) return
+        q = ld_local_own_slot(ts%local, first)
+        teller = -1
+        if (q > 0) then
+          teller = h%rank
+          ts%failure = sphere_failure(ts, set, q, first)
         end if
-        return
-      end do
-    end associate
+      end associate
+      PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, teller, 1, MPI_INTEGER, MPI_MAX, PETSC_COMM_WORLD, ierr))
+      PetscCallMPI(MPI_Bcast(ts%failure, len(ts%failure), MPI_CHARACTER, teller, PETSC_COMM_WORLD, ierr))
+      return
+    end if
+    do q = 1, ts%parts%n
+      if (.not. sphere_fault(ts, ts%parts, q)) cycle
+      ts%failure = sphere_failure(ts, ts%parts, q, q)
+      return
+    end do
   end subroutine time_step_guard
+
+  ! What is wrong with sphere q of p, of global index g, which fails the runtime guard (sphere_fault).
+  function sphere_failure(ts, p, q, g) result(text)
+    type(time_step_t), intent(in) :: ts
+    type(particles_t), intent(in) :: p
+    integer, intent(in) :: q, g
+    character(len=400) :: text
+    if (.not. (all(ieee_is_finite(p%velocity(:, q))) .and. all(ieee_is_finite(p%omega(:, q))) &
+               .and. all(ieee_is_finite(p%position(:, q))))) then
+      write(text, '(a,i0,a,3es10.3,a,3es10.3)') 'particle ', g, ' is not finite: velocity ', p%velocity(:, q), &
+           ' omega ', p%omega(:, q)
+    else
+      write(text, '(a,i0,a,f10.5,a,f10.5,a)') 'particle ', g, ' is half way through a wall (centre y = ', &
+           p%position(2, q), ', walls at 0 and ', ts%box(2), '): add &contact, keep &lubrication on, or lower &time dt'
+    end if
+  end function sphere_failure
 
   ! Whether sphere q of p fails the runtime guard: a non-finite velocity, omega or position, or
   ! half way through a wall (nothing physical holds it back any more: no wall contacts or
@@ -781,8 +782,8 @@ contains
   subroutine time_step_report(ts, seconds_per_step)
     type(time_step_t), intent(in) :: ts
     real(dp), intent(in) :: seconds_per_step
-    character(len=200) :: text
-    integer :: solves
+    character(len=300) :: text
+    integer :: solves, most, mpierr
     real(dp) :: seconds
     if (ts%steps_taken == 0) return
     if (associated(ts%fluid)) then
@@ -802,9 +803,13 @@ contains
       end if
     end if
     if (ts%local%live) then
-      ! the state between steps is the local sets; the replicated copy only for a failure
-      write(text, '(a,i0,a,i0,a)') 'spheres on the ranks'' local sets: the replicated view '// &
-           'brought up to date ', ts%local%view_updates, ' times in ', ts%steps_taken, ' steps (a failure needs it)'
+      ! the state between steps is the local sets; no rank keeps every sphere
+      most = ts%local%set%n
+      call MPI_Allreduce(MPI_IN_PLACE, most, 1, MPI_INTEGER, MPI_MAX, PETSC_COMM_WORLD, mpierr)
+      write(text, '(a,i0,a,f0.1,a,i0,a)') 'spheres on the ranks'' local sets: the replicated particles of ', &
+           ts%local%total, ' spheres (', real(ts%local%released, dp) / 1024.0_dp, &
+           ' kB a rank) released at the first step; no rank holds every sphere (at the end at most ', most, &
+           ', own and ghosts)'
       call log_line(text)
       write(text, '(a,i0,a,i0,a,f6.3,a)') 'spheres on the ranks'' local sets: the sets made ', &
            ts%local%sets_made, ' times in ', ts%steps_taken, ' steps (kept while no sphere has moved half the skin, ', &

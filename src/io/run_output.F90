@@ -241,18 +241,20 @@ contains
 
   ! Stop a run that went wrong at at_step: the series so far, the state of step (time) in
   ! failed_state.h5 beside the last good checkpoint (never over it), one message naming the step
-  ! and what went wrong, status 5.
-  subroutine run_output_fail(out, step, time, at_step, what)
+  ! and what went wrong, status 5. share: this rank's share of the spheres (absent: the replicated
+  ! particles).
+  subroutine run_output_fail(out, step, time, at_step, what, share)
     type(run_output_t), intent(inout) :: out
     integer, intent(in) :: step, at_step
     real(dp), intent(in) :: time
     character(len=*), intent(in) :: what
+    type(sphere_share_t), intent(in), optional :: share
     PetscErrorCode :: ierr
     character(len=:), allocatable :: path
     character(len=16) :: number
     path = trim(out%cfg%output%directory)//'/failed_state.h5'
     call series_close(out%series)
-    PetscCallA(checkpoint_write(path, out%cfg, out%state, step, time, ierr))
+    PetscCallA(checkpoint_write(path, out%cfg, out%state, step, time, ierr, share))
     write(number, '(i0)') at_step
     call fatal_error('fdsusp: fatal: at step '//trim(number)//': '//trim(what)//'; state written to '//path// &
                      ', the last good checkpoint is kept', 5)

@@ -1,5 +1,6 @@
-! The particles: state of the inertialess rigid spheres, replicated on every rank (doc/DESIGN.md
-! "Fictitious domain"), their motion mode, and the Adams-Bashforth position update (doc/METHOD.md §7.3).
+! The particles: state of the inertialess rigid spheres (every sphere, replicated on every rank at
+! the start; a rank's local set once the ranks' local sets hold the state: doc/DESIGN.md
+! "Parallelism"), their motion mode, and the Adams-Bashforth position update (doc/METHOD.md §7.3).
 ! Pure: no PETSc, MPI or files.
 module mod_particles
   use mod_kinds, only: dp
@@ -7,8 +8,8 @@ module mod_particles
   use mod_columns, only: column_t, sphere_column, sphere_rows
   implicit none
   private
-  public :: particles_t, sphere_share_t, particles_init, advance_positions, displacements, configuration_fault, impose_motion, &
-            particles_columns
+  public :: particles_t, sphere_share_t, particles_init, particles_release, advance_positions, displacements, &
+            configuration_fault, impose_motion, particles_columns
   public :: MOTION_FREE, MOTION_PRESCRIBED, MOTION_FROZEN, MOTION_RESISTANCE, MOTION_FIXED, motion_code
 
   ! resistance: velocities imposed as for prescribed, but the configuration is held where it is
@@ -94,8 +95,27 @@ contains
     p%stresslet_hydro = 0.0_dp
   end subroutine particles_init
 
-  ! X^{n+1} = X^n + dt (3/2 U^n - 1/2 U^{n-1}), forward Euler on the first step; wrap the
-  ! periodic directions into [0, L).
+  !> The per-sphere arrays of p released: what is left describes the system (n, the unit radius,
+  !> the motion, have_prev) and holds no sphere. Once the ranks' local sets hold the state
+  !> (mod_ld_local), the replicated particles are released so, and no rank keeps every sphere.
+  !> Returns the bytes released.
+  subroutine particles_release(p, bytes)
+    type(particles_t), intent(inout) :: p
+    integer(kind=8), intent(out) :: bytes
+    bytes = 8_8 * (size(p%radii, kind=8) + size(p%position, kind=8) + size(p%velocity, kind=8) &
+                   + size(p%omega, kind=8) + size(p%velocity_prev, kind=8) + size(p%prescribed_velocity, kind=8) &
+                   + size(p%prescribed_omega, kind=8) + size(p%external_force, kind=8) &
+                   + size(p%external_torque, kind=8) + size(p%force_hydro, kind=8) + size(p%torque_hydro, kind=8) &
+                   + size(p%stresslet_hydro, kind=8))
+    deallocate(p%radii, p%position, p%velocity, p%omega, p%velocity_prev, p%prescribed_velocity, &
+               p%prescribed_omega, p%external_force, p%external_torque, p%force_hydro, p%torque_hydro, &
+               p%stresslet_hydro)
+    if (allocated(p%sets_made_z)) then
+      bytes = bytes + 8_8 * size(p%sets_made_z, kind=8)
+      deallocate(p%sets_made_z)
+    end if
+  end subroutine particles_release
+
   !> The velocities of the motions that are not solved for: prescribed and resistance take the
   !> prescribed ones, fixed spheres are at rest. Free and frozen spheres are left as they are.
   subroutine impose_motion(p)
@@ -110,6 +130,8 @@ contains
     end select
   end subroutine impose_motion
 
+  ! X^{n+1} = X^n + dt (3/2 U^n - 1/2 U^{n-1}), forward Euler on the first step; wrap the
+  ! periodic directions into [0, L).
   subroutine advance_positions(p, dt, box, periodic)
     type(particles_t), intent(inout) :: p
     real(dp), intent(in) :: dt, box(3)

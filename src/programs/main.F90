@@ -43,7 +43,7 @@ program fdsusp
   use mod_sphere_ownership, only: sphere_ownership_mine
   use mod_checkpoint, only: checkpoint_state_t, checkpoint_check, checkpoint_read
   use mod_time_step, only: time_step_t, time_step_create, time_step_advance, time_step_guard, time_step_report, &
-                           time_step_complete_view, time_step_share
+                           time_step_share
   use mod_run_output, only: run_output_t, run_output_open, run_output_step, run_output_checkpoint, &
                             run_output_fail, run_output_close
   implicit none
@@ -214,19 +214,13 @@ program fdsusp
   if (step >= cfg%time%steps) stop_reason = RUN_DONE
   do while (stop_reason == RUN_GOES_ON)
     PetscCallA(time_step_advance(ts, step, ierr))
-    if (len_trim(ts%failure) > 0) then
-      PetscCallA(time_step_complete_view(ts, ierr))
-      call run_output_fail(out, step, time, step + 1, ts%failure)
-    end if
+    if (len_trim(ts%failure) > 0) call run_output_fail(out, step, time, step + 1, ts%failure, output_share())
     step = step + 1
     time = time + cfg%time%dt
     PetscCallA(run_output_step(out, step, time, ierr, output_share()))
     ! the runtime guard: a non-finite or escaped state stops the run with a diagnostic
     PetscCallA(time_step_guard(ts, step, ierr))
-    if (len_trim(ts%failure) > 0) then
-      PetscCallA(time_step_complete_view(ts, ierr))
-      call run_output_fail(out, step, time, step, ts%failure)
-    end if
+    if (len_trim(ts%failure) > 0) call run_output_fail(out, step, time, step, ts%failure, output_share())
     stop_reason = run_stop_reason(cfg, step, first_step, wall_start, steady_flow())
   end do
 
@@ -263,8 +257,8 @@ program fdsusp
 contains
 
   ! What the output takes of the spheres: this rank's share when the state is the ranks' local sets
-  ! (lubrication dynamics on several ranks, time_step_share), else nothing (a disassociated pointer,
-  ! an absent argument: the replicated particles).
+  ! (time_step_share), else nothing (a disassociated pointer, an absent argument: the replicated
+  ! particles).
   function output_share() result(p)
     type(sphere_share_t), pointer :: p
     logical :: shared

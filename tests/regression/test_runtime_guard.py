@@ -124,14 +124,16 @@ T.check(len(set(stops)) == 1 and 'particle 1 and particle 2' in stops[0],
 # The runtime guard in lubrication dynamics on several ranks, where the local sets are the state
 # between steps (mod_ld_local) and each rank looks at its own spheres: particle 1 poisoned at step
 # 12, between two series records (every 5 steps), stops 1 and 2 ranks alike (status 5, one message
-# naming the particle), and failed_state.h5 holds the poisoned velocity (the view gathered for it).
+# naming the particle), and failed_state.h5 holds the poisoned velocity. Particle 1 sits in the upper
+# slab: on 2 ranks rank 1 owns it, finds the fault, describes it for every rank and writes its row
+# of failed_state.h5 (no rank holds every sphere after the first step).
 d = T.scratch('runtime_guard_nan_ld')
 deck = T.write_deck(d, 'n.nml', """&domain box = 6.4, 6.4, 6.4, y_boundary = 'walls', shear_rate = 1 /
 &fluid model = 'none' /
 &time dt = 1e-3, steps = 20 /
 &output directory = 'out', progress_every = 10, series_every = 5 /
 &lubrication model = 'none' /
-&particles number = 2, position(:,1) = 3.2, 3.2, 2.2, position(:,2) = 3.2, 3.2, 4.21 /
+&particles number = 2, position(:,1) = 3.2, 3.2, 4.21, position(:,2) = 3.2, 3.2, 2.2 /
 &contact roughness = 0.01 /
 """)
 stops = []
