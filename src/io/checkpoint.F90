@@ -33,9 +33,10 @@
 ! names the pieces (fluid, Lambda, particles, contact history, statistics, offset) for the
 ! checkpoints, the restart and failed_state.h5 alike.
 ! Written in parallel to NAME.tmp: the fields by PETSc's HDF5 viewer, then the per-sphere datasets
-! of /particles by every rank through MPI-IO (mod_particles_io, mod_h5_parallel), and the fields'
+! of /particles by every rank through MPI-IO (mod_particles_io, mod_h5_parallel), with the ranks'
+! local sets the springs of /contacts too (mod_contacts_io, contacts_write_shares), and the fields'
 ! checksums with every rank reading a share of each field's rows (the sums of the shares joined in
-! the file's order: joined_sums); completed by rank 0 (attributes, /contacts, /rheology), flushed
+! the file's order: joined_sums); completed by rank 0 (attributes, a replicated /contacts, /rheology), flushed
 ! to disk and renamed over NAME: the previous checkpoint survives until the new one is whole. A
 ! restart verifies the fields the same way, in parallel, before rank 0 inspects the rest.
 #include <petsc/finclude/petscdmda.h>
@@ -58,7 +59,7 @@ module mod_checkpoint
   use mod_particles_io, only: particles_write, particles_read_state, owned_spheres, owned_spheres_rule
   use mod_h5_parallel, only: h5_parallel_create, h5_parallel_open, h5_parallel_close
   use mod_contact, only: contact_history_t
-  use mod_contacts_io, only: contacts_write, contacts_read, contacts_gather
+  use mod_contacts_io, only: contacts_write, contacts_write_shares, contacts_read
   use mod_rheology, only: rheology_t, rheo_state, rheo_restore
   use mod_shear_protocol, only: shear_protocol_t, shear_protocol_state, shear_protocol_restore, shear_protocol_varies, &
                                 PROTOCOL_STATE_SIZE
@@ -99,7 +100,6 @@ contains
     real(dp), intent(in) :: time
     PetscErrorCode, intent(out) :: ierr
     type(sphere_share_t), intent(in), optional :: share
-    type(contact_history_t) :: every_spring
     PetscViewer :: viewer
     integer(HID_T) :: file, group
     integer :: err, k, stars, unsigned
@@ -162,9 +162,12 @@ contains
                              owned_spheres(state%owned_spheres, state%parts, cfg%domain%box), message)
       end if
       if (len_trim(message) > 0) call write_failed_everywhere(trim(message))
-      ! (rank 0 writes the springs below: from a share, every rank's gathered to it first)
-      if (associated(state%history) .and. present(share)) &
-        call contacts_gather(state%history, share%id, share%own, share%total, every_spring)
+      ! the springs: from the ranks' shares every rank writes a run of the rows (rank 0 writes the
+      ! replicated history below)
+      if (associated(state%history) .and. present(share)) then
+        call contacts_write_shares(file, state%history, share%id, share%own, share%total, message)
+        if (len_trim(message) > 0) call write_failed_everywhere(trim(message))
+      end if
     end if
     ! the fields' checksums, each rank reading a share of their rows (no rank holds a field)
     unsigned = 0
@@ -175,9 +178,8 @@ contains
     call h5_parallel_close(file, err)
     if (err /= 0) call write_failed_everywhere('cannot be completed (closing it failed)')
 
-    ! The rest by rank 0 alone: the signatures of the datasets, the attributes, the contact
-    ! history (whose order in the file depends on the ranks' shares: one writer keeps it that of
-    ! one rank) and the statistics; then the file is published.
+    ! The rest by rank 0 alone: the signatures of the datasets, the attributes, the replicated
+    ! contact history and the statistics; then the file is published.
     if (is_root()) then
       call h5fopen_f(trim(tmp), H5F_ACC_RDWR_F, file, err)
       if (err /= 0) call write_failed('cannot be reopened to complete the checkpoint')
@@ -210,13 +212,8 @@ contains
       end if
       failed = failed .or. err /= 0
       if (associated(state%parts)) then
-        if (associated(state%history)) then
-          if (present(share)) then
-            call contacts_write(file, every_spring, state%parts%n)
-          else
-            call contacts_write(file, state%history, state%parts%n)
-          end if
-        end if
+        if (associated(state%history) .and. .not. present(share)) &
+          call contacts_write(file, state%history, state%parts%n)
       end if
       if (associated(state%rh)) then
         call put_int('rheology_window', [state%rh%discard_step, state%rh%block_steps])

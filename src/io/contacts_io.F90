@@ -2,21 +2,23 @@
 ! with attributes np (particle count) and count (open contacts with a spring), and, when
 ! count > 0, the datasets ids (count x 2 integers as seen from C/Python: owner, partner; partner
 ! -1 / -2 is the lower / upper wall) and spring (count x 3 doubles: Upsilon in units of a), in
-! the canonical order of history_pack. Written by rank 0 into the open checkpoint (when each rank
-! holds the springs of its own spheres' pairs, contacts_gather first collects them on rank 0); read
-! by rank 0 and broadcast, every rank then unpacks the same history.
+! the canonical order of history_pack. Written by rank 0 into the open checkpoint, or, when each
+! rank holds the springs of its own spheres' pairs, by every rank through MPI-IO
+! (contacts_write_shares: each rank a run of the rows); read by rank 0 and broadcast, every rank
+! then unpacks the same history.
 #include <petsc/finclude/petscsys.h>
 module mod_contacts_io
   use hdf5
   use petscsys
   use mod_kinds, only: dp
   use mod_contact, only: contact_history_t, history_size, history_pack, history_unpack, history_clear
-  use mod_sorting, only: sorted_position
+  use mod_sorting, only: sorted_position, ascending_order
+  use mod_h5_parallel, only: h5_parallel_write_columns, h5_parallel_write_int_columns, h5_parallel_agree
   use mod_h5util, only: write_attribute, read_attribute, has_object, write_dataset, read_dataset
   use mod_errors, only: is_root, file_error, file_error_from_root, abort_run, warn_line
   implicit none
   private
-  public :: contacts_write, contacts_read, contacts_gather
+  public :: contacts_write, contacts_write_shares, contacts_read
 
 contains
 
@@ -47,48 +49,100 @@ contains
     call h5gclose_f(group, err)
   end subroutine contacts_write
 
-  ! The history of every pair on rank 0 (all), from h on each rank holding the springs of the pairs
-  ! with one of its own spheres (a rank's local set, mod_ld_local: the global indices id of its
-  ! spheres, ascending, which of them are its own, total spheres): each pair from the owner of its
-  ! first sphere, so each once. Other ranks' all is empty. Collective (one gather to rank 0, 5
-  ! values a spring).
-  subroutine contacts_gather(h, id, own, total, all)
+  ! Write /contacts into a file open on every rank through MPI-IO (mod_h5_parallel), from h on each
+  ! rank holding the springs of the pairs with one of its own spheres (a rank's local set,
+  ! mod_ld_local: the global indices id of its spheres, ascending, which of them are its own, total
+  ! spheres): the same group as contacts_write, in the same canonical order. Each pair is taken
+  ! from the owner of its first sphere (so once) and sent to the rank that writes the range of
+  ! first spheres it falls in (rank r: the first spheres of the r-th of P equal index ranges, one
+  ! all-to-all, 5 values a spring), which sorts them and writes its run of rows, after the runs of
+  ! the ranks before (an exclusive prefix sum of the counts). No rank holds every spring. message:
+  ! '' or what failed, the same on every rank. Collective.
+  subroutine contacts_write_shares(file, h, id, own, total, message)
+    integer(HID_T), intent(in) :: file
     type(contact_history_t), intent(in) :: h
     integer, intent(in) :: id(:), total
     logical, intent(in) :: own(:)
-    type(contact_history_t), intent(inout) :: all
-    integer, allocatable :: keys(:, :), counts(:), displs(:)
-    real(dp), allocatable :: ups(:, :), mine(:, :), every(:, :)
-    integer :: n, np, k, i, p, r, ranks, rank, info, ierr
+    character(len=*), intent(out) :: message
+    integer, allocatable :: keys(:, :), writer(:), send_count(:), recv_count(:), send_start(:), recv_start(:), &
+                            order(:), rows(:), fill(:)
+    real(dp), allocatable :: ups(:, :), send(:, :), received(:, :)
+    integer :: n, np, k, i, p, ranks, first, count, err, e(2)
+    integer(HID_T) :: group
+    PetscErrorCode :: ierr
+    message = ''
+    call MPI_Comm_size(PETSC_COMM_WORLD, ranks, ierr)
     n = history_size(h)
-    allocate(keys(2, n), ups(3, n), mine(5, n))
+    allocate(keys(2, n), ups(3, n))
     if (n > 0) call history_pack(h, np, keys, ups)
+    ! the springs of the pairs whose first sphere (never a wall) is own, and their writers
+    allocate(writer(n))
     k = 0
     do i = 1, n
-      ! each pair from the owner of its first sphere (a sphere, never a wall)
       p = sorted_position(id, keys(1, i))
       if (p == 0) cycle
       if (.not. own(p)) cycle
       k = k + 1
-      mine(:, k) = [real(keys(:, i), dp), ups(:, i)]
+      keys(:, k) = keys(:, i)
+      ups(:, k) = ups(:, i)
+      writer(k) = int((int(keys(1, i) - 1, 8) * ranks) / total)
     end do
-    call MPI_Comm_size(PETSC_COMM_WORLD, ranks, ierr)
-    call MPI_Comm_rank(PETSC_COMM_WORLD, rank, ierr)
-    allocate(counts(ranks), displs(ranks))
-    call MPI_Gather(5 * k, 1, MPI_INTEGER, counts, 1, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
-    displs(1) = 0
-    do r = 2, ranks
-      displs(r) = displs(r - 1) + counts(r - 1)
+    allocate(send_count(ranks), recv_count(ranks), send_start(ranks), recv_start(ranks), fill(ranks))
+    send_count = 0
+    do i = 1, k
+      send_count(writer(i) + 1) = send_count(writer(i) + 1) + 1
     end do
-    allocate(every(5, merge(sum(counts) / 5, 0, rank == 0)))
-    call MPI_Gatherv(mine, 5 * k, MPI_DOUBLE_PRECISION, every, counts, displs, MPI_DOUBLE_PRECISION, 0, &
-                     PETSC_COMM_WORLD, ierr)
-    call history_clear(all)
-    if (rank /= 0) return
-    call history_unpack(all, total, size(every, 2), nint(every(1:2, :)), every(3:5, :), info)
-    if (info /= 0) call abort_run('internal error: the springs gathered from the ranks do not form a '// &
-                                  'contact history (mod_contacts_io)')
-  end subroutine contacts_gather
+    send_start(1) = 0
+    do p = 2, ranks
+      send_start(p) = send_start(p - 1) + send_count(p - 1)
+    end do
+    allocate(send(5, k))
+    fill = send_start
+    do i = 1, k
+      fill(writer(i) + 1) = fill(writer(i) + 1) + 1
+      send(:, fill(writer(i) + 1)) = [real(keys(:, i), dp), ups(:, i)]
+    end do
+    call MPI_Alltoall(send_count, 1, MPI_INTEGER, recv_count, 1, MPI_INTEGER, PETSC_COMM_WORLD, ierr)
+    recv_start(1) = 0
+    do p = 2, ranks
+      recv_start(p) = recv_start(p - 1) + recv_count(p - 1)
+    end do
+    allocate(received(5, sum(recv_count)))
+    call MPI_Alltoallv(send, 5 * send_count, 5 * send_start, MPI_DOUBLE_PRECISION, received, 5 * recv_count, &
+                       5 * recv_start, MPI_DOUBLE_PRECISION, PETSC_COMM_WORLD, ierr)
+    ! this rank's run of rows: its springs in the canonical order (first sphere, then partner)
+    deallocate(keys, ups)
+    count = size(received, 2)
+    keys = nint(received(1:2, :))
+    order = ascending_order(keys(2, :))
+    order = order(ascending_order(keys(1, order)))
+    first = 0
+    call MPI_Exscan(count, first, 1, MPI_INTEGER, MPI_SUM, PETSC_COMM_WORLD, ierr)
+    call MPI_Comm_rank(PETSC_COMM_WORLD, p, ierr)
+    if (p == 0) first = 0                  ! (MPI_Exscan leaves rank 0's undefined)
+    rows = [(first + i, i = 1, count)]
+    n = count
+    call MPI_Allreduce(MPI_IN_PLACE, n, 1, MPI_INTEGER, MPI_SUM, PETSC_COMM_WORLD, ierr)
+    ! the group and its attributes on every rank alike (parallel HDF5's metadata), then the rows
+    call h5gcreate_f(file, 'contacts', group, err)
+    call h5_parallel_agree(err)
+    if (err /= 0) then
+      message = 'cannot take the group /contacts'
+      return
+    end if
+    call write_attribute(group, 'np', [total], e(1))
+    call write_attribute(group, 'count', [n], e(2))
+    err = maxval(abs(e))
+    call h5_parallel_agree(err)
+    if (err /= 0) message = 'cannot write the attributes of /contacts'
+    if (n > 0 .and. err == 0) then
+      call h5_parallel_write_int_columns(group, 'ids', n, rows, keys(:, order), err)
+      if (err /= 0) message = 'cannot take /contacts/ids'
+      if (err == 0) call h5_parallel_write_columns(group, 'spring', n, rows, received(3:5, order), err)
+      if (err /= 0 .and. len_trim(message) == 0) message = 'cannot take /contacts/spring'
+    end if
+    call h5gclose_f(group, err)
+  end subroutine contacts_write_shares
 
   ! Restart: the history from the checkpoint PATH (collective). np: the particle count of the
   ! run. A checkpoint without /contacts (written by a run without contacts) gives an empty

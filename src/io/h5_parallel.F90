@@ -1,6 +1,6 @@
 ! Parallel HDF5 (MPI-IO) for the files every rank writes together (doc/DESIGN.md "Files", issue 45):
-! open or create a file collectively, and write a (k, N) dataset of doubles, one column per sphere,
-! from the columns each rank owns, given their global indices (any set: a rank with none takes
+! open or create a file collectively, and write a (k, N) dataset of doubles (or integers), one
+! column per sphere (or contact), from the columns each rank owns, given their global indices (any set: a rank with none takes
 ! part all the same). The dataset is the one write_dataset_2d (mod_h5util) makes: one chunk with
 ! HDF5's Fletcher-32 checksum. HDF5 1.10.2 and later (Debian bookworm has 1.10.8) write filtered
 ! datasets in parallel, collectively only: every transfer here is collective (H5FD_MPIO_COLLECTIVE),
@@ -22,7 +22,8 @@ module mod_h5_parallel
   use mod_sorting, only: ascending_order
   implicit none
   private
-  public :: h5_parallel_create, h5_parallel_open, h5_parallel_close, h5_parallel_write_columns, h5_parallel_agree
+  public :: h5_parallel_create, h5_parallel_open, h5_parallel_close, h5_parallel_write_columns, &
+            h5_parallel_write_int_columns, h5_parallel_agree
 
   ! the most runs of consecutive columns selected as a union of hyperslabs (more: element by
   ! element; h5_parallel_write_columns): few enough that both ways serve in the tests'
@@ -84,16 +85,49 @@ contains
     integer, intent(in) :: columns(:)
     real(dp), intent(in) :: values(:, :)
     integer, intent(out) :: err
+    integer, allocatable :: order(:)
+    real(dp), allocatable, target :: buffer(:, :)
+    ! (the columns by ascending index, the order HDF5 transfers them in)
+    order = ascending_order(columns)
+    allocate(buffer(size(values, 1), max(1, size(columns))))
+    buffer = 0.0_dp
+    if (size(columns) > 0) buffer(:, 1:size(columns)) = values(:, order)
+    call write_sorted_columns(loc, name, n, columns(order), size(values, 1), H5T_NATIVE_DOUBLE, c_loc(buffer), err)
+  end subroutine h5_parallel_write_columns
+
+  !> As h5_parallel_write_columns, for a dataset of integers (the contacts' pairs).
+  subroutine h5_parallel_write_int_columns(loc, name, n, columns, values, err)
+    integer(HID_T), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: n
+    integer, intent(in) :: columns(:)
+    integer, intent(in) :: values(:, :)
+    integer, intent(out) :: err
+    integer, allocatable :: order(:)
+    integer, allocatable, target :: buffer(:, :)
+    order = ascending_order(columns)
+    allocate(buffer(size(values, 1), max(1, size(columns))))
+    buffer = 0
+    if (size(columns) > 0) buffer(:, 1:size(columns)) = values(:, order)
+    call write_sorted_columns(loc, name, n, columns(order), size(values, 1), H5T_NATIVE_INTEGER, c_loc(buffer), err)
+  end subroutine h5_parallel_write_int_columns
+
+  ! The dataset NAME (k, n) of type dtype: this rank's columns, ascending, from the buffer at data
+  ! (k values a column, in the same order; at least one column's room). Collective.
+  subroutine write_sorted_columns(loc, name, n, columns, k, dtype, data, err)
+    integer(HID_T), intent(in) :: loc, dtype
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: n, k
+    integer, intent(in) :: columns(:)
+    type(c_ptr), intent(in) :: data
+    integer, intent(out) :: err
     integer(HID_T) :: file_space, memory_space, dcpl, dxpl, dset
     integer(HSIZE_T) :: dims(2)
     integer :: e, m, j, c, first, runs
     integer(HSIZE_T), allocatable :: points(:, :)
-    integer, allocatable :: order(:)
-    real(dp), allocatable, target :: buffer(:, :)
-    type(c_ptr) :: data
 
     m = size(columns)
-    dims = [size(values, 1, kind=HSIZE_T), int(n, HSIZE_T)]
+    dims = [int(k, HSIZE_T), int(n, HSIZE_T)]
     dset = -1
     call h5screate_simple_f(2, dims, file_space, err)
     ! one chunk with Fletcher-32, as a dataset of mod_h5util (a dataset of no elements cannot be
@@ -104,7 +138,7 @@ contains
       call h5pset_chunk_f(dcpl, 2, dims, err)
       if (err == 0) call h5pset_fletcher32_f(dcpl, err)
     end if
-    if (err == 0) call h5dcreate_f(loc, name, H5T_NATIVE_DOUBLE, file_space, dset, err, dcpl)
+    if (err == 0) call h5dcreate_f(loc, name, dtype, file_space, dset, err, dcpl)
     call close_plist(dcpl)
     call h5_parallel_agree(err)
     if (err /= 0) then
@@ -113,31 +147,26 @@ contains
       return
     end if
 
-    ! the file's columns of this rank, which HDF5 transfers in the file's order: the buffer holds
-    ! them by ascending index. Selected as a union of hyperslabs (one per run of consecutive
-    ! indices) when the runs are few, else element by element: HDF5 1.10's union of hyperslabs
-    ! costs about quadratically in the runs (1934 spheres in z-slabs on 2 ranks, ~970 runs a
-    ! rank: 72 ms a step of a checkpoint and a snapshot, by elements 16 ms; doc/BENCHMARKS.md
-    ! §19), while the elements cost in proportion to the values (all spheres on one rank, 1 run:
-    ! 21 ms a step by elements, 13 ms by one hyperslab).
-    order = ascending_order(columns)
-    allocate(buffer(size(values, 1), max(1, m)))
-    buffer = 0.0_dp
-    if (m > 0) buffer(:, 1:m) = values(:, order)
+    ! the file's columns of this rank, selected as a union of hyperslabs (one per run of
+    ! consecutive indices) when the runs are few, else element by element: HDF5 1.10's union of
+    ! hyperslabs costs about quadratically in the runs (1934 spheres in z-slabs on 2 ranks, ~970
+    ! runs a rank: 72 ms a step of a checkpoint and a snapshot, by elements 16 ms;
+    ! doc/BENCHMARKS.md §19), while the elements cost in proportion to the values (all spheres on
+    ! one rank, 1 run: 21 ms a step by elements, 13 ms by one hyperslab).
     runs = 0
     do j = 1, m
       if (j == 1) then
         runs = 1
-      else if (columns(order(j)) /= columns(order(j - 1)) + 1) then
+      else if (columns(j) /= columns(j - 1) + 1) then
         runs = runs + 1
       end if
     end do
     call h5sselect_none_f(file_space, err)
     if (runs > max_hyperslabs) then
-      allocate(points(2, size(values, 1) * m))
+      allocate(points(2, k * m))
       do j = 1, m
-        do c = 1, size(values, 1)
-          points(:, (j - 1) * size(values, 1) + c) = [int(c, HSIZE_T), int(columns(order(j)), HSIZE_T)]
+        do c = 1, k
+          points(:, (j - 1) * k + c) = [int(c, HSIZE_T), int(columns(j), HSIZE_T)]
         end do
       end do
       call h5sselect_elements_f(file_space, H5S_SELECT_SET_F, 2, size(points, 2, kind=SIZE_T), points, err)
@@ -146,15 +175,15 @@ contains
       do j = 1, m
         if (err /= 0) exit
         if (j < m) then
-          if (columns(order(j + 1)) == columns(order(j)) + 1) cycle
+          if (columns(j + 1) == columns(j) + 1) cycle
         end if
-        ! the run columns(order(first:j))
-        call h5sselect_hyperslab_f(file_space, H5S_SELECT_OR_F, [0_HSIZE_T, int(columns(order(first)) - 1, HSIZE_T)], &
+        ! the run columns(first:j)
+        call h5sselect_hyperslab_f(file_space, H5S_SELECT_OR_F, [0_HSIZE_T, int(columns(first) - 1, HSIZE_T)], &
                                    [dims(1), int(j - first + 1, HSIZE_T)], err)
         first = j + 1
       end do
     end if
-    call h5screate_simple_f(1, [size(buffer, kind=HSIZE_T)], memory_space, e)
+    call h5screate_simple_f(1, [int(k, HSIZE_T) * max(1, m)], memory_space, e)
     err = max(err, abs(e))
     if (m == 0) call h5sselect_none_f(memory_space, e)
     err = max(err, abs(e))
@@ -168,9 +197,7 @@ contains
       call h5sselect_none_f(file_space, e)
       call h5sselect_none_f(memory_space, e)
     end if
-    data = c_loc(buffer)
-    call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, data, e, mem_space_id=memory_space, file_space_id=file_space, &
-                    xfer_prp=dxpl)
+    call h5dwrite_f(dset, dtype, data, e, mem_space_id=memory_space, file_space_id=file_space, xfer_prp=dxpl)
     err = max(err, abs(e))
     call close_plist(dxpl)
     call h5sclose_f(memory_space, e)
@@ -178,7 +205,7 @@ contains
     call h5dclose_f(dset, e)
     err = max(err, abs(e))
     call h5_parallel_agree(err)
-  end subroutine h5_parallel_write_columns
+  end subroutine write_sorted_columns
 
   !> err becomes the largest of all ranks' (0 when no rank failed). Collective.
   subroutine h5_parallel_agree(err)

@@ -6,7 +6,8 @@
 # 2, 2 and 0 planes, so the transforms scatter between layouts and one rank holds no slab; and
 # 8 x 6 x 6 split 1 x 1 x 3, the pressure's Krylov solve on two-level cell-centred multigrid;
 # test_checkpoint_roundtrip: the fields through PETSc's parallel HDF5 viewer; test_series_append:
-# rank 0 alone writes the series, the others learn its verdicts; test_sphere_halo also on 5 ranks,
+# rank 0 alone writes the series, the others learn its verdicts; test_contacts_shares: every rank
+# writes the springs of its share, each a run of the rows; test_sphere_halo also on 5 ranks,
 # where a slab has ranks beyond reach). A run passes when it exits 0 and
 # its output ends with the program's 'all N checks passed'. The tolerances are the programs' own.
 # 3 ranks oversubscribe the 2 cores: ~5 s in all.
