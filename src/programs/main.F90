@@ -16,7 +16,7 @@ program fdsusp
   use mod_errors, only: log_line, warn_line, input_error, report_limits, fatal_error
   use mod_run_control, only: command_line, prepare_output_directory, continue_from_directory, run_stop_reason, &
                              run_stop_line, run_signal_line, RUN_GOES_ON, RUN_DONE
-  use mod_os_services, only: install_signal_handlers, release_directory, peak_resident_kb
+  use mod_os_services, only: install_signal_handlers, release_directory, peak_resident_kb, resident_kb
   use mod_timers, only: timers_register, stage_push, stage_pop, STAGE_SETUP
   use mod_h5util, only: h5util_init
   use mod_grid, only: grid_t, grid_create, grid_destroy
@@ -269,10 +269,20 @@ contains
 
   ! The peak resident memory of the run (VmHWM), summed over the ranks and per grid cell: gross,
   ! the libraries' fixed cost included. scripts/bench_memory.sh takes the difference of two grids
-  ! for the cost of a cell (doc/BENCHMARKS.md §14).
+  ! for the cost of a cell (doc/BENCHMARKS.md §14). Then what the ranks hold at the end (VmRSS):
+  ! the start's replicated particles released, a run's own state (doc/BENCHMARKS.md §23).
   subroutine memory_line()
     real(dp) :: kb(1), total(1), largest(1), cells
     integer :: nranks, mpierr
+    kb = real(resident_kb(), dp)
+    call MPI_Allreduce(kb, total, 1, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, mpierr)
+    call MPI_Allreduce(kb, largest, 1, MPI_DOUBLE_PRECISION, MPI_MAX, PETSC_COMM_WORLD, mpierr)
+    call MPI_Comm_size(PETSC_COMM_WORLD, nranks, mpierr)
+    if (total(1) >= 0.0_dp) then
+      write(text, '(a,i0,a,f10.1,a,f10.1,a)') 'memory: resident at the end (VmRSS) summed over ', nranks, ' ranks ', &
+           total(1) / 1024.0_dp, ' MiB, largest rank ', largest(1) / 1024.0_dp, ' MiB'
+      call log_line(text)
+    end if
     kb = real(peak_resident_kb(), dp)
     call MPI_Allreduce(kb, total, 1, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, mpierr)
     call MPI_Allreduce(kb, largest, 1, MPI_DOUBLE_PRECISION, MPI_MAX, PETSC_COMM_WORLD, mpierr)

@@ -1,17 +1,20 @@
 ! Operating-system services, the Fortran side of src/runtime/os_services_c.c: signals, atomic file
 ! publication, directories, the output directory's lock, the directory of the executable and the
-! peak resident memory.
+! resident memory (its peak and now).
 module mod_os_services
   use, intrinsic :: iso_c_binding, only: c_int, c_long, c_char, c_null_char
   implicit none
   private
   public :: install_signal_handlers, stop_signal, publish_file, make_directory, probe_directory, &
-            lock_directory, release_directory, executable_dir, peak_resident_kb
+            lock_directory, release_directory, executable_dir, peak_resident_kb, resident_kb
 
   interface
     integer(c_long) function fdsusp_peak_resident_kb() bind(C, name='fdsusp_peak_resident_kb')
       import :: c_long
     end function fdsusp_peak_resident_kb
+    integer(c_long) function fdsusp_resident_kb() bind(C, name='fdsusp_resident_kb')
+      import :: c_long
+    end function fdsusp_resident_kb
     subroutine fdsusp_install_signal_handlers() bind(C, name='fdsusp_install_signal_handlers')
     end subroutine fdsusp_install_signal_handlers
     integer(c_int) function fdsusp_stop_signal() bind(C, name='fdsusp_stop_signal')
@@ -108,5 +111,10 @@ contains
   integer function peak_resident_kb()
     peak_resident_kb = int(fdsusp_peak_resident_kb())
   end function peak_resident_kb
+
+  ! This process's resident set size now in kB (VmRSS), -1 where the system does not say.
+  integer function resident_kb()
+    resident_kb = int(fdsusp_resident_kb())
+  end function resident_kb
 
 end module mod_os_services

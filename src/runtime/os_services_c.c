@@ -234,21 +234,36 @@ int fdsusp_executable_dir(char *buf, int len)
   return (int)m;
 }
 
-/* The peak resident set size of this process in kB (VmHWM of /proc/self/status: exact, where
- * getrusage and PETSc's -memory_view sample), or -1 where there is no /proc (not Linux). The
- * memory report at the end of a run (doc/BENCHMARKS.md §14). */
-long fdsusp_peak_resident_kb(void)
+/* The value in kB of the line KEY (e.g. "VmHWM:") of /proc/self/status, or -1 where there is no
+ * /proc (not Linux). */
+static long status_kb(const char *key)
 {
   FILE *f = fopen("/proc/self/status", "r");
   char line[256];
+  size_t n = strlen(key);
   long kb = -1;
   if (!f) return -1;
   while (fgets(line, sizeof line, f)) {
-    if (strncmp(line, "VmHWM:", 6) == 0) {
-      kb = strtol(line + 6, NULL, 10);
+    if (strncmp(line, key, n) == 0) {
+      kb = strtol(line + n, NULL, 10);
       break;
     }
   }
   fclose(f);
   return kb;
+}
+
+/* The peak resident set size of this process in kB (VmHWM: exact, where getrusage and PETSc's
+ * -memory_view sample), or -1 where there is no /proc. The memory report at the end of a run
+ * (doc/BENCHMARKS.md §14). */
+long fdsusp_peak_resident_kb(void)
+{
+  return status_kb("VmHWM:");
+}
+
+/* The resident set size of this process now in kB (VmRSS), or -1 where there is no /proc: what
+ * the run keeps, beside the peak of its start (doc/BENCHMARKS.md §23). */
+long fdsusp_resident_kb(void)
+{
+  return status_kb("VmRSS:");
 }
