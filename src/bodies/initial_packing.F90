@@ -21,10 +21,13 @@ contains
   !> radius) the counts per species of its volume_share or number_share (mod_packing_geometry's
   !> rounding, doc/PACKING_INPUT.md), each sphere with its radius. A target the packer refuses
   !> stops the run with one message naming the deck variable; a compression that fails, with
-  !> status 3.
-  subroutine initial_packing_make(cfg, parts)
+  !> status 3. restart: the spheres of the packing, their count and radii, without their positions
+  !> (zero), which a checkpoint gives: a restart does not pack again (the packer's sweeps are
+  !> most of a large run's start, and each rank made them).
+  subroutine initial_packing_make(cfg, parts, restart)
     type(config_t), intent(in) :: cfg
     type(particles_t), intent(out) :: parts
+    logical, intent(in) :: restart
     real(dp), allocatable :: position(:, :), radius(:)
     character(len=400) :: message
     integer :: n, info, k, counts(cfg%species)
@@ -41,6 +44,13 @@ contains
       radius = [radius, spread(cfg%particles%radius(k), 1, counts(k))]
     end do
     n = size(radius)
+    if (restart) then
+      write(message, '(a,i0,a)') 'packing: not made at a restart: ', n, ' spheres, positions from the checkpoint'
+      call log_line(message)
+      call particles_init(parts, n, cfg%radius, motion_code(cfg%particles%motion))
+      parts%radii = radius
+      return
+    end if
     call random_packing_mixture(radius, cfg%domain%box, [.true., .not. cfg%walls, .true.], &
                                 cfg%particles%packing_min_gap, cfg%particles%seed, cfg%particles%packing_sweeps, &
                                 position, info, message, report)

@@ -92,22 +92,29 @@ contains
   end subroutine sphere_halo_create
 
   !> The rank whose slab holds z (wrapped into [0, lz)): equal slabs floor(P z/lz), as
-  !> mod_sphere_ownership; given edges, the last q with edge(q) <= z.
+  !> mod_sphere_ownership; given edges, the last q with edge(q) <= z (by bisection: log2 P
+  !> comparisons a sphere, an empty slab skipped as its upper neighbour's edge equals its own).
   pure integer function sphere_halo_slab_of(h, z)
     type(sphere_halo_t), intent(in) :: h
     real(dp), intent(in) :: z
     real(dp) :: zw
-    integer :: q
+    integer :: lo, hi, mid
     zw = modulo(z, h%lz)
     if (h%equal) then
       sphere_halo_slab_of = min(h%ranks - 1, max(0, int(zw / h%lz * h%ranks)))
     else
-      q = 0
-      do while (q < h%ranks - 1)
-        if (h%edge(q + 1) > zw) exit
-        q = q + 1
+      ! edge(lo) <= zw throughout (edge(0) = 0); the answer in lo..hi
+      lo = 0
+      hi = h%ranks - 1
+      do while (lo < hi)
+        mid = (lo + hi + 1) / 2
+        if (h%edge(mid) <= zw) then
+          lo = mid
+        else
+          hi = mid - 1
+        end if
       end do
-      sphere_halo_slab_of = q
+      sphere_halo_slab_of = lo
     end if
   end function sphere_halo_slab_of
 

@@ -297,12 +297,13 @@ contains
     call log_line(text)
   end subroutine memory_line
 
-  ! The spheres: a random packing made now (&particles solid_fraction), or the deck's or the
-  ! position file's. Lubrication dynamics moves spheres and nothing else: a file or packing that
-  ! yields none leaves nothing to compute (the deck itself is checked in mod_params).
+  ! The spheres: a random packing made now (&particles solid_fraction; at a restart only its count
+  ! and radii, the checkpoint having the positions), or the deck's or the position file's.
+  ! Lubrication dynamics moves spheres and nothing else: a file or packing that yields none leaves
+  ! nothing to compute (the deck itself is checked in mod_params).
   subroutine make_particles()
     if (cfg%particles%solid_fraction > 0.0_dp) then
-      call initial_packing_make(cfg, parts)
+      call initial_packing_make(cfg, parts, restarting)
     else
       call particles_load(cfg, parts)
     end if

@@ -126,7 +126,11 @@ compare(ref, results(d), '20 steps on 2 ranks + restart + 20 on 3 vs 40 on 1')
 # restart on as many ranks: the checkpoint keeps the sets the run held (particles/sets_made_z), so
 # the restart has the same owners, ghosts and rows, and repeats the run's arithmetic bitwise
 d, _ = run('ld_ranks_restart_same', 2, steps=20)
-run('ld_ranks_restart_same', 2, steps=40, args=['-restart', 'out/checkpoint.h5'], d=d)
+_, out_restart = run('ld_ranks_restart_same', 2, steps=40, args=['-restart', 'out/checkpoint.h5'], d=d)
+# (the deck packs its spheres: a restart takes their count and radii, not a packing, whose
+# positions the checkpoint replaces)
+T.check('packing: not made at a restart: 250 spheres' in out_restart and 'smallest gap' not in out_restart,
+        'the restart does not pack the spheres again (the run log)')
 same, two = results(d), results(dirs[2])
 worst = max(np.abs(same[k] - two[k]).max() for k in QUANTITIES)
 T.check(worst == 0.0, '20 steps on 2 ranks + restart + 20 on 2 = 40 on 2 bitwise (largest difference %.1e)' % worst)

@@ -25,6 +25,8 @@
 !      largest rank's count is within 30 % of it (a binomial count of ~180, sd 7 %, over up to 8
 !      ranks; one face only when the two slabs are one neighbour's: counted once per copy, as
 !      sent). The table line printed is doc/SCALING.md's.
+!   9. slabs of given edges (the grid's z-ranges in the resolved step), unequal, one of them empty:
+!      the slab of a centre is the last whose lower edge is at or below it (a scan's answer).
 ! Exact checks (no tolerance: positions and values are copied, not computed). Runs as a singleton
 ! (tests/run_tests.sh) and on 3 and 5 ranks (test_unit_petsc_ranks).
 #include <petsc/finclude/petscsys.h>
@@ -128,6 +130,7 @@ program test_sphere_halo
   end do
 
   call weak_scaling()
+  call given_edges()
   call finish('test_sphere_halo')
   PetscCallA(PetscFinalize(ierr))
 
@@ -183,6 +186,34 @@ contains
          most_sent, ' (forward 9 + reverse 15 values)'
     if (rank == 0) write(*, '(a)') trim(line)
   end subroutine weak_scaling
+
+  ! 9: slabs of given edges, unequal and with an empty one (0, 0.1, 0.1, ... of lz): the rank of a
+  ! centre (sphere_halo_slab_of's bisection) is the last slab whose lower edge is at or below it,
+  ! found by a scan, for 2000 centres, the edges themselves among them.
+  subroutine given_edges()
+    type(sphere_halo_t) :: g
+    real(dp) :: edges(0:ranks), z
+    integer :: q, j, scan
+    logical :: same
+    edges(0) = 0.0_dp
+    do q = 1, ranks - 1
+      edges(q) = lz * (real(q, dp) / ranks)**1.5_dp
+    end do
+    if (ranks >= 3) edges(2) = edges(1)          ! rank 1's slab is empty
+    edges(ranks) = lz
+    call sphere_halo_create(g, lz, reach, edges)
+    same = .true.
+    do j = 0, 2000
+      z = merge(edges(mod(j, ranks)), 1.3_dp * lz * j / 2000.0_dp - 0.1_dp * lz, mod(j, 7) == 0)
+      scan = 0
+      do q = 0, ranks - 1
+        if (edges(q) <= modulo(z, lz)) scan = q
+      end do
+      same = same .and. sphere_halo_slab_of(g, z) == scan
+    end do
+    call check(same, label('given edges (one slab empty from 3 ranks on): the slab of 2000 centres by bisection '// &
+                           'is the scan''s'))
+  end subroutine given_edges
 
   pure function carried(i) result(v)
     integer, intent(in) :: i
