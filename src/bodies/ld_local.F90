@@ -87,10 +87,11 @@ contains
   !> The local set of the step: on the first step (and after a restart) taken from the replicated
   !> parts of the start, which are then released (particles_release: n, the radius, the motion and
   !> have_prev stay; after a restart on as many ranks the sets are the checkpoint's run's:
-  !> parts%sets_made_z, so that the restart repeats its arithmetic bitwise), then kept from step to step while no sphere
-  !> has moved half the skin along z since the sets were made (every sphere a rank's own spheres reach within a kernel's range is then still among
-  !> its ghosts, and the ghosts, advanced like their owners from the same forwarded values, are
-  !> their owners' copies: nothing to send), else made again from the last step's (carry_on: the own
+  !> parts%sets_made_z, so that the restart repeats its arithmetic bitwise), then kept from step
+  !> to step while no sphere has moved half the skin along z since the sets were made (every
+  !> sphere a rank's own spheres reach within a kernel's range is then still among its ghosts, and
+  !> the ghosts, advanced like their owners from the same forwarded values, are their owners'
+  !> copies: nothing to send), else made again from the last step's (carry_on: the own
   !> spheres that left the slab migrate with what they carry, the ghosts rebuilt and given their
   !> owners' values, the springs sent to the neighbours whose spheres they touch). When the sets
   !> are made, the contacts, the links, the one-body model, the solver and the statistics are told
@@ -174,10 +175,10 @@ contains
   end subroutine sets_hold
 
   ! The local set taken from the replicated parts: own spheres by slab (no sphere moves between
-  ! ranks: every rank holds every sphere), the ghosts within reach, the state of each copied. The slabs are
-  ! those of each sphere's z when the sets were made (parts%sets_made_z, from a checkpoint of a run
-  ! on as many ranks: the same owners and ghosts as that run held), else of its position.
-  ! Collective.
+  ! ranks: every rank holds every sphere), the ghosts within reach, the state of each copied. The
+  ! slabs are those of each sphere's z when the sets were made (parts%sets_made_z, from a
+  ! checkpoint of a run on as many ranks: the same owners and ghosts as that run held), else of its
+  ! position. Collective.
   subroutine take_replicated(loc, parts, ierr)
     type(ld_local_t), intent(inout) :: loc
     type(particles_t), intent(in) :: parts
