@@ -88,9 +88,12 @@ RESISTANCE_F90 := $(addprefix src/kernels/,kinds.F90 vector.F90 resistance_table
 PAIRTRAJ_OBJ := $(call obj,$(REF_F90) $(RESISTANCE_F90))
 UNIT_BIN := $(patsubst tests/unit/%.F90,$(BUILD)/tests/%,$(UNIT_F90))
 UNIT_PETSC_BIN := $(patsubst tests/unit_petsc/%.F90,$(BUILD)/tests/%,$(UNIT_PETSC_F90))
-# pass/fail bookkeeping every unit test links (mod_unit_checks)
+# pass/fail bookkeeping every unit test links (mod_unit_checks); the start the unit tests on PETSc
+# share (mod_unit_start: PETSc, HDF5, a scratch directory)
 UNIT_CHECKS_F90 := tests/unit/unit_checks.F90
 UNIT_CHECKS_OBJ := $(call obj,$(UNIT_CHECKS_F90))
+UNIT_START_F90 := tests/unit_petsc/unit_start.F90
+UNIT_START_OBJ := $(call obj,$(UNIT_START_F90))
 
 PROGRAMS := $(BIN)/fdsusp $(BIN)/fdsusp-pack $(BIN)/fdsusp-resistance $(if $(REF_F90),$(BIN)/pairtraj)
 
@@ -125,13 +128,13 @@ $(BIN)/pairtraj: $(PAIRTRAJ_OBJ) | $(BIN)
 	$(FC_LINKER) $(OPTFLAGS) -o $@ $^
 $(UNIT_BIN): $(BUILD)/tests/%: $(BUILD)/tests/unit/%.o $(UNIT_CHECKS_OBJ) $(PURE_OBJ) | $(BUILD)/tests
 	$(FC_LINKER) $(OPTFLAGS) -o $@ $^ -llapack -lblas
-$(UNIT_PETSC_BIN): $(BUILD)/tests/%: $(BUILD)/tests/unit_petsc/%.o $(UNIT_CHECKS_OBJ) $(LIB_OBJ) | $(BUILD)/tests
+$(UNIT_PETSC_BIN): $(BUILD)/tests/%: $(BUILD)/tests/unit_petsc/%.o $(UNIT_CHECKS_OBJ) $(UNIT_START_OBJ) $(LIB_OBJ) | $(BUILD)/tests
 	$(FC_LINKER) $(OPTFLAGS) -o $@ $^ $(LIBS)
 
 # Module dependencies, regenerated whenever a source changes.
-$(BUILD)/deps.mk: $(SRC_F90) $(PROGRAM_SRC) $(REF_F90) $(UNIT_F90) $(UNIT_CHECKS_F90) $(UNIT_PETSC_F90) scripts/f90deps
+$(BUILD)/deps.mk: $(SRC_F90) $(PROGRAM_SRC) $(REF_F90) $(UNIT_F90) $(UNIT_CHECKS_F90) $(UNIT_START_F90) $(UNIT_PETSC_F90) scripts/f90deps
 	@mkdir -p $(@D)
-	@scripts/f90deps $(BUILD) $(SRC_F90) $(PROGRAM_SRC) $(REF_F90) $(UNIT_F90) $(UNIT_CHECKS_F90) $(UNIT_PETSC_F90) > $@
+	@scripts/f90deps $(BUILD) $(SRC_F90) $(PROGRAM_SRC) $(REF_F90) $(UNIT_F90) $(UNIT_CHECKS_F90) $(UNIT_START_F90) $(UNIT_PETSC_F90) > $@
 -include $(BUILD)/deps.mk
 
 NP ?= 2

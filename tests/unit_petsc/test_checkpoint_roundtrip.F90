@@ -22,7 +22,6 @@
 ! z-slab (mod_particles_io), as the program does.
 #include <petsc/finclude/petscdmda.h>
 program test_checkpoint_roundtrip
-  use, intrinsic :: iso_fortran_env, only: output_unit
   use petscdmda
   use mod_kinds, only: dp
   use mod_params, only: config_t
@@ -33,9 +32,8 @@ program test_checkpoint_roundtrip
   use mod_rheology, only: rheology_t, rheo_create, rheo_state
   use mod_checkpoint, only: checkpoint_state_t, checkpoint_write, checkpoint_check, checkpoint_read
   use mod_sphere_ownership, only: sphere_ownership_mine
-  use mod_h5util, only: h5util_init
-  use mod_os_services, only: make_directory
   use mod_unit_checks, only: check, finish
+  use mod_unit_start, only: unit_start
   implicit none
 
   integer, parameter :: n_particles = 4, saved_step = 50
@@ -51,9 +49,9 @@ program test_checkpoint_roundtrip
   type(rheology_t), target :: rh, rh2
   type(checkpoint_state_t) :: state, state2
   PetscRandom :: rnd
-  character(len=512) :: dir, tmpdir, path
+  character(len=512) :: dir, path
   character(len=200) :: scene
-  integer :: status, pid(1), info, c, step
+  integer :: info, c, step
   integer :: ids(2, 4)
   real(dp) :: ups(3, 4), time, values(3, n_particles, 4)
   real(dp), allocatable :: noise(:)
@@ -61,20 +59,7 @@ program test_checkpoint_roundtrip
   integer :: seed_size
   integer, allocatable :: seed(:)
 
-  PetscCallA(PetscInitialize(ierr))
-  call MPI_Comm_rank(PETSC_COMM_WORLD, rank, ierr)
-  call MPI_Comm_size(PETSC_COMM_WORLD, nranks, ierr)
-  if (rank /= 0) open(unit=output_unit, file='/dev/null')
-  call h5util_init()
-  call get_environment_variable('TMPDIR', tmpdir, status=status)
-  if (status /= 0 .or. len_trim(tmpdir) == 0) tmpdir = '/tmp'
-  pid = getpid()
-  call MPI_Bcast(pid, 1, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
-  write(dir, '(a,i0)') trim(tmpdir)//'/fdsusp-test-checkpoint-', pid(1)
-  if (rank == 0) then
-    status = make_directory(dir)
-    if (status /= 0) error stop 'test_checkpoint_roundtrip: cannot create the temporary directory'
-  end if
+  call unit_start('test_checkpoint_roundtrip', rank, nranks, dir)
   path = trim(dir)//'/checkpoint.h5'
   write(scene, '(a,i0,a)') '8 x 6 x 4 with walls, 4 particles, ', nranks, ' rank(s)'
 

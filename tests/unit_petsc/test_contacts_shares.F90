@@ -11,44 +11,30 @@
 ! no datasets) from every rank. Singleton here; on 3 ranks in tests/regression/test_unit_petsc_ranks.sh.
 #include <petsc/finclude/petscsys.h>
 program test_contacts_shares
-  use, intrinsic :: iso_fortran_env, only: output_unit
   use hdf5
   use petscsys
   use mod_kinds, only: dp
   use mod_contact, only: contact_history_t, history_unpack, history_size, wall_lower, wall_upper
   use mod_contacts_io, only: contacts_write, contacts_write_shares
   use mod_h5_parallel, only: h5_parallel_create, h5_parallel_close
-  use mod_h5util, only: h5util_init, read_dataset, read_attribute
-  use mod_os_services, only: make_directory
+  use mod_h5util, only: read_dataset, read_attribute
   use mod_unit_checks, only: check, finish
+  use mod_unit_start, only: unit_start
   implicit none
 
   integer, parameter :: spheres = 300, pairs = 900, walls = 60
   PetscErrorCode :: ierr
   PetscMPIInt :: rank, nranks
   type(contact_history_t) :: every, share
-  integer :: ids(2, pairs + walls), status, pid(1), info, i, k, seed_size
+  integer :: ids(2, pairs + walls), info, i, k, seed_size
   integer, allocatable :: seed(:), local_id(:), mine(:)
   logical, allocatable :: own(:)
   real(dp) :: ups(3, pairs + walls), r(2)
-  character(len=512) :: dir, tmpdir
+  character(len=512) :: dir
   character(len=200) :: message
   character(len=40) :: scene
 
-  PetscCallA(PetscInitialize(ierr))
-  call MPI_Comm_rank(PETSC_COMM_WORLD, rank, ierr)
-  call MPI_Comm_size(PETSC_COMM_WORLD, nranks, ierr)
-  if (rank /= 0) open(unit=output_unit, file='/dev/null')
-  call h5util_init()
-  call get_environment_variable('TMPDIR', tmpdir, status=status)
-  if (status /= 0 .or. len_trim(tmpdir) == 0) tmpdir = '/tmp'
-  pid = getpid()
-  call MPI_Bcast(pid, 1, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
-  write(dir, '(a,i0)') trim(tmpdir)//'/fdsusp-test-contacts-shares-', pid(1)
-  if (rank == 0) then
-    status = make_directory(dir)
-    if (status /= 0) error stop 'test_contacts_shares: cannot create the temporary directory'
-  end if
+  call unit_start('test_contacts_shares', rank, nranks, dir)
   write(scene, '(i0,a)') nranks, ' rank(s)'
 
   ! the whole history, the same on every rank (distinct pairs: history_unpack refuses repeats)

@@ -33,13 +33,14 @@ program test_series_append
   use petscsys
   use hdf5
   use mod_kinds, only: dp
-  use mod_h5util, only: h5util_init, read_attribute
+  use mod_h5util, only: read_attribute
   use mod_columns, only: sphere_column
   use mod_series, only: series_t, series_column, series_add, series_open, series_record, series_flush, &
                         series_close, series_attributes
   use mod_os_services, only: make_directory, peak_resident_kb
   use mod_file_services, only: list_directory
   use mod_unit_checks, only: check, finish
+  use mod_unit_start, only: unit_start
   implicit none
 
   integer, parameter :: n_particles = 5, n_columns = 6
@@ -48,26 +49,12 @@ program test_series_append
   integer, parameter :: lengths(n_columns) = [1, 1, 1, 4, 3 * n_particles, 9 * n_particles]
   PetscErrorCode :: ierr
   PetscMPIInt :: rank, ranks
-  character(len=512) :: dir, tmpdir
+  character(len=512) :: dir
   type(series_t) :: s
-  integer :: step, status, pid(1)
+  integer :: step, status
   integer, allocatable :: expected(:)
 
-  PetscCallA(PetscInitialize(ierr))
-  call MPI_Comm_rank(PETSC_COMM_WORLD, rank, ierr)
-  call MPI_Comm_size(PETSC_COMM_WORLD, ranks, ierr)
-  if (rank /= 0) open(unit=output_unit, file='/dev/null')
-  call h5util_init()
-  call get_environment_variable('TMPDIR', tmpdir, status=status)
-  if (status /= 0 .or. len_trim(tmpdir) == 0) tmpdir = '/tmp'
-  pid = getpid()
-  call MPI_Bcast(pid, 1, MPI_INTEGER, 0, PETSC_COMM_WORLD, ierr)
-  write(dir, '(a,i0)') trim(tmpdir)//'/fdsusp-test-series-', pid(1)
-  if (rank == 0) then
-    status = make_directory(dir)
-    if (status /= 0) error stop 'test_series_append: cannot create the temporary directory'
-  end if
-  call MPI_Barrier(PETSC_COMM_WORLD, ierr)
+  call unit_start('test_series_append', rank, ranks, dir)
 
   ! 1. from the start: steps 0, 2, .., 22, flushed after 4 and 9 records, then closed
   call declare(s)
