@@ -18,7 +18,8 @@
 ! with the total number of spheres. The output takes each rank's share of the local sets
 ! (mod_time_step time_step_share: the series, the snapshots, the checkpoints, a failure's state).
 ! The first step takes the local set from the replicated particle state of the start (the deck,
-! the packing or the checkpoint), which is then released: from then on no rank holds every sphere.
+! the packing or the checkpoint), which is then released: from then on a rank holds its own spheres
+! and their ghosts only.
 !
 ! With one rank, or without contacts and links (the block-diagonal one-body problem), the step keeps
 ! the replicated state (ld_local_t%active false). An owned sphere sees every contact and link in

@@ -803,13 +803,13 @@ contains
       end if
     end if
     if (ts%local%live) then
-      ! the state between steps is the local sets; no rank keeps every sphere
+      ! the state between steps is the local sets; the replicated particles are gone
       most = ts%local%set%n
       call MPI_Allreduce(MPI_IN_PLACE, most, 1, MPI_INTEGER, MPI_MAX, PETSC_COMM_WORLD, mpierr)
-      write(text, '(a,i0,a,f0.1,a,i0,a)') 'spheres on the ranks'' local sets: the replicated particles of ', &
+      write(text, '(a,i0,a,f0.1,a,i0,a,i0,a)') 'spheres on the ranks'' local sets: the replicated particles of ', &
            ts%local%total, ' spheres (', real(ts%local%released, dp) / 1024.0_dp, &
-           ' kB a rank) released at the first step; no rank holds every sphere (at the end at most ', most, &
-           ', own and ghosts)'
+           ' kB a rank) released at the first step; each rank holds its own spheres and their ghosts only (at the end '// &
+           'at most ', most, ' of the ', ts%local%total, ' on a rank)'
       call log_line(text)
       write(text, '(a,i0,a,i0,a,f6.3,a)') 'spheres on the ranks'' local sets: the sets made ', &
            ts%local%sets_made, ' times in ', ts%steps_taken, ' steps (kept while no sphere has moved half the skin, ', &

@@ -97,7 +97,8 @@ contains
 
   !> The per-sphere arrays of p released: what is left describes the system (n, the unit radius,
   !> the motion, have_prev) and holds no sphere. Once the ranks' local sets hold the state
-  !> (mod_ld_local), the replicated particles are released so, and no rank keeps every sphere.
+  !> (mod_ld_local), the replicated particles are released so: a rank then holds its own spheres
+  !> and their ghosts only.
   !> Returns the bytes released.
   subroutine particles_release(p, bytes)
     type(particles_t), intent(inout) :: p

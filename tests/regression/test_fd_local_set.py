@@ -96,7 +96,7 @@ def compare(ref, other, what, keys):
 def log_counts(out):
     # (released: the replicated particles' kB freed at the first step)
     released = re.search(r'replicated particles of (\d+) spheres \(([\d.]+) kB a rank\) released at the first '
-                         r'step; no rank holds every sphere \(at the end at most (\d+)', out)
+                         r'step; each rank holds its own spheres and their ghosts only', out)
     made = re.search(r'the sets made (\d+) times in (\d+) steps', out)
     return (float(released.group(2)) if released else None, int(made.group(1)) if made else None)
 

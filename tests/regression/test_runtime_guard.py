@@ -126,7 +126,7 @@ T.check(len(set(stops)) == 1 and 'particle 1 and particle 2' in stops[0],
 # 12, between two series records (every 5 steps), stops 1 and 2 ranks alike (status 5, one message
 # naming the particle), and failed_state.h5 holds the poisoned velocity. Particle 1 sits in the upper
 # slab: on 2 ranks rank 1 owns it, finds the fault, describes it for every rank and writes its row
-# of failed_state.h5 (no rank holds every sphere after the first step).
+# of failed_state.h5 (the replicated particles are released after the first step).
 d = T.scratch('runtime_guard_nan_ld')
 deck = T.write_deck(d, 'n.nml', """&domain box = 6.4, 6.4, 6.4, y_boundary = 'walls', shear_rate = 1 /
 &fluid model = 'none' /
