@@ -1,10 +1,11 @@
 ! Parallel HDF5 (MPI-IO) for the files every rank writes together (doc/DESIGN.md "Files", issue 45):
 ! open or create a file collectively, and write a (k, N) dataset of doubles (or integers), one
-! column per sphere (or contact), from the columns each rank owns, given their global indices (any set: a rank with none takes
-! part all the same). The dataset is the one write_dataset_2d (mod_h5util) makes: one chunk with
-! HDF5's Fletcher-32 checksum. HDF5 1.10.2 and later (Debian bookworm has 1.10.8) write filtered
-! datasets in parallel, collectively only: every transfer here is collective (H5FD_MPIO_COLLECTIVE),
-! and the ranks send their columns to the rank that owns the chunk, which filters and writes it.
+! column per sphere (or contact), from the columns each rank owns, given their global indices (any
+! set: a rank with none takes part all the same). The dataset is the one write_dataset_2d
+! (mod_h5util) makes: chunks of at most 2^16 values (checked_chunk) with HDF5's Fletcher-32
+! checksum. HDF5 1.10.2 and later (Debian bookworm has 1.10.8) write filtered datasets in
+! parallel, collectively only: every transfer here is collective (H5FD_MPIO_COLLECTIVE), and the
+! ranks send their columns to the rank that owns each chunk, which filters and writes it.
 ! Every call is collective and returns an err agreed by all ranks (the largest): a failure seen by
 ! one rank is seen by every rank, so that no rank waits in the next collective call for ever.
 ! In parallel HDF5 every rank must make the same metadata calls (groups, datasets, attributes)
@@ -20,6 +21,7 @@ module mod_h5_parallel
   use, intrinsic :: iso_c_binding, only: c_loc, c_ptr
   use mod_kinds, only: dp
   use mod_sorting, only: ascending_order
+  use mod_h5util, only: checked_chunk
   implicit none
   private
   public :: h5_parallel_create, h5_parallel_open, h5_parallel_close, h5_parallel_write_columns, &
@@ -74,7 +76,7 @@ contains
     call h5_parallel_agree(err)
   end subroutine h5_parallel_close
 
-  !> The dataset NAME (k, n) in LOC, of doubles, one chunk with Fletcher-32 (as mod_h5util's
+  !> The dataset NAME (k, n) in LOC, of doubles, chunks with Fletcher-32 (as mod_h5util's
   !> write_dataset): this rank writes its columns values(:, j) into the file's columns
   !> columns(j) (1-based global indices, unique over all ranks, in any order; none: size 0), in
   !> one collective transfer. Collective; every rank passes the same name, k and n.
@@ -130,12 +132,13 @@ contains
     dims = [int(k, HSIZE_T), int(n, HSIZE_T)]
     dset = -1
     call h5screate_simple_f(2, dims, file_space, err)
-    ! one chunk with Fletcher-32, as a dataset of mod_h5util (a dataset of no elements cannot be
-    ! chunked); HDF5 allocates the chunk of a parallel file when the dataset is created
+    ! chunks with Fletcher-32, as a dataset of mod_h5util (a dataset of no elements cannot be
+    ! chunked); HDF5 allocates the chunks of a parallel file when the dataset is created, and a
+    ! collective write gathers each chunk on one rank, which filters and writes it
     call h5pcreate_f(H5P_DATASET_CREATE_F, dcpl, e)
     err = max(err, abs(e))
     if (err == 0 .and. all(dims > 0)) then
-      call h5pset_chunk_f(dcpl, 2, dims, err)
+      call h5pset_chunk_f(dcpl, 2, checked_chunk(dims), err)
       if (err == 0) call h5pset_fletcher32_f(dcpl, err)
     end if
     if (err == 0) call h5dcreate_f(loc, name, dtype, file_space, dset, err, dcpl)

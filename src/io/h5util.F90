@@ -9,7 +9,8 @@ module mod_h5util
   implicit none
   private
   public :: h5util_init, write_attribute, read_attribute, has_attribute, has_object
-  public :: write_string_attribute, read_string_attribute, write_dataset, read_dataset, dataset_dims, read_values
+  public :: write_string_attribute, read_string_attribute, write_dataset, read_dataset, dataset_dims, read_values, &
+            checked_chunk
   public :: HID_T, HSIZE_T
 
   interface write_attribute
@@ -204,6 +205,17 @@ contains
     call write_dataset_2d(loc, name, H5T_NATIVE_INTEGER, shape(values, kind=HSIZE_T), err, int_values=values)
   end subroutine write_dataset_int
 
+  !> The chunk of a (k, n) dataset with Fletcher-32 (k values a column: a sphere's, a spring's):
+  !> whole columns, at most 2^16 values, so that a read of a range of columns decodes only the
+  !> chunks it touches. One chunk of the whole dataset made a reader that goes through it in
+  !> blocks (the checksums' walk, 2^16 values a block) decode all of it for every block once it
+  !> outgrew HDF5's chunk cache (1 MiB): quadratic in the spheres (doc/BENCHMARKS.md §25).
+  pure function checked_chunk(dims) result(chunk)
+    integer(HSIZE_T), intent(in) :: dims(2)
+    integer(HSIZE_T) :: chunk(2)
+    chunk = [dims(1), max(1_HSIZE_T, min(dims(2), 2_HSIZE_T**16 / max(1_HSIZE_T, dims(1))))]
+  end function checked_chunk
+
   subroutine write_dataset_2d(loc, name, dtype, dims, err, real_values, int_values)
     integer(HID_T), intent(in) :: loc, dtype
     character(len=*), intent(in) :: name
@@ -215,11 +227,11 @@ contains
     integer :: e
     call h5screate_simple_f(2, dims, space, err)
     if (err /= 0) return
-    ! one chunk with HDF5's Fletcher-32 checksum, which every read verifies (a dataset of no
+    ! chunks with HDF5's Fletcher-32 checksum, which every read verifies (a dataset of no
     ! elements has no data to protect, and cannot be chunked)
     call h5pcreate_f(H5P_DATASET_CREATE_F, plist, err)
     if (err == 0 .and. all(dims > 0)) then
-      call h5pset_chunk_f(plist, 2, dims, err)
+      call h5pset_chunk_f(plist, 2, checked_chunk(dims), err)
       if (err == 0) call h5pset_fletcher32_f(plist, err)
     end if
     if (err == 0) call h5dcreate_f(loc, name, dtype, space, dset, err, plist)

@@ -4,11 +4,14 @@
 ! ids and spring, value for value and in the canonical order (first sphere, then partner; a wall's
 ! partner -1/-2 first). Checked exactly: the values travel as doubles (the pairs as doubles below
 ! 2^53) and are only moved, never computed.
-! The history: 300 spheres, 900 random pairs (partner > first sphere) and 60 wall springs, random
-! springs (a fixed Fortran seed), the same on every rank. The ranks' shares are not slabs: sphere g
-! is own to rank mod(7 g + 3, P), so every writer's run of rows gathers springs from every rank,
-! and a pair whose spheres are both own on one rank is held once. Also: an empty history (count 0,
-! no datasets) from every rank. Singleton here; on 3 ranks in tests/regression/test_unit_petsc_ranks.sh.
+! Two histories, the same on every rank: 300 spheres with 900 random pairs (partner > first
+! sphere) and 60 wall springs, random springs (a fixed Fortran seed); and 30000 spheres with 60000
+! pairs (g, g + 1) and (g, g + 2) and 60 wall springs, whose datasets span several chunks (at most
+! 2^16 values a chunk, mod_h5util's checked_chunk; a parallel write gathers each chunk on one rank).
+! The ranks' shares are not slabs: sphere g is own to rank mod(7 g + 3, P), so every writer's run
+! of rows gathers springs from every rank, and a pair whose spheres are both own on one rank is
+! held once. Also: an empty history (count 0, no datasets) from every rank. Singleton here; on 3
+! ranks in tests/regression/test_unit_petsc_ranks.sh.
 #include <petsc/finclude/petscsys.h>
 program test_contacts_shares
   use hdf5
@@ -22,28 +25,30 @@ program test_contacts_shares
   use mod_unit_start, only: unit_start
   implicit none
 
-  integer, parameter :: spheres = 300, pairs = 900, walls = 60
+  integer, parameter :: walls = 60
   PetscErrorCode :: ierr
   PetscMPIInt :: rank, nranks
   type(contact_history_t) :: every, share
-  integer :: ids(2, pairs + walls), info, i, k, seed_size
-  integer, allocatable :: seed(:), local_id(:), mine(:)
-  logical, allocatable :: own(:)
-  real(dp) :: ups(3, pairs + walls), r(2)
+  integer :: info, i, k, seed_size, spheres
+  integer, allocatable :: ids(:, :), seed(:), local_id(:), mine(:)
+  logical, allocatable :: own(:), held(:)
+  real(dp), allocatable :: ups(:, :)
+  real(dp) :: r(2)
   character(len=512) :: dir
   character(len=200) :: message
   character(len=40) :: scene
 
   call unit_start('test_contacts_shares', rank, nranks, dir)
-  write(scene, '(i0,a)') nranks, ' rank(s)'
-
-  ! the whole history, the same on every rank (distinct pairs: history_unpack refuses repeats)
   call random_seed(size=seed_size)
   allocate(seed(seed_size))
   seed = 4511
   call random_seed(put=seed)
+
+  ! the random history (distinct pairs: history_unpack refuses repeats)
+  spheres = 300
+  allocate(ids(2, 900 + walls))
   k = 0
-  do while (k < pairs)
+  do while (k < 900)
     call random_number(r)
     ids(1, k + 1) = 1 + int(r(1) * (spheres - 1))
     ids(2, k + 1) = ids(1, k + 1) + 1 + int(r(2) * min(12, spheres - ids(1, k + 1)))
@@ -51,29 +56,26 @@ program test_contacts_shares
     if (any(ids(1, 1:k) == ids(1, k + 1) .and. ids(2, 1:k) == ids(2, k + 1))) cycle
     k = k + 1
   end do
-  do i = 1, walls
-    ids(:, pairs + i) = [5 * i, merge(wall_lower, wall_upper, mod(i, 2) == 0)]
+  call add_walls(900)
+  call run_scene('random')
+
+  ! the large history: pairs (g, g + 1) and (g, g + 2), several chunks a dataset
+  spheres = 30000
+  deallocate(ids)
+  allocate(ids(2, 60000 + walls))
+  k = 0
+  do i = 1, spheres - 2
+    ids(:, k + 1) = [i, i + 1]
+    ids(:, k + 2) = [i, i + 2]
+    k = k + 2
   end do
-  call random_number(ups)
-  ups = 1.0e-3_dp * (ups - 0.5_dp)
-  call history_unpack(every, spheres, pairs + walls, ids, ups, info)
-  call check(info == 0, 'the whole history is built: 900 pairs and 60 wall springs (history_unpack)')
-
-  ! this rank's share: its own spheres (not a slab), the partners of their pairs as ghosts, and the
-  ! springs of the pairs with an own sphere
-  allocate(own(spheres))
-  own = [(mod(7 * i + 3, nranks) == rank, i = 1, spheres)]
-  mine = pack([(i, i = 1, pairs + walls)], [(own(ids(1, i)) .or. (ids(2, i) > 0 .and. own(max(1, ids(2, i)))), &
-                                              i = 1, pairs + walls)])
-  local_id = pack([(i, i = 1, spheres)], own .or. [(any(ids(1, mine) == i .or. ids(2, mine) == i), i = 1, spheres)])
-  call history_unpack(share, spheres, size(mine), ids(:, mine), ups(:, mine), info)
-  call check(info == 0, trim(scene)//': each rank''s share is a history (its own spheres'' pairs)')
-
-  call write_both('full', every, share)
-  ! nobody holds a spring
-  call history_unpack(every, spheres, 0, ids, ups, info)
-  call history_unpack(share, spheres, 0, ids, ups, info)
-  call write_both('empty', every, share)
+  ! (and four across the periodic ends, 60000 in all)
+  ids(:, k + 1) = [spheres - 1, spheres]
+  ids(:, k + 2) = [1, spheres]
+  ids(:, k + 3) = [1, spheres - 1]
+  ids(:, k + 4) = [2, spheres]
+  call add_walls(60000)
+  call run_scene('large')
 
   call MPI_Barrier(PETSC_COMM_WORLD, ierr)
   if (rank == 0) call execute_command_line('rm -rf '''//trim(dir)//'''')
@@ -81,6 +83,47 @@ program test_contacts_shares
   PetscCallA(PetscFinalize(ierr))
 
 contains
+
+  ! The wall springs after the pairs ids(:, 1:pairs): spheres 5, 10, ..., 300 on the walls in turn;
+  ! then random springs for all.
+  subroutine add_walls(pairs)
+    integer, intent(in) :: pairs
+    integer :: j
+    do j = 1, walls
+      ids(:, pairs + j) = [5 * j, merge(wall_lower, wall_upper, mod(j, 2) == 0)]
+    end do
+    if (allocated(ups)) deallocate(ups)
+    allocate(ups(3, size(ids, 2)))
+    call random_number(ups)
+    ups = 1.0e-3_dp * (ups - 0.5_dp)
+  end subroutine add_walls
+
+  ! The scene NAME: the whole history and this rank's share (its own spheres, not a slab; the
+  ! partners of their pairs as ghosts; the springs of the pairs with an own sphere), written both
+  ! ways and compared; then both emptied and compared again.
+  subroutine run_scene(name)
+    character(len=*), intent(in) :: name
+    integer :: n, j
+    n = size(ids, 2)
+    write(scene, '(i0,a)') nranks, ' rank(s)'
+    call history_unpack(every, spheres, n, ids, ups, info)
+    call check(info == 0, trim(scene)//', '//name//': the whole history is built (history_unpack)')
+    if (allocated(own)) deallocate(own, held)
+    allocate(own(spheres), held(spheres))
+    own = [(mod(7 * j + 3, nranks) == rank, j = 1, spheres)]
+    mine = pack([(j, j = 1, n)], [(own(ids(1, j)) .or. (ids(2, j) > 0 .and. own(max(1, ids(2, j)))), j = 1, n)])
+    held = own
+    held(ids(1, mine)) = .true.
+    held(pack(ids(2, mine), ids(2, mine) > 0)) = .true.
+    local_id = pack([(j, j = 1, spheres)], held)
+    call history_unpack(share, spheres, size(mine), ids(:, mine), ups(:, mine), info)
+    call check(info == 0, trim(scene)//', '//name//': each rank''s share is a history (its own spheres'' pairs)')
+    call write_both(name, every, share)
+    ! nobody holds a spring
+    call history_unpack(every, spheres, 0, ids, ups, info)
+    call history_unpack(share, spheres, 0, ids, ups, info)
+    call write_both(name//'_empty', every, share)
+  end subroutine run_scene
 
   ! The group from the shares (every rank, MPI-IO) and from the whole history (rank 0), compared.
   subroutine write_both(name, whole, part)
@@ -110,9 +153,11 @@ contains
     integer, intent(in) :: count
     integer(HID_T) :: f(2), g(2)
     integer :: e, j, a(1), np(2), counts(2)
+    integer(HID_T) :: dset, plist
+    integer(HSIZE_T) :: chunk(2)
     integer, allocatable :: pairs_read(:, :, :)
     real(dp), allocatable :: springs_read(:, :, :)
-    character(len=16) :: text
+    character(len=40) :: text
     allocate(pairs_read(2, max(1, count), 2), springs_read(3, max(1, count), 2))
     call h5fopen_f(shares_path, H5F_ACC_RDONLY_F, f(1), e)
     call h5fopen_f(whole_path, H5F_ACC_RDONLY_F, f(2), e)
@@ -125,14 +170,25 @@ contains
       if (count > 0) then
         call read_dataset(g(j), 'ids', pairs_read(:, :, j), e)
         call read_dataset(g(j), 'spring', springs_read(:, :, j), e)
+        if (j == 1) then
+          ! the chunks of the springs written in parallel (checked_chunk)
+          call h5dopen_f(g(j), 'spring', dset, e)
+          call h5dget_create_plist_f(dset, plist, e)
+          call h5pget_chunk_f(plist, 2, chunk, e)
+          call h5pclose_f(plist, e)
+          call h5dclose_f(dset, e)
+        end if
       end if
       call h5gclose_f(g(j), e)
       call h5fclose_f(f(j), e)
     end do
-    write(text, '(i0)') count
-    call check(all(np == spheres) .and. all(counts == count), trim(scene)//', '//name//': np 300 and count '// &
-               trim(text)//' in both files')
+    write(text, '(a,i0,a,i0)') 'np ', spheres, ' and count ', count
+    call check(all(np == spheres) .and. all(counts == count), trim(scene)//', '//name//': '//trim(text)// &
+               ' in both files')
     if (count == 0) return
+    write(text, '(i0,a,i0,a)') chunk(2), ' springs a chunk, ', (count + chunk(2) - 1) / chunk(2), ' chunks'
+    call check(chunk(1) == 3 .and. 3 * chunk(2) <= 2**16 .and. (count <= 21845 .or. chunk(2) < count), &
+               trim(scene)//', '//name//': /contacts/spring in chunks of at most 2^16 values ('//trim(text)//')')
     call check(all(pairs_read(:, :, 1) == pairs_read(:, :, 2)), trim(scene)//', '//name// &
                ': /contacts/ids from the shares is the whole history''s, in its order')
     call check(all(springs_read(:, :, 1) == springs_read(:, :, 2)), trim(scene)//', '//name// &
