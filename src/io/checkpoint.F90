@@ -36,8 +36,8 @@
 ! of /particles by every rank through MPI-IO (mod_particles_io, mod_h5_parallel), with the ranks'
 ! local sets the springs of /contacts too (mod_contacts_io, contacts_write_shares), and the fields'
 ! checksums with every rank reading a share of each field's rows (the sums of the shares joined in
-! the file's order: joined_sums); completed by rank 0 (attributes, a replicated /contacts, /rheology), flushed
-! to disk and renamed over NAME: the previous checkpoint survives until the new one is whole. A
+! the file's order: joined_sums); completed by rank 0 (attributes, a replicated /contacts,
+! /rheology), flushed to disk and renamed over NAME: the previous checkpoint survives until the new one is whole. A
 ! restart verifies the fields the same way, in parallel, before rank 0 inspects the rest.
 #include <petsc/finclude/petscdmda.h>
 module mod_checkpoint

@@ -69,7 +69,7 @@ contains
     real(dp), allocatable :: ups(:, :), send(:, :), received(:, :)
     integer :: n, np, k, i, p, ranks, first, count, err, e(2)
     integer(HID_T) :: group
-    PetscErrorCode :: ierr
+    PetscErrorCode :: ierr, mpi_err(4)
     message = ''
     call MPI_Comm_size(PETSC_COMM_WORLD, ranks, ierr)
     n = history_size(h)
@@ -102,14 +102,14 @@ contains
       fill(writer(i) + 1) = fill(writer(i) + 1) + 1
       send(:, fill(writer(i) + 1)) = [real(keys(:, i), dp), ups(:, i)]
     end do
-    call MPI_Alltoall(send_count, 1, MPI_INTEGER, recv_count, 1, MPI_INTEGER, PETSC_COMM_WORLD, ierr)
+    call MPI_Alltoall(send_count, 1, MPI_INTEGER, recv_count, 1, MPI_INTEGER, PETSC_COMM_WORLD, mpi_err(1))
     recv_start(1) = 0
     do p = 2, ranks
       recv_start(p) = recv_start(p - 1) + recv_count(p - 1)
     end do
     allocate(received(5, sum(recv_count)))
     call MPI_Alltoallv(send, 5 * send_count, 5 * send_start, MPI_DOUBLE_PRECISION, received, 5 * recv_count, &
-                       5 * recv_start, MPI_DOUBLE_PRECISION, PETSC_COMM_WORLD, ierr)
+                       5 * recv_start, MPI_DOUBLE_PRECISION, PETSC_COMM_WORLD, mpi_err(2))
     ! this rank's run of rows: its springs in the canonical order (first sphere, then partner)
     deallocate(keys, ups)
     count = size(received, 2)
@@ -117,12 +117,18 @@ contains
     order = ascending_order(keys(2, :))
     order = order(ascending_order(keys(1, order)))
     first = 0
-    call MPI_Exscan(count, first, 1, MPI_INTEGER, MPI_SUM, PETSC_COMM_WORLD, ierr)
+    call MPI_Exscan(count, first, 1, MPI_INTEGER, MPI_SUM, PETSC_COMM_WORLD, mpi_err(3))
     call MPI_Comm_rank(PETSC_COMM_WORLD, p, ierr)
     if (p == 0) first = 0                  ! (MPI_Exscan leaves rank 0's undefined)
     rows = [(first + i, i = 1, count)]
     n = count
-    call MPI_Allreduce(MPI_IN_PLACE, n, 1, MPI_INTEGER, MPI_SUM, PETSC_COMM_WORLD, ierr)
+    call MPI_Allreduce(MPI_IN_PLACE, n, 1, MPI_INTEGER, MPI_SUM, PETSC_COMM_WORLD, mpi_err(4))
+    err = maxval(abs(mpi_err))
+    call h5_parallel_agree(err)
+    if (err /= 0) then
+      message = 'cannot take /contacts: the springs could not be sent to the ranks writing them (MPI)'
+      return
+    end if
     ! the group and its attributes on every rank alike (parallel HDF5's metadata), then the rows
     call h5gcreate_f(file, 'contacts', group, err)
     call h5_parallel_agree(err)
