@@ -43,8 +43,7 @@ module mod_ld_local
   implicit none
   private
   public :: ld_local_t, ld_local_create, ld_local_begin, ld_local_contacts_agree, ld_local_contacts_update, &
-            ld_local_forward_motion, ld_local_links, &
-            ld_local_forward_velocities, ld_local_statistics, ld_local_own_slot
+            ld_local_forward_motion, ld_local_links, ld_local_statistics, ld_local_own_slot
 
   type :: ld_local_t
     logical :: active = .false.           ! the step runs on the local set
@@ -439,14 +438,6 @@ contains
     PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, part, 6, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, ierr))
     contacts%wall_force = before + part
   end subroutine ld_local_contacts_update
-
-  !> After the solve: the own spheres' velocities and angular velocities sent to their ghosts.
-  !> Collective among neighbours.
-  subroutine ld_local_forward_velocities(loc, ierr)
-    type(ld_local_t), intent(inout) :: loc
-    PetscErrorCode, intent(out) :: ierr
-    call ld_local_forward_motion(loc%halo, loc%set, ierr)
-  end subroutine ld_local_forward_velocities
 
   !> The own spheres' velocities and angular velocities of the local set p (held by halo) sent to
   !> their ghosts. Collective among neighbours.

@@ -16,7 +16,7 @@ module mod_ld_motion
   use mod_particles, only: particles_t, MOTION_FREE, MOTION_FROZEN, impose_motion
   use mod_particle_solver, only: particle_solver_t, particle_solver_solve
   use mod_particle_lubrication, only: particle_lubrication_t, particle_lubrication_corrections
-  use mod_ld_local, only: ld_local_t, ld_local_forward_velocities, ld_local_contacts_update
+  use mod_ld_local, only: ld_local_t, ld_local_forward_motion, ld_local_contacts_update
   use mod_lubrication_links, only: lubrication_links_corrections
   use mod_particle_contacts, only: particle_contacts_t, particle_contacts_implicit_update, particle_contacts_set_rate
   use mod_lubrication_dynamics, only: lubrication_dynamics_t, lubrication_dynamics_assemble, &
@@ -52,7 +52,7 @@ contains
       call lubrication_dynamics_assemble(ld, parts, solver%system, rhs, lubrication, contacts)
       PetscCall(particle_solver_solve(solver, rhs, parts, ierr, ''))
       if (present(local)) then
-        PetscCall(ld_local_forward_velocities(local, ierr))
+        PetscCall(ld_local_forward_motion(local%halo, parts, ierr))
         if (present(contacts)) then
           PetscCall(ld_local_contacts_update(contacts, parts%velocity, parts%omega, ierr))
         end if
@@ -144,7 +144,7 @@ contains
     parts%omega = 0.0_dp
     PetscCall(particle_solver_solve(solver, rhs0, parts, ierr, ' (stress control: the rate-independent part)'))
     if (present(local)) then
-      PetscCall(ld_local_forward_velocities(local, ierr))
+      PetscCall(ld_local_forward_motion(local%halo, parts, ierr))
     end if
     u0 = parts%velocity
     w0 = parts%omega
@@ -152,7 +152,7 @@ contains
     parts%omega = w1
     PetscCall(particle_solver_solve(solver, rhs1, parts, ierr, ' (stress control: the part per unit rate)'))
     if (present(local)) then
-      PetscCall(ld_local_forward_velocities(local, ierr))
+      PetscCall(ld_local_forward_motion(local%halo, parts, ierr))
     end if
     u1 = parts%velocity
     w1 = parts%omega

@@ -754,8 +754,7 @@ contains
     type(particles_t), intent(in) :: p
     integer, intent(in) :: q, g
     character(len=400) :: text
-    if (.not. (all(ieee_is_finite(p%velocity(:, q))) .and. all(ieee_is_finite(p%omega(:, q))) &
-               .and. all(ieee_is_finite(p%position(:, q))))) then
+    if (.not. sphere_finite(p, q)) then
       write(text, '(a,i0,a,3es10.3,a,3es10.3)') 'particle ', g, ' is not finite: velocity ', p%velocity(:, q), &
            ' omega ', p%omega(:, q)
     else
@@ -771,11 +770,18 @@ contains
     type(time_step_t), intent(in) :: ts
     type(particles_t), intent(in) :: p
     integer, intent(in) :: q
-    sphere_fault = .not. (all(ieee_is_finite(p%velocity(:, q))) .and. all(ieee_is_finite(p%omega(:, q))) &
-                          .and. all(ieee_is_finite(p%position(:, q))))
+    sphere_fault = .not. sphere_finite(p, q)
     if (ts%walls .and. .not. sphere_fault) sphere_fault = p%position(2, q) < 0.5_dp * p%radii(q) .or. &
                                                         p%position(2, q) > ts%box(2) - 0.5_dp * p%radii(q)
   end function sphere_fault
+
+  ! Whether sphere q of p has a finite velocity, omega and position.
+  pure logical function sphere_finite(p, q)
+    type(particles_t), intent(in) :: p
+    integer, intent(in) :: q
+    sphere_finite = all(ieee_is_finite(p%velocity(:, q))) .and. all(ieee_is_finite(p%omega(:, q))) &
+                    .and. all(ieee_is_finite(p%position(:, q)))
+  end function sphere_finite
 
   ! The run's account of its steps, in the run log: wall time per step (seconds_per_step) and the
   ! fluid solvers' mean iterations, the largest contact overlap, the particle solves.

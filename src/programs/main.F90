@@ -272,21 +272,16 @@ contains
   ! for the cost of a cell (doc/BENCHMARKS.md §14). Then what the ranks hold at the end (VmRSS):
   ! the start's replicated particles released, a run's own state (doc/BENCHMARKS.md §23).
   subroutine memory_line()
-    real(dp) :: kb(1), total(1), largest(1), cells
+    real(dp) :: total(1), largest(1), cells
     integer :: nranks, mpierr
-    kb = real(resident_kb(), dp)
-    call MPI_Allreduce(kb, total, 1, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, mpierr)
-    call MPI_Allreduce(kb, largest, 1, MPI_DOUBLE_PRECISION, MPI_MAX, PETSC_COMM_WORLD, mpierr)
     call MPI_Comm_size(PETSC_COMM_WORLD, nranks, mpierr)
+    call over_ranks(real(resident_kb(), dp), total, largest)
     if (total(1) >= 0.0_dp) then
       write(text, '(a,i0,a,f10.1,a,f10.1,a)') 'memory: resident at the end (VmRSS) summed over ', nranks, ' ranks ', &
            total(1) / 1024.0_dp, ' MiB, largest rank ', largest(1) / 1024.0_dp, ' MiB'
       call log_line(text)
     end if
-    kb = real(peak_resident_kb(), dp)
-    call MPI_Allreduce(kb, total, 1, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, mpierr)
-    call MPI_Allreduce(kb, largest, 1, MPI_DOUBLE_PRECISION, MPI_MAX, PETSC_COMM_WORLD, mpierr)
-    call MPI_Comm_size(PETSC_COMM_WORLD, nranks, mpierr)
+    call over_ranks(real(peak_resident_kb(), dp), total, largest)
     if (total(1) < 0.0_dp) return    ! no /proc
     write(text, '(a,i0,a,f10.1,a,f10.1,a)') 'memory: peak resident (VmHWM) summed over ', nranks, ' ranks ', &
          total(1) / 1024.0_dp, ' MiB, largest rank ', largest(1) / 1024.0_dp, ' MiB'
@@ -296,6 +291,15 @@ contains
     end if
     call log_line(text)
   end subroutine memory_line
+
+  ! A rank's kB summed over the ranks (total) and the largest rank's (largest). Collective.
+  subroutine over_ranks(kb, total, largest)
+    real(dp), intent(in) :: kb
+    real(dp), intent(out) :: total(1), largest(1)
+    integer :: mpierr
+    call MPI_Allreduce([kb], total, 1, MPI_DOUBLE_PRECISION, MPI_SUM, PETSC_COMM_WORLD, mpierr)
+    call MPI_Allreduce([kb], largest, 1, MPI_DOUBLE_PRECISION, MPI_MAX, PETSC_COMM_WORLD, mpierr)
+  end subroutine over_ranks
 
   ! The spheres: a random packing made now (&particles solid_fraction; at a restart only its count
   ! and radii, the checkpoint having the positions), or the deck's or the position file's.
